@@ -1,0 +1,111 @@
+#include "build_plugin.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "wireshark_env.h"
+
+namespace fs = std::filesystem;
+
+namespace dissgen {
+
+namespace {
+
+std::vector<std::string> split_words(const std::string& s) {
+    std::istringstream in(s);
+    std::vector<std::string> words;
+    std::string w;
+    while (in >> w) words.push_back(w);
+    return words;
+}
+
+bool has_runtime(const fs::path& dir) {
+    std::error_code ec;
+    return fs::exists(dir / "dissgen_runtime.cpp", ec) && fs::exists(dir / "dissgen_runtime.h", ec);
+}
+
+}  // namespace
+
+std::string plugin_basename(const std::string& rule_path) {
+    std::string stem = fs::path(rule_path).stem().string();
+    for (char& c : stem)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) && static_cast<unsigned char>(c) < 0x80) && c != '-') c = '_';
+    return "dissgen_" + stem;
+}
+
+std::string find_runtime_dir(const std::string& argv0) {
+    if (const char* env = std::getenv("DISSGEN_RUNTIME_DIR"); env && has_runtime(env)) return env;
+    std::error_code ec;
+    fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) exe = fs::absolute(argv0, ec);
+    fs::path installed = exe.parent_path().parent_path() / "share" / "dissgen" / "runtime";
+    if (has_runtime(installed)) return installed.string();
+#ifdef DISSGEN_SOURCE_RUNTIME_DIR
+    if (has_runtime(DISSGEN_SOURCE_RUNTIME_DIR)) return DISSGEN_SOURCE_RUNTIME_DIR;
+#endif
+    return "";
+}
+
+std::string build_and_install(const BuildRequest& req, std::string& installed_path) {
+    char pattern[] = "/tmp/dissgen-build-XXXXXX";
+    const char* tmp_env = std::getenv("TMPDIR");
+    std::string tmpl = std::string(tmp_env && *tmp_env ? tmp_env : "/tmp") + "/dissgen-build-XXXXXX";
+    std::vector<char> buf(tmpl.begin(), tmpl.end());
+    buf.push_back('\0');
+    const char* work = mkdtemp(buf.data());
+    if (!work) work = mkdtemp(pattern);
+    if (!work) return "cannot create a temporary build folder";
+    fs::path dir(work);
+    struct Cleanup {
+        fs::path d;
+        ~Cleanup() {
+            std::error_code ec;
+            fs::remove_all(d, ec);
+        }
+    } cleanup{dir};
+
+    fs::path source = dir / (req.stem + ".cpp");
+    std::ofstream(source) << req.generated_source;
+    fs::path output = dir / (req.stem + ".so");
+
+    std::string cflags, libs;
+    if (run_command({"pkg-config", "--cflags", "wireshark"}, &cflags) != 0 ||
+        run_command({"pkg-config", "--libs", "wireshark"}, &libs) != 0)
+        return "pkg-config cannot find Wireshark's development files: install libwireshark-dev";
+
+    const char* cxx = std::getenv("CXX");
+    std::vector<std::string> cmd = {cxx && *cxx ? cxx : "c++", "-std=c++17", "-O2", "-fPIC", "-shared",
+                                    "-DWS_BUILD_DLL", "-Werror=attributes", "-I" + req.runtime_dir};
+    for (const std::string& w : split_words(cflags)) cmd.push_back(w);
+    cmd.push_back(source.string());
+    cmd.push_back(req.runtime_dir + "/dissgen_runtime.cpp");
+    cmd.push_back("-o");
+    cmd.push_back(output.string());
+    cmd.push_back("-Wl,--no-undefined");
+    for (const std::string& w : split_words(libs)) cmd.push_back(w);
+
+    std::string log;
+    int status = run_command(cmd, &log, true);
+    if (status != 0) return "compiling the plugin failed (" + cmd[0] + " exit " + std::to_string(status) + "):\n" + log;
+
+    std::error_code ec;
+    fs::create_directories(req.target_dir, ec);
+    if (ec) return "cannot create " + req.target_dir + ": " + ec.message();
+    // Copy beside the target, then rename: a running Wireshark never sees a half-written file.
+    fs::path target = fs::path(req.target_dir) / (req.stem + ".so");
+    fs::path staging = fs::path(req.target_dir) / ("." + req.stem + ".so.tmp");
+    fs::copy_file(output, staging, fs::copy_options::overwrite_existing, ec);
+    if (ec) return "cannot write " + staging.string() + ": " + ec.message();
+    chmod(staging.c_str(), 0644);
+    fs::rename(staging, target, ec);
+    if (ec) return "cannot install " + target.string() + ": " + ec.message();
+    installed_path = target.string();
+    return "";
+}
+
+}  // namespace dissgen

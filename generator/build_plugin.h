@@ -1,0 +1,26 @@
+// Stage 4 (install): compile generated C++ with the runtime against the
+// installed libwireshark and place the plugin where Wireshark loads it.
+#pragma once
+
+#include <string>
+
+namespace dissgen {
+
+struct BuildRequest {
+    std::string generated_source;  // the emitted C++
+    std::string stem;              // rule file stem: plugin is dissgen_<stem>.so
+    std::string target_dir;        // where the plugin goes
+    std::string runtime_dir;       // plugin_runtime sources
+};
+
+// Returns "" on success, else a message for the user.
+std::string build_and_install(const BuildRequest& request, std::string& installed_path);
+
+// The folder holding dissgen_runtime.{h,cpp}: $DISSGEN_RUNTIME_DIR, the
+// installed share/dissgen/runtime beside the executable, or the source tree.
+std::string find_runtime_dir(const std::string& argv0);
+
+// "dissgen_<stem>" with the stem reduced to [A-Za-z0-9_-].
+std::string plugin_basename(const std::string& rule_path);
+
+}  // namespace dissgen

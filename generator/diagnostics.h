@@ -1,0 +1,36 @@
+// Diagnostics: every message carries the source line of the element it is
+// about, from parsing to the final "FILE:LINE: error: MESSAGE" text.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace dissgen {
+
+enum class Severity { Warning, Error };
+
+struct Diagnostic {
+    Severity severity;
+    int line;  // 1-based line in the rule file; 0 when the file as a whole is meant
+    std::string message;
+};
+
+class Diagnostics {
+public:
+    void error(int line, std::string message) {
+        items_.push_back({Severity::Error, line, std::move(message)});
+    }
+    void warning(int line, std::string message) {
+        items_.push_back({Severity::Warning, line, std::move(message)});
+    }
+    bool has_errors() const;
+    const std::vector<Diagnostic>& items() const { return items_; }
+
+    // gcc style, one per line, in the order found, sorted by line.
+    std::string format(const std::string& file) const;
+
+private:
+    std::vector<Diagnostic> items_;
+};
+
+}  // namespace dissgen

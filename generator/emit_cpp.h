@@ -1,0 +1,28 @@
+// Stage 3: validated model -> C++ source of a Wireshark plugin that plugs
+// into plugin_runtime/. The output is deterministic: no timestamps, no
+// absolute paths, so golden files can diff it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "model.h"
+
+namespace dissgen {
+
+// How a field is registered with Wireshark (hf_register_info).
+struct FieldType {
+    std::string type;     // "FT_UINT16", "FT_BYTES", "FT_NONE", ...
+    std::string display;  // "BASE_HEX", "16", "SEP_COLON", ...
+    uint64_t mask = 0;
+};
+
+FieldType field_type(const Node& n);
+
+// `source_name` is the rule file's base name, quoted in the header comment.
+std::string emit_cpp(const Protocol& proto, const std::string& source_name);
+
+// One line per field: filter name, Wireshark type, display name.
+std::string list_fields(const Protocol& proto);
+
+}  // namespace dissgen

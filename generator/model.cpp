@@ -1,0 +1,29 @@
+#include "model.h"
+
+namespace dissgen {
+
+const char* display_name(Display d) {
+    switch (d) {
+        case Display::Address: return "address";
+        case Display::NumberHex: return "numberhex";
+        case Display::NumberDec: return "numberdec";
+        case Display::Bool: return "bool";
+        case Display::Origin: return "origin";
+        case Display::Enum: return "enum";
+        case Display::NonDisplay: return "nondisplay";
+    }
+    return "?";
+}
+
+bool is_numeric_display(Display d) {
+    return d == Display::NumberHex || d == Display::NumberDec || d == Display::Bool ||
+           d == Display::Enum;
+}
+
+bool Node::is_numeric() const {
+    if (!is_leaf() || !has_fixed_length()) return false;
+    if (fixed_bits < 1 || fixed_bits > 64) return false;
+    return is_numeric_display(display) || display == Display::NonDisplay;
+}
+
+}  // namespace dissgen

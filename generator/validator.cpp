@@ -1,0 +1,409 @@
+#include "validator.h"
+
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <optional>
+
+namespace dissgen {
+
+namespace {
+
+std::string quote(const Node& n) { return "'" + n.name + "'"; }
+
+std::string at_line(const Node& n) { return " (line " + std::to_string(n.line) + ")"; }
+
+bool is_ancestor_or_self(const Node* ancestor, const Node* n) {
+    for (; n; n = n->parent)
+        if (n == ancestor) return true;
+    return false;
+}
+
+class Validator {
+public:
+    Validator(Protocol& proto, Diagnostics& diags) : proto_(proto), diags_(diags) {}
+    void run();
+
+private:
+    void check_root();
+    void inherit_and_check_node(Node& n, ByteOrder inherited);
+    void check_leaf_display(Node& n);
+    void layout_children(std::vector<std::unique_ptr<Node>>& children);
+    void close_group(std::vector<Node*>& group, unsigned bits);
+    std::optional<uint64_t> fixed_bytes(const Node& n) const;
+    void check_fixed_container(const Node& n);
+    void check_reference(Node& n, const FieldRef& ref, const std::string& what);
+    void check_pdulength();
+    bool offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const Node* t, uint64_t& offset,
+                   bool& fixed) const;
+    void parse_summary(Node& n);
+    void assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, const std::string& prefix);
+    void mark_slot(Node* n) { if (n) needs_slot_[n] = true; }
+    void assign_slots();
+
+    Protocol& proto_;
+    Diagnostics& diags_;
+    std::map<const Node*, bool> needs_slot_;
+    std::map<std::string, const Node*> filter_owner_;
+};
+
+void Validator::run() {
+    check_root();
+    for (auto& n : proto_.nodes) inherit_and_check_node(*n, proto_.byteorder);
+    layout_children(proto_.nodes);
+    for_each_node(proto_.nodes, [&](Node& n) {
+        if (n.is_container()) check_fixed_container(n);
+        if (n.length_kind == LengthKind::Field) check_reference(n, n.length_ref, "length");
+        if (n.count) check_reference(n, *n.count, "count");
+        if (n.repeat) check_reference(n, *n.repeat, "repeat");
+        if (n.if_field) check_reference(n, *n.if_field, "if");
+        if (n.summary) parse_summary(n);
+    });
+    check_pdulength();
+    assign_filter_names(proto_.nodes, proto_.filter);
+    assign_slots();
+}
+
+void Validator::check_root() {
+    if (!proto_.ethertype && proto_.hooks.empty())
+        diags_.error(proto_.line, "<root> needs an 'ethertype' or at least one <hook>; "
+                                  "otherwise nothing is decoded with these rules");
+    if (!is_valid_filter_segment(proto_.filter))
+        diags_.error(proto_.line,
+                     "protocol filter name '" + proto_.filter + "'" +
+                         (proto_.filter_given ? "" : " (the abbreviation lowercased)") +
+                         " is not valid: it must match [a-z][a-z0-9_]*" +
+                         (proto_.filter_given ? "" : "; set a 'filter' attribute on <root>"));
+    for (const Hook& h : proto_.hooks) {
+        bool ok = !h.table.empty();
+        for (char c : h.table)
+            ok = ok && (std::islower(static_cast<unsigned char>(c)) || std::isdigit(static_cast<unsigned char>(c)) ||
+                        c == '.' || c == '_');
+        if (!ok && !h.table.empty())
+            diags_.error(h.line, "bad hook table '" + h.table + "': expected a Wireshark dissector table such as udp.port");
+    }
+    if (proto_.nodes.empty()) diags_.warning(proto_.line, "<root> has no <node>: the protocol decodes nothing");
+}
+
+void Validator::inherit_and_check_node(Node& n, ByteOrder inherited) {
+    n.byteorder = n.byteorder_given.value_or(inherited);
+    if (n.is_container()) {
+        if (!n.display_given) n.display = Display::NonDisplay;
+        else if (n.display != Display::NonDisplay)
+            diags_.warning(n.line, "displaytype '" + std::string(display_name(n.display)) + "' has no effect on container " +
+                                       quote(n) + ": a container shows its name and its children");
+        if (n.length_kind == LengthKind::Bits && n.fixed_bits % 8 != 0)
+            diags_.error(n.line, "container " + quote(n) + " has length " + std::to_string(n.fixed_bits) +
+                                     "bit: a container's length must be whole bytes");
+        if (!n.enums.empty()) diags_.warning(n.line, "enum items on container " + quote(n) + " are ignored");
+    } else {
+        check_leaf_display(n);
+        if (n.summary) diags_.warning(n.line, "summary on leaf " + quote(n) + " is ignored: it applies to containers");
+    }
+    if (n.repeat && n.count)
+        diags_.error(n.line, "node " + quote(n) + " has both 'repeat' and 'count'; use one of them");
+    if (n.filter && !n.filter->empty() && !is_valid_filter_segment(*n.filter))
+        diags_.error(n.line, "bad filter '" + *n.filter + "': it must match [a-z][a-z0-9_]*");
+    if (n.filter && n.filter->empty() && n.is_leaf())
+        diags_.error(n.line, "filter=\"\" only applies to containers; leaf " + quote(n) + " needs a filter name");
+    for (auto& c : n.children) inherit_and_check_node(*c, n.byteorder);
+}
+
+void Validator::check_leaf_display(Node& n) {
+    if (n.length_kind == LengthKind::Children)
+        diags_.warning(n.line, "leaf " + quote(n) + " has no length and no children: it takes no bytes");
+    if (!n.display_given) n.display = Display::Origin;
+    bool numeric = is_numeric_display(n.display);
+    if (numeric) {
+        if (!n.has_fixed_length())
+            diags_.error(n.line, std::string(display_name(n.display)) + " display needs a fixed length of 1-64 bits; " +
+                                     quote(n) + " has a variable length");
+        else if (n.fixed_bits > 64)
+            diags_.error(n.line, std::string(display_name(n.display)) + " display on more than 64 bits: " + quote(n) +
+                                     " is " + std::to_string(n.fixed_bits) + " bits");
+    }
+    if (n.has_fixed_length() && n.fixed_bits <= 64) n.bits = static_cast<unsigned>(n.fixed_bits);
+    if (n.display == Display::Enum) {
+        for (const EnumItem& e : n.enums) {
+            if (n.bits > 0 && n.bits < 64 && e.value >> n.bits)
+                diags_.error(e.line, "enum value " + std::to_string(e.value) + " does not fit the " +
+                                         std::to_string(n.bits) + "-bit field " + quote(n));
+        }
+        std::map<uint64_t, int> seen;
+        for (const EnumItem& e : n.enums)
+            if (!seen.emplace(e.value, e.line).second)
+                diags_.warning(e.line, "enum value " + std::to_string(e.value) + " of " + quote(n) +
+                                           " is listed twice; the first item is used");
+    } else if (!n.enums.empty()) {
+        diags_.warning(n.line, "enum items of " + quote(n) + " are ignored: its displaytype is not 'enum'");
+    }
+}
+
+// Groups consecutive bit fields into whole-byte integers (RULES-SPEC,
+// "Lengths and bit fields"); recurses into containers.
+void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
+    std::vector<Node*> group;
+    unsigned group_bits = 0;
+    for (auto& child : children) {
+        Node& n = *child;
+        bool bit_leaf = n.is_leaf() && n.length_kind == LengthKind::Bits;
+        bool whole_bytes = bit_leaf && n.fixed_bits % 8 == 0;
+        if (group.empty() && (!bit_leaf || whole_bytes)) {
+            if (n.is_container()) layout_children(n.children);
+            continue;
+        }
+        if (!bit_leaf) {
+            diags_.error(group.front()->line, "bit group starting at " + quote(*group.front()) + " ends after " +
+                                                  std::to_string(group_bits) +
+                                                  " bits, not on a byte boundary (next is " + quote(n) + at_line(n) + ")");
+            group.clear();
+            group_bits = 0;
+            if (n.is_container()) layout_children(n.children);
+            continue;
+        }
+        if (n.is_repeated() || n.if_field)
+            diags_.error(n.line, "bit field " + quote(n) + " cannot have 'repeat', 'count' or 'if': it shares bytes "
+                                 "with its neighbours in a bit group");
+        if (n.display == Display::Origin || n.display == Display::Address)
+            diags_.error(n.line, std::string(display_name(n.display)) + " display needs whole bytes; bit field " +
+                                     quote(n) + " is part of a bit group (use numberhex, numberdec, bool or enum)");
+        if (!group.empty() && n.byteorder != group.front()->byteorder)
+            diags_.error(n.line, "bit field " + quote(n) + " has another byte order than its bit group starting at " +
+                                     quote(*group.front()));
+        group.push_back(&n);
+        group_bits += static_cast<unsigned>(std::min<uint64_t>(n.fixed_bits, 1u << 20));
+        if (group_bits % 8 == 0) {
+            close_group(group, group_bits);
+            group.clear();
+            group_bits = 0;
+        }
+    }
+    if (!group.empty())
+        diags_.error(group.front()->line, "bit group starting at " + quote(*group.front()) + " ends after " +
+                                              std::to_string(group_bits) + " bits, not on a byte boundary");
+}
+
+void Validator::close_group(std::vector<Node*>& group, unsigned bits) {
+    if (bits > 64) {
+        diags_.error(group.front()->line, "bit group starting at " + quote(*group.front()) + " is " +
+                                              std::to_string(bits) + " bits; a bit group spans 1 to 8 bytes");
+        return;
+    }
+    unsigned used = 0;
+    for (Node* n : group) {
+        n->in_bit_group = true;
+        n->group_bytes = bits / 8;
+        n->shift = n->byteorder == ByteOrder::Little ? used : bits - used - n->bits;
+        used += n->bits;
+    }
+    group.front()->group_first = true;
+    group.back()->group_last = true;
+}
+
+std::optional<uint64_t> Validator::fixed_bytes(const Node& n) const {
+    if (n.is_repeated() || n.if_field) return std::nullopt;
+    if (n.has_fixed_length()) return n.fixed_bits / 8;
+    if (n.length_kind != LengthKind::Children || n.is_leaf()) return std::nullopt;
+    uint64_t sum = 0;
+    uint64_t group_bits = 0;
+    for (const auto& c : n.children) {
+        if (c->in_bit_group) {
+            group_bits += c->bits;
+            continue;
+        }
+        auto b = fixed_bytes(*c);
+        if (!b) return std::nullopt;
+        sum += *b;
+    }
+    return sum + group_bits / 8;
+}
+
+void Validator::check_fixed_container(const Node& n) {
+    if (!n.has_fixed_length()) return;
+    uint64_t sum = 0, group_bits = 0;
+    for (const auto& c : n.children) {
+        if (c->in_bit_group) {
+            group_bits += c->bits;
+            continue;
+        }
+        auto b = fixed_bytes(*c);
+        if (!b) return;  // variable children: checked at run time
+        sum += *b;
+    }
+    sum += group_bits / 8;
+    if (sum != n.fixed_bits / 8)
+        diags_.error(n.line, "children of " + quote(n) + " add up to " + std::to_string(sum) + " bytes, but its length is " +
+                                 std::to_string(n.fixed_bits / 8) + " bytes");
+}
+
+// length, count and if read an earlier numeric field of the same repeat
+// instance; repeat reads a flag inside the repeated node.
+void Validator::check_reference(Node& n, const FieldRef& ref, const std::string& what) {
+    const Node* t = ref.target;
+    if (!t) return;  // the parser already reported the XPath
+    const std::string field = what + " field " + quote(*t) + at_line(*t);
+    if (!t->is_numeric()) {
+        diags_.error(n.line, field + " is not numeric: it must be a leaf of 1-64 bits shown as numberhex, "
+                                     "numberdec, bool, enum or nondisplay");
+        return;
+    }
+    if (what == "repeat") {
+        if (!is_ancestor_or_self(&n, t))
+            diags_.error(n.line, "repeat flag " + quote(*t) + at_line(*t) + " is outside the repeated node " + quote(n) +
+                                     "; it must be one of its fields");
+        mark_slot(const_cast<Node*>(t));
+        return;
+    }
+    if (t->doc_index >= n.doc_index) {
+        diags_.error(n.line, field + " is not decoded before " + quote(n) + "; it must come earlier in the file");
+        return;
+    }
+    for (const Node* r = t; r; r = r->parent) {
+        if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
+            diags_.error(n.line, field + " is inside repeated node " + quote(*r) + at_line(*r) +
+                                     ", which does not contain " + quote(n) +
+                                     "; use a field of the same instance or one outside every repeat");
+            return;
+        }
+    }
+    mark_slot(const_cast<Node*>(t));
+}
+
+// Finds the byte offset of `t` (of its bit group, for a bit field) from the
+// start of `nodes`; `fixed` turns false when a field before it has no fixed size.
+bool Validator::offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const Node* t, uint64_t& offset,
+                          bool& fixed) const {
+    for (const auto& c : nodes) {
+        if (c.get() == t) return true;
+        if (is_ancestor_or_self(c.get(), t)) {
+            if (c->is_repeated() || c->if_field) fixed = false;
+            return offset_of(c->children, t, offset, fixed);
+        }
+        if (c->in_bit_group) {
+            if (c->group_last) offset += c->group_bytes;
+            continue;
+        }
+        auto b = fixed_bytes(*c);
+        if (b) offset += *b;
+        else fixed = false;
+    }
+    return false;
+}
+
+void Validator::check_pdulength() {
+    if (!proto_.pdulength || !proto_.pdulength->target) return;
+    const Node* t = proto_.pdulength->target;
+    if (!t->is_numeric()) {
+        diags_.error(proto_.line, "pdulength field " + quote(*t) + at_line(*t) + " is not numeric");
+        return;
+    }
+    uint64_t offset = 0;
+    bool fixed = true;
+    offset_of(proto_.nodes, t, offset, fixed);
+    if (!fixed || t->is_repeated() || t->if_field) {
+        diags_.error(proto_.line, "pdulength field " + quote(*t) + " must be at a fixed offset from the start of the "
+                                                                     "message (only fixed-length fields before it)");
+        return;
+    }
+    proto_.pdu_fixed_len = static_cast<unsigned>(offset) + (t->in_bit_group ? t->group_bytes : t->bits / 8);
+    mark_slot(const_cast<Node*>(t));
+}
+
+void Validator::parse_summary(Node& n) {
+    if (!n.is_container()) return;
+    const std::string& s = *n.summary;
+    size_t i = 0;
+    while (i < s.size()) {
+        size_t open = s.find('{', i);
+        if (open == std::string::npos) {
+            n.summary_pieces.push_back({s.substr(i), nullptr});
+            break;
+        }
+        if (open > i) n.summary_pieces.push_back({s.substr(i, open - i), nullptr});
+        size_t close = s.find('}', open);
+        if (close == std::string::npos) {
+            diags_.error(n.line, "summary of " + quote(n) + " has '{' without '}'");
+            return;
+        }
+        std::string name = s.substr(open + 1, close - open - 1);
+        Node* found = nullptr;
+        for_each_node(n.children, [&](Node& d) {
+            if (!found && d.is_leaf() && d.name == name) found = &d;
+        });
+        if (!found) {
+            diags_.error(n.line, "summary of " + quote(n) + " refers to {" + name + "}, but no leaf named '" + name +
+                                     "' is inside it");
+            return;
+        }
+        n.summary_pieces.push_back({"", found});
+        mark_slot(found);
+        i = close + 1;
+    }
+}
+
+void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, const std::string& prefix) {
+    for (auto& child : nodes) {
+        Node& n = *child;
+        if (n.filter) {
+            n.segment = *n.filter;
+        } else {
+            n.segment = segment_from_name(n.name);
+            if (n.segment.empty()) {
+                n.segment = "f" + std::to_string(n.doc_index);
+                diags_.warning(n.line, "name " + quote(n) + " gives no filter name; using '" + n.segment +
+                                           "': add filter=\"...\" for a readable one");
+            }
+        }
+        std::string own = n.segment.empty() ? "" : prefix + "." + n.segment;
+        n.filter_name = own;
+        if (!own.empty()) {
+            auto [it, inserted] = filter_owner_.emplace(own, &n);
+            if (!inserted)
+                diags_.error(n.line, "duplicate filter name '" + own + "' (also used by " + quote(*it->second) +
+                                         at_line(*it->second) + "); give one of them a 'filter' attribute");
+        }
+        assign_filter_names(n.children, own.empty() ? prefix : own);
+    }
+}
+
+void Validator::assign_slots() {
+    int next = 0;
+    for_each_node(proto_.nodes, [&](Node& n) {
+        if (needs_slot_.count(&n)) n.slot = next++;
+    });
+    proto_.slot_count = next;
+}
+
+}  // namespace
+
+std::string segment_from_name(const std::string& name) {
+    std::string out;
+    bool pending_sep = false;
+    for (unsigned char c : name) {
+        char lower = static_cast<char>(std::tolower(c < 0x80 ? c : 0));
+        bool keep = c < 0x80 && (std::islower(static_cast<unsigned char>(lower)) || std::isdigit(c));
+        if (!keep) {
+            pending_sep = true;
+            continue;
+        }
+        if (pending_sep && !out.empty()) out += '_';
+        pending_sep = false;
+        out += lower;
+    }
+    if (!out.empty() && std::isdigit(static_cast<unsigned char>(out[0]))) out = "f" + out;
+    return out;
+}
+
+bool is_valid_filter_segment(const std::string& s) {
+    if (s.empty() || !std::islower(static_cast<unsigned char>(s[0]))) return false;
+    for (unsigned char c : s)
+        if (!(std::islower(c) || std::isdigit(c) || c == '_') || c >= 0x80) return false;
+    return true;
+}
+
+bool validate(Protocol& proto, Diagnostics& diags) {
+    Validator(proto, diags).run();
+    return !diags.has_errors();
+}
+
+}  // namespace dissgen

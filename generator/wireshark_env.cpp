@@ -1,0 +1,90 @@
+#include "wireshark_env.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <regex>
+#include <sstream>
+
+#include "text_util.h"
+
+namespace dissgen {
+
+int run_command(const std::vector<std::string>& argv, std::string* output, bool merge_stderr) {
+    int pipefd[2];
+    if (pipe(pipefd) != 0) return -1;
+    pid_t pid = fork();
+    if (pid < 0) return -1;
+    if (pid == 0) {
+        dup2(pipefd[1], STDOUT_FILENO);
+        if (merge_stderr) dup2(pipefd[1], STDERR_FILENO);
+        close(pipefd[0]);
+        close(pipefd[1]);
+        std::vector<char*> args;
+        for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+        args.push_back(nullptr);
+        execvp(args[0], args.data());
+        _exit(127);
+    }
+    close(pipefd[1]);
+    std::string out;
+    char buf[4096];
+    ssize_t n;
+    while ((n = read(pipefd[0], buf, sizeof buf)) > 0) out.append(buf, static_cast<size_t>(n));
+    close(pipefd[0]);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (output) *output = out;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static std::optional<std::string> major_minor(const std::string& text) {
+    static const std::regex version(R"((\d+)\.(\d+)\.\d+)");
+    std::smatch m;
+    if (!std::regex_search(text, m, version)) return std::nullopt;
+    return m[1].str() + "." + m[2].str();
+}
+
+std::optional<std::string> headers_version() {
+    std::string out;
+    if (run_command({"pkg-config", "--modversion", "wireshark"}, &out) != 0) return std::nullopt;
+    return major_minor(out);
+}
+
+std::optional<std::string> tshark_version() {
+    std::string out;
+    if (run_command({"tshark", "--version"}, &out) != 0) return std::nullopt;
+    return major_minor(out);
+}
+
+std::string user_plugin_dir(const std::string& version) {
+    const char* home = std::getenv("HOME");
+    return std::string(home ? home : ".") + "/.local/lib/wireshark/plugins/" + version + "/epan";
+}
+
+std::optional<std::string> system_plugin_dir() {
+    std::string out;
+    if (run_command({"pkg-config", "--variable=plugindir", "wireshark"}, &out) != 0) return std::nullopt;
+    out = trim(out);
+    if (out.empty()) return std::nullopt;
+    return out + "/epan";
+}
+
+std::vector<InstalledProtocol> installed_protocols() {
+    std::string out;
+    std::vector<InstalledProtocol> protocols;
+    if (run_command({"tshark", "-G", "protocols"}, &out) != 0) return protocols;
+    std::istringstream in(out);
+    std::string line;
+    while (std::getline(in, line)) {
+        std::istringstream fields(line);
+        InstalledProtocol p;
+        if (std::getline(fields, p.name, '\t') && std::getline(fields, p.short_name, '\t') &&
+            std::getline(fields, p.filter, '\t'))
+            protocols.push_back(p);
+    }
+    return protocols;
+}
+
+}  // namespace dissgen

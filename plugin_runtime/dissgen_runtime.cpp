@@ -1,0 +1,505 @@
+/* The table walk behind every dissgen-generated dissector.
+ *
+ * Wireshark's exceptions are longjmps that skip C++ destructors, so nothing
+ * here owns a non-trivial C++ object; memory comes from pinfo->pool. Every
+ * read is checked against the bytes left first, so no tvb_ or proto_ call
+ * can throw: malformed packets end in an expert info instead.
+ */
+#include "dissgen_runtime.h"
+
+#include <string.h>
+
+namespace {
+
+struct dg_slot {
+    guint64 value;
+    gint offset;
+    gint length;
+    gboolean present;
+    const dg_node *node;
+};
+
+/* Summaries of one repeated node's instances, gathered for the Info column. */
+struct dg_summaries {
+    wmem_strbuf_t *text;
+    guint count;
+};
+
+struct dg_state {
+    const dg_protocol *p;
+    tvbuff_t *tvb;
+    packet_info *pinfo;
+    dg_slot *slots;
+    gint packet_end;      /* captured bytes */
+    gboolean stopped;     /* a malformed spot was reported: decode nothing more */
+    gboolean want_text;   /* summaries are visible (tree or columns) */
+    wmem_strbuf_t *info;  /* the Info column being built */
+    guint64 group_value;  /* the bit group being decoded */
+};
+
+guint encoding_of(const dg_node *n) { return (n->flags & DG_LITTLE) ? ENC_LITTLE_ENDIAN : ENC_BIG_ENDIAN; }
+
+guint64 read_uint(tvbuff_t *tvb, gint offset, guint length, guint encoding)
+{
+    switch (length) {
+    case 1: return tvb_get_guint8(tvb, offset);
+    case 2: return tvb_get_guint16(tvb, offset, encoding);
+    case 3: return tvb_get_guint24(tvb, offset, encoding);
+    case 4: return tvb_get_guint32(tvb, offset, encoding);
+    case 5: return tvb_get_guint40(tvb, offset, encoding);
+    case 6: return tvb_get_guint48(tvb, offset, encoding);
+    case 7: return tvb_get_guint56(tvb, offset, encoding);
+    default: return tvb_get_guint64(tvb, offset, encoding);
+    }
+}
+
+guint64 bit_mask(guint bits) { return bits >= 64 ? G_MAXUINT64 : ((G_GUINT64_CONSTANT(1) << bits) - 1); }
+
+/* Reports a malformed spot at `offset` (clamped into the packet) and stops decoding. */
+void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format, ...)
+    G_GNUC_PRINTF(6, 7);
+
+void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format, ...)
+{
+    va_list ap;
+    va_start(ap, format);
+    char *text = wmem_strdup_vprintf(st->pinfo->pool, format, ap);
+    va_end(ap);
+    if (offset > st->packet_end) offset = st->packet_end;
+    if (length < 0 || offset + length > st->packet_end) length = st->packet_end - offset;
+    proto_tree_add_expert_format(tree, st->pinfo, ei, st->tvb, offset, length, "%s", text);
+    st->stopped = TRUE;
+}
+
+/* The value of a length or count reference, or FALSE (reported) when it is
+ * missing or negative. */
+gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char *what, proto_tree *tree,
+                   gint offset, gint64 *out)
+{
+    const dg_slot *s = &st->slots[ref->slot];
+    if (!s->present) {
+        report(st, tree, &st->p->ei->bad_length, offset, 0, "The %s of '%s' comes from a field that is not in this packet",
+               what, n->name);
+        return FALSE;
+    }
+    /* Values beyond 2^40 are past any packet's end anyway; clamping keeps the arithmetic exact. */
+    gint64 v = s->value > (G_GUINT64_CONSTANT(1) << 40) ? (G_GINT64_CONSTANT(1) << 40) : (gint64)s->value;
+    switch (ref->op) {
+    case '+': v += ref->operand; break;
+    case '-': v -= ref->operand; break;
+    case '*': v *= ref->operand; break;
+    default: break;
+    }
+    if (v < 0) {
+        report(st, tree, &st->p->ei->bad_length, offset, 0, "The %s of '%s' is negative (%" G_GINT64_MODIFIER "d)",
+               what, n->name, v);
+        return FALSE;
+    }
+    *out = v;
+    return TRUE;
+}
+
+void store(dg_state *st, const dg_node *n, guint64 value, gint offset, gint length)
+{
+    if (n->slot < 0) return;
+    dg_slot *s = &st->slots[n->slot];
+    s->value = value;
+    s->offset = offset;
+    s->length = length;
+    s->present = TRUE;
+    s->node = n;
+}
+
+gboolean condition_holds(const dg_state *st, const dg_node *n)
+{
+    const dg_slot *s = &st->slots[n->if_slot];
+    if (!s->present) return FALSE;
+    for (guint i = 0; i < n->in_count; i++) {
+        const dg_range *r = &st->p->ranges[n->in_first + i];
+        if (s->value >= r->low && s->value <= r->high) return TRUE;
+    }
+    return FALSE;
+}
+
+/* A leaf's value as its tree item shows it, for summaries. */
+const char *shown_value(const dg_state *st, const dg_slot *s)
+{
+    wmem_allocator_t *pool = st->pinfo->pool;
+    const dg_node *n = s->node;
+    switch (n->show) {
+    case DG_SHOW_HEX:
+        return wmem_strdup_printf(pool, "0x%0*" G_GINT64_MODIFIER "x", (int)((n->bits + 3) / 4), s->value);
+    case DG_SHOW_BOOL:
+        return s->value ? "True" : "False";
+    case DG_SHOW_ENUM: {
+        header_field_info *hfi = proto_registrar_get_nth(*n->hf);
+        const char *name = NULL;
+        if (hfi->display & BASE_VAL64_STRING)
+            name = try_val64_to_str(s->value, (const val64_string *)hfi->strings);
+        else
+            name = try_val_to_str((guint32)s->value, (const value_string *)hfi->strings);
+        return name ? name : wmem_strdup_printf(pool, "Unknown (0x%" G_GINT64_MODIFIER "x)", s->value);
+    }
+    case DG_SHOW_ADDRESS:
+        return tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ':');
+    case DG_SHOW_BYTES:
+        return tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' ');
+    default:
+        if (n->flags & DG_NUMERIC) return wmem_strdup_printf(pool, "%" G_GINT64_MODIFIER "u", s->value);
+        return tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' ');
+    }
+}
+
+const char *summary_text(const dg_state *st, const dg_node *n)
+{
+    wmem_strbuf_t *out = wmem_strbuf_new(st->pinfo->pool, "");
+    for (guint i = 0; i < n->summary_count; i++) {
+        const dg_summary_piece *piece = &st->p->pieces[n->summary_first + i];
+        if (piece->slot < 0) {
+            wmem_strbuf_append(out, piece->text);
+        } else {
+            const dg_slot *s = &st->slots[piece->slot];
+            wmem_strbuf_append(out, s->present ? shown_value(st, s) : "-");
+        }
+    }
+    return wmem_strbuf_get_str(out);
+}
+
+void info_append(dg_state *st, const char *text)
+{
+    if (wmem_strbuf_get_len(st->info) > 0) wmem_strbuf_append(st->info, ", ");
+    wmem_strbuf_append(st->info, text);
+}
+
+void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
+                  gboolean in_summary);
+
+void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end)
+{
+    if (n->flags & DG_GROUP_FIRST) {
+        if ((gint)n->length > end - *offset) {
+            report(st, tree, &st->p->ei->truncated, *offset, -1, "Truncated: '%s' needs %u bytes, only %d left",
+                   n->name, n->length, end - *offset);
+            return;
+        }
+        st->group_value = read_uint(st->tvb, *offset, n->length, encoding_of(n));
+    }
+    guint64 value = (st->group_value >> n->shift) & bit_mask(n->bits);
+    proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, n->length, encoding_of(n));
+    if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+    store(st, n, value, *offset, n->length);
+    if (n->flags & DG_GROUP_LAST) *offset += n->length;
+}
+
+void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end)
+{
+    if (n->flags & DG_GROUP) {
+        dissect_bit_field(st, n, tree, offset, end);
+        return;
+    }
+    gint64 length = 0;
+    switch (n->length_kind) {
+    case DG_LEN_FIXED: length = n->length; break;
+    case DG_LEN_FIELD:
+        if (!ref_value(st, &n->length_ref, n, "length", tree, *offset, &length)) return;
+        break;
+    case DG_LEN_REST: length = end - *offset; break;
+    default: length = 0; break;
+    }
+    gint left = end - *offset;
+    if (length > left) {
+        /* Show the bytes that are there, then say what is missing. */
+        if (!(n->flags & DG_NUMERIC) && left > 0) {
+            proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, left, ENC_NA);
+            if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+        }
+        if (n->length_kind == DG_LEN_FIELD)
+            report(st, tree, &st->p->ei->past_end, *offset, left,
+                   "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)", n->name,
+                   length, left);
+        else
+            report(st, tree, &st->p->ei->truncated, *offset, left,
+                   "Truncated: '%s' needs %" G_GINT64_MODIFIER "d bytes, only %d left", n->name, length, left);
+        return;
+    }
+    gint len = (gint)length;
+    guint64 value = 0;
+    proto_item *item = NULL;
+    if (n->flags & DG_NUMERIC) {
+        value = read_uint(st->tvb, *offset, (guint)len, encoding_of(n));
+        item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, encoding_of(n));
+    } else if (len > 0) {
+        item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, ENC_NA);
+    }
+    if (item && (n->flags & DG_HIDDEN)) proto_item_set_hidden(item);
+    store(st, n, value, *offset, len);
+    *offset += len;
+}
+
+void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
+                       gboolean in_summary, dg_summaries *sink)
+{
+    gint start = *offset;
+    gint64 length = -1;
+    switch (n->length_kind) {
+    case DG_LEN_FIXED: length = n->length; break;
+    case DG_LEN_FIELD:
+        if (!ref_value(st, &n->length_ref, n, "length", tree, start, &length)) return;
+        break;
+    case DG_LEN_REST: length = end - start; break;
+    default: break;
+    }
+    gboolean past_end = length > end - start;
+    gint inner_end = (length >= 0 && !past_end) ? start + (gint)length : end;
+
+    proto_item *item = NULL;
+    proto_tree *subtree;
+    if (n->hf) {
+        item = proto_tree_add_item(tree, *n->hf, st->tvb, start, -1, ENC_NA);
+        subtree = proto_item_add_subtree(item, *n->ett);
+    } else {
+        subtree = proto_tree_add_subtree(tree, st->tvb, start, -1, *n->ett, &item, n->name);
+    }
+    if (past_end)
+        report(st, subtree, n->length_kind == DG_LEN_FIELD ? &st->p->ei->past_end : &st->p->ei->truncated, start,
+               end - start, "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)",
+               n->name, length, end - start);
+    /* Decode what is there even when the length overruns. */
+    gboolean was_stopped = st->stopped;
+    st->stopped = FALSE;
+    dissect_list(st, n->first_child, n->child_count, subtree, offset, inner_end,
+                 in_summary || n->summary_count > 0);
+    st->stopped = st->stopped || was_stopped;
+    if (!st->stopped && length >= 0) *offset = inner_end;
+    proto_item_set_len(item, *offset - start);
+
+    if (n->summary_count > 0 && st->want_text) {
+        const char *text = summary_text(st, n);
+        proto_item_append_text(item, ": %s", text);
+        if (!in_summary) {
+            if (sink) {
+                if (sink->count++) wmem_strbuf_append(sink->text, ", ");
+                wmem_strbuf_append(sink->text, text);
+            } else {
+                info_append(st, text);
+            }
+        }
+    }
+}
+
+void clear_slots(dg_state *st, const dg_node *n)
+{
+    if (n->slot_count) memset(&st->slots[n->slot_first], 0, n->slot_count * sizeof(dg_slot));
+}
+
+void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
+                      gboolean in_summary, dg_summaries *sink)
+{
+    if (n->kind == DG_LEAF)
+        dissect_leaf(st, n, tree, offset, end);
+    else
+        dissect_container(st, n, tree, offset, end, in_summary, sink);
+}
+
+/* repeat: another instance while the flag is set; count: exactly N. Every
+ * instance must consume bytes, which bounds the loop by the packet size. */
+void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary)
+{
+    gint64 wanted = -1;
+    if (n->count.slot >= 0 && !ref_value(st, &n->count, n, "count", tree, *offset, &wanted)) return;
+    dg_summaries summaries = {NULL, 0};
+    gboolean collect = !in_summary && n->summary_count > 0 && st->want_text;
+    if (collect) summaries.text = wmem_strbuf_new(st->pinfo->pool, "");
+
+    for (gint64 done = 0; wanted < 0 || done < wanted; done++) {
+        if (wanted >= 0 && *offset >= end) {
+            report(st, tree, &st->p->ei->count_short, *offset, 0,
+                   "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after %" G_GINT64_MODIFIER "d",
+                   n->name, wanted, done);
+            st->stopped = FALSE; /* the data simply ended: siblings may still be empty-length */
+            break;
+        }
+        clear_slots(st, n);
+        gint before = *offset;
+        dissect_instance(st, n, tree, offset, end, in_summary, collect ? &summaries : NULL);
+        if (st->stopped || *offset == before) break;
+        if (n->repeat_slot >= 0) {
+            const dg_slot *flag = &st->slots[n->repeat_slot];
+            if (!flag->present || flag->value == 0) break;
+            if (*offset >= end) {
+                report(st, tree, &st->p->ei->more_no_data, *offset, 0,
+                       "'%s': the repeat flag '%s' says another follows, but no data is left", n->name,
+                       flag->node->name);
+                st->stopped = FALSE;
+                break;
+            }
+        }
+    }
+    if (collect && summaries.count > 1)
+        info_append(st, wmem_strdup_printf(st->pinfo->pool, "%s \xc3\x97%u: %s", n->name, summaries.count,
+                                           wmem_strbuf_get_str(summaries.text)));
+    else if (collect && summaries.count == 1)
+        info_append(st, wmem_strbuf_get_str(summaries.text));
+}
+
+void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
+                  gboolean in_summary)
+{
+    for (guint16 i = 0; i < count && !st->stopped; i++) {
+        const dg_node *n = &st->p->nodes[st->p->children[first + i]];
+        if (n->if_slot >= 0 && !condition_holds(st, n)) continue;
+        if (n->count.slot >= 0 || n->repeat_slot >= 0)
+            dissect_repeated(st, n, tree, offset, end, in_summary);
+        else
+            dissect_instance(st, n, tree, offset, end, in_summary, NULL);
+    }
+}
+
+/* --- registration ------------------------------------------------------- */
+
+struct dg_claim {
+    const char *table;
+    guint32 value;
+    dissector_handle_t handle;
+};
+
+GArray *claims; /* of dg_claim: table entries this plugin must own */
+
+/* Runs after every plugin's handoff and before Decode As choices (-d, the
+ * profile's decode_as_entries) are applied: whatever the plugin load order,
+ * our handle becomes the default for our values, and the other registrant
+ * stays selectable in Decode As. */
+void claim_tables(void)
+{
+    for (guint i = 0; claims && i < claims->len; i++) {
+        const dg_claim *c = &g_array_index(claims, dg_claim, i);
+        if (dissector_get_uint_handle(find_dissector_table(c->table), c->value) != c->handle)
+            dissector_add_uint(c->table, c->value, c->handle);
+    }
+}
+
+gboolean table_accepts_integers(const char *table)
+{
+    switch (get_dissector_table_selector_type(table)) {
+    case FT_UINT8: case FT_UINT16: case FT_UINT24: case FT_UINT32: return TRUE;
+    default: return FALSE;
+    }
+}
+
+} /* namespace */
+
+extern "C" {
+
+gboolean dg_protocol_names_free(const dg_protocol *p)
+{
+    const char *what = NULL, *value = NULL;
+    if (proto_get_id_by_filter_name(p->filter) != -1) {
+        what = "filter name";
+        value = p->filter;
+    } else if (proto_get_id_by_short_name(p->short_name) != -1) {
+        what = "abbreviation";
+        value = p->short_name;
+    } else if (proto_name_already_registered(p->name)) {
+        what = "name";
+        value = p->name;
+    }
+    if (!what) return TRUE;
+    report_failure("The dissgen plugin for \"%s\" was not loaded: another protocol already has the %s \"%s\". "
+                   "Change it in the rule file (<root %s=...>) and regenerate the plugin.",
+                   p->name, what, value, strcmp(what, "abbreviation") == 0 || strcmp(what, "name") == 0 ? what : "filter");
+    return FALSE;
+}
+
+void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett, int ett_count,
+                 ei_register_info *ei, int ei_count)
+{
+    *p->proto = proto_register_protocol(p->name, p->short_name, p->filter);
+    proto_register_field_array(*p->proto, hf, hf_count);
+    proto_register_subtree_array(ett, ett_count);
+    expert_module_t *experts = expert_register_protocol(*p->proto);
+    expert_register_field_array(experts, ei, ei_count);
+    register_dissector(p->filter, p->dissect, *p->proto);
+}
+
+void dg_handoff(const dg_protocol *p)
+{
+    if (*p->proto == -1) return; /* not registered: its names were taken */
+    dissector_handle_t handle = find_dissector(p->filter);
+    dissector_handle_t stream = p->dissect_stream ? create_dissector_handle(p->dissect_stream, *p->proto) : NULL;
+    if (!claims) {
+        claims = g_array_new(FALSE, FALSE, sizeof(dg_claim));
+        register_final_registration_routine(claim_tables);
+    }
+    for (guint i = 0; i < p->hook_count; i++) {
+        const dg_hook *h = &p->hooks[i];
+        if (!find_dissector_table(h->table) || !table_accepts_integers(h->table)) {
+            report_failure("The dissgen plugin for \"%s\" cannot hook into \"%s\": Wireshark has no integer "
+                           "dissector table of that name. The hook is ignored.", p->name, h->table);
+            continue;
+        }
+        dissector_handle_t h_handle = (stream && strcmp(h->table, "tcp.port") == 0) ? stream : handle;
+        dissector_add_uint(h->table, h->value, h_handle);
+        dg_claim c = {h->table, h->value, h_handle};
+        g_array_append_val(claims, c);
+    }
+}
+
+int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    col_set_str(pinfo->cinfo, COL_PROTOCOL, p->short_name);
+    col_clear(pinfo->cinfo, COL_INFO);
+
+    dg_state st;
+    memset(&st, 0, sizeof st);
+    st.p = p;
+    st.tvb = tvb;
+    st.pinfo = pinfo;
+    st.slots = wmem_alloc0_array(pinfo->pool, dg_slot, p->slot_count ? p->slot_count : 1);
+    st.packet_end = (gint)tvb_captured_length(tvb);
+    st.want_text = tree != NULL || pinfo->cinfo != NULL;
+    st.info = wmem_strbuf_new(pinfo->pool, "");
+
+    proto_item *root = proto_tree_add_item(tree, *p->proto, tvb, 0, -1, ENC_NA);
+    proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
+    gint offset = 0;
+    dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
+    proto_item_set_len(root, offset);
+
+    if (wmem_strbuf_get_len(st.info) > 0)
+        col_add_str(pinfo->cinfo, COL_INFO, wmem_strbuf_get_str(st.info));
+    else
+        col_set_str(pinfo->cinfo, COL_INFO, p->name);
+    return offset > 0 ? offset : st.packet_end;
+}
+
+} /* extern "C" */
+
+/* --- stream transports -------------------------------------------------- */
+
+namespace {
+
+guint message_length(packet_info *, tvbuff_t *tvb, int offset, void *data)
+{
+    const dg_protocol *p = (const dg_protocol *)data;
+    const dg_node *n = &p->nodes[p->pdu_node];
+    guint64 value = read_uint(tvb, offset + (gint)p->pdu_offset, n->length, encoding_of(n));
+    if (n->flags & DG_GROUP) value = (value >> n->shift) & bit_mask(n->bits);
+    gint64 total = (gint64)MIN(value, (guint64)G_MAXINT32) + p->pdu_add;
+    /* A length shorter than the length field itself cannot make progress. */
+    gint64 minimum = (gint64)(p->pdu_offset + n->length);
+    return (guint)CLAMP(total, minimum, (gint64)G_MAXINT32);
+}
+
+int dissect_message(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data)
+{
+    return dg_dissect((const dg_protocol *)data, tvb, pinfo, tree);
+}
+
+} /* namespace */
+
+extern "C" int dg_dissect_stream(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    const dg_node *n = &p->nodes[p->pdu_node];
+    tcp_dissect_pdus(tvb, pinfo, tree, TRUE, p->pdu_offset + n->length, message_length, dissect_message, (void *)p);
+    return (int)tvb_captured_length(tvb);
+}

@@ -1,0 +1,135 @@
+/* The runtime that dissgen-generated dissectors plug into.
+ *
+ * Generated code describes a protocol as static tables (hf_register_info,
+ * ett ids, and one dg_node per rule-file node in document order); the
+ * runtime walks those tables over the packet with tvb_/proto_ calls. All
+ * bounds are checked before each call, so a malformed packet yields expert
+ * infos and the tree decoded so far, never a Wireshark exception.
+ */
+#pragma once
+
+#include "dissgen_compat.h"
+
+/* Node kinds and length forms (RULES-SPEC "Lengths and bit fields"). */
+enum dg_kind { DG_LEAF = 0, DG_CONTAINER = 1 };
+enum dg_length_kind {
+    DG_LEN_FIXED = 0,    /* bytes in dg_node.length */
+    DG_LEN_FIELD = 1,    /* value of an earlier field, dg_node.length_ref */
+    DG_LEN_REST = 2,     /* to the end of the enclosing known-length container */
+    DG_LEN_CHILDREN = 3  /* sum of the children */
+};
+/* How a leaf's value is shown; used for summaries and the Info column. */
+enum dg_show {
+    DG_SHOW_HEX = 0, DG_SHOW_DEC, DG_SHOW_BOOL, DG_SHOW_ENUM, DG_SHOW_ADDRESS, DG_SHOW_BYTES, DG_SHOW_HIDDEN
+};
+enum dg_flags {
+    DG_LITTLE = 1 << 0,      /* little-endian value */
+    DG_NUMERIC = 1 << 1,     /* leaf read as an unsigned integer */
+    DG_HIDDEN = 1 << 2,      /* nondisplay leaf: hidden but filterable */
+    DG_GROUP = 1 << 3,       /* member of a bit group */
+    DG_GROUP_FIRST = 1 << 4, /* first member: reads the group's bytes */
+    DG_GROUP_LAST = 1 << 5   /* last member: moves past the group's bytes */
+};
+
+/* A run-time value taken from an earlier field, with optional arithmetic. */
+typedef struct dg_ref {
+    gint16 slot;    /* -1: none */
+    char op;        /* 0, '+', '-' or '*' */
+    gint64 operand;
+} dg_ref;
+
+typedef struct dg_range {
+    guint64 low, high;
+} dg_range;
+
+/* Literal text (slot < 0) or the shown value of the leaf in `slot`. */
+typedef struct dg_summary_piece {
+    const char *text;
+    gint16 slot;
+} dg_summary_piece;
+
+typedef struct dg_node {
+    const char *name;
+    int *hf;            /* NULL for a container left out of filter names */
+    int *ett;           /* containers only */
+    guint8 kind;        /* dg_kind */
+    guint8 length_kind; /* dg_length_kind */
+    guint8 show;        /* dg_show */
+    guint8 flags;       /* dg_flags */
+    guint32 length;     /* fixed length in bytes; a bit field's group length */
+    guint8 shift, bits; /* bit field: position and width inside its group */
+    gint16 slot;        /* where this leaf's value is kept, -1 if nobody reads it */
+    dg_ref length_ref;  /* DG_LEN_FIELD */
+    dg_ref count;       /* slot >= 0: decoded exactly that many times */
+    gint16 repeat_slot; /* >= 0: decoded again while that flag is non-zero */
+    gint16 if_slot;     /* >= 0: decoded only when that value is in the ranges */
+    guint16 in_first, in_count;
+    guint16 first_child, child_count;
+    guint16 slot_first, slot_count; /* slots inside this subtree */
+    guint16 summary_first, summary_count;
+} dg_node;
+
+/* Expert infos every generated protocol registers. */
+typedef struct dg_experts {
+    expert_field truncated;    /* packet ends inside a field */
+    expert_field past_end;     /* a length field points past its container or the packet */
+    expert_field more_no_data; /* repeat flag set, but no data left */
+    expert_field count_short;  /* count says more instances than the data holds */
+    expert_field bad_length;   /* negative or missing length / count */
+} dg_experts;
+
+typedef struct dg_hook {
+    const char *table;
+    guint32 value;
+} dg_hook;
+
+typedef struct dg_protocol {
+    const char *name;        /* long name, e.g. "EtherCAT" */
+    const char *short_name;  /* Protocol column, e.g. "ECATR" */
+    const char *filter;      /* display-filter name, e.g. "ecatr" */
+    int *proto;
+    int *ett;                /* the protocol's own subtree */
+    dissector_t dissect;     /* generated entry points, calling dg_dissect / dg_dissect_stream */
+    dissector_t dissect_stream;
+    const dg_node *nodes;
+    const guint16 *children; /* child index lists, addressed by first_child/child_count */
+    guint16 top_first, top_count; /* the top-level nodes' list in `children` */
+    const dg_range *ranges;
+    const dg_summary_piece *pieces;
+    guint16 slot_count;
+    dg_experts *ei;
+    const dg_hook *hooks;    /* ethertype first when present */
+    guint16 hook_count;
+    /* Stream transports (pdulength): message length = value of node pdu_node,
+     * found pdu_offset bytes into the message, plus pdu_add. */
+    gint16 pdu_node;         /* -1 when the protocol has no pdulength */
+    guint32 pdu_offset;
+    gint64 pdu_add;
+} dg_protocol;
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* True when no protocol of the running Wireshark uses this protocol's name,
+ * short name or filter name; otherwise reports the clash (report_failure)
+ * so the caller can skip registering, and Wireshark keeps running. */
+gboolean dg_protocol_names_free(const dg_protocol *p);
+
+/* Registers the protocol's hf/ett/expert arrays. */
+void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett, int ett_count,
+                 ei_register_info *ei, int ei_count);
+
+/* Handoff: adds the protocol to its ethertype/hook tables and makes sure it,
+ * not another plugin that registered the same values, is the default. */
+void dg_handoff(const dg_protocol *p);
+
+/* Dissects one message; returns the number of bytes decoded. */
+int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+
+/* Dissects a TCP segment holding whole or partial messages (pdulength). */
+int dg_dissect_stream(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+
+#ifdef __cplusplus
+}
+#endif
