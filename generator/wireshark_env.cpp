@@ -1,5 +1,6 @@
 #include "wireshark_env.h"
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -18,7 +19,12 @@ int run_command(const std::vector<std::string>& argv, std::string* output, bool 
     if (pid < 0) return -1;
     if (pid == 0) {
         dup2(pipefd[1], STDOUT_FILENO);
-        if (merge_stderr) dup2(pipefd[1], STDERR_FILENO);
+        if (merge_stderr) {
+            dup2(pipefd[1], STDERR_FILENO);
+        } else if (int devnull = open("/dev/null", O_WRONLY); devnull >= 0) {
+            dup2(devnull, STDERR_FILENO);  // tshark's start-up chatter is not ours to show
+            close(devnull);
+        }
         close(pipefd[0]);
         close(pipefd[1]);
         std::vector<char*> args;

@@ -17,7 +17,14 @@
 
 /* The plugin loader's entry points. In C++ a namespace-scope const has
  * internal linkage, so the data symbols are declared extern (inside an
- * extern "C" block) before they are defined. */
+ * extern "C" block) before they are defined.
+ *
+ * The protocol is registered at the start of the handoff phase, not in the
+ * register phase: per-user plugins register before global ones, so only
+ * after every plugin's register routine has run can a protocol whose names
+ * are taken (say, by Debian's ethercat.so) step aside instead of making
+ * Wireshark abort on a duplicate name. Subtree and field arrays are still
+ * open for registration then. */
 #ifdef __cplusplus
 #define DG_BEGIN_C extern "C" {
 #define DG_END_C }
@@ -27,6 +34,12 @@
 #endif
 
 #define DG_DECLARE_PLUGIN(register_fn, handoff_fn)                                   \
+    static void dg_register_nothing_yet(void) {}                                     \
+    static void dg_register_then_handoff(void)                                       \
+    {                                                                                \
+        register_fn();                                                               \
+        handoff_fn();                                                                \
+    }                                                                                \
     DG_BEGIN_C                                                                       \
     WS_DLL_PUBLIC_DEF extern const char plugin_version[];                            \
     WS_DLL_PUBLIC_DEF extern const int plugin_want_major;                            \
@@ -38,8 +51,8 @@
     void plugin_register(void)                                                       \
     {                                                                                \
         static proto_plugin plug;                                                    \
-        plug.register_protoinfo = register_fn;                                       \
-        plug.register_handoff = handoff_fn;                                          \
+        plug.register_protoinfo = dg_register_nothing_yet;                           \
+        plug.register_handoff = dg_register_then_handoff;                            \
         proto_register_plugin(&plug);                                                \
     }                                                                                \
     DG_END_C

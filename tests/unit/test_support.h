@@ -1,0 +1,41 @@
+// Helpers shared by the unit tests: run the generator's front end on a rule
+// file or on text, and read files of the source tree.
+#pragma once
+
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "diagnostics.h"
+#include "model.h"
+#include "parser.h"
+#include "validator.h"
+
+namespace dissgen::testing {
+
+inline std::string source_path(const std::string& relative) { return std::string(DISSGEN_SOURCE_DIR) + "/" + relative; }
+
+inline std::string read_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+struct Front {
+    std::unique_ptr<Protocol> proto;
+    Diagnostics diags;
+    bool ok() const { return proto && !diags.has_errors(); }
+    std::string messages() const { return diags.format("rules.xml"); }
+};
+
+// parse + validate, as `dissgen check` does (without asking tshark).
+inline Front front_end(const std::string& xml) {
+    Front f;
+    f.proto = parse_rules(xml, f.diags);
+    if (f.proto && !f.diags.has_errors()) validate(*f.proto, f.diags);
+    return f;
+}
+
+}  // namespace dissgen::testing
