@@ -1,0 +1,6 @@
+#!/usr/bin/env bash
+# Configures and builds dissgen, its unit tests and a plugin per rules/*.xml.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build build -j"$(nproc)"

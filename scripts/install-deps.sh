@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs the Debian packages dissgen needs to build, run and test, if any
+# are missing. Uses sudo when not root.
+set -euo pipefail
+packages=(cmake g++ make pkg-config libwireshark-dev tshark libglib2.0-dev libxml2-dev
+          libgtest-dev python3 util-linux)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+echo "installing: ${missing[*]}"
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
+$sudo apt-get update -q
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q "${missing[@]}"
