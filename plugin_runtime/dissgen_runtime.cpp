@@ -254,11 +254,13 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
 
     proto_item *item = NULL;
     proto_tree *subtree;
+    /* Length 0 now, the real length once the children are decoded: a length
+     * of -1 would throw when the container starts at the end of the packet. */
     if (n->hf) {
-        item = proto_tree_add_item(tree, *n->hf, st->tvb, start, -1, ENC_NA);
+        item = proto_tree_add_item(tree, *n->hf, st->tvb, start, 0, ENC_NA);
         subtree = proto_item_add_subtree(item, *n->ett);
     } else {
-        subtree = proto_tree_add_subtree(tree, st->tvb, start, -1, *n->ett, &item, n->name);
+        subtree = proto_tree_add_subtree(tree, st->tvb, start, 0, *n->ett, &item, n->name);
     }
     if (past_end)
         report(st, subtree, n->length_kind == DG_LEN_FIELD ? &st->p->ei->past_end : &st->p->ei->truncated, start,
@@ -459,7 +461,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     st.want_text = tree != NULL || pinfo->cinfo != NULL;
     st.info = wmem_strbuf_new(pinfo->pool, "");
 
-    proto_item *root = proto_tree_add_item(tree, *p->proto, tvb, 0, -1, ENC_NA);
+    proto_item *root = proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA);
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
     gint offset = 0;
     dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
