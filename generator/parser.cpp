@@ -10,7 +10,6 @@
 #include <cerrno>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <sstream>
 
 #include "text_util.h"
@@ -29,9 +28,30 @@ const std::vector<std::string> kHookAttributes = {"table", "value"};
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
                                                 "origin",  "enum",      "nondisplay"};
 
-int line_of(const xmlNode* el) { return static_cast<int>(xmlGetLineNo(el)); }
+int line_of(const xmlNode* el) {
+    if (el->type == XML_ELEMENT_NODE && el->line == 65535 && el->psvi)  // set by use_start_lines
+        return static_cast<int>(reinterpret_cast<ptrdiff_t>(el->psvi));
+    return static_cast<int>(xmlGetLineNo(el));
+}
 
 std::string element_name(const xmlNode* el) { return reinterpret_cast<const char*>(el->name); }
+
+// The valid name to suggest for an unknown one: one that begins with it or
+// contains it ("len" -> length, "type" -> displaytype), one it begins with
+// ("boolean" -> bool), else the closest by edit distance ("" if none is close).
+std::string suggest(const std::string& word, const std::vector<std::string>& valid) {
+    std::string w = word;
+    std::transform(w.begin(), w.end(), w.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (w.size() >= 3) {
+        for (const std::string& v : valid)
+            if (v.rfind(w, 0) == 0) return v;
+        for (const std::string& v : valid)
+            if (v.find(w) != std::string::npos) return v;
+        for (const std::string& v : valid)
+            if (v.size() >= 3 && w.rfind(v, 0) == 0) return v;
+    }
+    return closest_match(word, valid);
+}
 
 // Collects libxml2's messages instead of letting it print them.
 struct XmlErrorSink {
@@ -50,11 +70,145 @@ void collect_xml_error(void* user, xmlErrorPtr error) {
 
 void ignore_xml_error(void*, xmlErrorPtr) {}
 
-// Finds the line of `needle` in text, 0 if absent.
+// Finds the line of `needle` in text outside comments, 0 if absent.
 int line_of_text(const std::string& text, const std::string& needle) {
-    size_t at = text.find(needle);
-    if (at == std::string::npos) return 0;
-    return 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+    size_t at = 0;
+    while ((at = text.find(needle, at)) != std::string::npos) {
+        size_t open = text.rfind("<!--", at);
+        size_t close = open == std::string::npos ? std::string::npos : text.find("-->", open);
+        if (open == std::string::npos || close < at)
+            return 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+        at = close;  // past this comment (npos: it never ends)
+    }
+    return 0;
+}
+
+// The line where each start tag begins, in document order. libxml2 numbers
+// an element by the line where its start tag ends, which is not the element's
+// line when the tag is written over several lines (as the paper does).
+std::vector<int> start_tag_lines(const std::string& text) {
+    std::vector<int> lines;
+    int line = 1;
+    size_t i = 0;
+    const size_t n = text.size();
+    auto skip_past = [&](const char* end) {
+        size_t at = text.find(end, i);
+        size_t stop = at == std::string::npos ? n : at + std::char_traits<char>::length(end);
+        line += static_cast<int>(std::count(text.begin() + i, text.begin() + stop, '\n'));
+        i = stop;
+    };
+    while (i < n) {
+        if (text[i] != '<') {
+            if (text[i++] == '\n') ++line;
+        } else if (text.compare(i, 4, "<!--") == 0) {
+            skip_past("-->");
+        } else if (text.compare(i, 9, "<![CDATA[") == 0) {
+            skip_past("]]>");
+        } else if (text.compare(i, 2, "<?") == 0) {
+            skip_past("?>");
+        } else if (text.compare(i, 2, "</") == 0 || text.compare(i, 2, "<!") == 0) {
+            skip_past(">");
+        } else {
+            lines.push_back(line);
+            char quote = 0;  // attribute values may hold '>'
+            for (++i; i < n; ++i) {
+                char c = text[i];
+                if (c == '\n') ++line;
+                if (quote) {
+                    if (c == quote) quote = 0;
+                } else if (c == '"' || c == '\'') {
+                    quote = c;
+                } else if (c == '>') {
+                    ++i;
+                    break;
+                }
+            }
+        }
+    }
+    return lines;
+}
+
+// Hand-written matchers instead of std::regex: libstdc++'s regex recurses
+// once per character and overflows the stack on long attribute values.
+bool is_space(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }
+bool is_digit(char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }
+
+// "12byte" / "11bit": the digits and the unit ("" when `text` is not of that form).
+// `loose` also takes space before the unit, any case and a plural 's' ("10 Bytes").
+bool split_fixed_length(const std::string& text, bool loose, std::string& digits, std::string& unit) {
+    size_t i = 0;
+    while (i < text.size() && is_digit(text[i])) ++i;
+    if (i == 0) return false;
+    digits = text.substr(0, i);
+    if (loose)
+        while (i < text.size() && is_space(text[i])) ++i;
+    unit = text.substr(i);
+    if (loose) {
+        std::transform(unit.begin(), unit.end(), unit.begin(), [](unsigned char c) { return std::tolower(c); });
+        if (!unit.empty() && unit.back() == 's') unit.pop_back();
+    }
+    return unit == "byte" || unit == "bit";
+}
+
+// "XPATH * 2": splits off the operator and the integer at the end. The XPath
+// must not end in an operator or be empty.
+bool split_arithmetic(const std::string& text, std::string& path, char& op, std::string& number) {
+    size_t end = text.size();
+    while (end > 0 && is_digit(text[end - 1])) --end;
+    if (end == text.size()) return false;
+    number = text.substr(end);
+    while (end > 0 && is_space(text[end - 1])) --end;
+    if (end == 0 || std::string("+-*").find(text[end - 1]) == std::string::npos) return false;
+    op = text[end - 1];
+    --end;
+    while (end > 0 && is_space(text[end - 1])) --end;
+    if (end == 0 || std::string("+-*").find(text[end - 1]) != std::string::npos) return false;
+    path = text.substr(0, end);
+    return true;
+}
+
+// The offset of the first "<enum" whose tag has an attribute name starting
+// with a digit (the paper's <enum 0x0a="LRD"/>), npos if none.
+size_t find_paper_enum(const std::string& text) {
+    size_t close = 0;
+    for (size_t at = text.find("<enum"); at != std::string::npos; at = text.find("<enum", std::max(at + 1, close))) {
+        // a later "<enum" before `close` sees a part of what this one saw
+        size_t body = at + 5;
+        if (body >= text.size() || !is_space(text[body])) continue;
+        close = std::min(text.find('>', body), text.size());
+        for (size_t j = body + 1; j < close; ++j) {
+            if (!is_space(text[j - 1]) || !is_digit(text[j])) continue;
+            size_t k = j;
+            while (k < close && std::isalnum(static_cast<unsigned char>(text[k]))) ++k;
+            while (k < close && is_space(text[k])) ++k;
+            if (k < close && text[k] == '=') return at;
+        }
+    }
+    return std::string::npos;
+}
+
+void collect_elements(xmlNode* el, std::vector<xmlNode*>& out) {
+    for (; el; el = el->next) {
+        if (el->type != XML_ELEMENT_NODE) continue;
+        out.push_back(el);
+        collect_elements(el->children, out);
+    }
+}
+
+// Numbers every element by the line its start tag begins on.
+void use_start_lines(xmlDoc* doc, const std::string& text) {
+    std::vector<xmlNode*> elements;
+    collect_elements(xmlDocGetRootElement(doc), elements);
+    std::vector<int> lines = start_tag_lines(text);
+    if (lines.size() != elements.size()) return;  // keep libxml2's numbers
+    for (size_t k = 0; k < elements.size(); ++k) {
+        if (lines[k] < 65535) {
+            elements[k]->line = static_cast<unsigned short>(lines[k]);
+        } else {  // too big for the field: line_of reads it from psvi, unused otherwise
+            elements[k]->line = 65535;
+            elements[k]->psvi = reinterpret_cast<void*>(static_cast<ptrdiff_t>(lines[k]));
+        }
+    }
 }
 
 class Parser {
@@ -99,7 +253,7 @@ std::map<std::string, std::string> Parser::attributes(xmlNode* el,
         std::string name = reinterpret_cast<const char*>(a->name);
         if (std::find(allowed.begin(), allowed.end(), name) == allowed.end()) {
             std::string msg = "unknown attribute '" + name + "' on <" + element_name(el) + ">";
-            std::string near = closest_match(name, allowed);
+            std::string near = suggest(name, allowed);
             msg += near.empty() ? "; valid: " + join(allowed, ", ") : "; did you mean '" + near + "'?";
             diags_.error(line_of(el), msg);
             continue;
@@ -115,16 +269,20 @@ void Parser::unexpected_child(xmlNode* child, const std::string& parent,
                               const std::vector<std::string>& allowed) {
     if (child->type == XML_TEXT_NODE || child->type == XML_CDATA_SECTION_NODE) {
         xmlChar* content = xmlNodeGetContent(child);
-        std::string text = content ? trim(reinterpret_cast<const char*>(content)) : "";
+        std::string raw = content ? reinterpret_cast<const char*>(content) : "";
         xmlFree(content);
+        std::string text = trim(raw);
+        // libxml2 numbers a text node by the line where it ends.
+        size_t first = raw.find(text);
+        int line = line_of(child) - static_cast<int>(std::count(raw.begin() + first, raw.end(), '\n'));
         if (!text.empty())
-            diags_.error(line_of(child), "unexpected text '" + text.substr(0, 40) + "' in <" + parent + ">");
+            diags_.error(std::max(line, 1), "unexpected text '" + text.substr(0, 40) + "' in <" + parent + ">");
         return;
     }
     if (child->type != XML_ELEMENT_NODE) return;  // comments, processing instructions
     std::string name = element_name(child);
     std::string msg = "unknown element <" + name + "> in <" + parent + ">";
-    std::string near = closest_match(name, allowed);
+    std::string near = suggest(name, allowed);
     if (allowed.empty())
         msg += "; <" + parent + "> has no child elements";
     else if (!near.empty())
@@ -284,22 +442,22 @@ void Parser::parse_display(const std::string& text, int line, Node& node) {
         }
     }
     std::string msg = "unknown displaytype '" + text + "'";
-    std::string near = closest_match(text, kDisplayNames);
+    std::string near = suggest(text, kDisplayNames);
     if (!near.empty()) msg += " (did you mean '" + near + "'?)";
     diags_.error(line, msg + "; valid: " + join(kDisplayNames, ", "));
 }
 
 void Parser::parse_length(const std::string& raw, int line, Node& node, xmlNode*) {
     std::string text = trim(raw);
-    static const std::regex fixed(R"(^([0-9]+)(byte|bit)$)");
-    std::smatch m;
+    std::string digits, unit;
     if (text.empty()) {
         node.length_kind = LengthKind::Children;
     } else if (text == "rest") {
         node.length_kind = LengthKind::Rest;
-    } else if (std::regex_match(text, m, fixed)) {
-        uint64_t n = std::stoull(m[1].str().substr(0, 12));
-        bool bytes = m[2] == "byte";
+    } else if (split_fixed_length(text, false, digits, unit)) {
+        digits.erase(0, std::min(digits.find_first_not_of('0'), digits.size() - 1));
+        uint64_t n = digits.size() > 12 ? UINT64_MAX : std::stoull(digits);
+        bool bytes = unit == "byte";
         if (n == 0 || n > (1u << 20)) {
             diags_.error(line, "bad length '" + raw + "': a fixed length must be from 1 to 1048576");
             return;
@@ -307,13 +465,8 @@ void Parser::parse_length(const std::string& raw, int line, Node& node, xmlNode*
         node.length_kind = bytes ? LengthKind::Bytes : LengthKind::Bits;
         node.fixed_bits = bytes ? n * 8 : n;
     } else if (std::isdigit(static_cast<unsigned char>(text[0]))) {
-        static const std::regex loose(R"(^([0-9]+)\s*(byte|bit)s?$)", std::regex::icase);
         std::string msg = "bad length '" + raw + "': expected 'Nbyte', 'Nbit', an XPath, 'rest' or nothing";
-        if (std::regex_match(text, m, loose)) {
-            std::string unit = m[2].str();
-            std::transform(unit.begin(), unit.end(), unit.begin(), ::tolower);
-            msg += " (did you mean '" + m[1].str() + unit + "'?)";
-        }
+        if (split_fixed_length(text, true, digits, unit)) msg += " (did you mean '" + digits + unit + "'?)";
         diags_.error(line, msg);
     } else {
         node.length_kind = LengthKind::Field;
@@ -342,17 +495,24 @@ void Parser::parse_in_list(const std::string& text, int line, Node& node) {
         any = true;
     }
     if (!any) diags_.error(line, "empty 'in' list; expected numbers and ranges such as \"1-9,0x0d,14\"");
+    else if (trim(text).back() == ',')  // getline drops the empty last item
+        diags_.error(line, "bad 'in' list '" + text + "': expected numbers and ranges such as \"1-9,0x0d,14\"");
 }
 
 FieldRef Parser::make_ref(const std::string& text, int line, const std::string& attribute, bool arithmetic) {
     FieldRef ref;
     ref.xpath = trim(text);
-    static const std::regex tail(R"(^(.*[^-+*\s])\s*([-+*])\s*([0-9]+)$)");
-    std::smatch m;
-    if (arithmetic && std::regex_match(ref.xpath, m, tail)) {
-        ref.op = m[2].str()[0];
-        ref.operand = std::stoll(m[3].str().substr(0, 9));
-        ref.xpath = m[1].str();
+    std::string path, number;
+    char op = 0;
+    if (arithmetic && split_arithmetic(ref.xpath, path, op, number)) {
+        ref.op = op;
+        ref.xpath = path;
+        if (number.size() > 9) {
+            diags_.error(line, "number " + number + " after '" + ref.op + "' in '" + attribute +
+                                   "' is too large: at most 999999999");
+            return ref;
+        }
+        ref.operand = std::stoll(number);
     }
     if (ref.xpath.empty()) diags_.error(line, "empty XPath in '" + attribute + "'");
     return ref;
@@ -377,7 +537,10 @@ Node* Parser::resolve(const PendingRef& p) {
     xmlXPathObjectPtr obj = comp ? xmlXPathCompiledEval(comp, ctx) : nullptr;
     xmlSetStructuredErrorFunc(nullptr, nullptr);
     if (!comp || !obj) {
-        diags_.error(p.line, "invalid " + where);
+        diags_.error(p.line, "invalid " + where +
+                                 (p.attribute == "length"
+                                      ? "; a length is 'Nbyte', 'Nbit', an XPath, 'rest' or nothing"
+                                      : ""));
     } else if (obj->type != XPATH_NODESET) {
         diags_.error(p.line, where + " gives a value, not a node; it must select one <node>");
     } else {
@@ -449,10 +612,9 @@ std::unique_ptr<Protocol> parse_rules(const std::string& text, Diagnostics& diag
         // The paper writes enum items as attributes named by their value
         // (<enum 0x0a="LRD"/>), which no XML parser accepts: point at the
         // element and show the form this language uses instead.
-        static const std::regex paper_enum(R"(<enum\s[^>]*?\s[0-9][0-9A-Za-z]*\s*=)");
-        std::smatch m;
-        if (std::regex_search(text, m, paper_enum)) {
-            int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + m.position(0), '\n'));
+        size_t paper_enum = find_paper_enum(text);
+        if (paper_enum != std::string::npos) {
+            int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + paper_enum, '\n'));
             diags.error(line, "XML is not well-formed: an attribute name cannot start with a digit; "
                               "enum items are written <enum value=\"0x0a\" name=\"LRD 读数据\"/>, one element per item");
         } else {
@@ -462,6 +624,7 @@ std::unique_ptr<Protocol> parse_rules(const std::string& text, Diagnostics& diag
         return nullptr;
     }
 
+    use_start_lines(doc, text);
     xmlNode* root = xmlDocGetRootElement(doc);
     std::unique_ptr<Protocol> proto;
     if (!root || element_name(root) != "root") {

@@ -146,7 +146,11 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
     unsigned group_bits = 0;
     for (auto& child : children) {
         Node& n = *child;
-        bool bit_leaf = n.is_leaf() && n.length_kind == LengthKind::Bits;
+        // "Nbyte" counts as 8N bits: a whole-byte leaf inside a group joins it,
+        // unless it shows bytes (origin, address), which a group cannot hold.
+        bool bit_leaf = n.is_leaf() && (n.length_kind == LengthKind::Bits ||
+                                         (n.length_kind == LengthKind::Bytes && n.display != Display::Origin &&
+                                          n.display != Display::Address));
         bool whole_bytes = bit_leaf && n.fixed_bits % 8 == 0;
         if (group.empty() && (!bit_leaf || whole_bytes)) {
             if (n.is_container()) layout_children(n.children);
@@ -164,6 +168,9 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
         if (n.is_repeated() || n.if_field)
             diags_.error(n.line, "bit field " + quote(n) + " cannot have 'repeat', 'count' or 'if': it shares bytes "
                                  "with its neighbours in a bit group");
+        // A bit field written without a displaytype shows its value in hex: the
+        // nearest thing to origin's "raw bytes in hex" for a part of a byte.
+        if (n.display == Display::Origin && !n.display_given) n.display = Display::NumberHex;
         if (n.display == Display::Origin || n.display == Display::Address)
             diags_.error(n.line, std::string(display_name(n.display)) + " display needs whole bytes; bit field " +
                                      quote(n) + " is part of a bit group (use numberhex, numberdec, bool or enum)");
