@@ -61,11 +61,12 @@ Layout make_layout(const Protocol& proto) {
     std::set<std::string> used;
     for_each_node(proto.nodes, [&](const Node& n) {
         l.nodes.push_back(&n);
-        std::string id = ident_for(proto, n);
-        if (!used.insert(id).second) {
-            id += "_" + std::to_string(n.doc_index);
-            used.insert(id);
-        }
+        // Filter names are unique, but "a.b_c" and "a_b.c" make the same identifier:
+        // add the node's position, and a counter should even that be taken.
+        std::string base = ident_for(proto, n);
+        std::string id = base;
+        for (int k = 0; !used.insert(id).second; ++k)
+            id = base + "_" + std::to_string(n.doc_index) + (k ? "_" + std::to_string(k) : "");
         l.ident[&n] = id;
     });
     auto add_list = [&](const std::vector<std::unique_ptr<Node>>& kids, const Node* owner) {
@@ -323,11 +324,13 @@ void Emitter::register_functions() {
         {"more_no_data", "PI_MALFORMED", "PI_WARN", "The repeat flag says more follow, but no data is left"},
         {"count_short", "PI_MALFORMED", "PI_WARN", "Fewer instances than the count field says"},
         {"bad_length", "PI_MALFORMED", "PI_ERROR", "A length or count is missing or negative"},
+        {"unused", "PI_PROTOCOL", "PI_WARN", "A length says more bytes than its fields hold"},
     };
-    for (size_t i = 0; i < 5; ++i)
+    const size_t expert_count = sizeof experts / sizeof experts[0];
+    for (size_t i = 0; i < expert_count; ++i)
         o_ << "        { &ei_" << f << "." << experts[i][0] << ", { \"" << f << ".expert." << experts[i][0] << "\", "
            << experts[i][1] << ", " << experts[i][2] << ", \"" << experts[i][3] << "\", EXPFILL } }"
-           << (i < 4 ? ",\n" : "\n");
+           << (i + 1 < expert_count ? ",\n" : "\n");
     o_ << "    };\n\n"
        << "    if (!dg_protocol_names_free(&" << f << "_protocol))\n        return;\n"
        << "    dg_register(&" << f << "_protocol, hf, " << (first ? "0" : "(int)G_N_ELEMENTS(hf)")

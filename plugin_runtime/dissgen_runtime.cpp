@@ -32,8 +32,10 @@ struct dg_state {
     dg_slot *slots;
     gint packet_end;      /* captured bytes */
     gboolean stopped;     /* a malformed spot was reported: decode nothing more */
-    gboolean want_text;   /* summaries are visible (tree or columns) */
-    wmem_strbuf_t *info;  /* the Info column being built */
+    gboolean want_text;   /* summaries are shown: a visible tree, or columns */
+    gboolean want_info;   /* the Info column is shown (pinfo->cinfo) */
+    wmem_strbuf_t *info;  /* the Info column being built (want_info) */
+    wmem_strbuf_t *text;  /* scratch for one container's summary (want_text) */
     guint64 group_value;  /* the bit group being decoded */
 };
 
@@ -42,14 +44,14 @@ guint encoding_of(const dg_node *n) { return (n->flags & DG_LITTLE) ? ENC_LITTLE
 guint64 read_uint(tvbuff_t *tvb, gint offset, guint length, guint encoding)
 {
     switch (length) {
-    case 1: return tvb_get_guint8(tvb, offset);
-    case 2: return tvb_get_guint16(tvb, offset, encoding);
-    case 3: return tvb_get_guint24(tvb, offset, encoding);
-    case 4: return tvb_get_guint32(tvb, offset, encoding);
-    case 5: return tvb_get_guint40(tvb, offset, encoding);
-    case 6: return tvb_get_guint48(tvb, offset, encoding);
-    case 7: return tvb_get_guint56(tvb, offset, encoding);
-    default: return tvb_get_guint64(tvb, offset, encoding);
+    case 1: return dg_tvb_get_uint8(tvb, offset);
+    case 2: return dg_tvb_get_uint16(tvb, offset, encoding);
+    case 3: return dg_tvb_get_uint24(tvb, offset, encoding);
+    case 4: return dg_tvb_get_uint32(tvb, offset, encoding);
+    case 5: return dg_tvb_get_uint40(tvb, offset, encoding);
+    case 6: return dg_tvb_get_uint48(tvb, offset, encoding);
+    case 7: return dg_tvb_get_uint56(tvb, offset, encoding);
+    default: return dg_tvb_get_uint64(tvb, offset, encoding);
     }
 }
 
@@ -121,16 +123,53 @@ gboolean condition_holds(const dg_state *st, const dg_node *n)
     return FALSE;
 }
 
-/* A leaf's value as its tree item shows it, for summaries. */
-const char *shown_value(const dg_state *st, const dg_slot *s)
+/* Summary text is built with memcpy appends (wmem_strbuf_append copies with
+ * g_strlcpy, byte by byte) and hand-made numbers instead of printf: it runs
+ * for every instance of a summarised container. */
+void append_str(wmem_strbuf_t *out, const char *text) { wmem_strbuf_append_len(out, text, strlen(text)); }
+
+/* Same text as "%" G_GINT64_MODIFIER "u". */
+void append_dec(wmem_strbuf_t *out, guint64 v)
+{
+    char buf[24];
+    gsize i = sizeof buf;
+    do {
+        buf[--i] = (char)('0' + v % 10);
+        v /= 10;
+    } while (v);
+    wmem_strbuf_append_len(out, buf + i, sizeof buf - i);
+}
+
+/* Same text as "0x%0*" G_GINT64_MODIFIER "x" with width `digits` (at most 16 used). */
+void append_hex(wmem_strbuf_t *out, guint64 v, guint digits)
+{
+    static const char hex[] = "0123456789abcdef";
+    char buf[2 + 16];
+    gsize i = sizeof buf;
+    guint n = 0;
+    do {
+        buf[--i] = hex[v & 0xf];
+        v >>= 4;
+        n++;
+    } while (v);
+    for (; n < digits && n < 16; n++) buf[--i] = '0';
+    buf[--i] = 'x';
+    buf[--i] = '0';
+    wmem_strbuf_append_len(out, buf + i, sizeof buf - i);
+}
+
+/* Appends a leaf's value as its tree item shows it, for summaries. */
+void append_shown_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s)
 {
     wmem_allocator_t *pool = st->pinfo->pool;
     const dg_node *n = s->node;
     switch (n->show) {
     case DG_SHOW_HEX:
-        return wmem_strdup_printf(pool, "0x%0*" G_GINT64_MODIFIER "x", (int)((n->bits + 3) / 4), s->value);
+        append_hex(out, s->value, (n->bits + 3) / 4);
+        return;
     case DG_SHOW_BOOL:
-        return s->value ? "True" : "False";
+        append_str(out, s->value ? "True" : "False");
+        return;
     case DG_SHOW_ENUM: {
         header_field_info *hfi = proto_registrar_get_nth(*n->hf);
         const char *name = NULL;
@@ -138,37 +177,51 @@ const char *shown_value(const dg_state *st, const dg_slot *s)
             name = try_val64_to_str(s->value, (const val64_string *)hfi->strings);
         else
             name = try_val_to_str((guint32)s->value, (const value_string *)hfi->strings);
-        return name ? name : wmem_strdup_printf(pool, "Unknown (0x%" G_GINT64_MODIFIER "x)", s->value);
+        if (name)
+            append_str(out, name);
+        else
+            wmem_strbuf_append_printf(out, "Unknown (0x%" G_GINT64_MODIFIER "x)", s->value);
+        return;
     }
     case DG_SHOW_ADDRESS:
-        return tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ':');
+        append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ':'));
+        return;
     case DG_SHOW_BYTES:
-        return tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' ');
+        append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' '));
+        return;
     default:
-        if (n->flags & DG_NUMERIC) return wmem_strdup_printf(pool, "%" G_GINT64_MODIFIER "u", s->value);
-        return tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' ');
+        if (n->flags & DG_NUMERIC)
+            append_dec(out, s->value);
+        else
+            append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' '));
+        return;
     }
 }
 
+/* The summary of container n, in st->text (valid until the next summary). */
 const char *summary_text(const dg_state *st, const dg_node *n)
 {
-    wmem_strbuf_t *out = wmem_strbuf_new(st->pinfo->pool, "");
+    wmem_strbuf_t *out = st->text;
+    wmem_strbuf_truncate(out, 0);
     for (guint i = 0; i < n->summary_count; i++) {
         const dg_summary_piece *piece = &st->p->pieces[n->summary_first + i];
         if (piece->slot < 0) {
-            wmem_strbuf_append(out, piece->text);
+            append_str(out, piece->text);
         } else {
             const dg_slot *s = &st->slots[piece->slot];
-            wmem_strbuf_append(out, s->present ? shown_value(st, s) : "-");
+            if (s->present)
+                append_shown_value(st, out, s);
+            else
+                wmem_strbuf_append_len(out, "-", 1);
         }
     }
     return wmem_strbuf_get_str(out);
 }
 
-void info_append(dg_state *st, const char *text)
+void info_append(dg_state *st, const char *text, gsize len)
 {
-    if (wmem_strbuf_get_len(st->info) > 0) wmem_strbuf_append(st->info, ", ");
-    wmem_strbuf_append(st->info, text);
+    if (wmem_strbuf_get_len(st->info) > 0) wmem_strbuf_append_len(st->info, ", ", 2);
+    wmem_strbuf_append_len(st->info, text, len);
 }
 
 void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
@@ -184,10 +237,13 @@ void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
         }
         st->group_value = read_uint(st->tvb, *offset, n->length, encoding_of(n));
     }
-    guint64 value = (st->group_value >> n->shift) & bit_mask(n->bits);
-    proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, n->length, encoding_of(n));
-    if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
-    store(st, n, value, *offset, n->length);
+    /* No tree (e.g. tshark's summary lines): only values later nodes read are
+     * wanted. proto_tree_add_item() would check the length and return NULL. */
+    if (tree) {
+        proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, n->length, encoding_of(n));
+        if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+    }
+    if (n->slot >= 0) store(st, n, (st->group_value >> n->shift) & bit_mask(n->bits), *offset, n->length);
     if (n->flags & DG_GROUP_LAST) *offset += n->length;
 }
 
@@ -209,7 +265,7 @@ void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
     gint left = end - *offset;
     if (length > left) {
         /* Show the bytes that are there, then say what is missing. */
-        if (!(n->flags & DG_NUMERIC) && left > 0) {
+        if (!(n->flags & DG_NUMERIC) && left > 0 && tree) {
             proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, left, ENC_NA);
             if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
         }
@@ -225,10 +281,12 @@ void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
     gint len = (gint)length;
     guint64 value = 0;
     proto_item *item = NULL;
+    /* The value is read only when a later node needs it (store() keeps it),
+     * the item added only when there is a tree. */
     if (n->flags & DG_NUMERIC) {
-        value = read_uint(st->tvb, *offset, (guint)len, encoding_of(n));
-        item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, encoding_of(n));
-    } else if (len > 0) {
+        if (n->slot >= 0) value = read_uint(st->tvb, *offset, (guint)len, encoding_of(n));
+        if (tree) item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, encoding_of(n));
+    } else if (len > 0 && tree) {
         item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, ENC_NA);
     }
     if (item && (n->flags & DG_HIDDEN)) proto_item_set_hidden(item);
@@ -253,10 +311,12 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     gint inner_end = (length >= 0 && !past_end) ? start + (gint)length : end;
 
     proto_item *item = NULL;
-    proto_tree *subtree;
+    proto_tree *subtree = NULL;
     /* Length 0 now, the real length once the children are decoded: a length
      * of -1 would throw when the container starts at the end of the packet. */
-    if (n->hf) {
+    if (!tree) {
+        /* nothing to add to */
+    } else if (n->hf) {
         item = proto_tree_add_item(tree, *n->hf, st->tvb, start, 0, ENC_NA);
         subtree = proto_item_add_subtree(item, *n->ett);
     } else {
@@ -272,18 +332,27 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     dissect_list(st, n->first_child, n->child_count, subtree, offset, inner_end,
                  in_summary || n->summary_count > 0);
     st->stopped = st->stopped || was_stopped;
+    if (!st->stopped && length >= 0 && *offset < inner_end &&
+        (n->length_kind == DG_LEN_FIXED || n->length_kind == DG_LEN_FIELD)) {
+        /* The length says more than the fields hold: say so, then skip to the end. */
+        proto_tree_add_expert_format(subtree, st->pinfo, &st->p->ei->unused, st->tvb, *offset, inner_end - *offset,
+                                     "'%s' is %" G_GINT64_MODIFIER "d bytes, but its fields end after %d: "
+                                     "%d bytes are not decoded",
+                                     n->name, length, *offset - start, inner_end - *offset);
+    }
     if (!st->stopped && length >= 0) *offset = inner_end;
     proto_item_set_len(item, *offset - start);
 
     if (n->summary_count > 0 && st->want_text) {
         const char *text = summary_text(st, n);
-        proto_item_append_text(item, ": %s", text);
-        if (!in_summary) {
+        gsize text_len = wmem_strbuf_get_len(st->text);
+        if (item) proto_item_append_text(item, ": %s", text);
+        if (!in_summary && st->want_info) {
             if (sink) {
-                if (sink->count++) wmem_strbuf_append(sink->text, ", ");
-                wmem_strbuf_append(sink->text, text);
+                if (sink->count++) wmem_strbuf_append_len(sink->text, ", ", 2);
+                wmem_strbuf_append_len(sink->text, text, text_len);
             } else {
-                info_append(st, text);
+                info_append(st, text, text_len);
             }
         }
     }
@@ -310,7 +379,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     gint64 wanted = -1;
     if (n->count.slot >= 0 && !ref_value(st, &n->count, n, "count", tree, *offset, &wanted)) return;
     dg_summaries summaries = {NULL, 0};
-    gboolean collect = !in_summary && n->summary_count > 0 && st->want_text;
+    gboolean collect = !in_summary && n->summary_count > 0 && st->want_info;
     if (collect) summaries.text = wmem_strbuf_new(st->pinfo->pool, "");
 
     for (gint64 done = 0; wanted < 0 || done < wanted; done++) {
@@ -337,11 +406,17 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
             }
         }
     }
-    if (collect && summaries.count > 1)
-        info_append(st, wmem_strdup_printf(st->pinfo->pool, "%s \xc3\x97%u: %s", n->name, summaries.count,
-                                           wmem_strbuf_get_str(summaries.text)));
-    else if (collect && summaries.count == 1)
-        info_append(st, wmem_strbuf_get_str(summaries.text));
+    if (collect && summaries.count > 1) {
+        /* "NAME ×COUNT: SUMMARY, SUMMARY, ..." */
+        if (wmem_strbuf_get_len(st->info) > 0) wmem_strbuf_append_len(st->info, ", ", 2);
+        append_str(st->info, n->name);
+        wmem_strbuf_append_len(st->info, " \xc3\x97", 3);
+        append_dec(st->info, summaries.count);
+        wmem_strbuf_append_len(st->info, ": ", 2);
+        wmem_strbuf_append_len(st->info, wmem_strbuf_get_str(summaries.text), wmem_strbuf_get_len(summaries.text));
+    } else if (collect && summaries.count == 1) {
+        info_append(st, wmem_strbuf_get_str(summaries.text), wmem_strbuf_get_len(summaries.text));
+    }
 }
 
 void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
@@ -458,8 +533,14 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     st.pinfo = pinfo;
     st.slots = wmem_alloc0_array(pinfo->pool, dg_slot, p->slot_count ? p->slot_count : 1);
     st.packet_end = (gint)tvb_captured_length(tvb);
-    st.want_text = tree != NULL || pinfo->cinfo != NULL;
-    st.info = wmem_strbuf_new(pinfo->pool, "");
+    /* Summaries are text for the Info column and for container items; build
+     * them only when someone sees them: tshark -T fields and -V have a visible
+     * tree and no columns, summary lines have columns and no tree, and a
+     * filter-only pass (-Y with -w) has neither. */
+    st.want_info = pinfo->cinfo != NULL;
+    st.want_text = st.want_info || (tree != NULL && PTREE_DATA(tree)->visible);
+    st.info = st.want_info ? wmem_strbuf_new(pinfo->pool, "") : NULL;
+    st.text = st.want_text ? wmem_strbuf_new(pinfo->pool, "") : NULL;
 
     proto_item *root = proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA);
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
@@ -467,7 +548,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
     proto_item_set_len(root, offset);
 
-    if (wmem_strbuf_get_len(st.info) > 0)
+    if (st.info && wmem_strbuf_get_len(st.info) > 0)
         col_add_str(pinfo->cinfo, COL_INFO, wmem_strbuf_get_str(st.info));
     else
         col_set_str(pinfo->cinfo, COL_INFO, p->name);

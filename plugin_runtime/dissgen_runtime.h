@@ -76,6 +76,7 @@ typedef struct dg_experts {
     expert_field more_no_data; /* repeat flag set, but no data left */
     expert_field count_short;  /* count says more instances than the data holds */
     expert_field bad_length;   /* negative or missing length / count */
+    expert_field unused;       /* a known-length container's fields end before it does */
 } dg_experts;
 
 typedef struct dg_hook {

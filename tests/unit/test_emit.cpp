@@ -1,0 +1,266 @@
+// Stage 3 (generator/emit_cpp.cpp): how fields are registered with Wireshark
+// (field_type), value strings, hooks, and the `dissgen fields` listing.
+#include <gtest/gtest.h>
+
+#include <set>
+#include <sstream>
+
+#include "emit_cpp.h"
+#include "test_support.h"
+
+namespace dissgen::testing {
+namespace {
+
+std::string rules(const std::string& body, const std::string& root_attrs = "ethertype=\"0x88b5\"") {
+    return "<root name=\"Test\" abbreviation=\"TST\" " + root_attrs + ">\n" + body + "</root>\n";
+}
+
+const Node* find(const Protocol& proto, const std::string& name) {
+    const Node* found = nullptr;
+    for_each_node(proto.nodes, [&](const Node& n) {
+        if (!found && n.name == name) found = &n;
+    });
+    return found;
+}
+
+void expect_type(const Protocol& proto, const std::string& name, const std::string& type, const std::string& display,
+                 uint64_t mask = 0) {
+    const Node* n = find(proto, name);
+    ASSERT_NE(n, nullptr) << name;
+    FieldType t = field_type(*n);
+    EXPECT_EQ(t.type, type) << name;
+    EXPECT_EQ(t.display, display) << name;
+    EXPECT_EQ(t.mask, mask) << name << std::hex << ": 0x" << t.mask;
+}
+
+TEST(FieldType, EveryDisplayTypeOnWholeBytes) {
+    Front f = front_end(rules("  <node name=\"mac\" length=\"6byte\" displaytype=\"address\"/>\n"
+                              "  <node name=\"ip\" length=\"4byte\" displaytype=\"address\"/>\n"
+                              "  <node name=\"raw\" length=\"4byte\" displaytype=\"origin\"/>\n"
+                              "  <node name=\"default\" length=\"2byte\"/>\n"
+                              "  <node name=\"h8\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"h16\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"d24\" length=\"3byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"d32\" length=\"32bit\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"d40\" length=\"5byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"h64\" length=\"8byte\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"flag\" length=\"1byte\" displaytype=\"bool\"/>\n"
+                              "  <node name=\"flag32\" length=\"4byte\" displaytype=\"bool\"/>\n"
+                              "  <node name=\"e8\" length=\"1byte\" displaytype=\"enum\"/>\n"
+                              "  <node name=\"e32\" length=\"4byte\" displaytype=\"enum\"/>\n"
+                              "  <node name=\"hidden\" length=\"2byte\" displaytype=\"nondisplay\"/>\n"
+                              "  <node name=\"hidden blob\" length=\"12byte\" displaytype=\"nondisplay\"/>\n"
+                              "  <node name=\"var\" length=\"../node[@name='h8']\"/>\n"
+                              "  <node name=\"tail\" length=\"rest\" displaytype=\"address\"/>\n"
+                              "  <node name=\"box\"><node name=\"x\" length=\"1byte\"/></node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Protocol& p = *f.proto;
+    expect_type(p, "mac", "FT_BYTES", "SEP_COLON");
+    expect_type(p, "ip", "FT_BYTES", "SEP_COLON");
+    expect_type(p, "raw", "FT_BYTES", "SEP_SPACE");
+    expect_type(p, "default", "FT_BYTES", "SEP_SPACE");
+    expect_type(p, "h8", "FT_UINT8", "BASE_HEX");
+    expect_type(p, "h16", "FT_UINT16", "BASE_HEX");
+    expect_type(p, "d24", "FT_UINT24", "BASE_DEC");
+    expect_type(p, "d32", "FT_UINT32", "BASE_DEC");
+    expect_type(p, "d40", "FT_UINT40", "BASE_DEC");
+    expect_type(p, "h64", "FT_UINT64", "BASE_HEX");
+    expect_type(p, "flag", "FT_BOOLEAN", "BASE_NONE");
+    expect_type(p, "flag32", "FT_BOOLEAN", "BASE_NONE");
+    expect_type(p, "e8", "FT_UINT8", "BASE_HEX");
+    expect_type(p, "e32", "FT_UINT32", "BASE_HEX");
+    expect_type(p, "hidden", "FT_UINT16", "BASE_DEC");
+    expect_type(p, "hidden blob", "FT_BYTES", "BASE_NONE");
+    expect_type(p, "var", "FT_BYTES", "SEP_SPACE");
+    expect_type(p, "tail", "FT_BYTES", "SEP_COLON");
+    expect_type(p, "box", "FT_NONE", "BASE_NONE");
+}
+
+TEST(FieldType, EnumsOfFiveToEightBytesUseVal64) {
+    Front f = front_end(rules("  <node name=\"e40\" length=\"5byte\" displaytype=\"enum\"><enum value=\"0xffffffffff\" name=\"max\"/></node>\n"
+                              "  <node name=\"e48\" length=\"6byte\" displaytype=\"enum\"/>\n"
+                              "  <node name=\"e56\" length=\"7byte\" displaytype=\"enum\"/>\n"
+                              "  <node name=\"e64\" length=\"64bit\" displaytype=\"enum\"><enum value=\"0xffffffffffffffff\" name=\"all\"/></node>\n"
+                              "  <node name=\"e32\" length=\"4byte\" displaytype=\"enum\"><enum value=\"7\" name=\"seven\"/></node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Protocol& p = *f.proto;
+    expect_type(p, "e40", "FT_UINT40", "BASE_HEX|BASE_VAL64_STRING");
+    expect_type(p, "e48", "FT_UINT48", "BASE_HEX|BASE_VAL64_STRING");
+    expect_type(p, "e56", "FT_UINT56", "BASE_HEX|BASE_VAL64_STRING");
+    expect_type(p, "e64", "FT_UINT64", "BASE_HEX|BASE_VAL64_STRING");
+    expect_type(p, "e32", "FT_UINT32", "BASE_HEX");
+
+    std::string code = emit_cpp(p, "t.xml");
+    EXPECT_NE(code.find("static const val64_string tst_e40_vals[] = {\n    { 0xffffffffff, \"max\" },"), std::string::npos) << code;
+    EXPECT_NE(code.find("static const val64_string tst_e64_vals[] = {\n    { 0xffffffffffffffff, \"all\" },"), std::string::npos) << code;
+    EXPECT_NE(code.find("static const value_string tst_e32_vals[] = {\n    { 0x00000007, \"seven\" },"), std::string::npos) << code;
+    EXPECT_NE(code.find("VALS64(tst_e40_vals)"), std::string::npos);
+    EXPECT_NE(code.find("VALS64(tst_e64_vals)"), std::string::npos);
+    EXPECT_NE(code.find("VALS(tst_e32_vals)"), std::string::npos);
+    EXPECT_EQ(code.find("VALS(tst_e64_vals)"), std::string::npos);
+}
+
+TEST(FieldType, EtherCatLittleEndianWordMasks) {
+    Front f = front_end(read_file(source_path("rules/ethercat.xml")));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Node* datagram = find(*f.proto, "Datagram");
+    ASSERT_NE(datagram, nullptr);
+    std::map<std::string, FieldType> types;
+    for (const auto& c : datagram->children) types[c->name] = field_type(*c);
+    EXPECT_EQ(types["Length"].type, "FT_UINT16");
+    EXPECT_EQ(types["Length"].display, "BASE_DEC");
+    EXPECT_EQ(types["Length"].mask, 0x07ffu);
+    EXPECT_EQ(types["Reserved"].type, "FT_UINT16");
+    EXPECT_EQ(types["Reserved"].mask, 0x3800u);
+    EXPECT_EQ(types["Circulating"].type, "FT_BOOLEAN");
+    EXPECT_EQ(types["Circulating"].display, "16");  // the group's width
+    EXPECT_EQ(types["Circulating"].mask, 0x4000u);
+    EXPECT_EQ(types["More"].type, "FT_BOOLEAN");
+    EXPECT_EQ(types["More"].display, "16");
+    EXPECT_EQ(types["More"].mask, 0x8000u);
+    EXPECT_EQ(types["Command"].type, "FT_UINT8");
+    EXPECT_EQ(types["Command"].mask, 0u);
+    EXPECT_EQ(types["Interrupt"].type, "FT_UINT16");
+    EXPECT_EQ(types["Interrupt"].mask, 0u);
+    // frame header: length 11, reserved 1, type 4 (an enum in a 16-bit group)
+    const Node* header = f.proto->nodes[0].get();
+    EXPECT_EQ(field_type(*header->children[0]).mask, 0x07ffu);
+    EXPECT_EQ(field_type(*header->children[1]).mask, 0x0800u);
+    FieldType type = field_type(*header->children[2]);
+    EXPECT_EQ(type.type, "FT_UINT16");
+    EXPECT_EQ(type.display, "BASE_HEX");
+    EXPECT_EQ(type.mask, 0xf000u);
+}
+
+TEST(FieldType, BigEndianGroupMasks) {
+    Front f = front_end(rules("  <node name=\"Version\" length=\"4bit\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"IHL\" length=\"4bit\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"Flags\" length=\"3bit\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"Offset\" length=\"13bit\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"M\" length=\"1bit\" displaytype=\"bool\"/>\n"
+                              "  <node name=\"Kind\" length=\"2bit\" displaytype=\"enum\"/>\n"
+                              "  <node name=\"Value\" length=\"21bit\" displaytype=\"nondisplay\"/>\n"
+                              "  <node name=\"Top\" length=\"1bit\" displaytype=\"bool\"/>\n"
+                              "  <node name=\"Low\" length=\"63bit\" displaytype=\"numberhex\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Protocol& p = *f.proto;
+    expect_type(p, "Version", "FT_UINT8", "BASE_DEC", 0xf0);
+    expect_type(p, "IHL", "FT_UINT8", "BASE_DEC", 0x0f);
+    expect_type(p, "Flags", "FT_UINT16", "BASE_HEX", 0xe000);
+    expect_type(p, "Offset", "FT_UINT16", "BASE_DEC", 0x1fff);
+    expect_type(p, "M", "FT_BOOLEAN", "24", 0x800000);
+    expect_type(p, "Kind", "FT_UINT24", "BASE_HEX", 0x600000);
+    expect_type(p, "Value", "FT_UINT24", "BASE_DEC", 0x1fffff);
+    expect_type(p, "Top", "FT_BOOLEAN", "64", 0x8000000000000000ull);
+    expect_type(p, "Low", "FT_UINT64", "BASE_HEX", 0x7fffffffffffffffull);
+}
+
+TEST(FieldType, LittleEndianGroupsOfThreeAndFiveBytes) {
+    Front f = front_end(rules("  <node name=\"a\" length=\"20bit\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"b\" length=\"4bit\" displaytype=\"enum\"/>\n"
+                              "  <node name=\"c\" length=\"4bit\" displaytype=\"enum\"/>\n"
+                              "  <node name=\"d\" length=\"36bit\" displaytype=\"numberdec\"/>\n",
+                              "ethertype=\"1\" byteorder=\"little\""));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Protocol& p = *f.proto;
+    expect_type(p, "a", "FT_UINT24", "BASE_HEX", 0x0fffff);
+    expect_type(p, "b", "FT_UINT24", "BASE_HEX", 0xf00000);
+    // a 4-bit enum inside a 5-byte group is registered as a 40-bit field
+    expect_type(p, "c", "FT_UINT40", "BASE_HEX|BASE_VAL64_STRING", 0x0f);
+    expect_type(p, "d", "FT_UINT40", "BASE_DEC", 0xfffffffff0ull);
+}
+
+TEST(Emit, HooksWithoutEthertype) {
+    Front f = front_end("<root name=\"Hooked\" abbreviation=\"HK\">\n"
+                        "  <hook table=\"udp.port\" value=\"34980\"/>\n"
+                        "  <hook table=\"tcp.port\" value=\"0x10\"/>\n"
+                        "  <node name=\"a\" length=\"1byte\"/>\n"
+                        "</root>\n");
+    ASSERT_TRUE(f.ok()) << f.messages();
+    std::string code = emit_cpp(*f.proto, "hooked.xml");
+    EXPECT_NE(code.find("static const dg_hook hk_hooks[] = {\n    { \"udp.port\", 34980 },\n    { \"tcp.port\", 16 }\n};"),
+              std::string::npos)
+        << code;
+    EXPECT_EQ(code.find("\"ethertype\""), std::string::npos);
+
+    Front e = front_end(rules("  <hook table=\"udp.port\" value=\"1\"/>\n  <node name=\"a\" length=\"1byte\"/>\n"));
+    ASSERT_TRUE(e.ok()) << e.messages();
+    EXPECT_NE(emit_cpp(*e.proto, "t.xml").find("static const dg_hook tst_hooks[] = {\n    { \"ethertype\", 0x88b5 },\n"
+                                               "    { \"udp.port\", 1 }\n};"),
+              std::string::npos);
+}
+
+TEST(Emit, NamesAreCStrings) {
+    Front f = front_end(rules("  <node name=\"say &quot;hi&quot; \\ 数据\" filter=\"say\" length=\"1byte\" "
+                              "description=\"tab&#9;here\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_NE(code.find("\"say \\\"hi\\\" \\\\ 数据\""), std::string::npos) << code;
+    EXPECT_NE(code.find("\"tab\\011here\""), std::string::npos) << code;
+}
+
+TEST(Emit, FieldsWithoutFilterNameHaveNoHf) {
+    Front f = front_end(rules("  <node name=\"Wrap\" filter=\"\"><node name=\"x\" length=\"1byte\"/></node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_NE(code.find("{ \"Wrap\", NULL, &ett_"), std::string::npos) << code;
+    EXPECT_NE(code.find("\"tst.x\""), std::string::npos);
+    EXPECT_EQ(code.find("\"tst.wrap\""), std::string::npos);
+}
+
+// Known bug in emit_cpp.cpp make_layout(): when an identifier is taken, the
+// "_<doc_index>" fallback is not checked for uniqueness, so two C variables
+// get the same name and the plugin does not compile. Enable once fixed.
+TEST(Emit, IdentifiersStayUniqueWhenTheFallbackIsTaken) {
+    Front f = front_end(rules("  <node name=\"a b 3\" filter=\"\"><node name=\"a b\" length=\"1byte\"/></node>\n"
+                              "  <node name=\"a b\" filter=\"\"><node name=\"c\" length=\"1byte\"/></node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    std::istringstream code(emit_cpp(*f.proto, "t.xml"));
+    std::set<std::string> declared;
+    std::string line;
+    while (std::getline(code, line))
+        if (line.rfind("static gint ett_", 0) == 0 || line.rfind("static int hf_", 0) == 0)
+            EXPECT_TRUE(declared.insert(line).second) << "declared twice: " << line;
+}
+
+TEST(ListFields, OneLinePerFieldInDocumentOrder) {
+    Front f = front_end("<root name=\"My Proto\" abbreviation=\"MYP\" ethertype=\"1\" byteorder=\"little\">\n"
+                        "  <node name=\"Header\" length=\"2byte\">\n"
+                        "    <node name=\"Length\" length=\"11bit\" displaytype=\"numberdec\"/>\n"
+                        "    <node name=\"More\" length=\"5bit\" displaytype=\"bool\"/>\n"
+                        "  </node>\n"
+                        "  <node name=\"Body\" filter=\"\">\n"
+                        "    <node name=\"MAC\" length=\"6byte\" displaytype=\"address\"/>\n"
+                        "    <node name=\"命令\" length=\"1byte\" displaytype=\"enum\"/>\n"
+                        "    <node name=\"Data\" length=\"rest\"/>\n"
+                        "  </node>\n"
+                        "</root>\n");
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_EQ(list_fields(*f.proto),
+              "myp\tFT_PROTOCOL\tMy Proto\n"
+              "myp.header\tFT_NONE\tHeader\n"
+              "myp.header.length\tFT_UINT16\tLength\n"
+              "myp.header.more\tFT_BOOLEAN\tMore\n"
+              "myp.mac\tFT_BYTES\tMAC\n"
+              "myp.f6\tFT_UINT8\t命令\n"
+              "myp.data\tFT_BYTES\tData\n");
+}
+
+TEST(ListFields, ShippedEthercat) {
+    Front f = front_end(read_file(source_path("rules/ethercat.xml")));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    std::string fields = list_fields(*f.proto);
+    EXPECT_EQ(fields.rfind("ecatr\tFT_PROTOCOL\tEtherCAT\n", 0), 0u) << fields;
+    for (const char* line : {"ecatr.header\tFT_NONE\tHeader\n", "ecatr.header.length\tFT_UINT16\tLength\n",
+                             "ecatr.header.type\tFT_UINT16\tType\n", "ecatr.datagram\tFT_NONE\tDatagram\n",
+                             "ecatr.datagram.cmd\tFT_UINT8\tCommand\n", "ecatr.datagram.adp\tFT_UINT16\tSlave address (ADP)\n",
+                             "ecatr.datagram.lad\tFT_UINT32\tLogical address\n", "ecatr.datagram.len\tFT_UINT16\tLength\n",
+                             "ecatr.datagram.more\tFT_BOOLEAN\tMore\n", "ecatr.datagram.data\tFT_BYTES\tData\n",
+                             "ecatr.payload\tFT_BYTES\tPayload\n"})
+        EXPECT_NE(fields.find(line), std::string::npos) << line << "\nin:\n" << fields;
+    EXPECT_EQ(fields.find("ecatr.datagrams"), std::string::npos);  // filter=""
+    EXPECT_EQ(fields.find("ecatr.datagram.address\t"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace dissgen::testing
