@@ -10,10 +10,60 @@
 #include <epan/dissectors/packet-tcp.h>
 #include <wsutil/report_message.h>
 
-#if WIRESHARK_VERSION_MAJOR > 4 || (WIRESHARK_VERSION_MAJOR == 4 && WIRESHARK_VERSION_MINOR >= 4)
-#define DG_HAVE_PLUGIN_DESCRIBE 1
+/* True when the headers compiled against are Wireshark MAJOR.MINOR or later.
+ * ws_version.h belongs to the headers, so a plugin's plugin_want_major/minor
+ * (below) are those of the libwireshark-dev it was built with. */
+#define DG_WS_AT_LEAST(major, minor)                                                  \
+    (WIRESHARK_VERSION_MAJOR > (major) ||                                            \
+     (WIRESHARK_VERSION_MAJOR == (major) && WIRESHARK_VERSION_MINOR >= (minor)))
+
+/* 4.4 installs wsutil/plugins.h (absent in 4.0) with the plugin description
+ * flags; its loader calls an optional plugin_describe(). */
+#if DG_WS_AT_LEAST(4, 4)
 #include <wsutil/plugins.h>
 #endif
+#ifdef WS_PLUGIN_DESC_DISSECTOR
+#define DG_HAVE_PLUGIN_DESCRIBE 1
+#endif
+
+/* Integer reads. 4.4 renamed tvb_get_guintN to tvb_get_uintN and deprecated
+ * the old names (an error with -Werror); 4.0 has only the old ones. */
+#if DG_WS_AT_LEAST(4, 4)
+#define dg_tvb_get_uint8 tvb_get_uint8
+#define dg_tvb_get_uint16 tvb_get_uint16
+#define dg_tvb_get_uint24 tvb_get_uint24
+#define dg_tvb_get_uint32 tvb_get_uint32
+#define dg_tvb_get_uint40 tvb_get_uint40
+#define dg_tvb_get_uint48 tvb_get_uint48
+#define dg_tvb_get_uint56 tvb_get_uint56
+#define dg_tvb_get_uint64 tvb_get_uint64
+#else
+#define dg_tvb_get_uint8 tvb_get_guint8
+#define dg_tvb_get_uint16 tvb_get_guint16
+#define dg_tvb_get_uint24 tvb_get_guint24
+#define dg_tvb_get_uint32 tvb_get_guint32
+#define dg_tvb_get_uint40 tvb_get_guint40
+#define dg_tvb_get_uint48 tvb_get_guint48
+#define dg_tvb_get_uint56 tvb_get_guint56
+#define dg_tvb_get_uint64 tvb_get_guint64
+#endif
+
+/* Differences that need no code here, checked against 4.0, 4.4 and 4.6
+ * (tests/multiversion/compile_all.sh):
+ * - EI_INIT is {-1,-1} before 4.6 and {0,0} from 4.6: generated code leaves
+ *   its expert_field ids zero-initialised (static storage), which every
+ *   version's expert_register_field_array() accepts, and uses them only
+ *   after registering them.
+ * - ett_ ids must start at -1 before 4.4 (0 is also accepted later):
+ *   generated code initialises them to -1.
+ * - value_string.h moved from epan/ to wsutil/ in 4.6: only epan/packet.h is
+ *   included, which includes it from wherever it lives.
+ * - gboolean/guint/gint parameters became bool/unsigned/int in 4.4 (the glib
+ *   types are not deprecated): guint and unsigned are the same type, so
+ *   callbacks (tcp_dissect_pdus' length function) match both, and TRUE
+ *   converts to bool.
+ * - proto_name_already_registered() returns int in 4.0, bool later: only
+ *   tested for truth. */
 
 /* The plugin loader's entry points. In C++ a namespace-scope const has
  * internal linkage, so the data symbols are declared extern (inside an
@@ -33,6 +83,16 @@
 #define DG_END_C
 #endif
 
+/* 4.4+: tell the loader this plugin is a dissector (shown by tshark -G plugins
+ * and Wireshark's About dialog). */
+#ifdef DG_HAVE_PLUGIN_DESCRIBE
+#define DG_DEFINE_PLUGIN_DESCRIBE                                                    \
+    WS_DLL_PUBLIC uint32_t plugin_describe(void);                                    \
+    uint32_t plugin_describe(void) { return WS_PLUGIN_DESC_DISSECTOR; }
+#else
+#define DG_DEFINE_PLUGIN_DESCRIBE
+#endif
+
 #define DG_DECLARE_PLUGIN(register_fn, handoff_fn)                                   \
     static void dg_register_nothing_yet(void) {}                                     \
     static void dg_register_then_handoff(void)                                       \
@@ -45,6 +105,7 @@
     WS_DLL_PUBLIC_DEF extern const int plugin_want_major;                            \
     WS_DLL_PUBLIC_DEF extern const int plugin_want_minor;                            \
     WS_DLL_PUBLIC void plugin_register(void);                                        \
+    DG_DEFINE_PLUGIN_DESCRIBE                                                        \
     const char plugin_version[] = "1.0";                                             \
     const int plugin_want_major = WIRESHARK_VERSION_MAJOR;                           \
     const int plugin_want_minor = WIRESHARK_VERSION_MINOR;                           \
