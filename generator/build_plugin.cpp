@@ -82,6 +82,9 @@ std::string build_and_install(const BuildRequest& req, std::string& installed_pa
     std::vector<std::string> cmd = {cxx && *cxx ? cxx : "c++", "-std=c++17", "-O2", "-fPIC", "-shared",
                                     "-DWS_BUILD_DLL", "-Werror=attributes", "-I" + req.runtime_dir};
     for (const std::string& w : split_words(cflags)) cmd.push_back(w);
+    // Extra flags, e.g. -fsanitize=address,undefined for the sanitizer test runs.
+    if (const char* extra = std::getenv("DISSGEN_CXXFLAGS"))
+        for (const std::string& w : split_words(extra)) cmd.push_back(w);
     cmd.push_back(source.string());
     cmd.push_back(req.runtime_dir + "/dissgen_runtime.cpp");
     cmd.push_back("-o");

@@ -3,7 +3,7 @@
 # are missing. Uses sudo when not root.
 set -euo pipefail
 packages=(cmake g++ make pkg-config libwireshark-dev tshark libglib2.0-dev libxml2-dev
-          libgtest-dev python3 util-linux)
+          libgtest-dev python3 util-linux clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,0 +1,908 @@
+#!/usr/bin/env python3
+"""Differential test: dissgen's EtherCAT plugin (ecatr) against Wireshark's own plugin
+(ecatf/ecat) and against the bytes' ground truth.  Python 3 stdlib only.
+
+  ecat_differential.py --dissgen build/bin/dissgen --source-dir . [--frames 3000] [--seed 1]
+  ecat_differential.py --dissgen build/bin/dissgen --source-dir . --corpus /work/shared/corpus/ethercat
+
+Generated mode writes N varied frames (pcapgen.py) in one capture; corpus mode reads every
+*.pcap/*.pcapng of DIR in place (exit 77 with "SKIPPED: ..." when DIR is missing).  Each
+capture is decoded by tshark twice, once per side, in a throw-away HOME holding our plugin:
+  ours:      tshark -r CAP -T fields -E occurrence=a -E aggregator=, -e ecatr.* ...
+  Wireshark: tshark -r CAP -T json -J "ecatf ecat" -d ethertype==0x88a4,ecatf -d udp.port==34980,ecatf
+and every field is compared frame by frame, datagram by datagram, with:
+  truth  the ecatr contract applied to the captured bytes (pcapgen.decode_ecat; for generated
+         frames also checked against the values the generator wrote)
+  model  what Wireshark's plugin is known to show for those bytes (ws_model below): it ignores
+         the header's Length, so with M=1 on the last datagram it reads the padding as one more
+         datagram; it drops a datagram that is cut short (no partial tree) and the whole tree
+         when a datagram header or a lone datagram is cut; it shows no Data for zero-length
+         datagrams and where it decodes ESC registers (register space, incl. reads with WKC 0
+         where it shows nothing) or DC receive times, only the bytes after a mailbox header
+         for mailbox datagrams, and nothing more of a frame once its mailbox sub-dissector throws.
+A value where ours and Wireshark differ is "explained" only when ours equals the truth and
+Wireshark equals the model; ours must equal the truth everywhere.  A frame fails on any
+unexplained difference or any difference from the truth.  Last line: "N passed, M failed".
+"""
+
+import argparse
+import glob
+import json
+import os
+import re
+import struct
+import subprocess
+import sys
+import time
+from collections import OrderedDict, defaultdict
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+sys.dont_write_bytecode = True      # no __pycache__ in the source tree
+import pcapgen  # noqa: E402
+from pcapgen import Partial, is_logical  # noqa: E402
+import tshark_env  # noqa: E402
+
+SKIP_CODE = 77
+
+# key, scope, ours field, Wireshark field, kind
+FIELDS = [
+    ("length", "header", "ecatr.header.length", "ecatf.length", "int"),
+    ("reserved", "header", "ecatr.header.reserved", "ecatf.reserved", "int"),
+    ("type", "header", "ecatr.header.type", "ecatf.type", "int"),
+    ("cmd", "dg", "ecatr.datagram.cmd", "ecat.cmd", "int"),
+    ("idx", "dg", "ecatr.datagram.idx", "ecat.idx", "int"),
+    ("adp", "dg", "ecatr.datagram.adp", "ecat.adp", "int"),
+    ("ado", "dg", "ecatr.datagram.ado", "ecat.ado", "int"),
+    ("lad", "dg", "ecatr.datagram.lad", "ecat.lad", "int"),
+    ("len", "dg", "ecatr.datagram.len", "ecat.subframe.length", "int"),
+    ("reserved", "dg", "ecatr.datagram.reserved", "ecat.subframe.reserved", "int"),
+    ("circulating", "dg", "ecatr.datagram.circulating", "ecat.subframe.circulating", "bool"),
+    ("more", "dg", "ecatr.datagram.more", "ecat.subframe.more", "bool"),
+    ("irq", "dg", "ecatr.datagram.irq", "ecat.int", "int"),
+    ("data", "dg", "ecatr.datagram.data", "ecat.data", "bytes"),
+    ("wkc", "dg", "ecatr.datagram.wkc", "ecat.cnt", "int"),
+]
+HEADER_KEYS = [f[0] for f in FIELDS if f[1] == "header"]
+DG_KEYS = [f[0] for f in FIELDS if f[1] == "dg"]
+KIND = {(f[1], f[0]): f[4] for f in FIELDS}
+WS_DG_FIELD = {f[3]: f[0] for f in FIELDS if f[1] == "dg"}
+WS_HDR_FIELD = {f[3]: f[0] for f in FIELDS if f[1] == "header"}
+# Fields that only exist for some commands (the others are one per datagram).
+ONLY_FOR = {"adp": lambda c: not is_logical(c), "ado": lambda c: not is_logical(c),
+            "lad": is_logical}
+
+WS_DECODE_AS = ["-d", "ethertype==0x88a4,ecatf", "-d", "udp.port==34980,ecatf"]
+
+
+class _Missing:
+    def __repr__(self):
+        return "-"
+
+
+MISSING = _Missing()
+
+
+# --------------------------------------------------------------------------- value parsing
+
+class ReprError(ValueError):
+    pass
+
+
+_INT_RE = re.compile(r"0[xX][0-9a-fA-F]+|[0-9]+")
+_HEX2 = re.compile(r"[0-9a-fA-F]{2}")
+_BOOLS = {"1": True, "True": True, "true": True, "TRUE": True,
+          "0": False, "False": False, "false": False, "FALSE": False}
+
+
+def parse_value(kind, s):
+    """tshark text -> Python value; representation differences are normalised here and only
+    here ("0x0010" == "16", "1" == "True", "01:02" == "01 02" == "0102", "<MISSING>" == b"");
+    anything else is an error."""
+    s = s.strip()
+    if kind == "int":
+        if not _INT_RE.fullmatch(s):
+            raise ReprError("not an integer: %r" % s)
+        return int(s, 16) if s[:2] in ("0x", "0X") else int(s)
+    if kind == "bool":
+        try:
+            return _BOOLS[s]
+        except KeyError:
+            raise ReprError("not a boolean: %r" % s) from None
+    if kind == "bytes":
+        if s == "<MISSING>":        # how tshark -T fields prints a zero-length FT_BYTES item
+            return b""
+        # hex pairs, either run together or all separated by one of ':' ' ' '-' '.'
+        for sep in ":- .":
+            if sep in s:
+                parts = s.split(sep)
+                break
+        else:
+            parts = [s[k:k + 2] for k in range(0, len(s), 2)]
+        if s and not all(len(p) == 2 and _HEX2.fullmatch(p) for p in parts):
+            raise ReprError("not bytes: %r" % (s if len(s) < 80 else s[:80] + "..."))
+        return bytes.fromhex("".join(parts))
+    raise AssertionError(kind)
+
+
+def shown(v):
+    if v is MISSING:
+        return "(absent)"
+    if isinstance(v, Partial):
+        return "(absent, or the %d bytes present: %s)" % (len(v.value), short_hex(v.value))
+    if isinstance(v, bytes):
+        return short_hex(v)
+    if isinstance(v, bool):
+        return str(v)
+    if isinstance(v, int):
+        return "%d (0x%x)" % (v, v)
+    if isinstance(v, ReprError):
+        return "unparsable %s" % v
+    return repr(v)
+
+
+def short_hex(b, limit=48):
+    h = b.hex()
+    if len(b) > limit:
+        return "%s...(%d bytes)" % (h[:limit * 2], len(b))
+    return h if h else "(empty)"
+
+
+# --------------------------------------------------------------------------- our side
+
+def ours_command(cap, fieldset):
+    # quote=d: a field that is there is printed in quotes, one that is not as nothing (a
+    # zero-length FT_BYTES item prints as <MISSING>).
+    args = ["-r", cap, "-T", "fields", "-E", "header=n", "-E", "separator=/t", "-E", "quote=d",
+            "-E", "occurrence=a", "-E", "aggregator=,", "-e", "frame.number"]
+    for f in FIELDS:
+        args += ["-e", f[2] if fieldset == "ecatr" else f[3]]
+    return args
+
+
+def parse_ours(text, expected_by_frame):
+    """-T fields lines -> {frame: {"header": {k: v}, "datagrams": [ {k: v} ], "problems": [..]}}.
+    Values of one field are given to the datagrams in order (adp/ado only to non-logical
+    commands, lad only to logical ones); surplus values are a problem of the frame."""
+    result = {}
+    for line in text.splitlines():
+        cols = line.split("\t")
+        if len(cols) != len(FIELDS) + 1:
+            raise RuntimeError("unexpected -T fields line: %r" % line[:200])
+        num = int(cols[0].strip('"'))
+        cols = cols[1:]
+        if not any(cols):
+            continue
+        exp = expected_by_frame.get(num)
+        rec = {"header": {}, "datagrams": [], "problems": []}
+        lists = {}
+        for (key, scope, _, _, kind), col in zip(FIELDS, cols):
+            if col == "":
+                raw = []
+            elif len(col) >= 2 and col[0] == col[-1] == '"':
+                raw = col[1:-1].split(",")
+            else:
+                raise RuntimeError("frame %d: unquoted -T fields value %r" % (num, col[:80]))
+            vals = []
+            for r in raw:
+                try:
+                    vals.append(parse_value(kind, r))
+                except ReprError as e:
+                    vals.append(e)
+            lists[(scope, key)] = vals
+        for key in HEADER_KEYS:
+            v = lists[("header", key)]
+            if len(v) > 1:
+                rec["problems"].append("%d values of header %s" % (len(v), key))
+            rec["header"][key] = v[0] if v else MISSING
+        cmds = lists[("dg", "cmd")]
+        rec["datagrams"] = [{"cmd": c} for c in cmds]
+        for key in DG_KEYS:
+            if key == "cmd":
+                continue
+            vals = lists[("dg", key)]
+            pred = ONLY_FOR.get(key, lambda c: True)
+            idx = [i for i, d in enumerate(rec["datagrams"])
+                   if not isinstance(d["cmd"], ReprError) and pred(d["cmd"])]
+            targets = [rec["datagrams"][i] for i in idx]
+            if key == "data":
+                # The contract: a zero-length Data field adds no item (as in Wireshark's plugin),
+                # so the values belong to the datagrams whose Length is not 0.
+                idx = [i for i in idx if rec["datagrams"][i].get("len") != 0]
+                targets = [rec["datagrams"][i] for i in idx]
+            for d, v in zip(targets, vals):
+                d[key] = v
+            if len(vals) > len(targets):
+                rec["problems"].append("%s: %d values for %d datagrams that can have it (%s)" %
+                                       (FIELDS_BY_KEY[key][2], len(vals), len(targets),
+                                        ",".join(shown(v) for v in vals[len(targets):])[:200]))
+        result[num] = rec
+    return result
+
+
+FIELDS_BY_KEY = {f[0]: f for f in FIELDS if f[1] == "dg"}
+
+# How tshark -T fields prints each ecatr field (used only by --simulate perfect).
+_FMT = {("header", "length"): "%d", ("header", "reserved"): "%d", ("header", "type"): "%d",
+        ("dg", "cmd"): "0x%02x", ("dg", "idx"): "0x%02x", ("dg", "adp"): "0x%04x", ("dg", "ado"): "0x%04x",
+        ("dg", "lad"): "0x%08x", ("dg", "len"): "%d", ("dg", "reserved"): "%d", ("dg", "irq"): "0x%04x",
+        ("dg", "wkc"): "%d"}
+
+
+def perfect_fields_text(expected, nframes):
+    """-T fields output of an ideal ecatr plugin (the truth; a cut data field left out)."""
+    lines = []
+    for num in range(1, nframes + 1):
+        e = expected.get(num)
+        cols = ['"%d"' % num]
+        for key, scope, _, _, kind in FIELDS:
+            if e is None or e["header"] is None:
+                vals = []
+            elif scope == "header":
+                vals = [e["header"][key]]
+            else:
+                vals = [d[key] for d in e["datagrams"] if key in d and not isinstance(d[key], Partial)]
+            out = []
+            for v in vals:
+                if kind == "bool":
+                    out.append("1" if v else "0")
+                elif kind == "bytes":
+                    out.append(v.hex() if v else "<MISSING>")
+                else:
+                    out.append(_FMT[(scope, key)] % v)
+            cols.append('"%s"' % ",".join(out) if out else "")
+        lines.append("\t".join(cols))
+    return "\n".join(lines) + "\n"
+
+
+# --------------------------------------------------------------------------- Wireshark side
+
+def ws_command(cap):
+    return ["-r", cap, "-T", "json", "-J", "ecatf ecat"] + WS_DECODE_AS
+
+
+class _Obj(list):
+    """A JSON object as its (key, value) pairs: tshark repeats keys (two datagrams with the
+    same summary text), which a dict would merge."""
+
+
+def _pairs(v):
+    return v if isinstance(v, _Obj) else None
+
+
+def parse_ws_json(path):
+    """tshark -T json -> [ {"header": {..}, "datagrams": [ {k: v} ], "malformed": bool} ] (one per
+    packet, in order).  Only the datagram subtree itself, its Header and the Length subtree are
+    read (no mailbox/EoE contents)."""
+    with open(path, "rb") as fh:
+        pkts = json.load(fh, object_pairs_hook=_Obj)
+    out = []
+    for pk in pkts:
+        src = dict(pk)["_source"]
+        layers = dict(src)["layers"]
+        rec = {"header": {}, "datagrams": [], "malformed": False, "has_ecat": False}
+        ecatf = ecat = None
+        for k, v in layers:
+            if k == "ecatf" and ecatf is None:
+                ecatf = v
+            elif k == "ecat" and ecat is None:
+                ecat = v
+            elif k.startswith("_ws.malformed") or k.startswith("_ws.short"):
+                rec["malformed"] = True
+        if ecatf is not None:
+            for k, v in ecatf:
+                if k in WS_HDR_FIELD:
+                    rec["header"][WS_HDR_FIELD[k]] = _parse_or_err("int", v)
+        if ecat is not None:
+            rec["has_ecat"] = True
+            for k, v in ecat:
+                if k.startswith("_ws.malformed") or k.startswith("_ws.short"):
+                    rec["malformed"] = True
+                sub = _pairs(v)
+                if sub is None or not k.startswith("EtherCAT datagram"):
+                    continue
+                d = {}
+                for k2, v2 in sub:
+                    if k2 == "Header" and _pairs(v2) is not None:
+                        for k3, v3 in v2:
+                            if k3.startswith("Length") and _pairs(v3) is not None:
+                                for k4, v4 in v3:
+                                    if k4 in WS_DG_FIELD:
+                                        key = WS_DG_FIELD[k4]
+                                        d[key] = _parse_or_err(KIND[("dg", key)], v4)
+                            elif k3 in WS_DG_FIELD:
+                                key = WS_DG_FIELD[k3]
+                                d[key] = _parse_or_err(KIND[("dg", key)], v3)
+                    elif k2 in WS_DG_FIELD:
+                        key = WS_DG_FIELD[k2]
+                        d[key] = _parse_or_err(KIND[("dg", key)], v2)
+                    elif k2.startswith("_ws.malformed"):
+                        rec["malformed"] = True
+                rec["datagrams"].append(d)
+        out.append(rec)
+    return out
+
+
+def _parse_or_err(kind, v):
+    if not isinstance(v, str):
+        return ReprError("not a value: %r" % (v,))
+    try:
+        return parse_value(kind, v)
+    except ReprError as e:
+        return e
+
+
+# --------------------------------------------------------------------------- Wireshark model
+
+REGISTER_CMDS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 13, 14)     # commands whose data Wireshark matches
+READ_CMDS = (1, 4, 7)                                     # against its ESC register table
+MAILBOX_TYPES = (1, 2, 3, 4, 5)                           # AoE, EoE, CoE, FoE, SoE
+ESC_REGISTER_END = 0x0A00       # Wireshark's register table ends below this offset
+
+
+class OneOf:
+    """The model allows any of these (each with the reason it differs from the truth)."""
+    def __init__(self, *options):
+        self.options = options      # (value, reason) pairs
+
+    def __repr__(self):
+        return "OneOf%r" % (self.options,)
+
+
+def ws_model(payload):
+    """What Wireshark 4.0's ecatf/ecat plugin shows for an EtherCAT payload (as captured).
+    Returns {"header": {..} or None, "datagrams": [ {key: value | MISSING | OneOf} ],
+             "why": {(index, key): reason}, "note": [..], "dropped_why": reason, "mailboxes": [..]}."""
+    res = {"header": None, "datagrams": [], "why": {}, "note": [], "dropped_why": None,
+           "mailboxes": []}
+    if len(payload) < 2:
+        return res
+    h = struct.unpack("<H", payload[:2])[0]
+    res["header"] = {"length": h & 0x7FF, "reserved": (h >> 11) & 1, "type": h >> 12}
+    if h >> 12 != 1:
+        return res
+    tvb = payload[2:]
+    L = len(tvb)
+
+    def hdr_at(off):
+        if off + 10 > L:
+            return None
+        cmd, idx, addr, lw, irq = struct.unpack("<BBIHH", tvb[off:off + 10])
+        return cmd, idx, addr, lw, irq
+
+    # 1. Wireshark first walks the chain of datagram headers (M bit) over the whole buffer,
+    #    padding included; a header cut short there throws before any tree is made.
+    off = 0
+    chain = []
+    while True:
+        hd = hdr_at(off)
+        if hd is None:
+            res["note"].append("ws: datagram header cut short while counting -> no ecat tree")
+            res["dropped_why"] = ("ws-no-tree: a datagram header in the M chain (Length ignored, padding "
+                                  "included) is cut short, Wireshark shows no datagram at all")
+            return res
+        chain.append(off)
+        off += 12 + (hd[3] & 0x7FF)
+        if not (off < L and hd[3] & 0x8000):
+            break
+    # 2. A single datagram: its working counter is read for the Info column.
+    if len(chain) == 1:
+        hd = hdr_at(0)
+        if 12 + (hd[3] & 0x7FF) > L:
+            res["note"].append("ws: lone datagram cut short -> no ecat tree")
+            res["dropped_why"] = "ws-no-tree: the only datagram is cut short, Wireshark shows no datagram at all"
+            return res
+    # 3. Each datagram's working counter is read before anything of it is shown: a datagram
+    #    cut short is not shown at all and ends the dissection.
+    for i, off in enumerate(chain):
+        cmd, idx, addr, lw, irq = hdr_at(off)
+        n = lw & 0x7FF
+        if off + 12 + n > L:
+            res["note"].append("ws: datagram %d cut short -> not shown (no partial tree)" % (i + 1))
+            res["dropped_why"] = "ws-truncated: datagram cut short, Wireshark shows no partial tree"
+            break
+        data = tvb[off + 10:off + 10 + n]
+        wkc = struct.unpack("<H", tvb[off + 10 + n:off + 12 + n])[0]
+        d = {"cmd": cmd, "idx": idx}
+        if is_logical(cmd):
+            d["lad"] = addr
+        else:
+            d["adp"] = addr & 0xFFFF
+            d["ado"] = addr >> 16
+        d.update({"len": n, "reserved": (lw >> 11) & 7, "circulating": bool(lw & 0x4000),
+                  "more": bool(lw & 0x8000), "irq": irq, "wkc": wkc})
+        ado = addr >> 16
+        if cmd in (1, 4) and ado == 0x0900 and lw >= 16 and wkc > 0:
+            d["data"] = MISSING
+            res["why"][(i, "data")] = "ws-dc-view: APRD/FPRD of DC receive times (0x900) shows a 'Dc' subtree, no Data"
+            if off + 10 + 16 > L:      # it reads 16 bytes of receive times whatever the length
+                res["note"].append("ws: DC receive times read past the end -> datagram header only")
+                del d["wkc"]
+                res["datagrams"].append(d)
+                res["dropped_why"] = "ws-dc-view: reading 16 bytes of DC receive times ran past the end"
+                res["why"][(i, "wkc")] = res["dropped_why"]
+                break
+        elif n == 0:
+            d["data"] = MISSING
+            res["why"][(i, "data")] = "ws-no-empty-data: Wireshark adds no Data item for a zero-length datagram"
+        elif cmd in REGISTER_CMDS and ado < ESC_REGISTER_END:
+            if cmd in READ_CMDS and wkc == 0:
+                why = "ws-register-read-wkc0: register read with WKC 0, Wireshark drops the data"
+            else:
+                why = "ws-register-view: ESC register fields shown instead of Data"
+            d["data"] = OneOf((data, None), (MISSING, why))
+        else:
+            d["data"] = data
+            if n >= 6 and ado >= 0x1000 and (cmd in (2, 3, 5, 6) or (cmd in (1, 4) and wkc == 1)):
+                mlen = struct.unpack("<H", data[:2])[0]
+                mtype = data[5] & 0x0F
+                if mtype in MAILBOX_TYPES and mlen <= 1500:
+                    rest = data[min(mlen + 6, n):]
+                    d["data"] = rest if rest else MISSING
+                    res["why"][(i, "data")] = ("ws-mailbox: mailbox header (type %d, length %d) decoded as a "
+                                               "mailbox, Data is only the %d bytes after it" % (mtype, mlen, len(rest)))
+                    res["mailboxes"].append(i)
+        res["datagrams"].append(d)
+    return res
+
+
+def model_after_mailbox_exception(model, ws):
+    """Wireshark's mailbox sub-dissector throws on some mailbox contents (too short for the
+    service it names); the exception ends the whole EtherCAT dissection: that datagram loses
+    Data and WKC, the following datagrams are not shown, and the packet is marked malformed.
+    The model cannot foresee the sub-dissector, so when Wireshark marks the packet malformed
+    and stops right at a mailbox datagram, the model is cut there."""
+    if not ws.get("malformed"):
+        return model
+    for k in model["mailboxes"]:
+        if k < len(ws["datagrams"]) and "wkc" not in ws["datagrams"][k] and len(ws["datagrams"]) == k + 1:
+            why = ("ws-mailbox-exception: Wireshark's mailbox sub-dissector threw on datagram %d's mailbox, "
+                   "the rest of the frame is not shown" % (k + 1))
+            m = dict(model)
+            m["datagrams"] = [dict(d) for d in model["datagrams"][:k + 1]]
+            m["why"] = dict(model["why"])
+            for key in ("data", "wkc"):
+                m["datagrams"][k][key] = MISSING
+                m["why"][(k, key)] = why
+            m["dropped_why"] = why
+            m["note"] = model["note"] + ["ws: mailbox sub-dissector exception"]
+            return m
+    return model
+
+
+def model_matches(pred, val):
+    """(ok, reason) for a Wireshark value against the model's prediction."""
+    if isinstance(pred, OneOf):
+        for v, why in pred.options:
+            if v == val:
+                return True, why
+        return False, None
+    return pred == val, None
+
+
+# --------------------------------------------------------------------------- comparison
+
+class Stats:
+    def __init__(self):
+        self.cols = ("values", "agree", "explained", "mismatch", "ours!=truth", "ws!=model")
+        self.rows = OrderedDict()
+        for f in FIELDS:
+            self.rows[f[2]] = dict.fromkeys(self.cols, 0)
+        self.explained = defaultdict(int)
+        self.frames_pass = 0
+        self.frames_fail = 0
+        self.failures = []
+        self.frames_with_explanations = defaultdict(int)
+        self.notes = defaultdict(int)
+
+    def table(self):
+        w = max(len(k) for k in self.rows)
+        lines = ["%-*s %s" % (w, "field (ours)", " ".join("%11s" % c for c in self.cols))]
+        for k, r in self.rows.items():
+            lines.append("%-*s %s" % (w, k, " ".join("%11d" % r[c] for c in self.cols)))
+        return "\n".join(lines)
+
+
+def _eq(a, b):
+    """Same value and same type (True is not 1); MISSING equals only MISSING."""
+    if a is MISSING or b is MISSING:
+        return a is b
+    if isinstance(a, (ReprError, Partial, OneOf)) or isinstance(b, (ReprError, Partial, OneOf)):
+        return False
+    return type(a) is type(b) and a == b
+
+
+def truth_ok(exp, val):
+    if isinstance(exp, bytes) and exp == b"":
+        return val is MISSING, None     # zero-length Data: no item (the contract)
+    if isinstance(exp, Partial):
+        return val is MISSING or (isinstance(val, bytes) and val == exp.value), \
+            ("partial shown" if val is not MISSING else "partial absent")
+    return _eq(exp, val), None
+
+
+def compare_frame(num, exp, model, ours, ws, stats, context):
+    """Compare one frame; return list of problem dicts (empty when the frame passes)."""
+    problems = []
+    ours = ours or {"header": {}, "datagrams": [], "problems": []}
+    ws = ws or {"header": {}, "datagrams": [], "malformed": False}
+    model = model_after_mailbox_exception(model, ws)
+    for p in ours.get("problems", []):
+        problems.append({"frame": num, "what": "ours: " + p})
+
+    def one(scope, key, i, e, o, w, m, why_model):
+        fname = FIELDS_BY_SCOPE[(scope, key)]
+        row = stats.rows[fname]
+        if e is MISSING and o is MISSING and w is MISSING and m is MISSING:
+            return
+        row["values"] += 1
+        t_ok, t_note = truth_ok(e, o)
+        if t_note:
+            stats.notes["a cut Data field (absent or the bytes present are both accepted): ours: " + t_note] += 1
+        m_ok, m_why = model_matches(m, w)
+        why = m_why or why_model
+        if not t_ok:
+            row["ours!=truth"] += 1
+        if not m_ok:
+            row["ws!=model"] += 1
+        if _eq(o, w):
+            row["agree"] += 1
+            if t_ok:
+                return
+        elif t_ok and m_ok and why:
+            row["explained"] += 1
+            stats.explained[why.split(":")[0]] += 1
+            context["explained"].add(why.split(":")[0])
+            return
+        else:
+            row["mismatch"] += 1
+        where = "header" if scope == "header" else "datagram %d" % (i + 1)
+        problems.append({"frame": num, "field": fname, "where": where, "ours": o, "wireshark": w,
+                         "truth": e, "model": m, "why": why,
+                         "verdict": ("ours differs from the truth" if not t_ok else
+                                     "Wireshark differs from ours and the model does not explain it")})
+
+    for note in model["note"]:
+        stats.notes[re.sub(r"datagram \d+", "datagram N", note)] += 1
+    eh = exp["header"] or {}
+    mh = model["header"] or {}
+    for key in HEADER_KEYS:
+        one("header", key, 0, eh.get(key, MISSING), ours["header"].get(key, MISSING),
+            ws["header"].get(key, MISSING), mh.get(key, MISSING), None)
+    edg, mdg = exp["datagrams"], model["datagrams"]
+    odg, wdg = ours["datagrams"], ws["datagrams"]
+    n = max(len(edg), len(mdg), len(odg), len(wdg))
+    for i in range(n):
+        e_d = edg[i] if i < len(edg) else None
+        m_d = mdg[i] if i < len(mdg) else None
+        for key in DG_KEYS:
+            e = e_d.get(key, MISSING) if e_d else MISSING
+            m = m_d.get(key, MISSING) if m_d else MISSING
+            o = odg[i].get(key, MISSING) if i < len(odg) else MISSING
+            w = wdg[i].get(key, MISSING) if i < len(wdg) else MISSING
+            why = model["why"].get((i, key))
+            if why is None and not _eq(e, m) and not isinstance(m, OneOf):
+                if e_d is None and m_d is not None:
+                    why = ("ws-invented-datagram: M=1 on the last datagram, Wireshark reads the bytes after "
+                           "the header's Length (padding) as another datagram")
+                elif m_d is None and e_d is not None:
+                    why = model["dropped_why"]
+                elif isinstance(e, Partial) and m is MISSING:
+                    why = "ws-truncated: datagram cut short, Wireshark shows no partial tree"
+            one("dg", key, i, e, o, w, m, why)
+    return problems
+
+
+FIELDS_BY_SCOPE = {(f[1], f[0]): f[2] for f in FIELDS}
+
+
+# --------------------------------------------------------------------------- running
+
+def run_sides(env, cap, fieldset, tag):
+    """Run both tshark sides at once; return (ours -T fields text or None, ws json path, seconds).
+    fieldset None (--simulate perfect) runs only the Wireshark side."""
+    t0 = time.time()
+    ws_out = env.path(tag + ".ws.json")
+    ours_out = env.path(tag + ".ours.tsv")
+    runs = [("Wireshark", ws_command(cap), ws_out)]
+    if fieldset is not None:
+        runs.append(("ours", ours_command(cap, fieldset), ours_out))
+    procs = []
+    for side, args, out in runs:
+        fh = open(out, "w")
+        procs.append((side, fh, subprocess.Popen(env.command(args), env=env.env(), cwd=env.home,
+                                                 stdout=fh, stderr=subprocess.PIPE, text=True)))
+    for side, fh, p in procs:
+        err = p.communicate()[1]
+        fh.close()
+        if p.returncode != 0:
+            raise tshark_env.TsharkError("tshark (%s side) exited %d on %s:\n%s" % (side, p.returncode, cap, err))
+        if err.strip():
+            print("note: tshark (%s side) stderr on %s:\n%s" % (side, os.path.basename(cap), err.strip()))
+    ours_text = None
+    if fieldset is not None:
+        with open(ours_out) as fh:
+            ours_text = fh.read()
+    return ours_text, ws_out, time.time() - t0
+
+
+def compare_capture(packets, ours_text, ws_json, stats, label, truths=None):
+    """packets: [(linktype, bytes, orig_len)] in capture order."""
+    expected = {}
+    models = {}
+    payloads = {}
+    for num, (lt, pkt, orig) in enumerate(packets, 1):
+        payload, encap = pcapgen.ecat_payload_of(pkt, lt)
+        if payload is None:
+            continue
+        expected[num] = pcapgen.decode_ecat(payload)
+        models[num] = ws_model(payload)
+        payloads[num] = (payload, pkt, orig, encap)
+    if truths is not None:
+        check_truth(expected, truths, payloads)
+    if ours_text is None:
+        ours_text = perfect_fields_text(expected, len(packets))
+    ours = parse_ours(ours_text, expected)
+    ws = parse_ws_json(ws_json)
+    if len(ws) != len(packets):
+        raise RuntimeError("%s: Wireshark JSON has %d packets, capture has %d" % (label, len(ws), len(packets)))
+    decoded = len(set(ours) & set(expected))
+    if expected and not decoded:
+        print("note: %s: our plugin decoded none of the %d EtherCAT frames (is ecatr registered on "
+              "ethertype 0x88A4 / udp.port 34980, and does it win over Wireshark's ecatf?)" % (label, len(expected)))
+    for num in sorted(set(ours) - set(expected)):
+        stats.frames_fail += 1
+        stats.failures.append(([{"frame": num, "what": "ours decoded a frame that is not EtherCAT by "
+                                 "ethertype 0x88A4 / UDP port 34980"}], label, None, None))
+    for num in sorted(expected):
+        context = {"explained": set()}
+        probs = compare_frame(num, expected[num], models[num], ours.get(num), ws[num - 1], stats, context)
+        for e in context["explained"]:
+            stats.frames_with_explanations[e] += 1
+        if probs:
+            stats.frames_fail += 1
+            t = truths[num - 1] if truths else None
+            stats.failures.append((probs, label, payloads[num], t))
+        else:
+            stats.frames_pass += 1
+    return len(expected)
+
+
+def check_truth(expected, truths, payloads):
+    """The reference decode of each generated frame equals what the generator wrote."""
+    for num, t in enumerate(truths, 1):
+        e = expected.get(num)
+        assert e is not None, "generated frame %d is not EtherCAT?" % num
+        assert e["header"] == t["header"] or "truncate_to" in t, (num, e["header"], t["header"])
+        if "truncate_to" in t or t["header"]["type"] != 1:
+            continue
+        want = pcapgen.expected_from_truth(t)
+        if e["datagrams"] != want:
+            raise AssertionError("frame %d: reference decode %r != generator truth %r" % (num, e["datagrams"], want))
+
+
+def print_failures(stats, limit):
+    shown_n = 0
+    for probs, label, pl, t in stats.failures:
+        if shown_n >= limit:
+            break
+        shown_n += 1
+        num = probs[0]["frame"]
+        print("--- %s frame %d%s" % (label, num, (" [%s]" % t["note"]) if t and t.get("note") else ""))
+        if pl:
+            payload, pkt, orig, encap = pl
+            ref = pcapgen.decode_ecat(payload)
+            print("    encapsulation %s, %d bytes captured of %d; datagrams: %s" %
+                  (encap, len(pkt), orig, ", ".join(
+                      "%s len %s" % (pcapgen.CMD_NAMES.get(d["cmd"], "0x%02x" % d["cmd"]), d.get("len", "?"))
+                      for d in ref["datagrams"]) or "none"))
+            print("    EtherCAT payload (%d bytes, from the frame header):" % len(payload))
+            h = payload.hex()
+            for k in range(0, min(len(h), 256), 64):
+                print("      " + h[k:k + 64])
+            if len(h) > 256:
+                print("      ... (%d more bytes)" % ((len(h) - 256) // 2))
+        for p in probs[:8]:
+            if "what" in p:
+                print("    " + p["what"])
+                continue
+            print("    %s %s: %s" % (p["where"], p["field"], p["verdict"]))
+            print("        ours:      %s" % shown(p["ours"]))
+            print("        Wireshark: %s" % shown(p["wireshark"]))
+            print("        truth:     %s" % shown(p["truth"]))
+            if p["why"]:
+                print("        (model: %s)" % p["why"])
+            elif not isinstance(p["model"], _Missing) or p["wireshark"] is not MISSING:
+                print("        model:     %s" % (shown(p["model"]) if not isinstance(p["model"], OneOf)
+                                                  else " or ".join(shown(v) for v, _ in p["model"].options)))
+        if len(probs) > 8:
+            print("    ... %d more differences in this frame" % (len(probs) - 8))
+
+
+def mismatch_class(p):
+    if "what" in p:
+        return re.sub(r"\d+(, \d+)*", "N", p["what"])
+    o, w, t = p["ours"], p["wireshark"], p["truth"]
+
+    def kind(v):
+        if v is MISSING:
+            return "absent"
+        if isinstance(v, ReprError):
+            return "unparsable"
+        if v == b"":
+            return "empty"
+        return "a value"
+    if p["verdict"].startswith("ours"):
+        if kind(o) == kind(t) == "a value":
+            return "%s: ours differs from the truth" % p["field"]
+        return "%s: ours %s, truth %s" % (p["field"], kind(o), kind(t))
+    return "%s: Wireshark %s, ours %s (= truth), not explained by the model" % (p["field"], kind(w), kind(o))
+
+
+def report(stats, args, extra=""):
+    print()
+    print("Per-field agreement (values: field occurrences compared; explained: known Wireshark "
+          "behaviour, ours checked against the truth instead):")
+    print(stats.table())
+    if stats.explained:
+        print()
+        print("Explained differences (values / frames):")
+        for k in sorted(stats.explained):
+            print("  %-28s %6d / %d" % (k, stats.explained[k], stats.frames_with_explanations[k]))
+    if stats.notes:
+        print()
+        print("Notes:")
+        for k in sorted(stats.notes):
+            print("  %6d x %s" % (stats.notes[k], k))
+    if stats.failures:
+        classes = defaultdict(lambda: [0, 0])
+        for probs, _, _, _ in stats.failures:
+            seen = set()
+            for p in probs:
+                c = mismatch_class(p)
+                classes[c][0] += 1
+                if c not in seen:
+                    classes[c][1] += 1
+                    seen.add(c)
+        print()
+        print("Mismatch classes (values / frames):")
+        for c, (nv, nf) in sorted(classes.items(), key=lambda kv: -kv[1][0]):
+            print("  %6d / %-6d %s" % (nv, nf, c))
+        print()
+        print("First mismatches:")
+        print_failures(stats, args.show)
+    if extra:
+        print(extra)
+    print()
+    print("%d passed, %d failed" % (stats.frames_pass, stats.frames_fail))
+
+
+def prepare_env(args):
+    env = tshark_env.TsharkEnv(keep=args.keep)
+    if args.simulate == "wireshark":
+        print("SIMULATION: 'ours' is Wireshark's own plugin read through -T fields (no dissgen)")
+        return env, "ecat"
+    if args.simulate == "perfect":
+        print("SIMULATION: 'ours' is an ideal plugin (the truth printed as -T fields; no dissgen)")
+        return env, None
+    rules = os.path.join(args.source_dir, "rules", "ethercat.xml")
+    t0 = time.time()
+    files = env.install_plugin(args.dissgen, rules)
+    env.assert_plugin_loaded("ecatr")
+    print("installed %s into %s in %.1fs (tshark runs as %s)" %
+          (", ".join(os.path.basename(f) for f in files), env.plugin_dir, time.time() - t0,
+           "uid 65534" if env.as_nobody else "the current user"))
+    return env, "ecatr"
+
+
+def generated(args):
+    t0 = time.time()
+    n = args.frames
+    specials = max(1, n // 300) if args.malformed is None else args.malformed
+    frames = pcapgen.random_frames(args.seed, n, args.max_datagrams, m_on_last=specials,
+                                   truncated=specials, other_types=min(specials, 3))
+    blob = pcapgen.pcap_bytes(frames)
+    truths = [pcapgen.truth(f, i + 1) for i, f in enumerate(frames)]
+    packets = []
+    for f in frames:
+        pkt, orig = pcapgen.encode_frame(f)
+        packets.append((1, pkt, orig))
+    t_gen = time.time() - t0
+    env, fieldset = prepare_env(args)
+    try:
+        cap = env.add_file("generated.pcap", blob)
+        if args.keep:
+            with open(env.path("generated.truth.json"), "w") as fh:
+                json.dump(truths, fh)
+        print("generated %d frames (seed %d, up to %d datagrams, %d M=1-on-last, %d truncated) in %.2fs: %s"
+              % (n, args.seed, args.max_datagrams, specials, specials, t_gen, cap))
+        ours_text, ws_json, t_run = run_sides(env, cap, fieldset, "generated")
+        t1 = time.time()
+        stats = Stats()
+        compare_capture(packets, ours_text, ws_json, stats, "generated", truths)
+        t_cmp = time.time() - t1
+        report(stats, args, "timing: generate %.2fs, tshark (both sides, in parallel) %.2fs, compare %.2fs"
+               % (t_gen, t_run, t_cmp))
+    finally:
+        env.cleanup()
+    return 0 if stats.frames_fail == 0 else 1
+
+
+def corpus(args):
+    d = args.corpus
+    files = sorted(glob.glob(os.path.join(d, "*.pcapng")) + glob.glob(os.path.join(d, "*.pcap")))
+    if not os.path.isdir(d) or not files:
+        print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng)" % d)
+        return SKIP_CODE
+    env, fieldset = prepare_env(args)
+    stats = Stats()
+    try:
+        t0 = time.time()
+        total = 0
+        for path in files:
+            cap = path
+            if env.as_nobody and not readable_by_nobody(path):
+                with open(path, "rb") as fh:     # a private copy in the temporary HOME only
+                    cap = env.add_file(os.path.basename(path), fh.read())
+            packets = list(pcapgen.read_capture(path))
+            ours_text, ws_json, _ = run_sides(env, cap, fieldset, "corpus")
+            before = (stats.frames_pass, stats.frames_fail)
+            n = compare_capture(packets, ours_text, ws_json, stats, os.path.basename(path))
+            total += n
+            print("%-40s %6d packets, %6d EtherCAT frames: %d passed, %d failed" %
+                  (os.path.basename(path), len(packets), n, stats.frames_pass - before[0],
+                   stats.frames_fail - before[1]))
+        report(stats, args, "timing: %d files, %d EtherCAT frames in %.2fs" % (len(files), total, time.time() - t0))
+    finally:
+        env.cleanup()
+    return 0 if stats.frames_fail == 0 else 1
+
+
+def readable_by_nobody(path):
+    p = os.path.abspath(path)
+    st = os.stat(p)
+    if not st.st_mode & 0o004:
+        return False
+    d = os.path.dirname(p)
+    while True:
+        if not os.stat(d).st_mode & 0o001:
+            return False
+        nd = os.path.dirname(d)
+        if nd == d:
+            return True
+        d = nd
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--dissgen", help="dissgen binary (default SOURCE_DIR/build/bin/dissgen)")
+    ap.add_argument("--source-dir", default=os.path.normpath(os.path.join(HERE, "..", "..")),
+                    help="repository root (rules/ethercat.xml)")
+    ap.add_argument("--frames", type=int, default=3000)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--max-datagrams", type=int, default=12, choices=range(1, 21), metavar="1..20")
+    ap.add_argument("--malformed", type=int, default=None,
+                    help="frames of each malformed kind (M=1 on last, truncated); default frames/300, at least 1")
+    ap.add_argument("--corpus", metavar="DIR", help="compare over the captures in DIR instead of generated frames")
+    ap.add_argument("--show", type=int, default=5, help="mismatching frames to print in detail")
+    ap.add_argument("--keep", action="store_true", help="keep the temporary HOME (captures, tshark outputs)")
+    ap.add_argument("--simulate", choices=("wireshark", "perfect"),
+                    help="no dissgen, to check this tool: 'ours' is Wireshark's own plugin read through "
+                         "-T fields (expect failures at its known defects), or an ideal plugin (expect none)")
+    args = ap.parse_args(argv)
+    if not args.simulate:
+        args.dissgen = args.dissgen or os.path.join(args.source_dir, "build", "bin", "dissgen")
+        if not os.path.isfile(os.path.join(args.source_dir, "rules", "ethercat.xml")):
+            ap.error("no rules/ethercat.xml under --source-dir %s" % args.source_dir)
+    try:
+        if args.corpus:
+            return corpus(args)
+        return generated(args)
+    except tshark_env.TsharkError as e:
+        print("ERROR: %s" % e)
+        print("0 passed, %d failed" % (args.frames if not args.corpus else 1))
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

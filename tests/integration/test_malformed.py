@@ -1,0 +1,153 @@
+#!/usr/bin/env python3
+"""Malformed EtherCAT frames through the plugin generated from rules/ethercat.xml.
+
+tshark must exit 0 with nothing on stderr, the rules protocol must never
+raise a Wireshark exception ("[Malformed Packet: ECATR]"), every defect must
+carry one of our expert infos where it happens, and what is there must still
+be decoded.
+"""
+import argparse
+import os
+import random
+import shutil
+import struct
+import sys
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pcapgen  # noqa: E402
+from pcapgen import Datagram, Frame  # noqa: E402
+from tshark_env import TsharkEnv  # noqa: E402
+
+ARGS = None
+ETH_HEADER = b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01" + b"\x88\xa4"
+OUR_EXPERTS = ("ecatr.expert.truncated", "ecatr.expert.past_end", "ecatr.expert.more_no_data",
+               "ecatr.expert.count_short", "ecatr.expert.bad_length", "ecatr.expert.unused")
+
+
+def pcap(packets):
+    """packets: [(captured bytes, original length)]"""
+    out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
+    for i, (data, orig) in enumerate(packets):
+        out.append(struct.pack("<IIII", 1700000000 + i, 0, len(data), orig))
+        out.append(data)
+    return b"".join(out)
+
+
+def frame_bytes(frame):
+    data, _ = pcapgen.encode_frame(frame)
+    return data
+
+
+class Malformed(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.env = TsharkEnv()
+        cls.env.install_plugin(ARGS.dissgen, os.path.join(ARGS.source_dir, "rules", "ethercat.xml"))
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.env.cleanup()
+
+    def decode(self, packets, fields):
+        cap = self.env.add_file("m.pcap", pcap(packets))
+        args = ["-r", cap, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=|"]
+        for f in fields:
+            args += ["-e", f]
+        p = self.env.tshark(args, check=False)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertEqual(p.stderr.strip(), "", "tshark complained")
+        verbose = self.env.tshark(["-r", cap, "-V"], check=False)
+        self.assertEqual(verbose.returncode, 0)
+        self.assertNotIn("[Malformed Packet: ECATR]", verbose.stdout, "a Wireshark exception escaped the rules")
+        self.assertNotIn("Dissector bug", verbose.stdout + verbose.stderr)
+        rows = [line.split("\t") for line in p.stdout.splitlines()]
+        self.assertEqual(len(rows), len(packets))
+        return rows
+
+    def test_truncated_at_every_byte_offset(self):
+        rng = random.Random(11)
+        frames = []
+        for _ in range(25):
+            n = rng.randint(1, 4)
+            frames.append(Frame([Datagram(cmd=rng.randint(0, 14), idx=rng.randint(0, 255),
+                                          data=bytes(rng.getrandbits(8) for _ in range(rng.randint(0, 20))),
+                                          wkc=rng.randint(0, 5)) for _ in range(n)], pad=False))
+        packets, expected_cmds = [], []
+        for f in frames:
+            whole = frame_bytes(f)
+            starts, at = [], 16  # command byte offsets of each datagram
+            for d in f.datagrams:
+                starts.append(at)
+                at += 12 + len(d.data)
+            for cut in range(15, len(whole)):
+                for orig in (len(whole), cut):   # snap-length truncation and a short frame
+                    packets.append((whole[:cut], orig))
+                    expected_cmds.append(["0x%02x" % d.cmd for d, s in zip(f.datagrams, starts) if s < cut])
+        rows = self.decode(packets, ["ecatr.datagram.cmd", "_ws.expert.message", "_ws.col.Protocol"])
+        for (data, _), row, cmds in zip(packets, rows, expected_cmds):
+            self.assertEqual(row[2], "ECATR")
+            got = row[0].split("|") if row[0] else []
+            self.assertEqual(got, cmds, "datagrams inside the cut must still be decoded (%d bytes)" % len(data))
+            if len(data) > 14:
+                self.assertTrue(any(w in row[1] for w in ("Truncated", "past the end")),
+                                "no expert info for a frame cut at %d bytes: %r" % (len(data), row[1]))
+
+    def test_length_fields_past_the_end(self):
+        f = Frame([Datagram(cmd=4, data=b"\x01\x02", wkc=1)], header_length=2000 & 0x7FF, pad=False)
+        g = Frame([Datagram(cmd=12, data=b"\x01\x02", wkc=1, len_field=900)], pad=False)
+        rows = self.decode([(frame_bytes(f), len(frame_bytes(f))), (frame_bytes(g), len(frame_bytes(g)))],
+                           ["ecatr.datagram.cmd", "_ws.expert.message"])
+        self.assertIn("'Datagrams' has length 2000, past the end of its data", rows[0][1])
+        self.assertEqual(rows[0][0], "0x04")
+        self.assertIn("past the end of its data", rows[1][1])
+        self.assertEqual(rows[1][0], "0x0c")
+
+    def test_more_flag_on_last_datagram_with_padding(self):
+        f = Frame([Datagram(cmd=7, data=b"\x00", wkc=3)], m_on_last=True)  # padded to 60 bytes
+        rows = self.decode([(frame_bytes(f), len(frame_bytes(f)))],
+                           ["ecatr.datagram.cmd", "ecatr.datagram.more", "_ws.expert.message"])
+        self.assertEqual(rows[0][0], "0x07", "no datagram may be invented from the padding")
+        self.assertEqual(rows[0][1], "1")
+        self.assertIn("the repeat flag 'More' says another follows, but no data is left", rows[0][2])
+
+    def test_header_length_longer_than_the_datagrams(self):
+        f = Frame([Datagram(cmd=1, data=b"\xaa\xbb", wkc=1)], header_length=14 + 20)
+        rows = self.decode([(frame_bytes(f), len(frame_bytes(f)))], ["ecatr.datagram.cmd", "_ws.expert.message"])
+        self.assertEqual(rows[0][0], "0x01")
+        self.assertIn("'Datagrams' is 34 bytes, but its fields end after 14: 20 bytes are not decoded", rows[0][1])
+
+    def test_over_a_hundred_empty_datagrams(self):
+        f = Frame([Datagram(cmd=0, idx=i & 0xFF) for i in range(124)])
+        rows = self.decode([(frame_bytes(f), len(frame_bytes(f)))],
+                           ["ecatr.datagram.cmd", "ecatr.datagram.idx", "_ws.expert.message"])
+        self.assertEqual(len(rows[0][0].split("|")), 124)
+        self.assertEqual(rows[0][2], "")
+
+    def test_random_bytes_on_the_ethertype(self):
+        rng = random.Random(3)
+        packets = []
+        for _ in range(3000):
+            body = bytes(rng.getrandbits(8) for _ in range(rng.randint(0, 200)))
+            packets.append((ETH_HEADER + body, 14 + len(body)))
+        rows = self.decode(packets, ["_ws.col.Protocol"])
+        for (data, _), row in zip(packets, rows):
+            # Ethernet calls no subdissector for an empty payload.
+            self.assertEqual(row[0], "ECATR" if len(data) > 14 else "0x88a4")
+
+
+def main():
+    global ARGS
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--dissgen", required=True)
+    parser.add_argument("--source-dir", required=True)
+    ARGS, rest = parser.parse_known_args()
+    if shutil.which("tshark") is None:
+        print("SKIPPED: tshark is not installed")
+        return 77
+    result = unittest.main(argv=[sys.argv[0]] + rest, exit=False, verbosity=2).result
+    return 0 if result.wasSuccessful() else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

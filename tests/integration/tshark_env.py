@@ -1,0 +1,261 @@
+#!/usr/bin/env python3
+"""A throw-away HOME for running tshark with a per-user dissgen plugin (Python 3 stdlib only).
+
+As root, Wireshark ignores per-user plugins, so tshark is run as uid/gid 65534 (setpriv) when
+this process is root, and everything it reads (HOME, plugin folder, captures) is made readable
+by that user.  Otherwise tshark simply runs with HOME set.
+
+    with TsharkEnv() as env:
+        env.install_plugin("build/bin/dissgen", "rules/ethercat.xml")
+        env.assert_plugin_loaded("ecatr")
+        cap = env.add_file("gen.pcap", blob)
+        out = env.tshark(["-r", cap, "-T", "fields", "-e", "ecatr.datagram.cmd"]).stdout
+
+CLI (for a quick look):  tshark_env.py --dissgen PATH --rules FILE [--protocol ecatr] [-- tshark args]
+"""
+
+import argparse
+import os
+import re
+import shutil
+import stat
+import subprocess
+import sys
+import tempfile
+
+NOBODY = 65534
+
+# What Wireshark's plugin loader says when it skips a plugin (stderr, exit status 0).
+LOADER_PATTERNS = re.compile(r"plugin|symbol|compiled for|\.so\b|couldn't load|undefined", re.I)
+
+# DISSGEN_SANITIZE=1: plugins are built with AddressSanitizer and UndefinedBehaviorSanitizer.
+SANITIZE = os.environ.get("DISSGEN_SANITIZE") == "1"
+SANITIZER_FLAGS = "-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined -g"
+SANITIZER_PRELOAD = "libasan.so.8 libubsan.so.1"
+
+
+class TsharkError(RuntimeError):
+    pass
+
+
+def wireshark_abi():
+    """Major.minor of the installed Wireshark, e.g. "4.0" (the per-user plugin folder name)."""
+    try:
+        v = subprocess.run(["pkg-config", "--modversion", "wireshark"], check=True,
+                           capture_output=True, text=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        out = subprocess.run(["tshark", "--version"], capture_output=True, text=True).stdout
+        m = re.search(r"TShark \(Wireshark\) (\d+\.\d+)", out)
+        if not m:
+            raise TsharkError("cannot tell the Wireshark version (no pkg-config wireshark, no tshark)")
+        return m.group(1)
+    m = re.match(r"(\d+)\.(\d+)", v)
+    if not m:
+        raise TsharkError("pkg-config --modversion wireshark gave %r" % v)
+    return "%s.%s" % m.groups()
+
+
+def _world_traversable(path):
+    path = os.path.abspath(path)
+    while True:
+        st = os.stat(path)
+        if not st.st_mode & stat.S_IXOTH:
+            return False
+        parent = os.path.dirname(path)
+        if parent == path:
+            return True
+        path = parent
+
+
+def _make_readable(path):
+    """chmod a+rX on path and everything below it."""
+    for root, dirs, files in os.walk(path):
+        os.chmod(root, os.stat(root).st_mode | 0o555)
+        for f in files:
+            p = os.path.join(root, f)
+            mode = os.stat(p).st_mode
+            os.chmod(p, mode | 0o444 | (0o111 if mode & 0o100 else 0))
+
+
+class TsharkEnv:
+    def __init__(self, keep=False, prefix="dissgen-tshark-", tshark="tshark"):
+        self.as_nobody = os.geteuid() == 0
+        base = tempfile.gettempdir()
+        if self.as_nobody and not _world_traversable(base):
+            base = "/tmp"
+        self.home = tempfile.mkdtemp(prefix=prefix, dir=base)
+        os.chmod(self.home, 0o755)
+        self.keep = keep
+        self.tshark_bin = shutil.which(tshark) or tshark
+        self.abi = wireshark_abi()
+        self.plugin_dir = os.path.join(self.home, ".local", "lib", "wireshark", "plugins",
+                                       self.abi, "epan")
+        self.installed = []
+
+    # -- files ---------------------------------------------------------------
+    def path(self, name):
+        return os.path.join(self.home, name)
+
+    def add_file(self, name, blob):
+        """Write blob (bytes) as HOME/name, readable by the tshark user; return its path."""
+        p = self.path(name)
+        with open(p, "wb") as fh:
+            fh.write(blob)
+        os.chmod(p, 0o644)
+        return p
+
+    # -- plugin --------------------------------------------------------------
+    def install_plugin(self, dissgen, rules, extra_args=()):
+        """Run `dissgen install RULES --dir <per-user plugin folder>`; return the new files."""
+        if not os.path.isfile(dissgen) or not os.access(dissgen, os.X_OK):
+            raise TsharkError("%s: no such executable (build dissgen first)" % dissgen)
+        os.makedirs(self.plugin_dir, exist_ok=True)
+        before = set(os.listdir(self.plugin_dir))
+        cmd = [dissgen, "install", rules, "--dir", self.plugin_dir] + list(extra_args)
+        build_env = dict(os.environ)
+        if SANITIZE:
+            build_env["DISSGEN_CXXFLAGS"] = SANITIZER_FLAGS
+        p = subprocess.run(cmd, capture_output=True, text=True, env=build_env)
+        if p.returncode != 0:
+            raise TsharkError("%s failed (exit %d):\n%s%s" % (" ".join(cmd), p.returncode, p.stdout, p.stderr))
+        _make_readable(self.home)
+        new = sorted(set(os.listdir(self.plugin_dir)) - before)
+        self.installed = [os.path.join(self.plugin_dir, f) for f in new] or \
+            [os.path.join(self.plugin_dir, f) for f in sorted(os.listdir(self.plugin_dir))]
+        if not self.installed:
+            raise TsharkError("%s succeeded but put nothing in %s" % (" ".join(cmd), self.plugin_dir))
+        return self.installed
+
+    # -- running -------------------------------------------------------------
+    def env(self):
+        e = {"HOME": self.home, "PATH": os.environ.get("PATH", "/usr/bin:/bin"),
+             "LANG": "C.UTF-8", "LC_ALL": "C.UTF-8", "TZ": "UTC",
+             "XDG_CONFIG_HOME": os.path.join(self.home, ".config")}
+        if SANITIZE:
+            # The plugin is built with ASan+UBSan; tshark is not, so the runtimes are
+            # preloaded. Any report aborts tshark (non-zero exit, report on stderr).
+            e["LD_PRELOAD"] = SANITIZER_PRELOAD
+            e["ASAN_OPTIONS"] = "detect_leaks=0:abort_on_error=1:halt_on_error=1"
+            e["UBSAN_OPTIONS"] = "print_stacktrace=1:halt_on_error=1"
+        return e
+
+    def command(self, args):
+        cmd = [self.tshark_bin] + list(args)
+        if self.as_nobody:
+            cmd = ["setpriv", "--reuid=%d" % NOBODY, "--regid=%d" % NOBODY, "--clear-groups"] + cmd
+        return cmd
+
+    def tshark(self, args, check=True, stdout=None, timeout=1800):
+        """Run tshark; return CompletedProcess (text stdout/stderr unless stdout is a file)."""
+        cmd = self.command(args)
+        p = subprocess.run(cmd, env=self.env(), cwd=self.home, timeout=timeout, text=True,
+                           stdout=stdout if stdout is not None else subprocess.PIPE,
+                           stderr=subprocess.PIPE)
+        if check and p.returncode != 0:
+            raise TsharkError("tshark exited %d: %s\n%s" % (p.returncode, " ".join(args), p.stderr))
+        return p
+
+    # -- checks --------------------------------------------------------------
+    def plugins(self):
+        """[(name, version, type, path)] from `tshark -G plugins`, and its stderr."""
+        p = self.tshark(["-G", "plugins"])
+        rows = []
+        for line in p.stdout.splitlines():
+            parts = [s.strip() for s in line.split("\t")]
+            if len(parts) >= 4:
+                rows.append(tuple(parts[:4]))
+        return rows, p.stderr
+
+    def protocols(self):
+        p = self.tshark(["-G", "protocols"])
+        return {line.split("\t")[2] for line in p.stdout.splitlines() if line.count("\t") >= 2}, p.stderr
+
+    def assert_plugin_loaded(self, protocol=None):
+        """The installed plugin file(s) are listed by `tshark -G plugins`, tshark printed no
+        loader warning, and (if given) the protocol's filter name is registered."""
+        if SANITIZE:
+            # `tshark -G plugins` hangs with the sanitizer runtimes preloaded; the
+            # protocol check below still proves the instrumented plugin loaded.
+            rows, err = [], ""
+            protocol = protocol or "ecatr"
+        else:
+            rows, err = self.plugins()
+        problems = []
+        if err.strip():
+            problems.append("tshark -G plugins wrote to stderr (loader warning?):\n" + err.strip())
+        listed = {os.path.realpath(r[3]) for r in rows}
+        for f in ([] if SANITIZE else self.installed or []):
+            if f.endswith(".so") and os.path.realpath(f) not in listed:
+                problems.append("%s is not listed by tshark -G plugins" % f)
+        if not SANITIZE and not any(f.endswith(".so") for f in self.installed or []):
+            ours = [r for r in rows if os.path.realpath(r[3]).startswith(os.path.realpath(self.plugin_dir))]
+            if not ours:
+                problems.append("no plugin from %s is listed by tshark -G plugins" % self.plugin_dir)
+        if protocol:
+            protos, perr = self.protocols()
+            if perr.strip():
+                problems.append("tshark -G protocols wrote to stderr:\n" + perr.strip())
+            if protocol not in protos:
+                problems.append("protocol %r is not registered" % protocol)
+        if problems:
+            raise TsharkError("plugin not loaded cleanly:\n- " + "\n- ".join(problems))
+        return rows
+
+    @staticmethod
+    def loader_warnings(stderr):
+        """The lines of a tshark stderr that look like plugin-loader complaints."""
+        return [l for l in stderr.splitlines() if LOADER_PATTERNS.search(l)]
+
+    # -- lifetime ------------------------------------------------------------
+    def cleanup(self):
+        if not self.keep:
+            shutil.rmtree(self.home, ignore_errors=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.cleanup()
+        return False
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--dissgen", help="dissgen binary (omit to run tshark without our plugin)")
+    ap.add_argument("--rules", help="rule file to install")
+    ap.add_argument("--protocol", help="filter name the plugin must register (e.g. ecatr)")
+    ap.add_argument("--keep", action="store_true", help="keep the temporary HOME")
+    ap.add_argument("tshark_args", nargs="*", help="arguments for one tshark run (after --)")
+    a = ap.parse_args(argv)
+    try:
+        return _run(a)
+    except TsharkError as e:
+        print("ERROR: %s" % e, file=sys.stderr)
+        return 1
+
+
+def _run(a):
+    with TsharkEnv(keep=a.keep) as env:
+        print("HOME=%s (plugin folder %s, tshark as %s)" %
+              (env.home, env.plugin_dir, "uid 65534" if env.as_nobody else "this user"), file=sys.stderr)
+        if a.dissgen:
+            files = env.install_plugin(a.dissgen, a.rules)
+            print("installed: %s" % ", ".join(files), file=sys.stderr)
+            env.assert_plugin_loaded(a.protocol)
+            print("plugin loaded cleanly", file=sys.stderr)
+        if a.tshark_args:
+            args = []
+            for x in a.tshark_args:     # captures given by path are copied into HOME
+                if os.path.isfile(x) and not x.startswith(env.home):
+                    with open(x, "rb") as fh:
+                        x = env.add_file(os.path.basename(x), fh.read())
+                args.append(x)
+            p = env.tshark(args, check=False)
+            sys.stdout.write(p.stdout)
+            sys.stderr.write(p.stderr)
+            return p.returncode
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
