@@ -285,7 +285,7 @@ void Emitter::protocol_struct() {
        << "    " << c_string(p_.name) << ", " << c_string(p_.abbreviation) << ", " << c_string(f) << ",\n"
        << "    &proto_" << f << ", &ett_" << f << ", dissect_" << f << ", "
        << (pdu ? "dissect_" + f + "_stream" : "NULL") << ",\n"
-       << "    " << f << "_nodes, " << f << "_children, 0, " << p_.nodes.size() << ",\n"
+       << "    " << f << "_nodes, " << l_.nodes.size() << ", " << f << "_children, 0, " << p_.nodes.size() << ",\n"
        << "    " << f << "_ranges, " << f << "_summary, " << p_.slot_count << ", &ei_" << f << ",\n"
        << "    " << f << "_hooks, " << hook_count << ",\n"
        << "    " << (pdu ? pdu->doc_index - 1 : -1) << ", "

@@ -7,6 +7,9 @@
  */
 #include "dissgen_runtime.h"
 
+#include <epan/stats_tree.h>
+#include <epan/tap.h>
+
 #include <string.h>
 
 namespace {
@@ -18,6 +21,23 @@ struct dg_slot {
     gboolean present;
     const dg_node *node;
 };
+
+/* One counted thing for the stats tree: an enum leaf's value, or how many
+ * instances a repeated node had in this message. */
+struct dg_tap_record {
+    guint16 node;
+    guint64 value;
+};
+
+struct dg_tap_data {
+    dg_tap_record *records;
+    guint count, capacity;
+};
+
+/* Each plugin links its own copy of the runtime and holds one protocol, so
+ * the stats tree callbacks (which get no user pointer) find it here. */
+const dg_protocol *stats_protocol;
+int stats_tap = -1;
 
 /* Summaries of one repeated node's instances, gathered for the Info column. */
 struct dg_summaries {
@@ -37,7 +57,20 @@ struct dg_state {
     wmem_strbuf_t *info;  /* the Info column being built (want_info) */
     wmem_strbuf_t *text;  /* scratch for one container's summary (want_text) */
     guint64 group_value;  /* the bit group being decoded */
+    dg_tap_data *tap;     /* what the stats tree counts; NULL when nobody listens */
 };
+
+void tap_record(dg_state *st, const dg_node *n, guint64 value)
+{
+    dg_tap_data *t = st->tap;
+    if (t->count == t->capacity) {
+        t->capacity = t->capacity ? 2 * t->capacity : 16;
+        t->records = (dg_tap_record *)wmem_realloc(st->pinfo->pool, t->records, t->capacity * sizeof(dg_tap_record));
+    }
+    t->records[t->count].node = (guint16)(n - st->p->nodes);
+    t->records[t->count].value = value;
+    t->count++;
+}
 
 guint encoding_of(const dg_node *n) { return (n->flags & DG_LITTLE) ? ENC_LITTLE_ENDIAN : ENC_BIG_ENDIAN; }
 
@@ -103,6 +136,7 @@ gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char
 
 void store(dg_state *st, const dg_node *n, guint64 value, gint offset, gint length)
 {
+    if (st->tap && n->show == DG_SHOW_ENUM) tap_record(st, n, value);
     if (n->slot < 0) return;
     dg_slot *s = &st->slots[n->slot];
     s->value = value;
@@ -382,6 +416,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     gboolean collect = !in_summary && n->summary_count > 0 && st->want_info;
     if (collect) summaries.text = wmem_strbuf_new(st->pinfo->pool, "");
 
+    guint instances = 0;
     for (gint64 done = 0; wanted < 0 || done < wanted; done++) {
         if (wanted >= 0 && *offset >= end) {
             report(st, tree, &st->p->ei->count_short, *offset, 0,
@@ -393,6 +428,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
         clear_slots(st, n);
         gint before = *offset;
         dissect_instance(st, n, tree, offset, end, in_summary, collect ? &summaries : NULL);
+        instances++;
         if (st->stopped || *offset == before) break;
         if (n->repeat_slot >= 0) {
             const dg_slot *flag = &st->slots[n->repeat_slot];
@@ -406,6 +442,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
             }
         }
     }
+    if (st->tap) tap_record(st, n, instances);
     if (collect && summaries.count > 1) {
         /* "NAME ×COUNT: SUMMARY, SUMMARY, ..." */
         if (wmem_strbuf_get_len(st->info) > 0) wmem_strbuf_append_len(st->info, ", ", 2);
@@ -463,6 +500,75 @@ gboolean table_accepts_integers(const char *table)
     }
 }
 
+/* --- statistics: tshark -z FILTER,tree, Statistics menu in Wireshark ---- */
+
+/* "Command (ecatr.datagram.cmd)": node names must be unique in the tree. */
+const char *stats_node_name(const dg_node *n, const char *what)
+{
+    header_field_info *hfi = n->hf ? proto_registrar_get_nth(*n->hf) : NULL;
+    return g_strdup_printf("%s%s (%s)", n->name, what, hfi ? hfi->abbrev : stats_protocol->filter);
+}
+
+int *stats_node_ids;       /* per node: its stats tree node, or 0 */
+char **stats_node_names;   /* per node: that node's name, or NULL */
+int stats_frames_id;
+
+void stats_init(stats_tree *st)
+{
+    const dg_protocol *p = stats_protocol;
+    guint n_nodes = p->node_count;
+    g_free(stats_node_ids);
+    if (stats_node_names) g_strfreev(stats_node_names);
+    stats_node_ids = g_new0(int, n_nodes ? n_nodes : 1);
+    stats_node_names = g_new0(char *, n_nodes + 1);
+    stats_frames_id = stats_tree_create_node(st, "Messages", 0, STAT_DT_INT, FALSE);
+    for (guint i = 0; i < n_nodes; i++) {
+        const dg_node *n = &p->nodes[i];
+        const char *what = NULL;
+        if (n->count.slot >= 0 || n->repeat_slot >= 0) what = " per message";
+        else if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM) what = "";
+        if (!what) continue;
+        stats_node_names[i] = (char *)stats_node_name(n, what);
+        stats_node_ids[i] = stats_tree_create_node(st, stats_node_names[i], 0, STAT_DT_INT, TRUE);
+    }
+}
+
+tap_packet_status stats_packet(stats_tree *st, packet_info *, epan_dissect_t *, const void *data, tap_flags_t)
+{
+    const dg_tap_data *t = (const dg_tap_data *)data;
+    const dg_protocol *p = stats_protocol;
+    tick_stat_node(st, "Messages", 0, FALSE);
+    char buf[64];
+    for (guint i = 0; i < t->count; i++) {
+        const dg_tap_record *r = &t->records[i];
+        const dg_node *n = &p->nodes[r->node];
+        if (!stats_node_ids[r->node]) continue;
+        const char *label = NULL;
+        if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM && n->count.slot < 0 && n->repeat_slot < 0) {
+            header_field_info *hfi = proto_registrar_get_nth(*n->hf);
+            label = (hfi->display & BASE_VAL64_STRING) ? try_val64_to_str(r->value, (const val64_string *)hfi->strings)
+                                                       : try_val_to_str((guint32)r->value, (const value_string *)hfi->strings);
+            if (!label) {
+                g_snprintf(buf, sizeof buf, "Unknown (0x%" G_GINT64_MODIFIER "x)", r->value);
+                label = buf;
+            }
+        } else {
+            g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "u", r->value);
+            label = buf;
+        }
+        tick_stat_node(st, stats_node_names[r->node], 0, TRUE);
+        tick_stat_node(st, label, stats_node_ids[r->node], FALSE);
+    }
+    return TAP_PACKET_REDRAW;
+}
+
+void register_stats_tree(const dg_protocol *p)
+{
+    stats_protocol = p;
+    stats_tap = register_tap(p->filter);
+    stats_tree_register_plugin(p->filter, p->filter, p->name, 0, stats_packet, stats_init, NULL);
+}
+
 } /* namespace */
 
 extern "C" {
@@ -496,6 +602,7 @@ void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett,
     expert_module_t *experts = expert_register_protocol(*p->proto);
     expert_register_field_array(experts, ei, ei_count);
     register_dissector(p->filter, p->dissect, *p->proto);
+    register_stats_tree(p);
 }
 
 void dg_handoff(const dg_protocol *p)
@@ -541,6 +648,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     st.want_text = st.want_info || (tree != NULL && PTREE_DATA(tree)->visible);
     st.info = st.want_info ? wmem_strbuf_new(pinfo->pool, "") : NULL;
     st.text = st.want_text ? wmem_strbuf_new(pinfo->pool, "") : NULL;
+    if (stats_tap >= 0 && have_tap_listener(stats_tap)) st.tap = wmem_new0(pinfo->pool, dg_tap_data);
 
     proto_item *root = proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA);
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
@@ -548,6 +656,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
     proto_item_set_len(root, offset);
 
+    if (st.tap) tap_queue_packet(stats_tap, pinfo, st.tap);
     if (st.info && wmem_strbuf_get_len(st.info) > 0)
         col_add_str(pinfo->cinfo, COL_INFO, wmem_strbuf_get_str(st.info));
     else

@@ -93,6 +93,7 @@ typedef struct dg_protocol {
     dissector_t dissect;     /* generated entry points, calling dg_dissect / dg_dissect_stream */
     dissector_t dissect_stream;
     const dg_node *nodes;
+    guint16 node_count;
     const guint16 *children; /* child index lists, addressed by first_child/child_count */
     guint16 top_first, top_count; /* the top-level nodes' list in `children` */
     const dg_range *ranges;

@@ -97,6 +97,23 @@ class PluginLoading(unittest.TestCase):
         self.assertEqual(rows[2][0], "ECATR", "EtherCAT over UDP 34980 must decode with the rules too")
         self.assertEqual(rows[2][3], "0x0e")
 
+    def test_stats_tree_counts_messages_instances_and_enum_values(self):
+        self.env.install_plugin(ARGS.dissgen, self.rules)
+        out = self.env.tshark(["-q", "-z", "ecatr,tree", "-r", self.capture]).stdout
+        counts = {}
+        for line in out.splitlines():
+            m = re.match(r"^(\s*)(\S.*?)\s{2,}(\d+)\s", line)
+            if m:
+                counts[(len(m.group(1)), m.group(2))] = int(m.group(3))
+        self.assertEqual(counts[(0, "Messages")], 3)
+        self.assertEqual(counts[(0, "Datagram per message (ecatr.datagram)")], 3)
+        self.assertEqual(counts[(1, "1")], 2)      # two frames with one datagram
+        self.assertEqual(counts[(1, "2")], 1)      # one with two
+        self.assertEqual(counts[(0, "Command (ecatr.datagram.cmd)")], 4)
+        for command in ("FPRD", "LRW", "BRD", "FRMW"):
+            self.assertEqual(counts[(1, command)], 1, command)
+        self.assertEqual(counts[(1, "EtherCAT datagrams")], 3)
+
     def test_wireshark_plugin_stays_selectable(self):
         self.env.install_plugin(ARGS.dissgen, self.rules)
         rows, _ = fields(self.env, self.capture, ["_ws.col.Protocol", "ecat.cmd", "ecatr.datagram.cmd"],
