@@ -1,0 +1,97 @@
+// Every ```xml example in the user documentation is a rule file that must
+// behave as the text says: valid, or (when its first line is
+// <!-- expect: LINE: error: MESSAGE -->) rejected with that diagnostic.
+#include <gtest/gtest.h>
+
+#include <regex>
+#include <vector>
+
+#include "emit_cpp.h"
+#include "test_support.h"
+
+namespace dissgen::testing {
+namespace {
+
+struct Example {
+    std::string doc;
+    int doc_line;
+    std::string xml;
+};
+
+std::vector<Example> examples_in(const std::string& doc) {
+    std::vector<Example> out;
+    std::istringstream in(read_file(source_path(doc)));
+    std::string line, xml;
+    int number = 0, start = 0;
+    bool inside = false;
+    while (std::getline(in, line)) {
+        ++number;
+        if (!inside && line.rfind("```xml", 0) == 0) {
+            inside = true;
+            start = number + 1;
+            xml.clear();
+        } else if (inside && line.rfind("```", 0) == 0) {
+            inside = false;
+            out.push_back({doc, start, xml});
+        } else if (inside) {
+            xml += line + "\n";
+        }
+    }
+    return out;
+}
+
+void check_examples(const std::string& doc, size_t at_least) {
+    std::vector<Example> examples = examples_in(doc);
+    EXPECT_GE(examples.size(), at_least) << doc;
+    static const std::regex expect(R"(^<!-- expect: (\d+): error: (.*) -->)");
+    for (const Example& e : examples) {
+        SCOPED_TRACE(e.doc + ":" + std::to_string(e.doc_line));
+        Front f = front_end(e.xml);
+        std::smatch m;
+        if (std::regex_search(e.xml, m, expect)) {
+            EXPECT_FALSE(f.ok());
+            std::string wanted = "rules.xml:" + m[1].str() + ": error: " + m[2].str();
+            EXPECT_NE(f.messages().find(wanted), std::string::npos) << f.messages() << "\nwanted: " << wanted;
+        } else {
+            ASSERT_TRUE(f.ok()) << f.messages();
+            EXPECT_FALSE(emit_cpp(*f.proto, "example.xml").empty());
+        }
+    }
+}
+
+TEST(Docs, ManualExamplesBehaveAsDocumented) { check_examples("docs/manual.md", 10); }
+
+TEST(Docs, ReadmeExamplesBehaveAsDocumented) { check_examples("README.md", 1); }
+
+TEST(Docs, ManualBitGroupMasksAreTheOnesItStates) {
+    auto examples = examples_in("docs/manual.md");
+    const Example* bits = nullptr;
+    for (const Example& e : examples)
+        if (e.xml.find("abbreviation=\"BITS\"") != std::string::npos) bits = &e;
+    ASSERT_NE(bits, nullptr);
+    Front f = front_end(bits->xml);
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Node& control = *f.proto->nodes[0];
+    EXPECT_EQ(field_type(*control.children[0]).mask, 0x07ffu);  // Length
+    EXPECT_EQ(field_type(*control.children[3]).mask, 0x8000u);  // More
+    const Node& flags = *f.proto->nodes[1];
+    EXPECT_EQ(field_type(*flags.children[0]).mask, 0xe0u);      // Version
+    EXPECT_EQ(field_type(*flags.children[1]).mask, 0x1fu);      // Priority
+    EXPECT_EQ(flags.children[1]->display, Display::NumberHex);
+}
+
+TEST(Docs, ManualNamingExampleGivesTheNamesItStates) {
+    for (const Example& e : examples_in("docs/manual.md")) {
+        if (e.xml.find("abbreviation=\"NAME\"") == std::string::npos) continue;
+        Front f = front_end(e.xml);
+        ASSERT_TRUE(f.ok()) << f.messages();
+        std::string fields = list_fields(*f.proto);
+        for (const char* name : {"name.working_counter_wkc\t", "name.cmd\t", "name.type\t"})
+            EXPECT_NE(fields.find(name), std::string::npos) << fields;
+        return;
+    }
+    FAIL() << "naming example not found";
+}
+
+}  // namespace
+}  // namespace dissgen::testing
