@@ -11,18 +11,6 @@
 namespace dissgen::testing {
 namespace {
 
-std::string rules(const std::string& body, const std::string& root_attrs = "ethertype=\"0x88b5\"") {
-    return "<root name=\"Test\" abbreviation=\"TST\" " + root_attrs + ">\n" + body + "</root>\n";
-}
-
-const Node* find(const Protocol& proto, const std::string& name) {
-    const Node* found = nullptr;
-    for_each_node(proto.nodes, [&](const Node& n) {
-        if (!found && n.name == name) found = &n;
-    });
-    return found;
-}
-
 void expect_type(const Protocol& proto, const std::string& name, const std::string& type, const std::string& display,
                  uint64_t mask = 0) {
     const Node* n = find(proto, name);

@@ -8,10 +8,6 @@ namespace dissgen::testing {
 namespace {
 
 // A rule file around `body` (the nodes), on line 2 onwards.
-std::string rules(const std::string& body, const std::string& root_attrs = "ethertype=\"0x88b5\"") {
-    return "<root name=\"Test\" abbreviation=\"TST\" " + root_attrs + ">\n" + body + "</root>\n";
-}
-
 struct Parsed {
     std::unique_ptr<Protocol> proto;
     Diagnostics diags;
@@ -23,14 +19,6 @@ Parsed parse(const std::string& xml) {
     Parsed p;
     p.proto = parse_rules(xml, p.diags);
     return p;
-}
-
-const Node* find(const Protocol& proto, const std::string& name) {
-    const Node* found = nullptr;
-    for_each_node(proto.nodes, [&](const Node& n) {
-        if (!found && n.name == name) found = &n;
-    });
-    return found;
 }
 
 // ---- parse_number ---------------------------------------------------------

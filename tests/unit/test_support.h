@@ -38,4 +38,22 @@ inline Front front_end(const std::string& xml) {
     return f;
 }
 
+// A rule file with one root around `body`.
+inline std::string rules(const std::string& body, const std::string& root_attrs = "ethertype=\"0x88b5\"") {
+    return "<root name=\"Test\" abbreviation=\"TST\" " + root_attrs + ">\n" + body + "</root>\n";
+}
+
+// The first node named `name`, in document order.
+inline const Node* find(const Protocol& proto, const std::string& name) {
+    const Node* found = nullptr;
+    for_each_node(proto.nodes, [&](const Node& n) {
+        if (!found && n.name == name) found = &n;
+    });
+    return found;
+}
+
+inline bool contains(const std::string& haystack, const std::string& needle) {
+    return haystack.find(needle) != std::string::npos;
+}
+
 }  // namespace dissgen::testing

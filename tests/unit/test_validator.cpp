@@ -7,22 +7,6 @@
 namespace dissgen::testing {
 namespace {
 
-std::string rules(const std::string& body, const std::string& root_attrs = "ethertype=\"0x88b5\"") {
-    return "<root name=\"Test\" abbreviation=\"TST\" " + root_attrs + ">\n" + body + "</root>\n";
-}
-
-const Node* find(const Protocol& proto, const std::string& name) {
-    const Node* found = nullptr;
-    for_each_node(proto.nodes, [&](const Node& n) {
-        if (!found && n.name == name) found = &n;
-    });
-    return found;
-}
-
-bool contains(const std::string& haystack, const std::string& needle) {
-    return haystack.find(needle) != std::string::npos;
-}
-
 // ---- filter names: the segment rule ------------------------------------------------
 
 TEST(Segment, LowercasesAndJoinsRunsWithUnderscore) {
