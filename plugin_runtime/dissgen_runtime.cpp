@@ -57,6 +57,7 @@ struct dg_state {
     wmem_strbuf_t *info;  /* the Info column being built (want_info) */
     wmem_strbuf_t *text;  /* scratch for one container's summary (want_text) */
     guint64 group_value;  /* the bit group being decoded */
+    guint32 hook_value;   /* pinfo->match_uint on entry: the hook (or Decode As) value, for ifhook */
     dg_tap_data *tap;     /* what the stats tree counts; NULL when nobody listens */
 };
 
@@ -211,22 +212,28 @@ void append_shown_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s
             name = try_val64_to_str(s->value, (const val64_string *)hfi->strings);
         else
             name = try_val_to_str((guint32)s->value, (const value_string *)hfi->strings);
-        if (name)
+        if (name) {
             append_str(out, name);
-        else
-            wmem_strbuf_append_printf(out, "Unknown (0x%" G_GINT64_MODIFIER "x)", s->value);
+        } else {
+            /* As the tree shows it: as many hex digits as the field's bits need. */
+            wmem_strbuf_append_len(out, "Unknown (", 9);
+            append_hex(out, s->value, (n->bits + 3) / 4);
+            wmem_strbuf_append_len(out, ")", 1);
+        }
         return;
     }
+    /* An empty byte field (length 0 from a field, or 'rest' with nothing left)
+     * shows nothing: tvb_bytes_to_str_punct() asserts len > 0. */
     case DG_SHOW_ADDRESS:
-        append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ':'));
+        if (s->length > 0) append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ':'));
         return;
     case DG_SHOW_BYTES:
-        append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' '));
+        if (s->length > 0) append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' '));
         return;
     default:
         if (n->flags & DG_NUMERIC)
             append_dec(out, s->value);
-        else
+        else if (s->length > 0)
             append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' '));
         return;
     }
@@ -456,11 +463,21 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     }
 }
 
+gboolean hook_holds(const dg_state *st, const dg_node *n)
+{
+    for (guint i = 0; i < n->hook_count; i++) {
+        const dg_range *r = &st->p->ranges[n->hook_first + i];
+        if (st->hook_value >= r->low && st->hook_value <= r->high) return TRUE;
+    }
+    return FALSE;
+}
+
 void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
                   gboolean in_summary)
 {
     for (guint16 i = 0; i < count && !st->stopped; i++) {
         const dg_node *n = &st->p->nodes[st->p->children[first + i]];
+        if (n->hook_count && !hook_holds(st, n)) continue;
         if (n->if_slot >= 0 && !condition_holds(st, n)) continue;
         if (n->count.slot >= 0 || n->repeat_slot >= 0)
             dissect_repeated(st, n, tree, offset, end, in_summary);
@@ -549,7 +566,8 @@ tap_packet_status stats_packet(stats_tree *st, packet_info *, epan_dissect_t *, 
             label = (hfi->display & BASE_VAL64_STRING) ? try_val64_to_str(r->value, (const val64_string *)hfi->strings)
                                                        : try_val_to_str((guint32)r->value, (const value_string *)hfi->strings);
             if (!label) {
-                g_snprintf(buf, sizeof buf, "Unknown (0x%" G_GINT64_MODIFIER "x)", r->value);
+                /* padded like the tree item: "Unknown (0x07)" for an 8-bit field */
+                g_snprintf(buf, sizeof buf, "Unknown (0x%0*" G_GINT64_MODIFIER "x)", (int)((n->bits + 3) / 4), r->value);
                 label = buf;
             }
         } else {
@@ -628,10 +646,20 @@ void dg_handoff(const dg_protocol *p)
     }
 }
 
+/* Key of the per-packet count of messages decoded (p_add_proto_data). */
+#define DG_MESSAGES_KEY 0x6d736773u
+
 int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     col_set_str(pinfo->cinfo, COL_PROTOCOL, p->short_name);
-    col_clear(pinfo->cinfo, COL_INFO);
+    /* Several messages in one packet (a TCP segment): each adds its Info text. */
+    guint *messages = (guint *)p_get_proto_data(pinfo->pool, pinfo, *p->proto, DG_MESSAGES_KEY);
+    if (!messages) {
+        messages = wmem_new0(pinfo->pool, guint);
+        p_add_proto_data(pinfo->pool, pinfo, *p->proto, DG_MESSAGES_KEY, messages);
+    }
+    gboolean first_message = (*messages)++ == 0;
+    if (first_message) col_clear(pinfo->cinfo, COL_INFO);
 
     dg_state st;
     memset(&st, 0, sizeof st);
@@ -640,6 +668,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     st.pinfo = pinfo;
     st.slots = wmem_alloc0_array(pinfo->pool, dg_slot, p->slot_count ? p->slot_count : 1);
     st.packet_end = (gint)tvb_captured_length(tvb);
+    st.hook_value = pinfo->match_uint;
     /* Summaries are text for the Info column and for container items; build
      * them only when someone sees them: tshark -T fields and -V have a visible
      * tree and no columns, summary lines have columns and no tree, and a
@@ -657,10 +686,11 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     proto_item_set_len(root, offset);
 
     if (st.tap) tap_queue_packet(stats_tap, pinfo, st.tap);
-    if (st.info && wmem_strbuf_get_len(st.info) > 0)
-        col_add_str(pinfo->cinfo, COL_INFO, wmem_strbuf_get_str(st.info));
+    const char *info = st.info && wmem_strbuf_get_len(st.info) > 0 ? wmem_strbuf_get_str(st.info) : p->name;
+    if (first_message)
+        col_add_str(pinfo->cinfo, COL_INFO, info);
     else
-        col_set_str(pinfo->cinfo, COL_INFO, p->name);
+        col_append_sep_str(pinfo->cinfo, COL_INFO, " | ", info);
     return offset > 0 ? offset : st.packet_end;
 }
 
