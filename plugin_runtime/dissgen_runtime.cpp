@@ -7,6 +7,7 @@
  */
 #include "dissgen_runtime.h"
 
+#include <epan/proto_data.h>
 #include <epan/stats_tree.h>
 #include <epan/tap.h>
 
