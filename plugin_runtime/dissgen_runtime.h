@@ -67,6 +67,14 @@ typedef struct dg_node {
     guint16 first_child, child_count;
     guint16 slot_first, slot_count; /* slots inside this subtree */
     guint16 summary_first, summary_count;
+    /* ifhook: decoded only when the value the dissector table matched
+     * (pinfo->match_uint: the port, the ethertype) is in these ranges.
+     * Generated code gives them only for nodes that have the attribute. */
+#ifdef __cplusplus
+    guint16 hook_first = 0, hook_count = 0;
+#else
+    guint16 hook_first, hook_count;
+#endif
 } dg_node;
 
 /* Expert infos every generated protocol registers. */
