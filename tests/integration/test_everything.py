@@ -16,7 +16,6 @@ so far, and never a Wireshark exception.
 
     test_everything.py --dissgen build/bin/dissgen --source-dir .  [--keep-pcap DIR]
 """
-import argparse
 import os
 import random
 import re
@@ -28,7 +27,7 @@ import unittest
 import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import TsharkEnv  # noqa: E402
+from tshark_env import TsharkEnv, run_unittests  # noqa: E402
 
 ARGS = None
 PROTO = "evry"
@@ -1043,19 +1042,11 @@ class Everything(unittest.TestCase):
 
 
 def main():
-    global ARGS
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--dissgen", required=True)
-    parser.add_argument("--source-dir", required=True)
-    parser.add_argument("--seed", type=int, default=2024)
-    parser.add_argument("--messages", type=int, default=300, help="valid messages")
-    parser.add_argument("--keep-pcap", help="copy the capture here")
-    ARGS, rest = parser.parse_known_args()
-    if shutil.which("tshark") is None:
-        print("SKIPPED: tshark is not installed")
-        return 77
-    result = unittest.main(argv=[sys.argv[0]] + rest, exit=False, verbosity=2).result
-    return 0 if result.wasSuccessful() else 1
+    def arguments(parser):
+        parser.add_argument("--seed", type=int, default=2024)
+        parser.add_argument("--messages", type=int, default=300, help="valid messages")
+        parser.add_argument("--keep-pcap", help="copy the capture here")
+    return run_unittests(arguments)[1]
 
 
 if __name__ == "__main__":

@@ -6,10 +6,8 @@ raise a Wireshark exception ("[Malformed Packet: ECATR]"), every defect must
 carry one of our expert infos where it happens, and what is there must still
 be decoded.
 """
-import argparse
 import os
 import random
-import shutil
 import struct
 import sys
 import unittest
@@ -17,7 +15,7 @@ import unittest
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pcapgen  # noqa: E402
 from pcapgen import Datagram, Frame  # noqa: E402
-from tshark_env import TsharkEnv  # noqa: E402
+from tshark_env import TsharkEnv, run_unittests  # noqa: E402
 
 ARGS = None
 ETH_HEADER = b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01" + b"\x88\xa4"
@@ -137,16 +135,7 @@ class Malformed(unittest.TestCase):
 
 
 def main():
-    global ARGS
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--dissgen", required=True)
-    parser.add_argument("--source-dir", required=True)
-    ARGS, rest = parser.parse_known_args()
-    if shutil.which("tshark") is None:
-        print("SKIPPED: tshark is not installed")
-        return 77
-    result = unittest.main(argv=[sys.argv[0]] + rest, exit=False, verbosity=2).result
-    return 0 if result.wasSuccessful() else 1
+    return run_unittests()[1]
 
 
 if __name__ == "__main__":

@@ -10,7 +10,6 @@
 - the paper's own example generates a working plugin;
 - as root in CI, `dissgen install --system` serves root's tshark.
 """
-import argparse
 import os
 import re
 import shutil
@@ -22,7 +21,7 @@ import unittest
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pcapgen  # noqa: E402
 from pcapgen import Datagram, Frame  # noqa: E402
-from tshark_env import TsharkEnv  # noqa: E402
+from tshark_env import TsharkEnv, run_unittests  # noqa: E402
 
 ARGS = None
 SYSTEM_ETHERCAT = "/usr/lib/x86_64-linux-gnu/wireshark/plugins/4.0/epan/ethercat.so"
@@ -231,16 +230,7 @@ def pcapgen_raw(frame):
 
 
 def main():
-    global ARGS
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--dissgen", required=True)
-    parser.add_argument("--source-dir", required=True)
-    ARGS, rest = parser.parse_known_args()
-    if shutil.which("tshark") is None:
-        print("SKIPPED: tshark is not installed")
-        return 77
-    result = unittest.main(argv=[sys.argv[0]] + rest, exit=False, verbosity=2).result
-    return 0 if result.wasSuccessful() else 1
+    return run_unittests()[1]
 
 
 if __name__ == "__main__":

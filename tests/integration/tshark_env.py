@@ -219,6 +219,28 @@ class TsharkEnv:
         return False
 
 
+
+def run_unittests(add_arguments=None):
+    """The entry point of every tests/integration/test_*.py: parses --dissgen and
+    --source-dir (plus what `add_arguments(parser)` adds), runs the module's
+    unittest cases, and returns the exit status for ctest (77: skipped)."""
+    import argparse
+    import unittest
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--dissgen", required=True)
+    parser.add_argument("--source-dir", required=True)
+    if add_arguments:
+        add_arguments(parser)
+    args, rest = parser.parse_known_args()
+    if shutil.which("tshark") is None:
+        print("SKIPPED: tshark is not installed")
+        return args, 77
+    main_module = sys.modules["__main__"]
+    main_module.ARGS = args
+    result = unittest.main(module=main_module, argv=[sys.argv[0]] + rest, exit=False, verbosity=2).result
+    return args, (0 if result.wasSuccessful() else 1)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--dissgen", help="dissgen binary (omit to run tshark without our plugin)")
