@@ -44,6 +44,7 @@ struct Layout {
     std::vector<int> children_flat;
     std::vector<ValueRange> ranges;
     std::map<const Node*, int> range_first;
+    std::map<const Node*, int> hook_range_first;     // ifhook lists, after every 'in' list
     std::vector<std::pair<std::string, int>> pieces;  // (text, slot)
     std::map<const Node*, int> piece_first;
 };
@@ -81,6 +82,14 @@ Layout make_layout(const Protocol& proto) {
             l.range_first[n] = static_cast<int>(l.ranges.size());
             l.ranges.insert(l.ranges.end(), n->in_list.begin(), n->in_list.end());
         }
+    }
+    for (const Node* n : l.nodes) {
+        if (n->has_hook) {
+            l.hook_range_first[n] = static_cast<int>(l.ranges.size());
+            l.ranges.insert(l.ranges.end(), n->hook_list.begin(), n->hook_list.end());
+        }
+    }
+    for (const Node* n : l.nodes) {
         if (!n->summary_pieces.empty()) {
             l.piece_first[n] = static_cast<int>(l.pieces.size());
             for (const SummaryPiece& p : n->summary_pieces)
@@ -269,7 +278,10 @@ void Emitter::node_table() {
            << (n.if_field ? l_.range_first.at(&n) : 0) << ", " << (n.if_field ? n.in_list.size() : 0) << ", "
            << (n.is_container() ? l_.first_child.at(&n) : 0) << ", " << n.children.size() << ", " << slot_first
            << ", " << slot_count << ", " << (l_.piece_first.count(&n) ? l_.piece_first.at(&n) : 0) << ", "
-           << n.summary_pieces.size() << " },\n";
+           << n.summary_pieces.size();
+        // ifhook ranges (first, count): only where given, the struct defaults them to none.
+        if (n.has_hook) o_ << ", " << l_.hook_range_first.at(&n) << ", " << n.hook_list.size();
+        o_ << " },\n";
     }
     if (l_.nodes.empty()) o_ << "    { NULL, NULL, NULL, 0, 0, 0, 0, 0, 0, 0, -1, {-1, 0, 0}, {-1, 0, 0}, -1, -1, 0, 0, 0, 0, 0, 0, 0, 0 }\n";
     o_ << "};\n\n";

@@ -64,6 +64,10 @@ struct Node {
     std::optional<FieldRef> repeat, count, if_field;
     std::vector<ValueRange> in_list;
     bool has_in = false;
+    // ifhook: decoded only when the packet came through a hook (dissector
+    // table entry, Decode As included) whose value is in this list.
+    std::vector<ValueRange> hook_list;
+    bool has_hook = false;
     std::optional<std::string> filter;  // empty string: leave container out of names
     std::string description;
     std::optional<std::string> summary;
@@ -90,6 +94,8 @@ struct Node {
     bool is_container() const { return !children.empty(); }
     bool is_leaf() const { return children.empty(); }
     bool is_repeated() const { return repeat.has_value() || count.has_value(); }
+    // Decoded only under a condition (if/in or ifhook): may take no bytes.
+    bool is_conditional() const { return if_field.has_value() || has_hook; }
     bool has_fixed_length() const {
         return length_kind == LengthKind::Bits || length_kind == LengthKind::Bytes;
     }

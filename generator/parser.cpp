@@ -22,7 +22,7 @@ const std::vector<std::string> kRootAttributes = {"name",   "abbreviation", "eth
                                                   "byteorder", "pdulength", "pdulengthadd"};
 const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displaytype", "repeat",
                                                   "count",  "filter",    "byteorder",   "description",
-                                                  "if",     "in",        "summary"};
+                                                  "if",     "in",        "summary",     "ifhook"};
 const std::vector<std::string> kEnumAttributes = {"value", "name"};
 const std::vector<std::string> kHookAttributes = {"table", "value"};
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
@@ -232,6 +232,8 @@ private:
     void parse_length(const std::string& text, int line, Node& node, xmlNode* el);
     void parse_display(const std::string& text, int line, Node& node);
     void parse_in_list(const std::string& text, int line, Node& node);
+    bool parse_value_list(const std::string& text, int line, const std::string& attribute,
+                          std::vector<ValueRange>& out);
     bool parse_byteorder(const std::string& text, int line, ByteOrder& out);
     FieldRef make_ref(const std::string& text, int line, const std::string& attribute, bool arithmetic);
     void defer(FieldRef& ref, xmlNode* context, int line, const std::string& attribute);
@@ -396,6 +398,10 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
     if (attrs.count("in")) parse_in_list(attrs["in"], node->line, *node);
     if (node->if_field && !node->has_in) diags_.error(node->line, "'if' needs an 'in' list of values");
     if (node->has_in && !node->if_field) diags_.error(node->line, "'in' needs an 'if' field to test");
+    if (attrs.count("ifhook")) {
+        node->has_hook = true;
+        parse_value_list(attrs["ifhook"], node->line, "ifhook", node->hook_list);
+    }
     parse_length(attrs.count("length") ? attrs["length"] : "", node->line, *node, el);
 
     for (xmlNode* c = el->children; c; c = c->next) {
@@ -476,6 +482,14 @@ void Parser::parse_length(const std::string& raw, int line, Node& node, xmlNode*
 
 void Parser::parse_in_list(const std::string& text, int line, Node& node) {
     node.has_in = true;
+    parse_value_list(text, line, "in", node.in_list);
+}
+
+// "1-9,0x0d,14": numbers and ranges, for 'in' and 'ifhook'.
+bool Parser::parse_value_list(const std::string& text, int line, const std::string& attribute,
+                              std::vector<ValueRange>& out) {
+    const std::string bad = "bad '" + attribute + "' list '" + text +
+                            "': expected numbers and ranges such as \"1-9,0x0d,14\"";
     std::stringstream ss(text);
     std::string item;
     bool any = false;
@@ -488,15 +502,21 @@ void Parser::parse_in_list(const std::string& text, int line, Node& node) {
                       : parse_number(item.substr(0, dash), r.low) && parse_number(item.substr(dash + 1), r.high);
         if (dash == std::string::npos) r.high = r.low;
         if (!ok || r.high < r.low) {
-            diags_.error(line, "bad 'in' list '" + text + "': expected numbers and ranges such as \"1-9,0x0d,14\"");
-            return;
+            diags_.error(line, bad);
+            return false;
         }
-        node.in_list.push_back(r);
+        out.push_back(r);
         any = true;
     }
-    if (!any) diags_.error(line, "empty 'in' list; expected numbers and ranges such as \"1-9,0x0d,14\"");
-    else if (trim(text).back() == ',')  // getline drops the empty last item
-        diags_.error(line, "bad 'in' list '" + text + "': expected numbers and ranges such as \"1-9,0x0d,14\"");
+    if (!any) {
+        diags_.error(line, "empty '" + attribute + "' list; expected numbers and ranges such as \"1-9,0x0d,14\"");
+        return false;
+    }
+    if (trim(text).back() == ',') {  // getline drops the empty last item
+        diags_.error(line, bad);
+        return false;
+    }
+    return true;
 }
 
 FieldRef Parser::make_ref(const std::string& text, int line, const std::string& attribute, bool arithmetic) {

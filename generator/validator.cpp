@@ -34,6 +34,7 @@ private:
     void check_fixed_container(const Node& n);
     void check_reference(Node& n, const FieldRef& ref, const std::string& what);
     void check_pdulength();
+    void check_hook_list(const Node& n);
     bool offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const Node* t, uint64_t& offset,
                    bool& fixed) const;
     void parse_summary(Node& n);
@@ -57,6 +58,7 @@ void Validator::run() {
         if (n.count) check_reference(n, *n.count, "count");
         if (n.repeat) check_reference(n, *n.repeat, "repeat");
         if (n.if_field) check_reference(n, *n.if_field, "if");
+        if (n.has_hook) check_hook_list(n);
         if (n.summary) parse_summary(n);
     });
     check_pdulength();
@@ -168,6 +170,9 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
         if (n.is_repeated() || n.if_field)
             diags_.error(n.line, "bit field " + quote(n) + " cannot have 'repeat', 'count' or 'if': it shares bytes "
                                  "with its neighbours in a bit group");
+        else if (n.has_hook)
+            diags_.error(n.line, "bit field " + quote(n) + " cannot have 'ifhook': it shares bytes with its "
+                                 "neighbours in a bit group");
         // A bit field written without a displaytype shows its value in hex: the
         // nearest thing to origin's "raw bytes in hex" for a part of a byte.
         if (n.display == Display::Origin && !n.display_given) n.display = Display::NumberHex;
@@ -208,7 +213,7 @@ void Validator::close_group(std::vector<Node*>& group, unsigned bits) {
 }
 
 std::optional<uint64_t> Validator::fixed_bytes(const Node& n) const {
-    if (n.is_repeated() || n.if_field) return std::nullopt;
+    if (n.is_repeated() || n.is_conditional()) return std::nullopt;
     if (n.has_fixed_length()) return n.fixed_bits / 8;
     if (n.length_kind != LengthKind::Children || n.is_leaf()) return std::nullopt;
     uint64_t sum = 0;
@@ -314,6 +319,20 @@ void Validator::check_pdulength() {
     }
     proto_.pdu_fixed_len = static_cast<unsigned>(offset) + (t->in_bit_group ? t->group_bytes : t->bits / 8);
     mark_slot(const_cast<Node*>(t));
+}
+
+// ifhook values are those of the root's ethertype and hooks (or a Decode As
+// choice); a list that matches none of them is most likely a mistake.
+void Validator::check_hook_list(const Node& n) {
+    std::vector<uint64_t> values;
+    if (proto_.ethertype) values.push_back(*proto_.ethertype);
+    for (const Hook& h : proto_.hooks) values.push_back(h.value);
+    for (uint64_t v : values)
+        for (const ValueRange& r : n.hook_list)
+            if (v >= r.low && v <= r.high) return;
+    if (!n.hook_list.empty())
+        diags_.warning(n.line, quote(n) + " has an 'ifhook' list that matches none of the root's ethertype and hook "
+                               "values: it is decoded only through Decode As on such a value");
 }
 
 void Validator::parse_summary(Node& n) {

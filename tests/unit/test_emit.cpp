@@ -250,5 +250,45 @@ TEST(ListFields, ShippedEthercat) {
     EXPECT_EQ(fields.find("ecatr.datagram.address\t"), std::string::npos);
 }
 
+// ifhook: its ranges go after every 'in' list, and only rows of nodes that have
+// the attribute get the two extra columns (dg_node defaults them to none), so
+// generated code for rule files without it does not change.
+TEST(Emit, IfhookRangesFollowTheInListsOnTheirRowsOnly) {
+    Front f = front_end(rules("  <hook table=\"udp.port\" value=\"2222\"/>\n"
+                              "  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"Encap\" length=\"2byte\" displaytype=\"numberhex\" "
+                              "ifhook=\"0-2221,2223-0xffffffff\"/>\n"
+                              "  <node name=\"IO\" length=\"2byte\" displaytype=\"numberhex\" ifhook=\"2222\" "
+                              "if=\"../node[@name='Kind']\" in=\"1,3\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_TRUE(find(*f.proto, "IO")->has_hook);
+    EXPECT_FALSE(find(*f.proto, "Kind")->has_hook);
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_TRUE(contains(code, "static const dg_range tst_ranges[] = { { 0x1, 0x1 }, { 0x3, 0x3 }, "
+                               "{ 0x0, 0x8ad }, { 0x8af, 0xffffffff }, { 0x8ae, 0x8ae } };"))
+        << code;
+    // Kind: no extra columns; Encap: ranges 2-3; IO: its 'in' at 0-1, ifhook at 4.
+    EXPECT_TRUE(contains(code, ", 0, 0, 0, 0, 0, 1, 0, 0 },\n    /* 1: line 4 */")) << code;
+    EXPECT_TRUE(contains(code, ", 0, 0, 0, 0, 2, 2 },\n    /* 2: line 5 */")) << code;
+    EXPECT_TRUE(contains(code, ", 4, 1 },\n};")) << code;
+}
+
+TEST(Validate, IfhookNodesHaveNoFixedSizeAndMayHoldThePduLength) {
+    Front f = front_end(rules("  <hook table=\"tcp.port\" value=\"44818\"/>\n"
+                              "  <hook table=\"udp.port\" value=\"2222\"/>\n"
+                              "  <node name=\"Header\" ifhook=\"44818\">\n"
+                              "    <node name=\"Length\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
+                              "  </node>\n"
+                              "  <node name=\"Box\" length=\"2byte\">\n"
+                              "    <node name=\"A\" length=\"1byte\"/>\n"
+                              "    <node name=\"B\" length=\"1byte\" ifhook=\"2222\"/>\n"
+                              "  </node>\n",
+                              "pdulength=\"node[@name='Header']/node[@name='Length']\" pdulengthadd=\"2\""));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_EQ(f.proto->pdu_fixed_len, 2u);
+    EXPECT_TRUE(find(*f.proto, "B")->is_conditional());
+    EXPECT_EQ(f.messages().find("warning"), std::string::npos) << f.messages();
+}
+
 }  // namespace
 }  // namespace dissgen::testing
