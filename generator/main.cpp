@@ -72,6 +72,32 @@ void check_names_against_wireshark(const Protocol& p, Diagnostics& diags, bool a
     }
 }
 
+// The dissgen package installs a plugin per shipped rule file into Wireshark's
+// global folder as dissgen-packaged-STEM.so, built from share/dissgen/rules/STEM.xml.
+// Returns the one whose protocol shares a name with `p`, and that protocol's filter name.
+struct Packaged {
+    std::string plugin, filter;
+};
+Packaged packaged_plugin_for(const Protocol& p, const std::string& system_dir) {
+    const std::string prefix = "dissgen-packaged-", suffix = ".so";
+    std::error_code ec;
+    fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) return {};
+    fs::path rules_dir = exe.parent_path().parent_path() / "share" / "dissgen" / "rules";
+    for (fs::directory_iterator it(system_dir, ec), end; !ec && it != end; it.increment(ec)) {
+        std::string f = it->path().filename().string();
+        if (f.size() <= prefix.size() + suffix.size() || f.rfind(prefix, 0) != 0 ||
+            f.compare(f.size() - suffix.size(), suffix.size(), suffix) != 0)
+            continue;
+        fs::path rules = rules_dir / (f.substr(prefix.size(), f.size() - prefix.size() - suffix.size()) + ".xml");
+        Diagnostics ignored;
+        auto other = fs::exists(rules, ec) ? parse_rule_file(rules.string(), ignored) : nullptr;
+        if (other && (other->filter == p.filter || other->abbreviation == p.abbreviation || other->name == p.name))
+            return {it->path().string(), other->filter};
+    }
+    return {};
+}
+
 int cmd_check(const std::string& path) {
     Diagnostics diags;
     Loaded l = load(path, diags);
@@ -142,6 +168,28 @@ int cmd_install(const std::string& path, const std::string& dir, bool system, co
         if (geteuid() == 0)
             std::cerr << "dissgen: note: you are root, and Wireshark run as root ignores per-user plugins; "
                          "installing into " << target_dir << " anyway. Use --system for root's Wireshark.\n";
+    }
+    // A packaged plugin for the same protocol: Wireshark registers per-user plugins
+    // before global ones, so a per-user build takes over and the packaged one steps
+    // aside; two global ones would register in directory order, i.e. unpredictably.
+    if (auto sys = system_plugin_dir()) {
+        std::error_code ec;
+        bool into_system = system || fs::equivalent(target_dir, *sys, ec);
+        auto [packaged, packaged_filter] = packaged_plugin_for(*l.proto, *sys);
+        if (!packaged.empty() && into_system) {
+            std::cerr << "dissgen: the dissgen package's " << packaged << " already provides protocol '"
+                      << packaged_filter << "' in Wireshark's global plugin folder, and Wireshark would load "
+                      << "the two in no fixed order. Install per user instead (without --system; Wireshark run "
+                      << "as root ignores per-user plugins), or first set the packaged plugin aside:\n"
+                      << "  dpkg-divert --local --rename --divert " << packaged << ".disabled --add " << packaged
+                      << "\n";
+            return 1;
+        }
+        if (!packaged.empty())
+            std::cerr << "dissgen: note: the dissgen package's " << packaged << " provides protocol '"
+                      << packaged_filter << "' too. Wireshark registers per-user plugins first, so this one "
+                      << "replaces it for you and the packaged one steps aside. Wireshark run as root keeps the "
+                      << "packaged one.\n";
     }
     std::string runtime = find_runtime_dir(argv0);
     if (runtime.empty()) {

@@ -148,6 +148,13 @@ void store(dg_state *st, const dg_node *n, guint64 value, gint offset, gint leng
     s->node = n;
 }
 
+/* Whether store() uses a leaf's value: a later node reads it (slot) or the
+ * stats tree counts it. Otherwise the walk need not read it from the tvb. */
+gboolean value_wanted(const dg_state *st, const dg_node *n)
+{
+    return n->slot >= 0 || (st->tap && n->show == DG_SHOW_ENUM);
+}
+
 gboolean condition_holds(const dg_state *st, const dg_node *n)
 {
     const dg_slot *s = &st->slots[n->if_slot];
@@ -285,7 +292,7 @@ void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
         proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, n->length, encoding_of(n));
         if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
     }
-    if (n->slot >= 0) store(st, n, (st->group_value >> n->shift) & bit_mask(n->bits), *offset, n->length);
+    if (value_wanted(st, n)) store(st, n, (st->group_value >> n->shift) & bit_mask(n->bits), *offset, n->length);
     if (n->flags & DG_GROUP_LAST) *offset += n->length;
 }
 
@@ -323,10 +330,10 @@ void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
     gint len = (gint)length;
     guint64 value = 0;
     proto_item *item = NULL;
-    /* The value is read only when a later node needs it (store() keeps it),
-     * the item added only when there is a tree. */
+    /* The value is read only when store() uses it, the item added only when
+     * there is a tree. */
     if (n->flags & DG_NUMERIC) {
-        if (n->slot >= 0) value = read_uint(st->tvb, *offset, (guint)len, encoding_of(n));
+        if (value_wanted(st, n)) value = read_uint(st->tvb, *offset, (guint)len, encoding_of(n));
         if (tree) item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, encoding_of(n));
     } else if (len > 0 && tree) {
         item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, ENC_NA);
@@ -594,6 +601,17 @@ extern "C" {
 
 gboolean dg_protocol_names_free(const dg_protocol *p)
 {
+    /* The very same protocol from another plugin (a packaged plugin and the
+     * user's own build of the same rules): the first one registered wins, and
+     * this one steps aside without a dialog at every start. */
+    int same = proto_get_id_by_filter_name(p->filter);
+    if (same != -1 && strcmp(proto_get_protocol_name(same), p->name) == 0 &&
+        strcmp(proto_get_protocol_short_name(find_protocol_by_id(same)), p->short_name) == 0) {
+        /* ws_log, not ws_info: that macro would compile the source path into the plugin */
+        ws_log("dissgen", LOG_LEVEL_INFO, "\"%s\" (%s) is already registered by another plugin; this one steps aside",
+               p->name, p->filter);
+        return FALSE;
+    }
     const char *what = NULL, *value = NULL;
     if (proto_get_id_by_filter_name(p->filter) != -1) {
         what = "filter name";
