@@ -119,8 +119,9 @@ gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char
                what, n->name);
         return FALSE;
     }
-    /* Values beyond 2^40 are past any packet's end anyway; clamping keeps the arithmetic exact. */
-    gint64 v = s->value > (G_GUINT64_CONSTANT(1) << 40) ? (G_GINT64_CONSTANT(1) << 40) : (gint64)s->value;
+    /* Values beyond 2^31 are past any packet's end anyway; clamping there keeps
+     * even "* 999999999" (the largest operand the generator accepts) in range. */
+    gint64 v = s->value > (G_GUINT64_CONSTANT(1) << 31) ? (G_GINT64_CONSTANT(1) << 31) : (gint64)s->value;
     switch (ref->op) {
     case '+': v += ref->operand; break;
     case '-': v -= ref->operand; break;
