@@ -27,7 +27,7 @@ import time
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import TsharkEnv, run_unittests  # noqa: E402
+from tshark_env import SANITIZE, TsharkEnv, run_unittests  # noqa: E402
 
 ARGS = None
 ENV = None       # our plugins installed (ENIPR + EtherCAT)
@@ -367,6 +367,7 @@ def ethercat_frame():
 
 
 class Loading(unittest.TestCase):
+    @unittest.skipIf(SANITIZE, "tshark -G plugins cannot run with the sanitizer runtimes preloaded")
     def test_enip_and_ethercat_plugins_load_together(self):
         rows = ENV.assert_plugin_loaded("enipr")
         names = [r[0] for r in rows]
