@@ -382,6 +382,9 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
         }
         std::string own = n.segment.empty() ? "" : prefix + "." + n.segment;
         n.filter_name = own;
+        if (!own.empty() && is_reserved_expert_name(proto_.filter, own))
+            diags_.error(n.line, "filter name '" + own + "' is reserved for the protocol's expert infos; "
+                                 "give " + quote(n) + " or its container another 'filter'");
         if (!own.empty()) {
             auto [it, inserted] = filter_owner_.emplace(own, &n);
             if (!inserted)
@@ -401,6 +404,12 @@ void Validator::assign_slots() {
 }
 
 }  // namespace
+
+bool is_reserved_expert_name(const std::string& protocol_filter, const std::string& field_filter) {
+    for (const char* expert : kExpertNames)
+        if (field_filter == protocol_filter + ".expert." + expert) return true;
+    return false;
+}
 
 std::string segment_from_name(const std::string& name) {
     std::string out;

@@ -18,4 +18,10 @@ std::string segment_from_name(const std::string& name);
 
 bool is_valid_filter_segment(const std::string& s);
 
+// Every generated protocol registers these expert infos as P.expert.NAME
+// (emit_cpp.cpp), so no field may take those filter names.
+constexpr const char* kExpertNames[] = {"truncated", "past_end", "more_no_data", "count_short", "bad_length",
+                                        "unused"};
+bool is_reserved_expert_name(const std::string& protocol_filter, const std::string& field_filter);
+
 }  // namespace dissgen

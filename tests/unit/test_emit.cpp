@@ -292,3 +292,22 @@ TEST(Validate, IfhookNodesHaveNoFixedSizeAndMayHoldThePduLength) {
 
 }  // namespace
 }  // namespace dissgen::testing
+
+namespace dissgen::testing {
+namespace {
+
+// The validator reserves kExpertNames because the emitter registers exactly those.
+TEST(Emit, ExpertInfosAreExactlyTheReservedNames) {
+    Front f = front_end(rules("<node name=\"A\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    size_t registered = 0;
+    for (size_t at = code.find("\"tst.expert."); at != std::string::npos; at = code.find("\"tst.expert.", at + 1))
+        ++registered;
+    EXPECT_EQ(registered, sizeof kExpertNames / sizeof kExpertNames[0]);
+    for (const char* name : kExpertNames)
+        EXPECT_TRUE(contains(code, std::string("\"tst.expert.") + name + "\"")) << name;
+}
+
+}  // namespace
+}  // namespace dissgen::testing
