@@ -31,6 +31,7 @@ private:
     void layout_children(std::vector<std::unique_ptr<Node>>& children);
     void close_group(std::vector<Node*>& group, unsigned bits);
     std::optional<uint64_t> fixed_bytes(const Node& n) const;
+    std::optional<uint64_t> children_fixed_bytes(const Node& n) const;
     void check_fixed_container(const Node& n);
     void check_reference(Node& n, const FieldRef& ref, const std::string& what);
     void check_pdulength();
@@ -216,8 +217,13 @@ std::optional<uint64_t> Validator::fixed_bytes(const Node& n) const {
     if (n.is_repeated() || n.is_conditional()) return std::nullopt;
     if (n.has_fixed_length()) return n.fixed_bits / 8;
     if (n.length_kind != LengthKind::Children || n.is_leaf()) return std::nullopt;
-    uint64_t sum = 0;
-    uint64_t group_bits = 0;
+    return children_fixed_bytes(n);
+}
+
+// The bytes n's children take when all of them have a fixed size (bit groups
+// count by their whole bytes); nullopt when one of them is variable.
+std::optional<uint64_t> Validator::children_fixed_bytes(const Node& n) const {
+    uint64_t sum = 0, group_bits = 0;
     for (const auto& c : n.children) {
         if (c->in_bit_group) {
             group_bits += c->bits;
@@ -232,19 +238,10 @@ std::optional<uint64_t> Validator::fixed_bytes(const Node& n) const {
 
 void Validator::check_fixed_container(const Node& n) {
     if (!n.has_fixed_length()) return;
-    uint64_t sum = 0, group_bits = 0;
-    for (const auto& c : n.children) {
-        if (c->in_bit_group) {
-            group_bits += c->bits;
-            continue;
-        }
-        auto b = fixed_bytes(*c);
-        if (!b) return;  // variable children: checked at run time
-        sum += *b;
-    }
-    sum += group_bits / 8;
-    if (sum != n.fixed_bits / 8)
-        diags_.error(n.line, "children of " + quote(n) + " add up to " + std::to_string(sum) + " bytes, but its length is " +
+    auto sum = children_fixed_bytes(n);
+    if (!sum) return;  // variable children: checked at run time
+    if (*sum != n.fixed_bits / 8)
+        diags_.error(n.line, "children of " + quote(n) + " add up to " + std::to_string(*sum) + " bytes, but its length is " +
                                  std::to_string(n.fixed_bits / 8) + " bytes");
 }
 
