@@ -38,17 +38,17 @@ std::string plugin_basename(const std::string& rule_path) {
     return "dissgen_" + stem;
 }
 
-std::string find_runtime_dir(const std::string& argv0) {
-    if (const char* env = std::getenv("DISSGEN_RUNTIME_DIR"); env && has_runtime(env)) return env;
+std::string share_dir(const std::string& argv0) {
     std::error_code ec;
     fs::path exe = fs::read_symlink("/proc/self/exe", ec);
     if (ec) exe = fs::absolute(argv0, ec);
-    fs::path installed = exe.parent_path().parent_path() / "share" / "dissgen" / "runtime";
-    if (has_runtime(installed)) return installed.string();
-#ifdef DISSGEN_SOURCE_RUNTIME_DIR
-    if (has_runtime(DISSGEN_SOURCE_RUNTIME_DIR)) return DISSGEN_SOURCE_RUNTIME_DIR;
-#endif
-    return "";
+    return (exe.parent_path().parent_path() / "share" / "dissgen").string();
+}
+
+std::string find_runtime_dir(const std::string& argv0) {
+    if (const char* env = std::getenv("DISSGEN_RUNTIME_DIR"); env && has_runtime(env)) return env;
+    fs::path installed = fs::path(share_dir(argv0)) / "runtime";
+    return has_runtime(installed) ? installed.string() : "";
 }
 
 std::string build_and_install(const BuildRequest& req, std::string& installed_path) {

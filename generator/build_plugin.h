@@ -16,8 +16,12 @@ struct BuildRequest {
 // Returns "" on success, else a message for the user.
 std::string build_and_install(const BuildRequest& request, std::string& installed_path);
 
-// The folder holding dissgen_runtime.{h,cpp}: $DISSGEN_RUNTIME_DIR, the
-// installed share/dissgen/runtime beside the executable, or the source tree.
+// <exe>/../share/dissgen: the runtime and shipped rules of an installed
+// dissgen, and (through links CMake makes) of build/bin/dissgen.
+std::string share_dir(const std::string& argv0);
+
+// The folder holding dissgen_runtime.{h,cpp}: $DISSGEN_RUNTIME_DIR, else
+// share_dir()/runtime; "" when neither has it.
 std::string find_runtime_dir(const std::string& argv0);
 
 // "dissgen_<stem>" with the stem reduced to [A-Za-z0-9_-].

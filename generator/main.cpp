@@ -78,12 +78,10 @@ void check_names_against_wireshark(const Protocol& p, Diagnostics& diags, bool a
 struct Packaged {
     std::string plugin, filter;
 };
-Packaged packaged_plugin_for(const Protocol& p, const std::string& system_dir) {
+Packaged packaged_plugin_for(const Protocol& p, const std::string& system_dir, const std::string& argv0) {
     const std::string prefix = "dissgen-packaged-", suffix = ".so";
     std::error_code ec;
-    fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-    if (ec) return {};
-    fs::path rules_dir = exe.parent_path().parent_path() / "share" / "dissgen" / "rules";
+    fs::path rules_dir = fs::path(share_dir(argv0)) / "rules";
     for (fs::directory_iterator it(system_dir, ec), end; !ec && it != end; it.increment(ec)) {
         std::string f = it->path().filename().string();
         if (f.size() <= prefix.size() + suffix.size() || f.rfind(prefix, 0) != 0 ||
@@ -175,7 +173,7 @@ int cmd_install(const std::string& path, const std::string& dir, bool system, co
     if (auto sys = system_plugin_dir()) {
         std::error_code ec;
         bool into_system = system || fs::equivalent(target_dir, *sys, ec);
-        auto [packaged, packaged_filter] = packaged_plugin_for(*l.proto, *sys);
+        auto [packaged, packaged_filter] = packaged_plugin_for(*l.proto, *sys, argv0);
         if (!packaged.empty() && into_system) {
             std::cerr << "dissgen: the dissgen package's " << packaged << " already provides protocol '"
                       << packaged_filter << "' in Wireshark's global plugin folder, and Wireshark would load "
