@@ -156,15 +156,20 @@ gboolean value_wanted(const dg_state *st, const dg_node *n)
     return n->slot >= 0 || (st->tap && n->show == DG_SHOW_ENUM);
 }
 
+/* Whether value lies in one of the `count` ranges from ranges[first] on. */
+gboolean in_ranges(const dg_protocol *p, guint16 first, guint16 count, guint64 value)
+{
+    for (guint i = 0; i < count; i++) {
+        const dg_range *r = &p->ranges[first + i];
+        if (value >= r->low && value <= r->high) return TRUE;
+    }
+    return FALSE;
+}
+
 gboolean condition_holds(const dg_state *st, const dg_node *n)
 {
     const dg_slot *s = &st->slots[n->if_slot];
-    if (!s->present) return FALSE;
-    for (guint i = 0; i < n->in_count; i++) {
-        const dg_range *r = &st->p->ranges[n->in_first + i];
-        if (s->value >= r->low && s->value <= r->high) return TRUE;
-    }
-    return FALSE;
+    return s->present && in_ranges(st->p, n->in_first, n->in_count, s->value);
 }
 
 /* Summary text is built with memcpy appends (wmem_strbuf_append copies with
@@ -474,11 +479,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
 
 gboolean hook_holds(const dg_state *st, const dg_node *n)
 {
-    for (guint i = 0; i < n->hook_count; i++) {
-        const dg_range *r = &st->p->ranges[n->hook_first + i];
-        if (st->hook_value >= r->low && st->hook_value <= r->high) return TRUE;
-    }
-    return FALSE;
+    return in_ranges(st->p, n->hook_first, n->hook_count, st->hook_value);
 }
 
 void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
