@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """dissgen's EtherCAT plugin against Wireshark's own, a Lua dissector and the floor (Python 3 stdlib only).
 
     python3 bench/bench.py [--runs 3] [--frames 200000] [--json results.json]

@@ -1,3 +1,4 @@
+-- SPDX-License-Identifier: GPL-2.0-or-later
 -- EtherCAT datagrams as a Wireshark user would write them in Lua: the baseline that
 -- bench/bench.py compares the dissgen plugin with. Same fields as rules/ethercat.xml
 -- (header length/reserved/type, then datagrams until one has M = 0, inside the header's

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Write a large, valid dissgen rule file for timing `dissgen install` (Python 3 stdlib only).
 
     gen_rules.py [--fields 2000] -o big.xml

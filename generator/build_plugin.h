@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Stage 4 (install): compile generated C++ with the runtime against the
 // installed libwireshark and place the plugin where Wireshark loads it.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Diagnostics: every message carries the source line of the element it is
 // about, from parsing to the final "FILE:LINE: error: MESSAGE" text.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 #include "emit_cpp.h"
 
 #include <cstdio>
@@ -199,6 +200,10 @@ void Emitter::header() {
        << " * Edit the rule file and regenerate: dissgen install " << source_ << "\n"
        << " *\n"
        << " * Protocol " << p_.name << " (" << p_.abbreviation << "), display filter \"" << p_.filter << "\".\n"
+       << " *\n"
+       << " * It is built with the dissgen runtime and libwireshark, both under the\n"
+       << " * GNU General Public License, version 2 or later: so is the plugin.\n"
+       << " * SPDX-License-Identifier: GPL-2.0-or-later\n"
        << " */\n"
        << "#include \"dissgen_runtime.h\"\n\n";
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Stage 3: validated model -> C++ source of a Wireshark plugin that plugs
 // into plugin_runtime/. The output is deterministic: no timestamps, no
 // absolute paths, so golden files can diff it.

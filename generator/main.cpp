@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // dissgen: rule file (XML) -> Wireshark dissector plugin.
 //
 //   dissgen check FILE.xml                 validate only

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // The rule model: plain data describing one protocol as a tree of fields.
 // The parser fills in what the file says; the validator checks it and adds
 // what follows from it (bit groups, filter names, value slots).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Stage 1: rule file (XML) -> model. Reads the document with libxml2,
 // checks elements and attributes, parses attribute values and resolves every
 // XPath with libxml2's XPath engine (the node itself is the context node).

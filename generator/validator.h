@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Stage 2: check a parsed protocol against the rule language and derive what
 // the emitter needs: effective byte orders and display types, bit groups and
 // masks, display-filter names, and the value slots that lengths, counts,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // What the generator needs to know about the installed Wireshark: its
 // version (headers and tshark), its plugin folders, and its protocol names.
 #pragma once

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 # Debian package of dissgen, included from the top CMakeLists.txt.
 #
 #   cmake --build build --target package        # or: cd build && cpack -G DEB

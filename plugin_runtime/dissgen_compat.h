@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* The one place that knows how Wireshark's plugin API differs between the
  * versions dissgen supports; generated code and the runtime include only
  * this. */

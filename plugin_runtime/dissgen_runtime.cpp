@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* The table walk behind every dissgen-generated dissector.
  *
  * Wireshark's exceptions are longjmps that skip C++ destructors, so nothing

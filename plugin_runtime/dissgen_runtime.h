@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 /* The runtime that dissgen-generated dissectors plug into.
  *
  * Generated code describes a protocol as static tables (hf_register_info,

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # Configures and builds dissgen, its unit tests and a plugin per rules/*.xml.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # The main job, on a fresh Debian bookworm machine: install what is missing,
 # build, generate the EtherCAT plugin from rules/ethercat.xml and decode the
 # shipped sample capture with tshark.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # Installs the Debian packages dissgen needs to build, run and test, if any
 # are missing. Uses sudo when not root.
 set -euo pipefail

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // libFuzzer target for the generator's front end: bytes in, diagnostics or a
 // model (and its generated C++) out. Any crash, leak, hang or sanitizer
 // report on a mutated rule file is a bug.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # Builds the libFuzzer target for the rule-file front end (clang, with
 # AddressSanitizer and UndefinedBehaviorSanitizer) and runs it for a bounded
 # time, seeded with every rule file in the repository. The corpus lives in a

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Convert an XWD image (e.g. Xvfb's -fbdir frame buffer, Xvfb_screen0) to PNG.
 
     xwd2png.py SCREEN.xwd OUT.png [--crop X,Y,W,H] [--scale N]

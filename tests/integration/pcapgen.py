@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """EtherCAT capture generator, reader and reference decoder (Python 3 stdlib only).
 
 Library:

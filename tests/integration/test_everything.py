@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Every construct of the rule language at once: tests/rules/everything.xml.
 
 A protocol-specific encoder (Python 3 stdlib only) builds randomised but valid

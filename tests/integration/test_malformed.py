@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Malformed EtherCAT frames through the plugin generated from rules/ethercat.xml.
 
 tshark must exit 0 with nothing on stderr, the rules protocol must never

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """How a dissgen plugin lives in the installed Wireshark (real tshark, real plugins).
 
 - `dissgen install` puts a plugin that tshark loads with no warning;

@@ -20,6 +20,7 @@
 # Environment: CXX (default c++); DISSGEN_DEBIAN_MIRROR overrides the mirror
 # taken from the machine's apt sources; DISSGEN_MULTIVERSION_SUITES (default
 # "trixie sid").
+# SPDX-License-Identifier: GPL-2.0-or-later
 set -uo pipefail
 
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -30,7 +31,7 @@ while [ $# -gt 0 ]; do
     --dissgen) dissgen="$2"; shift 2 ;;
     --dissgen=*) dissgen="${1#*=}"; shift ;;
     --keep) keep=1; shift ;;
-    -h|--help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "compile_all.sh: unknown argument $1 (try --help)" >&2; exit 2 ;;
   esac
 done

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # The Debian package, for real: build it with CPack, install it, use it as a
 # user would (outside the source tree), remove it and check nothing is left.
 # It installs and removes system files, so it runs only in CI (CI set) as root

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # `dissgen install` builds only when the Wireshark headers (pkg-config
 # --modversion wireshark) and the installed Wireshark (tshark --version) are the
 # same major.minor release: Wireshark's loader rejects any other plugin with

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Every ```xml example in the user documentation is a rule file that must
 // behave as the text says: valid, or (when its first line is
 // <!-- expect: LINE: error: MESSAGE -->) rejected with that diagnostic.

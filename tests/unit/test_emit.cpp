@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Stage 3 (generator/emit_cpp.cpp): how fields are registered with Wireshark
 // (field_type), value strings, hooks, and the `dissgen fields` listing.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // The generated C++ of the shipped rules and of the paper's example is kept
 // in tests/golden, so any change in emitted code shows up as a diff.
 // Regenerate with: UPDATE_GOLDEN=1 ctest -R Golden

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Stage 1 (generator/parser.cpp): numbers, length forms, 'in' lists,
 // arithmetic tails, XPath resolution relative to the node, line numbers.
 #include <gtest/gtest.h>

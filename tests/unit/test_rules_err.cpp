@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Rule files as data, one test per file (found at run time, so adding a file
 // adds a test):
 //   tests/rules_err/*.xml  one mistake each; the first line is

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Helpers shared by the unit tests: run the generator's front end on a rule
 // file or on text, and read files of the source tree.
 #pragma once

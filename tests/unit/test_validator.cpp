@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // Stage 2 (generator/validator.cpp): display-filter names, bit-group layout,
 // defaults and inheritance, references, slots, pdulength and summaries.
 #include <gtest/gtest.h>
