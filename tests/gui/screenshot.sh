@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # The real Wireshark GUI with a dissgen plugin, headless: install the EtherCAT
 # plugin for an unprivileged user in a temporary HOME, start Wireshark (Qt)
 # under Xvfb on samples/ethercat-demo.pcap, go to a frame, expand the rules'
@@ -99,6 +100,15 @@ else
 fi
 user_env=(env -i HOME="$home" PATH=/usr/bin:/bin LANG=C.UTF-8 LC_ALL=C.UTF-8 TZ=UTC TMPDIR=/tmp
           XDG_RUNTIME_DIR="$home/run" XDG_CONFIG_HOME="$home/.config")
+
+# What that user runs and reads is staged in $work: the checkout (build/bin/dissgen,
+# the rules, the runtime its share/dissgen links to) may sit in a private folder.
+mkdir -p "$work/prefix/bin" "$work/prefix/share" "$work/rules"
+cp "$dissgen" "$work/prefix/bin/dissgen"
+cp -rL "$(dirname "$dissgen")/../share/dissgen" "$work/prefix/share/dissgen"
+cp "$rules" "$work/rules/"
+dissgen="$work/prefix/bin/dissgen" rules="$work/rules/$(basename "$rules")"
+chmod -R a+rX "$work/prefix" "$work/rules"
 
 # --- the plugin, for that user ---------------------------------------------------
 if [ -n "$also" ]; then

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Differential test: dissgen's EtherCAT plugin (ecatr) against Wireshark's own plugin
 (ecatf/ecat) and against the bytes' ground truth.  Python 3 stdlib only.
 
@@ -840,10 +841,7 @@ def corpus(args):
         t0 = time.time()
         total = 0
         for path in files:
-            cap = path
-            if env.as_nobody and not readable_by_nobody(path):
-                with open(path, "rb") as fh:     # a private copy in the temporary HOME only
-                    cap = env.add_file(os.path.basename(path), fh.read())
+            cap = env.readable(path)     # a copy in the temporary HOME if need be
             packets = list(pcapgen.read_capture(path))
             ours_text, ws_json, _ = run_sides(env, cap, fieldset, "corpus")
             before = (stats.frames_pass, stats.frames_fail)
@@ -856,21 +854,6 @@ def corpus(args):
     finally:
         env.cleanup()
     return 0 if stats.frames_fail == 0 else 1
-
-
-def readable_by_nobody(path):
-    p = os.path.abspath(path)
-    st = os.stat(p)
-    if not st.st_mode & 0o004:
-        return False
-    d = os.path.dirname(p)
-    while True:
-        if not os.stat(d).st_mode & 0o001:
-            return False
-        nd = os.path.dirname(d)
-        if nd == d:
-            return True
-        d = nd
 
 
 def main(argv=None):

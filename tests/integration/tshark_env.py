@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """A throw-away HOME for running tshark with a per-user dissgen plugin (Python 3 stdlib only).
 
 As root, Wireshark ignores per-user plugins, so tshark is run as uid/gid 65534 (setpriv) when
@@ -55,11 +56,14 @@ def wireshark_abi():
     return "%s.%s" % m.groups()
 
 
-def _world_traversable(path):
+def readable_by_others(path):
+    """Whether any user can read path: the file is world-readable and every folder above it
+    world-searchable (a checkout in a mode-700 folder is not, whoever owns it)."""
     path = os.path.abspath(path)
+    if os.path.isfile(path) and not os.stat(path).st_mode & stat.S_IROTH:
+        return False
     while True:
-        st = os.stat(path)
-        if not st.st_mode & stat.S_IXOTH:
+        if os.path.isdir(path) and not os.stat(path).st_mode & stat.S_IXOTH:
             return False
         parent = os.path.dirname(path)
         if parent == path:
@@ -81,7 +85,7 @@ class TsharkEnv:
     def __init__(self, keep=False, prefix="dissgen-tshark-", tshark="tshark"):
         self.as_nobody = os.geteuid() == 0
         base = tempfile.gettempdir()
-        if self.as_nobody and not _world_traversable(base):
+        if self.as_nobody and not readable_by_others(base):
             base = "/tmp"
         self.home = tempfile.mkdtemp(prefix=prefix, dir=base)
         os.chmod(self.home, 0o755)
@@ -103,6 +107,19 @@ class TsharkEnv:
             fh.write(blob)
         os.chmod(p, 0o644)
         return p
+
+    def readable(self, path):
+        """A path to the file at path that the tshark user can read: path itself when it
+        can, else a copy in HOME (the checkout or the corpus may sit in a private folder)."""
+        if not self.as_nobody or readable_by_others(path):
+            return path
+        staged = os.path.join(self.home, "staged")
+        os.makedirs(staged, mode=0o755, exist_ok=True)
+        copy = os.path.join(staged, os.path.basename(path))
+        if not os.path.exists(copy):
+            shutil.copyfile(path, copy)
+            os.chmod(copy, 0o644)
+        return copy
 
     # -- plugin --------------------------------------------------------------
     def install_plugin(self, dissgen, rules, extra_args=()):
