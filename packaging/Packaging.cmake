@@ -62,20 +62,31 @@ endfunction()
 dissgen_install_gzipped(${CMAKE_CURRENT_LIST_DIR}/dissgen.1 ${CMAKE_INSTALL_MANDIR}/man1)
 dissgen_install_gzipped(${CMAKE_SOURCE_DIR}/README.md ${CMAKE_INSTALL_DOCDIR})
 
-# Debian's changelog and copyright (the latter once the project has a LICENSE file).
+# The Maintainer field names whoever builds and distributes the package: set
+# DISSGEN_PACKAGE_MAINTAINER, or DEBFULLNAME and DEBEMAIL as for any Debian
+# packaging. The project has no mail address yet: the default says so with a
+# reserved .invalid domain (RFC 2606; a well-formed address that never delivers).
+if(DEFINED ENV{DEBFULLNAME} AND DEFINED ENV{DEBEMAIL})
+  set(maintainer_default "$ENV{DEBFULLNAME} <$ENV{DEBEMAIL}>")
+else()
+  set(maintainer_default "dissgen developers <maintainers@dissgen.invalid>")
+endif()
+set(DISSGEN_PACKAGE_MAINTAINER "${maintainer_default}" CACHE STRING
+    "Maintainer of the Debian package: \"Name <address>\"")
+
+# Debian's changelog, and the machine-readable copyright file (DEP-5; the
+# licence itself is LICENSE, the GPL version 2 text).
 string(TIMESTAMP changelog_date "%a, %d %b %Y %H:%M:%S +0000" UTC)   # honours SOURCE_DATE_EPOCH
 configure_file(${CMAKE_CURRENT_LIST_DIR}/changelog.Debian.in
                ${CMAKE_BINARY_DIR}/packaging/changelog.Debian @ONLY)
 dissgen_install_gzipped(${CMAKE_BINARY_DIR}/packaging/changelog.Debian ${CMAKE_INSTALL_DOCDIR})
-if(EXISTS ${CMAKE_SOURCE_DIR}/LICENSE)
-  install(FILES ${CMAKE_SOURCE_DIR}/LICENSE DESTINATION ${CMAKE_INSTALL_DOCDIR} RENAME copyright)
-endif()
+install(FILES ${CMAKE_CURRENT_LIST_DIR}/copyright DESTINATION ${CMAKE_INSTALL_DOCDIR})
 
 # --- package metadata ------------------------------------------------------------
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME dissgen)
 set(CPACK_PACKAGE_VENDOR "dissgen developers")
-set(CPACK_PACKAGE_CONTACT "dissgen developers <dev@dissgen.example>")
+set(CPACK_PACKAGE_CONTACT "${DISSGEN_PACKAGE_MAINTAINER}")
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Wireshark dissector plugins from XML protocol rules")
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_STRIP_FILES TRUE)

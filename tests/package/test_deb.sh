@@ -104,7 +104,8 @@ for dep in "libwireshark-dev (>= $abi)" "libwireshark-dev (<< $next_abi)" libxml
 done
 for f in /usr/bin/dissgen /usr/share/dissgen/runtime/dissgen_runtime.h \
          /usr/share/dissgen/runtime/dissgen_runtime.cpp /usr/share/dissgen/runtime/dissgen_compat.h \
-         /usr/share/dissgen/rules/ethercat.xml "$packaged_plugin" /usr/share/man/man1/dissgen.1.gz; do
+         /usr/share/dissgen/rules/ethercat.xml "$packaged_plugin" /usr/share/man/man1/dissgen.1.gz \
+         /usr/share/doc/dissgen/copyright; do
   check "contains $f" grep -qx "$f" "$work/contents"
 done
 check "everything is under /usr, nothing in /usr/local" \
@@ -113,6 +114,22 @@ mkdir "$work/x"
 dpkg-deb -x "$deb" "$work/x"
 leaks=$(grep -rlF -e "$source_dir" -e "$build_dir" -e /usr/local "$work/x" 2>/dev/null)
 check "no build or /usr/local path inside any file${leaks:+ (found in: $leaks)}" test -z "$leaks"
+copyright="$work/x/usr/share/doc/dissgen/copyright"
+check "the copyright file is machine-readable (DEP-5), GPL-2+ for all files" \
+  bash -c 'head -1 "$1" | grep -q "^Format: https://www.debian.org/doc/packaging-manuals/copyright-format/1.0/" &&
+           grep -q "^Files: \*$" "$1" && grep -q "^License: GPL-2+$" "$1" &&
+           grep -q "/usr/share/common-licenses/GPL-2" "$1"' _ "$copyright"
+# lintian, when it is there or can be installed (CI): no error, no copyright complaint.
+command -v lintian >/dev/null ||
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends lintian >"$work/lintian-apt.log" 2>&1
+if command -v lintian >/dev/null; then
+  lintian "$deb" >"$work/lintian" 2>&1
+  sed 's/^/  lintian: /' "$work/lintian"
+  check "lintian reports no error and nothing about the copyright file" \
+    bash -c '! grep -q "^E: " "$1" && ! grep -qi "copyright" "$1"' _ "$work/lintian"
+else
+  echo "  (lintian not available: not run)"
+fi
 unstripped=$(find "$work/x" -type f \( -name '*.so' -o -path '*/bin/*' \) -exec sh -c \
   'readelf -S "$1" | grep -q "\.debug_info" && echo "$1"' _ {} \;)
 check "binaries are stripped${unstripped:+ (not: $unstripped)}" test -z "$unstripped"
