@@ -2,7 +2,12 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 # The main job, on a fresh Debian bookworm machine: install what is missing,
 # build, generate the EtherCAT plugin from rules/ethercat.xml and decode the
-# shipped sample capture with tshark.
+# shipped captures with tshark:
+#   samples/replay-sdo-error.pcapng  real traffic (ethercrab master, one EK1914):
+#                                    the bus scan, CoE mailbox exchanges (SDO
+#                                    uploads, one aborted), repeated DC frames
+#   samples/ethercat-demo.pcap       generated frames with cyclic process data (LRW)
+# (samples/README says where they come from.)
 #
 # The plugin goes into a throw-away HOME so your own Wireshark set-up is left
 # alone (for yourself, run: build/bin/dissgen install rules/ethercat.xml).
@@ -17,7 +22,7 @@ version=$(pkg-config --modversion wireshark | cut -d. -f1,2)
 demo_home=$(mktemp -d /tmp/dissgen-demo-XXXXXX)
 trap 'rm -rf "$demo_home"' EXIT
 build/bin/dissgen install rules/ethercat.xml --dir "$demo_home/.local/lib/wireshark/plugins/$version/epan"
-cp samples/ethercat-demo.pcap "$demo_home/"
+cp samples/replay-sdo-error.pcapng samples/ethercat-demo.pcap "$demo_home/"
 chmod -R a+rX "$demo_home"
 
 tshark_as_user() {
@@ -27,14 +32,43 @@ tshark_as_user() {
     HOME="$demo_home" tshark "$@"
   fi
 }
-capture="$demo_home/ethercat-demo.pcap"
-echo
-echo "== tshark -r samples/ethercat-demo.pcap (summary lines)"
-tshark_as_user -r "$capture"
-echo
-echo "== tshark -V, frame 8: the tree built from rules/ethercat.xml"
-tshark_as_user -r "$capture" -V -O ecatr -Y "frame.number == 8"
-echo
-echo "== display filter on a rule field: ecatr.datagram.cmd == 0x0c (LRW)"
-tshark_as_user -r "$capture" -Y "ecatr.datagram.cmd == 0x0c" -T fields -e frame.number \
-  -e ecatr.datagram.lad -e ecatr.datagram.wkc -E occurrence=a -E aggregator=, | head -5
+section() { echo; echo "== $1"; }
+real="$demo_home/replay-sdo-error.pcapng"
+generated="$demo_home/ethercat-demo.pcap"
+# Frames as the slaves returned them: the first slave sets the locally
+# administered bit of the master's source address (10:10:... -> 12:10:...).
+returned="eth.src == 12:10:10:10:10:10"
+
+section "samples/replay-sdo-error.pcapng, a real capture: $(tshark_as_user -r "$real" | wc -l) frames, ECATR in the Protocol column"
+tshark_as_user -r "$real" -c 6
+
+section "the bus scan: what came back (BRD counts the slaves in the working counter, APWR gives the one slave station address 0x1000)"
+echo "frame  command      ADP     ADO     WKC"
+tshark_as_user -r "$real" -Y "frame.number <= 24 && $returned" -T fields \
+  -e frame.number -e _ws.col.Info -e ecatr.datagram.adp -e ecatr.datagram.ado -e ecatr.datagram.wkc |
+  awk -F'\t' '{printf "%5s  %-12s %-7s %-7s %s\n", $1, $2, $3, $4, $5}'
+
+section "a mailbox exchange: CoE SDO uploads written to the slave's mailbox (ADO 0x1000), answers read back (0x1100)"
+echo "(first 16 data bytes: mailbox header, CoE header 0x2000 request / 0x3000 response, SDO command, index, subindex, data)"
+tshark_as_user -r "$real" \
+  -Y "$returned && ecatr.datagram.wkc == 1 && (ecatr.datagram.ado == 0x1000 || ecatr.datagram.ado == 0x1100)" \
+  -T fields -e frame.number -e _ws.col.Info -e ecatr.datagram.ado -e ecatr.datagram.data |
+  awk -F'\t' '{printf "%5s  %-14s ADO %s  %s\n", $1, $2, $3, substr($4, 1, 47)}' | tail -6
+echo "(frame 544: SDO command 0x80, abort: object 0x1001 does not exist, abort code 0x06020000)"
+
+section "frame 544 as Wireshark's tree shows it, from rules/ethercat.xml"
+tshark_as_user -r "$real" -V -O ecatr -Y "frame.number == 544" | sed -n '/^EtherCAT/,$p' | cut -c1-100
+
+section "repeated frames: distributed-clock drift compensation, FRMW of the system time (ADO 0x0910), $(
+  tshark_as_user -r "$real" -Y "ecatr.datagram.cmd == 0x0e && $returned" | wc -l) returned"
+echo "(working counter 0: no slave processed them, as with the BWR to 0x0910 in the scan)"
+echo "frame  time         command     ADO     WKC"
+tshark_as_user -r "$real" -Y "ecatr.datagram.cmd == 0x0e && $returned" -T fields \
+  -e frame.number -e frame.time_relative -e _ws.col.Info -e ecatr.datagram.ado -e ecatr.datagram.wkc |
+  awk -F'\t' '{printf "%5s  %.6f s  %-11s %-7s %s\n", $1, $2, $3, $4, $5}' | head -4
+
+section "cyclic process data (LRW, logical addressing), from the generated samples/ethercat-demo.pcap"
+echo "frame  logical address  lengths  data  working counters (one per datagram of the frame)"
+tshark_as_user -r "$generated" -Y "ecatr.datagram.cmd == 0x0c" -T fields -e frame.number \
+  -e ecatr.datagram.lad -e ecatr.datagram.len -e ecatr.datagram.data -e ecatr.datagram.wkc \
+  -E occurrence=a -E aggregator=, | head -5
