@@ -24,18 +24,29 @@ using namespace dissgen;
 
 namespace {
 
+// Every command and option, each described once: tests/cli/help_vs_man.py
+// checks that packaging/dissgen.1 documents the same ones (and only those).
 const char kUsage[] =
     "usage: dissgen check FILE.xml\n"
     "       dissgen generate FILE.xml -o DIR\n"
     "       dissgen fields FILE.xml\n"
     "       dissgen install FILE.xml [--dir DIR | --system]\n"
+    "       dissgen --help | --version\n"
     "\n"
+    "commands:\n"
     "  check     validate the rule file; diagnostics as FILE:LINE: error: MESSAGE\n"
     "  generate  write the plugin's C++ source (dissgen_STEM.cpp) into DIR\n"
     "  fields    one line per field: display-filter name, Wireshark type, name\n"
     "  install   generate, compile against the installed Wireshark and install the\n"
-    "            plugin: per user by default, --system for Wireshark's global plugin\n"
-    "            folder (needed when Wireshark runs as root), --dir DIR anywhere\n";
+    "            plugin (dissgen_STEM.so), per user by default\n"
+    "\n"
+    "options:\n"
+    "  -o DIR      generate: the folder to write into\n"
+    "  --dir DIR   install: into DIR instead of the per-user plugin folder\n"
+    "  --system    install: into Wireshark's global plugin folder (needed when\n"
+    "              Wireshark runs as root: it ignores per-user plugins)\n"
+    "  -h, --help  print this help and exit\n"
+    "  --version   print dissgen's version and exit\n";
 
 struct Loaded {
     std::unique_ptr<Protocol> proto;
