@@ -272,6 +272,25 @@ class Display10a(unittest.TestCase):
         data = rows[2]["dspt.piece.piece_data"].split("|")
         self.assertEqual([d.replace(":", "").replace(" ", "") for d in data], ["6768", b"abcdefgh".hex()])
 
+    def test_reassembly_faults_give_an_expert_info_where_they_are(self):
+        def tagged(tag, number, data, with_id=True):
+            return bytes([7, tag]) + (struct.pack("<H", 5) if with_id else b"") + struct.pack("<I", number) + data
+        frames = [to_port(tagged(1, 0, b"whole")),                  # 1: clean, one fragment, complete
+                  to_port(tagged(0, 0, b"no id", with_id=False)),   # 2: the id field is not in this message
+                  to_port(tagged(1, 70000, b"far"))]                # 3: fragment number out of range
+        cap = capture("tagged.pcap", frames)
+        rows = both_passes(cap, ["dspt.tagged.tagged_data", "dspt.fragment.count", "dspt.expert.bad_length",
+                                 "_ws.expert"])
+        self.assertEqual(rows[0]["dspt.fragment.count"], "1")
+        self.assertEqual(rows[0]["_ws.expert"], "")
+        for r in rows[1:]:
+            self.assertNotEqual(r["dspt.expert.bad_length"], "", r)
+            self.assertEqual(r["dspt.fragment.count"], "", r)
+        # The fragment's bytes are still shown.
+        self.assertEqual(rows[1]["dspt.tagged.tagged_data"].replace(" ", ""), b"no id".hex())
+        self.assertEqual(rows[2]["dspt.tagged.tagged_data"].replace(" ", ""), b"far".hex())
+        assert_no_exception(cap)
+
     def test_stringz_without_nul_and_string_past_the_end(self):
         no_nul = bytes([1]) + b"Motor\0\0\0" + bytes([2]) + b"ok" + b"unterminated"
         past_end = bytes([1]) + b"Motor\0\0\0" + bytes([40]) + b"short"
