@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "emit_cpp.h"
 
+#include "validator.h"
+
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -110,6 +113,12 @@ const char* show_of(const Node& n) {
         case Display::Address: return "DG_SHOW_ADDRESS";
         case Display::Origin: return "DG_SHOW_BYTES";
         case Display::NonDisplay: return "DG_SHOW_HIDDEN";
+        case Display::String: return "DG_SHOW_STRING";
+        case Display::StringZ: return "DG_SHOW_STRINGZ";
+        case Display::IPv4: return "DG_SHOW_IPV4";
+        case Display::Int: return "DG_SHOW_INT";
+        case Display::Float: return "DG_SHOW_FLOAT";
+        case Display::Time: return "DG_SHOW_TIME";
     }
     return "DG_SHOW_HIDDEN";
 }
@@ -172,6 +181,13 @@ private:
     void node_table();
     void protocol_struct();
     void register_functions();
+    // issue 10a
+    bool uses_reassembly() const;
+    void extra_table();
+    void fragment_declarations();
+    void range_strings(const Node& n);
+    std::string rvals(const Node& n) const { return l_.ident.at(&n) + "_rvals"; }
+    std::map<const Node*, int> extra_index_;
     std::string hf(const Node& n) const { return "hf_" + l_.ident.at(&n); }
     std::string ett(const Node& n) const { return "ett_" + l_.ident.at(&n); }
     std::string vals(const Node& n) const { return l_.ident.at(&n) + "_vals"; }
@@ -187,8 +203,10 @@ private:
 std::string Emitter::run() {
     header();
     declarations();
+    fragment_declarations();
     value_strings();
     tables();
+    extra_table();
     node_table();
     protocol_struct();
     register_functions();
@@ -221,6 +239,10 @@ void Emitter::declarations() {
 void Emitter::value_strings() {
     for (const Node* n : l_.nodes) {
         if (n->is_container() || n->display != Display::Enum) continue;
+        if (n->has_enum_ranges()) {
+            range_strings(*n);
+            continue;
+        }
         bool wide = uses_val64(*n);
         o_ << "static const " << (wide ? "val64_string " : "value_string ") << vals(*n) << "[] = {\n";
         std::set<uint64_t> seen;
@@ -286,6 +308,9 @@ void Emitter::node_table() {
            << n.summary_pieces.size();
         // ifhook ranges (first, count): only where given, the struct defaults them to none.
         if (n.has_hook) o_ << ", " << l_.hook_range_first.at(&n) << ", " << n.hook_list.size();
+        // issue 10a: the node's dg_extra, after the ifhook ranges.
+        if (extra_index_.count(&n))
+            o_ << (n.has_hook ? "" : ", 0, 0") << ", &" << p_.filter << "_extra[" << extra_index_.at(&n) << "]";
         o_ << " },\n";
     }
     if (l_.nodes.empty()) o_ << "    { NULL, NULL, NULL, 0, 0, 0, 0, 0, 0, 0, -1, {-1, 0, 0}, {-1, 0, 0}, -1, -1, 0, 0, 0, 0, 0, 0, 0, 0 }\n";
@@ -306,7 +331,9 @@ void Emitter::protocol_struct() {
        << "    " << f << "_ranges, " << f << "_summary, " << p_.slot_count << ", &ei_" << f << ",\n"
        << "    " << f << "_hooks, " << hook_count << ",\n"
        << "    " << (pdu ? pdu->doc_index - 1 : -1) << ", "
-       << (pdu ? p_.pdu_fixed_len - value_bytes(*pdu) : 0) << ", " << p_.pdulengthadd << "\n};\n\n";
+       << (pdu ? p_.pdu_fixed_len - value_bytes(*pdu) : 0) << ", " << p_.pdulengthadd;
+    if (uses_reassembly()) o_ << ",\n    &" << f << "_reassembly, &" << f << "_fragment_items";  // issue 10a
+    o_ << "\n};\n\n";
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
        << "    return dg_dissect(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";
     if (pdu)
@@ -324,16 +351,25 @@ void Emitter::register_functions() {
         std::string strings = "NULL";
         if (n->is_leaf() && n->display == Display::Enum)
             strings = uses_val64(*n) ? "VALS64(" + vals(*n) + ")" : "VALS(" + vals(*n) + ")";
+        if (n->is_leaf() && n->display == Display::Enum && n->has_enum_ranges()) strings = "RVALS(" + rvals(*n) + ")";
         o_ << (first ? "" : ",\n") << "        { &" << hf(*n) << ",\n          { " << c_string(n->name) << ", "
            << c_string(n->filter_name) << ", " << t.type << ", " << t.display << ", " << strings << ", "
            << hex(t.mask) << ",\n            " << (n->description.empty() ? "NULL" : c_string(n->description))
            << ", HFILL } }";
         first = false;
     }
+    if (uses_reassembly()) {  // issue 10a: the fragment fields of Wireshark's reassembly API
+        for (const auto& fr : fragment_fields(p_)) {
+            o_ << (first ? "" : ",\n") << "        { &frag_hf_" << fr.ident << ",\n          { " << c_string(fr.name)
+               << ", " << c_string(fr.filter) << ", " << fr.type << ", " << fr.display << ", NULL, 0x0, NULL, HFILL } }";
+            first = false;
+        }
+    }
     if (first) o_ << "        { NULL, { NULL, NULL, FT_NONE, BASE_NONE, NULL, 0x0, NULL, HFILL } }";
     o_ << "\n    };\n\n    static gint *ett[] = {\n        &ett_" << f;
     for (const Node* n : l_.nodes)
         if (n->is_container()) o_ << ",\n        &" << ett(*n);
+    if (uses_reassembly()) o_ << ",\n        &frag_ett_fragment,\n        &frag_ett_fragments";
     o_ << "\n    };\n\n    static ei_register_info ei[] = {\n";
     const char* experts[][4] = {
         {"truncated", "PI_MALFORMED", "PI_ERROR", "The packet ends inside a field"},
@@ -356,10 +392,112 @@ void Emitter::register_functions() {
        << "DG_DECLARE_PLUGIN(proto_register_" << f << ", proto_reg_handoff_" << f << ")\n";
 }
 
+// --- issue 10a ---------------------------------------------------------------
+
+bool Emitter::uses_reassembly() const {
+    for (const Node* n : l_.nodes)
+        if (n->reassembles()) return true;
+    return false;
+}
+
+void Emitter::fragment_declarations() {
+    if (!uses_reassembly()) return;
+    o_ << "/* Reassembly across frames (Wireshark's reassembly API). */\n";
+    for (const auto& fr : fragment_fields(p_)) o_ << "static int frag_hf_" << fr.ident << " = -1;\n";
+    const std::string& f = p_.filter;
+    o_ << "static gint frag_ett_fragment = -1;\nstatic gint frag_ett_fragments = -1;\n"
+       << "static reassembly_table " << f << "_reassembly;\n\n"
+       << "static const fragment_items " << f << "_fragment_items = {\n"
+       << "    &frag_ett_fragment, &frag_ett_fragments,\n"
+       << "    &frag_hf_fragments, &frag_hf_fragment, &frag_hf_fragment_overlap, &frag_hf_fragment_overlap_conflicts,\n"
+       << "    &frag_hf_fragment_multiple_tails, &frag_hf_fragment_too_long_fragment, &frag_hf_fragment_error,\n"
+       << "    &frag_hf_fragment_count, &frag_hf_reassembled_in, &frag_hf_reassembled_length,\n"
+       << "    &frag_hf_reassembled_data, \"Fragments\"\n};\n\n";
+}
+
+void Emitter::range_strings(const Node& n) {
+    o_ << "static const range_string " << rvals(n) << "[] = {\n";
+    int digits = static_cast<int>((n.bits + 3) / 4);
+    for (const EnumItem& e : n.enums)
+        o_ << "    { " << hex(e.value, digits) << ", " << hex(e.high, digits) << ", " << c_string(e.name) << " },\n";
+    o_ << "    { 0, 0, NULL }\n};\n\n";
+}
+
+bool needs_extra(const Node& n) {
+    return (n.is_leaf() && (n.display == Display::String || n.display == Display::StringZ ||
+                            n.display == Display::Time)) ||
+           n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles();
+}
+
+void Emitter::extra_table() {
+    std::vector<const Node*> with;
+    for (const Node* n : l_.nodes)
+        if (needs_extra(*n)) {
+            extra_index_[n] = static_cast<int>(with.size());
+            with.push_back(n);
+        }
+    if (with.empty()) return;
+    auto slot = [](const std::optional<FieldRef>& r) { return r && r->target ? r->target->slot : -1; };
+    o_ << "/* What few nodes need beyond dg_node. Columns: encoding, units per second, repeat=\"rest\", direction,\n"
+       << " * dissector, reassembly (id slot, offset ref, number slot, last-flag slot, more-flag slot). */\n"
+       << "static const dg_extra " << p_.filter << "_extra[] = {\n";
+    for (const Node* n : with) {
+        const char* units = n->unit == "s" ? "1" : n->unit == "ms" ? "1000" : n->unit == "us" ? "1000000" : "1000000000";
+        const char* dir = n->direction == Direction::Request ? "DG_DIR_REQUEST"
+                          : n->direction == Direction::Response ? "DG_DIR_RESPONSE" : "DG_DIR_ANY";
+        o_ << "    /* " << n->doc_index - 1 << ": " << n->name << " */\n"
+           << "    { " << (n->encoding == "ascii" ? "ENC_ASCII" : "ENC_UTF_8") << ", " << units << ", "
+           << (n->repeat_rest ? 1 : 0) << ", " << dir << ", " << (n->dissector ? c_string(*n->dissector) : "NULL")
+           << ", " << slot(n->reassemble_id) << ", "
+           << ref_of(n->reassemble_offset ? &*n->reassemble_offset : nullptr) << ", " << slot(n->reassemble_seq)
+           << ", " << slot(n->reassemble_last) << ", " << slot(n->reassemble_more) << " },\n";
+    }
+    o_ << "};\n\n";
+}
+
 }  // namespace
+
+std::vector<FragmentField> fragment_fields(const Protocol& proto) {
+    const std::string& f = proto.filter;
+    return {
+        {"fragments", "Message fragments", f + ".fragments", "FT_NONE", "BASE_NONE"},
+        {"fragment", "Message fragment", f + ".fragment", "FT_FRAMENUM", "BASE_NONE"},
+        {"fragment_overlap", "Message fragment overlap", f + ".fragment.overlap", "FT_BOOLEAN", "BASE_NONE"},
+        {"fragment_overlap_conflicts", "Message fragment overlapping with conflicting data",
+         f + ".fragment.overlap.conflicts", "FT_BOOLEAN", "BASE_NONE"},
+        {"fragment_multiple_tails", "Message has multiple tail fragments", f + ".fragment.multiple_tails",
+         "FT_BOOLEAN", "BASE_NONE"},
+        {"fragment_too_long_fragment", "Message fragment too long", f + ".fragment.too_long_fragment", "FT_BOOLEAN",
+         "BASE_NONE"},
+        {"fragment_error", "Message defragmentation error", f + ".fragment.error", "FT_FRAMENUM", "BASE_NONE"},
+        {"fragment_count", "Message fragment count", f + ".fragment.count", "FT_UINT32", "BASE_DEC"},
+        {"reassembled_in", "Reassembled in", f + ".reassembled_in", "FT_FRAMENUM", "BASE_NONE"},
+        {"reassembled_length", "Reassembled length", f + ".reassembled.length", "FT_UINT32", "BASE_DEC"},
+        {"reassembled_data", "Reassembled data", f + ".reassembled.data", "FT_BYTES", "BASE_NONE"},
+    };
+}
+
+// issue 10a: the Wireshark type of string, stringz, ipv4, int, float and time leaves.
+std::optional<FieldType> typed_field_type(const Node& n) {
+    unsigned bytes = value_bytes(n);
+    switch (n.display) {
+        case Display::String: return FieldType{"FT_STRING", "BASE_NONE", 0};
+        case Display::StringZ: return FieldType{"FT_STRINGZ", "BASE_NONE", 0};
+        case Display::IPv4: return FieldType{"FT_IPv4", "BASE_NONE", 0};
+        case Display::Float: return FieldType{n.fixed_bits == 64 ? "FT_DOUBLE" : "FT_FLOAT", "BASE_NONE", 0};
+        case Display::Time: return FieldType{"FT_RELATIVE_TIME", "BASE_NONE", 0};
+        case Display::Int: {
+            uint64_t mask = 0;
+            if (n.in_bit_group) mask = (n.bits >= 64 ? ~0ull : ((1ull << n.bits) - 1)) << n.shift;
+            return FieldType{"FT_INT" + std::to_string(bytes * 8), "BASE_DEC", mask};
+        }
+        default: return std::nullopt;
+    }
+}
 
 FieldType field_type(const Node& n) {
     if (n.is_container()) return {"FT_NONE", "BASE_NONE", 0};
+    if (auto typed = typed_field_type(n)) return *typed;
     if (!n.is_numeric()) {
         const char* sep = n.display == Display::Address ? "SEP_COLON"
                           : n.display == Display::Origin ? "SEP_SPACE"
@@ -375,6 +513,7 @@ FieldType field_type(const Node& n) {
     std::string base = "BASE_DEC";
     if (n.display == Display::NumberHex) base = "BASE_HEX";
     if (n.display == Display::Enum) base = bytes > 4 ? "BASE_HEX|BASE_VAL64_STRING" : "BASE_HEX";
+    if (n.display == Display::Enum && n.has_enum_ranges()) base = "BASE_HEX|BASE_RANGE_STRING";  // issue 10a
     return {type, base, mask};
 }
 
@@ -389,6 +528,10 @@ std::string list_fields(const Protocol& proto) {
         if (n.filter_name.empty()) return;
         out << n.filter_name << "\t" << field_type(n).type << "\t" << n.name << "\n";
     });
+    bool reassembles = false;  // issue 10a
+    for_each_node(proto.nodes, [&](const Node& n) { reassembles = reassembles || n.reassembles(); });
+    if (reassembles)
+        for (const auto& fr : fragment_fields(proto)) out << fr.filter << "\t" << fr.type << "\t" << fr.name << "\n";
     return out.str();
 }
 

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "model.h"
 
@@ -19,6 +20,13 @@ struct FieldType {
 };
 
 FieldType field_type(const Node& n);
+
+// issue 10a: the fragment fields a reassembling protocol registers
+// (Wireshark's fragment_items): C identifier stem, name, filter name, type, display.
+struct FragmentField {
+    std::string ident, name, filter, type, display;
+};
+std::vector<FragmentField> fragment_fields(const Protocol& proto);
 
 // `source_name` is the rule file's base name, quoted in the header comment.
 std::string emit_cpp(const Protocol& proto, const std::string& source_name);

@@ -12,13 +12,19 @@ const char* display_name(Display d) {
         case Display::Origin: return "origin";
         case Display::Enum: return "enum";
         case Display::NonDisplay: return "nondisplay";
+        case Display::String: return "string";
+        case Display::StringZ: return "stringz";
+        case Display::IPv4: return "ipv4";
+        case Display::Int: return "int";
+        case Display::Float: return "float";
+        case Display::Time: return "time";
     }
     return "?";
 }
 
 bool is_numeric_display(Display d) {
     return d == Display::NumberHex || d == Display::NumberDec || d == Display::Bool ||
-           d == Display::Enum;
+           d == Display::Enum || d == Display::Int || d == Display::Time;
 }
 
 bool Node::is_numeric() const {

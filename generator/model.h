@@ -14,7 +14,14 @@ namespace dissgen {
 
 enum class ByteOrder { Big, Little };
 
-enum class Display { Address, NumberHex, NumberDec, Bool, Origin, Enum, NonDisplay };
+enum class Display {
+    Address, NumberHex, NumberDec, Bool, Origin, Enum, NonDisplay,
+    // issue 10a
+    String, StringZ, IPv4, Int, Float, Time
+};
+
+// issue 10a: direction="request|response" (Any: no such attribute)
+enum class Direction { Any, Request, Response };
 
 enum class LengthKind {
     Children,  // absent or empty: sum of the children
@@ -40,6 +47,9 @@ struct EnumItem {
     uint64_t value = 0;
     std::string name;
     int line = 0;
+    // issue 10a: value="LOW-HIGH" (a range; value is LOW)
+    uint64_t high = 0;
+    bool is_range = false;
 };
 
 struct ValueRange {
@@ -92,11 +102,29 @@ struct Node {
     int slot = -1;                         // value slot, -1 when nobody refers to it
     std::vector<SummaryPiece> summary_pieces;
 
+    // --- issue 10a: display attributes, repeat="rest", direction, hand-off, reassembly ---
+    std::string encoding = "utf-8";        // string, stringz: "ascii" or "utf-8"
+    bool encoding_given = false;
+    std::string unit = "ns";               // time: "ns", "us", "ms" or "s"
+    bool unit_given = false;
+    bool repeat_rest = false;              // repeat="rest": until the enclosing container ends
+    Direction direction = Direction::Any;  // direction="request|response"
+    std::optional<std::string> dissector;  // dissector="NAME": hand the bytes to that dissector
+    std::optional<FieldRef> reassemble_id, reassemble_offset, reassemble_seq, reassemble_last,
+        reassemble_more;
+    bool reassembles() const { return reassemble_id || reassemble_offset || reassemble_seq ||
+                                      reassemble_last || reassemble_more; }
+    bool has_enum_ranges() const {
+        for (const EnumItem& e : enums)
+            if (e.is_range) return true;
+        return false;
+    }
+
     bool is_container() const { return !children.empty(); }
     bool is_leaf() const { return children.empty(); }
-    bool is_repeated() const { return repeat.has_value() || count.has_value(); }
+    bool is_repeated() const { return repeat.has_value() || count.has_value() || repeat_rest; }
     // Decoded only under a condition (if/in or ifhook): may take no bytes.
-    bool is_conditional() const { return if_field.has_value() || has_hook; }
+    bool is_conditional() const { return if_field.has_value() || has_hook || direction != Direction::Any; }
     bool has_fixed_length() const {
         return length_kind == LengthKind::Bits || length_kind == LengthKind::Bytes;
     }

@@ -23,11 +23,18 @@ const std::vector<std::string> kRootAttributes = {"name",   "abbreviation", "eth
                                                   "byteorder", "pdulength", "pdulengthadd"};
 const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displaytype", "repeat",
                                                   "count",  "filter",    "byteorder",   "description",
-                                                  "if",     "in",        "summary",     "ifhook"};
+                                                  "if",     "in",        "summary",     "ifhook",
+                                                  // issue 10a
+                                                  "encoding", "unit", "direction", "dissector", "reassemble-id",
+                                                  "reassemble-offset", "reassemble-seq", "reassemble-last",
+                                                  "reassemble-more"};
 const std::vector<std::string> kEnumAttributes = {"value", "name"};
 const std::vector<std::string> kHookAttributes = {"table", "value"};
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
-                                                "origin",  "enum",      "nondisplay"};
+                                                "origin",  "enum",      "nondisplay",
+                                                // issue 10a
+                                                "string",  "stringz",   "ipv4",      "int",
+                                                "float",   "time"};
 
 int line_of(const xmlNode* el) {
     if (el->type == XML_ELEMENT_NODE && el->line == 65535 && el->psvi)  // set by use_start_lines
@@ -230,6 +237,9 @@ private:
     std::unique_ptr<Node> parse_node(xmlNode* el, Node* parent, int depth);
     void parse_enum(xmlNode* el, Node& node);
     void parse_hook(xmlNode* el, Protocol& proto);
+    void parse_10a_attributes(std::map<std::string, std::string>& attrs, int line, Node& node);
+    void defer_10a_refs(Node& node, xmlNode* el);
+    bool parse_enum_range(const std::string& text, EnumItem& item);
     void parse_length(const std::string& text, int line, Node& node, xmlNode* el);
     void parse_display(const std::string& text, int line, Node& node);
     void parse_in_list(const std::string& text, int line, Node& node);
@@ -393,7 +403,8 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
         if (parse_byteorder(attrs["byteorder"], node->line, order)) node->byteorder_given = order;
     }
     if (attrs.count("displaytype")) parse_display(attrs["displaytype"], node->line, *node);
-    if (attrs.count("repeat")) node->repeat = make_ref(attrs["repeat"], node->line, "repeat", false);
+    if (attrs.count("repeat") && trim(attrs["repeat"]) == "rest") node->repeat_rest = true;  // issue 10a
+    else if (attrs.count("repeat")) node->repeat = make_ref(attrs["repeat"], node->line, "repeat", false);
     if (attrs.count("count")) node->count = make_ref(attrs["count"], node->line, "count", true);
     if (attrs.count("if")) node->if_field = make_ref(attrs["if"], node->line, "if", false);
     if (attrs.count("in")) parse_in_list(attrs["in"], node->line, *node);
@@ -404,6 +415,7 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
         parse_value_list(attrs["ifhook"], node->line, "ifhook", node->hook_list);
     }
     parse_length(attrs.count("length") ? attrs["length"] : "", node->line, *node, el);
+    parse_10a_attributes(attrs, node->line, *node);
 
     for (xmlNode* c = el->children; c; c = c->next) {
         if (c->type == XML_ELEMENT_NODE && element_name(c) == "node")
@@ -417,6 +429,7 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
     if (node->count) defer(*node->count, el, node->line, "count");
     if (node->if_field) defer(*node->if_field, el, node->line, "if");
     if (node->length_kind == LengthKind::Field) defer(node->length_ref, el, node->line, "length");
+    defer_10a_refs(*node, el);
     return node;
 }
 
@@ -428,10 +441,12 @@ void Parser::parse_enum(xmlNode* el, Node& node) {
         diags_.error(item.line, "enum items are written <enum value=\"0x0a\" name=\"LRD 读数据\"/>");
         return;
     }
-    if (!parse_number(attrs["value"], item.value)) {
-        diags_.error(item.line, "bad enum value '" + attrs["value"] + "': expected hex (0x0a) or decimal");
+    if (!parse_number(attrs["value"], item.value) && !parse_enum_range(attrs["value"], item)) {
+        diags_.error(item.line, "bad enum value '" + attrs["value"] +
+                                    "': expected hex (0x0a) or decimal, or a range such as 0x11-0x1f");
         return;
     }
+    if (!item.is_range) item.high = item.value;  // issue 10a
     item.name = attrs["name"];
     for (xmlNode* c = el->children; c; c = c->next) unexpected_child(c, "enum", {});
     node.enums.push_back(item);
@@ -440,7 +455,9 @@ void Parser::parse_enum(xmlNode* el, Node& node) {
 void Parser::parse_display(const std::string& text, int line, Node& node) {
     static const Display kValues[] = {Display::Address, Display::NumberHex, Display::NumberDec,
                                       Display::Bool,    Display::Origin,    Display::Enum,
-                                      Display::NonDisplay};
+                                      Display::NonDisplay,
+                                      Display::String,  Display::StringZ,   Display::IPv4,
+                                      Display::Int,     Display::Float,     Display::Time};
     for (size_t i = 0; i < kDisplayNames.size(); ++i) {
         if (text == kDisplayNames[i]) {
             node.display = kValues[i];
@@ -449,7 +466,7 @@ void Parser::parse_display(const std::string& text, int line, Node& node) {
         }
     }
     std::string msg = "unknown displaytype '" + text + "'";
-    std::string near = suggest(text, kDisplayNames);
+    std::string near = text.empty() ? "" : suggest(text, kDisplayNames);
     if (!near.empty()) msg += " (did you mean '" + near + "'?)";
     diags_.error(line, msg + "; valid: " + join(kDisplayNames, ", "));
 }
@@ -541,6 +558,67 @@ FieldRef Parser::make_ref(const std::string& text, int line, const std::string& 
 
 void Parser::defer(FieldRef& ref, xmlNode* context, int line, const std::string& attribute) {
     if (!ref.xpath.empty()) pending_.push_back({&ref, context, line, attribute});
+}
+
+// issue 10a: encoding, unit, direction, dissector and the reassemble-* fields.
+void Parser::parse_10a_attributes(std::map<std::string, std::string>& attrs, int line, Node& node) {
+    if (attrs.count("encoding")) {
+        node.encoding = trim(attrs["encoding"]);
+        node.encoding_given = true;
+        if (node.encoding != "ascii" && node.encoding != "utf-8")
+            diags_.error(line, "bad encoding '" + attrs["encoding"] + "': expected 'ascii' or 'utf-8'");
+    }
+    if (attrs.count("unit")) {
+        node.unit = trim(attrs["unit"]);
+        node.unit_given = true;
+        if (node.unit != "ns" && node.unit != "us" && node.unit != "ms" && node.unit != "s")
+            diags_.error(line, "bad unit '" + attrs["unit"] + "': expected 'ns', 'us', 'ms' or 's'");
+    }
+    if (attrs.count("direction")) {
+        const std::string d = trim(attrs["direction"]);
+        if (d == "request") node.direction = Direction::Request;
+        else if (d == "response") node.direction = Direction::Response;
+        else diags_.error(line, "bad direction '" + attrs["direction"] + "': expected 'request' or 'response'");
+    }
+    if (attrs.count("dissector")) {
+        node.dissector = trim(attrs["dissector"]);
+        bool ok = !node.dissector->empty();
+        for (unsigned char c : *node.dissector)
+            ok = ok && c > 0x20 && c < 0x7f && c != '"' && c != '\\';
+        if (!ok)
+            diags_.error(line, "bad dissector name '" + attrs["dissector"] +
+                                   "': expected a Wireshark dissector name such as eth_withoutfcs");
+    }
+    struct { const char* attribute; std::optional<FieldRef>* ref; bool arithmetic; } refs[] = {
+        {"reassemble-id", &node.reassemble_id, false},     {"reassemble-offset", &node.reassemble_offset, true},
+        {"reassemble-seq", &node.reassemble_seq, false},   {"reassemble-last", &node.reassemble_last, false},
+        {"reassemble-more", &node.reassemble_more, false},
+    };
+    for (auto& r : refs)
+        if (attrs.count(r.attribute)) *r.ref = make_ref(attrs[r.attribute], line, r.attribute, r.arithmetic);
+}
+
+void Parser::defer_10a_refs(Node& node, xmlNode* el) {
+    struct { const char* attribute; std::optional<FieldRef>* ref; } refs[] = {
+        {"reassemble-id", &node.reassemble_id},     {"reassemble-offset", &node.reassemble_offset},
+        {"reassemble-seq", &node.reassemble_seq},   {"reassemble-last", &node.reassemble_last},
+        {"reassemble-more", &node.reassemble_more},
+    };
+    for (auto& r : refs)
+        if (*r.ref) defer(**r.ref, el, node.line, r.attribute);
+}
+
+// "0x0011-0x001f" or "17-31": an enum item for a range of values.
+bool Parser::parse_enum_range(const std::string& text, EnumItem& item) {
+    size_t dash = text.find('-');
+    if (dash == std::string::npos || dash == 0) return false;
+    uint64_t low = 0, high = 0;
+    if (!parse_number(text.substr(0, dash), low) || !parse_number(text.substr(dash + 1), high) || high < low)
+        return false;
+    item.value = low;
+    item.high = high;
+    item.is_range = true;
+    return true;
 }
 
 void Parser::resolve_all() {

@@ -14,6 +14,12 @@ std::string quote(const Node& n) { return "'" + n.name + "'"; }
 
 std::string at_line(const Node& n) { return " (line " + std::to_string(n.line) + ")"; }
 
+// issue 10a: displays that show whole bytes and never join a bit group.
+bool is_byte_display(Display d) {
+    return d == Display::Origin || d == Display::Address || d == Display::String || d == Display::StringZ ||
+           d == Display::IPv4 || d == Display::Float || d == Display::Time;
+}
+
 bool is_ancestor_or_self(const Node* ancestor, const Node* n) {
     for (; n; n = n->parent)
         if (n == ancestor) return true;
@@ -43,6 +49,13 @@ private:
     void assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, const std::string& prefix);
     void mark_slot(Node* n) { if (n) needs_slot_[n] = true; }
     void assign_slots();
+    // issue 10a
+    void check_10a(Node& n);
+    void check_string_display(Node& n);
+    void check_enum_ranges(const Node& n);
+    void check_handoff(const Node& n);
+    void check_reassembly(Node& n);
+    void check_fragment_names();
 
     Protocol& proto_;
     Diagnostics& diags_;
@@ -62,9 +75,11 @@ void Validator::run() {
         if (n.if_field) check_reference(n, *n.if_field, "if");
         if (n.has_hook) check_hook_list(n);
         if (n.summary) parse_summary(n);
+        check_10a(n);
     });
     check_pdulength();
     assign_filter_names(proto_.nodes, proto_.filter);
+    check_fragment_names();
     assign_slots();
 }
 
@@ -114,7 +129,7 @@ void Validator::inherit_and_check_node(Node& n, ByteOrder inherited) {
 }
 
 void Validator::check_leaf_display(Node& n) {
-    if (n.length_kind == LengthKind::Children)
+    if (n.length_kind == LengthKind::Children && n.display != Display::StringZ)
         diags_.warning(n.line, "leaf " + quote(n) + " has no length and no children: it takes no bytes");
     if (!n.display_given) n.display = Display::Origin;
     bool numeric = is_numeric_display(n.display);
@@ -153,8 +168,7 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
         // "Nbyte" counts as 8N bits: a whole-byte leaf inside a group joins it,
         // unless it shows bytes (origin, address), which a group cannot hold.
         bool bit_leaf = n.is_leaf() && (n.length_kind == LengthKind::Bits ||
-                                         (n.length_kind == LengthKind::Bytes && n.display != Display::Origin &&
-                                          n.display != Display::Address));
+                                         (n.length_kind == LengthKind::Bytes && !is_byte_display(n.display)));
         bool whole_bytes = bit_leaf && n.fixed_bits % 8 == 0;
         if (group.empty() && (!bit_leaf || whole_bytes)) {
             if (n.is_container()) layout_children(n.children);
@@ -175,12 +189,15 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
         else if (n.has_hook)
             diags_.error(n.line, "bit field " + quote(n) + " cannot have 'ifhook': it shares bytes with its "
                                  "neighbours in a bit group");
+        else if (n.direction != Direction::Any)  // issue 10a
+            diags_.error(n.line, "bit field " + quote(n) + " cannot have 'direction': it shares bytes with its "
+                                 "neighbours in a bit group");
         // A bit field written without a displaytype shows its value in hex: the
         // nearest thing to origin's "raw bytes in hex" for a part of a byte.
         if (n.display == Display::Origin && !n.display_given) n.display = Display::NumberHex;
-        if (n.display == Display::Origin || n.display == Display::Address)
+        if (is_byte_display(n.display))
             diags_.error(n.line, std::string(display_name(n.display)) + " display needs whole bytes; bit field " +
-                                     quote(n) + " is part of a bit group (use numberhex, numberdec, bool or enum)");
+                                     quote(n) + " is part of a bit group (use numberhex, numberdec, bool, enum or int)");
         if (!group.empty() && n.byteorder != group.front()->byteorder)
             diags_.error(n.line, "bit field " + quote(n) + " has another byte order than its bit group starting at " +
                                      quote(*group.front()));
@@ -399,6 +416,141 @@ void Validator::assign_slots() {
         if (needs_slot_.count(&n)) n.slot = next++;
     });
     proto_.slot_count = next;
+}
+
+// --- issue 10a: display types, range enums, repeat="rest", direction, hand-off, reassembly ---
+
+void Validator::check_10a(Node& n) {
+    if (n.repeat_rest && n.count)
+        diags_.error(n.line, "node " + quote(n) + " has both repeat=\"rest\" and 'count'; use one of them");
+    if (n.encoding_given && n.display != Display::String && n.display != Display::StringZ)
+        diags_.error(n.line, "'encoding' applies to string and stringz leaves; " + quote(n) + " is shown as " +
+                                 display_name(n.display));
+    if (n.unit_given && n.display != Display::Time)
+        diags_.error(n.line, "'unit' applies to time leaves; " + quote(n) + " is shown as " + display_name(n.display));
+    if (n.direction != Direction::Any) {
+        bool port_hook = false;
+        for (const Hook& h : proto_.hooks)
+            if (h.table.size() > 5 && h.table.compare(h.table.size() - 5, 5, ".port") == 0) port_hook = true;
+        if (!port_hook)
+            diags_.warning(n.line, quote(n) + " has a 'direction', but <root> has no <hook> on a port table "
+                                   "(such as udp.port): it is decoded only through Decode As on a port");
+    }
+    if (n.is_leaf()) {
+        check_string_display(n);
+        if (!n.enums.empty() && n.display == Display::Enum) check_enum_ranges(n);
+    }
+    if (n.dissector) check_handoff(n);
+    if (n.reassembles()) check_reassembly(n);
+}
+
+void Validator::check_string_display(Node& n) {
+    const std::string shown = display_name(n.display);
+    switch (n.display) {
+        case Display::String:
+            if (n.length_kind == LengthKind::Children)
+                diags_.error(n.line, "string display needs a length (Nbyte, a length field or 'rest'); " + quote(n) +
+                                         " has none (use stringz for text that ends with a NUL)");
+            [[fallthrough]];
+        case Display::StringZ:
+            if (n.length_kind == LengthKind::Bits && n.fixed_bits % 8 != 0 && !n.in_bit_group)
+                diags_.error(n.line, shown + " display needs whole bytes; " + quote(n) + " is " +
+                                         std::to_string(n.fixed_bits) + " bits");
+            break;
+        case Display::IPv4:
+            if (!n.has_fixed_length() || n.fixed_bits != 32)
+                diags_.error(n.line, "ipv4 display needs a length of 4byte; " + quote(n) + " has another length");
+            break;
+        case Display::Float:
+            if (!n.has_fixed_length() || (n.fixed_bits != 32 && n.fixed_bits != 64))
+                diags_.error(n.line, "float display needs a length of 4byte or 8byte (IEEE 754 single or double); " +
+                                         quote(n) + " has another length");
+            break;
+        case Display::Time:
+            if (n.has_fixed_length() && n.fixed_bits <= 64 && n.fixed_bits % 8 != 0 && !n.in_bit_group)
+                diags_.error(n.line, "time display needs 1 to 8 whole bytes; " + quote(n) + " is " +
+                                         std::to_string(n.fixed_bits) + " bits");
+            break;
+        default: break;
+    }
+}
+
+// Range items become a range_string: at most 32 bits, no two items overlapping.
+void Validator::check_enum_ranges(const Node& n) {
+    if (!n.has_enum_ranges()) return;
+    if (n.bits > 32) {
+        diags_.error(n.line, "enum ranges need a field of at most 32 bits; " + quote(n) + " is " +
+                                 std::to_string(n.bits) + " bits");
+        return;
+    }
+    for (size_t i = 0; i < n.enums.size(); ++i) {
+        const EnumItem& e = n.enums[i];
+        if (e.is_range && n.bits > 0 && n.bits < 64 && e.high >> n.bits)
+            diags_.error(e.line, "enum range up to " + std::to_string(e.high) + " does not fit the " +
+                                     std::to_string(n.bits) + "-bit field " + quote(n));
+        for (size_t j = 0; j < i; ++j) {
+            const EnumItem& f = n.enums[j];
+            if (e.value <= f.high && f.value <= e.high) {
+                diags_.error(e.line, "enum item '" + e.name + "' overlaps item '" + f.name + "' (line " +
+                                         std::to_string(f.line) + ") of " + quote(n) +
+                                         "; with ranges every value must have one name");
+                break;
+            }
+        }
+    }
+}
+
+// dissector= and reassemble-* work on a leaf of bytes with a length.
+bool handoff_leaf_ok(const Node& n) {
+    return n.is_leaf() && n.length_kind != LengthKind::Children && !n.in_bit_group &&
+           (n.display == Display::Origin || n.display == Display::Address || n.display == Display::String ||
+            n.display == Display::StringZ);
+}
+
+void Validator::check_handoff(const Node& n) {
+    if (!handoff_leaf_ok(n))
+        diags_.error(n.line, "dissector=\"" + *n.dissector + "\" needs a leaf of bytes with a length "
+                             "(displaytype origin, address, string or stringz; Nbyte, a length field or 'rest'); " +
+                             quote(n) + (n.is_container() ? " is a container" : " is not one"));
+}
+
+void Validator::check_reassembly(Node& n) {
+    if (!handoff_leaf_ok(n)) {
+        diags_.error(n.line, "reassembly needs a leaf of bytes with a length (displaytype origin, address, string "
+                             "or stringz; Nbyte, a length field or 'rest'); " +
+                                 quote(n) + (n.is_container() ? " is a container" : " is not one"));
+        return;
+    }
+    if (!n.reassemble_id)
+        diags_.error(n.line, "reassembly of " + quote(n) + " needs 'reassemble-id' (the field that tells "
+                                                            "the reassembled messages apart)");
+    if (!n.reassemble_offset == !n.reassemble_seq)
+        diags_.error(n.line, "reassembly of " + quote(n) + " needs exactly one of 'reassemble-offset' (byte offset "
+                                                            "of the fragment) and 'reassemble-seq' (fragment number)");
+    if (!n.reassemble_last == !n.reassemble_more)
+        diags_.error(n.line, "reassembly of " + quote(n) + " needs exactly one of 'reassemble-last' (non-zero on "
+                                                            "the last fragment) and 'reassemble-more' (non-zero when "
+                                                            "more follow)");
+    struct { const char* what; std::optional<FieldRef>* ref; } refs[] = {
+        {"reassemble-id", &n.reassemble_id},     {"reassemble-offset", &n.reassemble_offset},
+        {"reassemble-seq", &n.reassemble_seq},   {"reassemble-last", &n.reassemble_last},
+        {"reassemble-more", &n.reassemble_more},
+    };
+    for (auto& r : refs)
+        if (*r.ref) check_reference(n, **r.ref, r.what);
+}
+
+// The fragment fields every reassembling protocol registers (P.fragments, ...).
+void Validator::check_fragment_names() {
+    bool reassembles = false;
+    for_each_node(proto_.nodes, [&](const Node& n) { reassembles = reassembles || n.reassembles(); });
+    if (!reassembles) return;
+    for (const char* name : kFragmentNames) {
+        auto it = filter_owner_.find(proto_.filter + "." + name);
+        if (it != filter_owner_.end())
+            diags_.error(it->second->line, "filter name '" + it->first + "' is taken by the reassembly's fragment "
+                                           "fields; give " + quote(*it->second) + " another 'filter'");
+    }
 }
 
 }  // namespace

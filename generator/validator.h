@@ -23,6 +23,15 @@ bool is_valid_filter_segment(const std::string& s);
 // (emit_cpp.cpp), so no field may take those filter names.
 constexpr const char* kExpertNames[] = {"truncated", "past_end", "more_no_data", "count_short", "bad_length",
                                         "unused"};
+// issue 10a: a protocol that reassembles registers these fields as P.NAME
+// (emit_cpp.cpp; the fragment_items of Wireshark's reassembly API).
+constexpr const char* kFragmentNames[] = {"fragments",        "fragment",
+                                          "fragment.overlap", "fragment.overlap.conflicts",
+                                          "fragment.multiple_tails", "fragment.too_long_fragment",
+                                          "fragment.error",   "fragment.count",
+                                          "reassembled_in",   "reassembled.length",
+                                          "reassembled.data"};
+
 bool is_reserved_expert_name(const std::string& protocol_filter, const std::string& field_filter);
 
 }  // namespace dissgen

@@ -8,6 +8,17 @@
 #include <epan/packet.h>
 #include <epan/expert.h>
 #include <epan/proto.h>
+/* issue 10a: reassembly and hand-off. reassemble.h and show_exception.h have no C++ guards;
+ * packet-tcp.h includes reassemble.h outside its own, so they come first. */
+#include <epan/exceptions.h>
+#ifdef __cplusplus
+extern "C" {
+#endif
+#include <epan/show_exception.h>
+#include <epan/reassemble.h>
+#ifdef __cplusplus
+}
+#endif
 #include <epan/dissectors/packet-tcp.h>
 #include <wsutil/report_message.h>
 
@@ -47,6 +58,13 @@
 #define dg_tvb_get_uint48 tvb_get_guint48
 #define dg_tvb_get_uint56 tvb_get_guint56
 #define dg_tvb_get_uint64 tvb_get_guint64
+#endif
+
+/* issue 10a: 4.4 renamed tvb_find_guint8 too. */
+#if DG_WS_AT_LEAST(4, 4)
+#define dg_tvb_find_uint8 tvb_find_uint8
+#else
+#define dg_tvb_find_uint8 tvb_find_guint8
 #endif
 
 /* Differences that need no code here, checked against 4.0, 4.4 and 4.6

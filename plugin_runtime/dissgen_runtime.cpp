@@ -12,6 +12,7 @@
 #include <epan/stats_tree.h>
 #include <epan/tap.h>
 
+#include <float.h>
 #include <string.h>
 
 namespace {
@@ -61,6 +62,7 @@ struct dg_state {
     guint64 group_value;  /* the bit group being decoded */
     guint32 hook_value;   /* pinfo->match_uint on entry: the hook (or Decode As) value, for ifhook */
     dg_tap_data *tap;     /* what the stats tree counts; NULL when nobody listens */
+    guint8 direction;     /* issue 10a: DG_DIR_REQUEST/RESPONSE when a port hook matched, else DG_DIR_ANY */
 };
 
 void tap_record(dg_state *st, const dg_node *n, guint64 value)
@@ -208,6 +210,64 @@ void append_hex(wmem_strbuf_t *out, guint64 v, guint digits)
     wmem_strbuf_append_len(out, buf + i, sizeof buf - i);
 }
 
+/* The name an enum's value_string, val64_string or range_string gives the value, or NULL. */
+const char *enum_name(const header_field_info *hfi, guint64 value)
+{
+    if (hfi->display & BASE_RANGE_STRING) return try_rval_to_str((guint32)value, (const range_string *)hfi->strings);
+    if (hfi->display & BASE_VAL64_STRING) return try_val64_to_str(value, (const val64_string *)hfi->strings);
+    return try_val_to_str((guint32)value, (const value_string *)hfi->strings);
+}
+
+/* issue 10a: a time leaf's count of units as an nstime. */
+nstime_t time_of(const dg_node *n, guint64 value)
+{
+    guint64 per_second = n->extra && n->extra->units_per_second ? n->extra->units_per_second : 1000000000u;
+    nstime_t t;
+    t.secs = (time_t)(value / per_second);
+    t.nsecs = (int)((value % per_second) * (1000000000u / per_second));
+    return t;
+}
+
+/* issue 10a: the values of string, stringz, ipv4, int, float and time leaves,
+ * for summaries and the Info column (as the tree item shows them). */
+void append_typed_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s)
+{
+    const dg_node *n = s->node;
+    char buf[64];
+    switch (n->show) {
+    case DG_SHOW_STRING:
+    case DG_SHOW_STRINGZ:
+        if (s->length > 0)
+            append_str(out, (const char *)tvb_get_string_enc(st->pinfo->pool, st->tvb, s->offset, s->length,
+                                                             n->extra ? n->extra->encoding : ENC_UTF_8));
+        return;
+    case DG_SHOW_IPV4: {
+        guint32 a = (guint32)s->value;
+        g_snprintf(buf, sizeof buf, "%u.%u.%u.%u", a >> 24, (a >> 16) & 0xff, (a >> 8) & 0xff, a & 0xff);
+        break;
+    }
+    case DG_SHOW_INT: {
+        guint64 v = s->value;
+        if (n->bits > 0 && n->bits < 64 && (v >> (n->bits - 1)) & 1) v |= ~bit_mask(n->bits);
+        g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "d", (gint64)v);
+        break;
+    }
+    case DG_SHOW_FLOAT:
+        if (s->length == 4)
+            g_snprintf(buf, sizeof buf, "%.*g", FLT_DIG, tvb_get_ieee_float(st->tvb, s->offset, encoding_of(n)));
+        else
+            g_snprintf(buf, sizeof buf, "%.*g", DBL_DIG, tvb_get_ieee_double(st->tvb, s->offset, encoding_of(n)));
+        break;
+    case DG_SHOW_TIME: {
+        nstime_t t = time_of(n, s->value);
+        g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "d.%09d seconds", (gint64)t.secs, t.nsecs);
+        break;
+    }
+    default: return;
+    }
+    append_str(out, buf);
+}
+
 /* Appends a leaf's value as its tree item shows it, for summaries. */
 void append_shown_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s)
 {
@@ -221,12 +281,7 @@ void append_shown_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s
         append_str(out, s->value ? "True" : "False");
         return;
     case DG_SHOW_ENUM: {
-        header_field_info *hfi = proto_registrar_get_nth(*n->hf);
-        const char *name = NULL;
-        if (hfi->display & BASE_VAL64_STRING)
-            name = try_val64_to_str(s->value, (const val64_string *)hfi->strings);
-        else
-            name = try_val_to_str((guint32)s->value, (const value_string *)hfi->strings);
+        const char *name = enum_name(proto_registrar_get_nth(*n->hf), s->value);
         if (name) {
             append_str(out, name);
         } else {
@@ -244,6 +299,10 @@ void append_shown_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s
         return;
     case DG_SHOW_BYTES:
         if (s->length > 0) append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' '));
+        return;
+    case DG_SHOW_STRING: case DG_SHOW_STRINGZ: case DG_SHOW_IPV4: case DG_SHOW_INT: case DG_SHOW_FLOAT:
+    case DG_SHOW_TIME:
+        append_typed_value(st, out, s);
         return;
     default:
         if (n->flags & DG_NUMERIC)
@@ -303,6 +362,127 @@ void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     if (n->flags & DG_GROUP_LAST) *offset += n->length;
 }
 
+/* --- issue 10a: strings, hand-off to other dissectors, reassembly ------- */
+
+/* The encoding a non-numeric leaf's item is added with. */
+guint item_encoding(const dg_node *n)
+{
+    switch (n->show) {
+    case DG_SHOW_STRING: case DG_SHOW_STRINGZ: return n->extra ? n->extra->encoding : ENC_UTF_8;
+    case DG_SHOW_IPV4: case DG_SHOW_FLOAT: return encoding_of(n);
+    default: return ENC_NA;
+    }
+}
+
+/* Bytes from offset to the first NUL before end, NUL included; one more than
+ * is left when there is none. */
+gint64 stringz_length(const dg_state *st, gint offset, gint end)
+{
+    if (offset >= end) return 1;
+    gint nul = dg_tvb_find_uint8(st->tvb, offset, end - offset, 0);
+    return nul < 0 ? (gint64)(end - offset) + 1 : (gint64)(nul - offset) + 1;
+}
+
+/* Per node: the handle its dissector= names (NULL: absent from this Wireshark,
+ * the bytes are shown raw), and the name of its reassembled data source.
+ * Filled at handoff; one protocol per plugin, like stats_protocol. */
+dissector_handle_t *handoff_handles;
+char **reassembled_names;
+
+/* Gives tvb to the leaf's dissector. Its exceptions end its own tree, not our
+ * walk (show_exception, as Wireshark's dissectors do), and it may not
+ * rewrite our Protocol and Info columns. */
+void call_handoff(dg_state *st, dissector_handle_t handle, tvbuff_t *tvb, proto_tree *tree)
+{
+    packet_info *pinfo = st->pinfo;
+    gboolean writable = col_get_writable(pinfo->cinfo, COL_INFO);
+    col_set_writable(pinfo->cinfo, -1, FALSE);
+    TRY {
+        call_dissector(handle, tvb, pinfo, tree);
+    }
+    CATCH_NONFATAL_ERRORS {
+        show_exception(tvb, pinfo, tree, EXCEPT_CODE, GET_MESSAGE);
+    }
+    ENDTRY;
+    col_set_writable(pinfo->cinfo, -1, writable);
+}
+
+/* A slot's value, or FALSE (an expert info, decoding goes on) when the field
+ * is not in this packet. */
+gboolean reassembly_value(dg_state *st, const dg_node *n, gint16 slot, proto_tree *tree, gint offset, guint64 *out)
+{
+    const dg_slot *s = &st->slots[slot];
+    if (!s->present) {
+        proto_tree_add_expert_format(tree, st->pinfo, &st->p->ei->bad_length, st->tvb, offset, 0,
+                                     "'%s' cannot be reassembled: a field it needs is not in this packet", n->name);
+        return FALSE;
+    }
+    *out = s->value;
+    return TRUE;
+}
+
+/* Adds the fragment in tvb[offset, offset+len) to its message; returns the
+ * whole message in the frame that completes it, NULL otherwise. */
+tvbuff_t *add_fragment(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len)
+{
+    const dg_extra *x = n->extra;
+    const dg_protocol *p = st->p;
+    guint64 id = 0, number = 0, flag = 0;
+    gint64 frag_offset = 0;
+    if (!reassembly_value(st, n, x->reassemble_id, tree, offset, &id)) return NULL;
+    if (x->reassemble_seq >= 0 && !reassembly_value(st, n, x->reassemble_seq, tree, offset, &number)) return NULL;
+    if (x->reassemble_offset.slot >= 0 &&
+        !ref_value(st, &x->reassemble_offset, n, "fragment offset", tree, offset, &frag_offset))
+        return NULL;
+    gint16 flag_slot = x->reassemble_last >= 0 ? x->reassemble_last : x->reassemble_more;
+    if (!reassembly_value(st, n, flag_slot, tree, offset, &flag)) return NULL;
+    gboolean more = x->reassemble_last >= 0 ? flag == 0 : flag != 0;
+    if (frag_offset > G_MAXINT32 || number > G_MAXUINT16) {
+        proto_tree_add_expert_format(tree, st->pinfo, &p->ei->bad_length, st->tvb, offset, len,
+                                     "'%s': fragment offset or number out of range", n->name);
+        return NULL;
+    }
+    packet_info *pinfo = st->pinfo;
+    gboolean save_fragmented = pinfo->fragmented;
+    pinfo->fragmented = TRUE;
+    fragment_head *head = x->reassemble_seq >= 0
+        ? fragment_add_seq_check(p->reassembly, st->tvb, offset, pinfo, (guint32)id, NULL, (guint32)number,
+                                 (guint32)len, more)
+        : fragment_add_check(p->reassembly, st->tvb, offset, pinfo, (guint32)id, NULL, (guint32)frag_offset,
+                             (guint32)len, more);
+    tvbuff_t *whole = process_reassembled_data(st->tvb, offset, pinfo, reassembled_names[n - p->nodes], head,
+                                               p->fragments, NULL, tree);
+    pinfo->fragmented = save_fragmented;
+    return whole;
+}
+
+/* A leaf with dissector= or reassemble-*: its bytes (or, once reassembled,
+ * the whole message) go to the named dissector, or are shown raw. */
+void dissect_handoff(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len)
+{
+    dissector_handle_t handle = handoff_handles ? handoff_handles[n - st->p->nodes] : NULL;
+    tvbuff_t *payload;
+    if (n->extra->reassemble_id >= 0 && st->p->reassembly) {
+        if (tree) { /* the fragment itself */
+            proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, item_encoding(n));
+            if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+        }
+        payload = add_fragment(st, n, tree, offset, len);
+        if (!payload) return;
+        if (!handle) {
+            proto_tree_add_item(tree, *n->hf, payload, 0, -1, item_encoding(n));
+            return;
+        }
+    } else {
+        proto_item *item = tree ? proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, item_encoding(n)) : NULL;
+        /* Shown by the other dissector: our field stays filterable, hidden. */
+        if (item && (handle || (n->flags & DG_HIDDEN))) proto_item_set_hidden(item);
+        if (!handle) return;
+        payload = tvb_new_subset_length(st->tvb, offset, len);
+    }
+    call_handoff(st, handle, payload, tree);
+}
+
 void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end)
 {
     if (n->flags & DG_GROUP) {
@@ -316,16 +496,22 @@ void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
         if (!ref_value(st, &n->length_ref, n, "length", tree, *offset, &length)) return;
         break;
     case DG_LEN_REST: length = end - *offset; break;
-    default: length = 0; break;
+    default:
+        /* issue 10a: a stringz without a length runs to its NUL, included. */
+        length = n->show == DG_SHOW_STRINGZ ? stringz_length(st, *offset, end) : 0;
+        break;
     }
     gint left = end - *offset;
     if (length > left) {
         /* Show the bytes that are there, then say what is missing. */
         if (!(n->flags & DG_NUMERIC) && left > 0 && tree) {
-            proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, left, ENC_NA);
+            proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, left, item_encoding(n));
             if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
         }
-        if (n->length_kind == DG_LEN_FIELD)
+        if (n->show == DG_SHOW_STRINGZ && n->length_kind == DG_LEN_CHILDREN)
+            report(st, tree, &st->p->ei->truncated, *offset, left,
+                   "Truncated: '%s' has no NUL before the end of its data (%d bytes left)", n->name, left);
+        else if (n->length_kind == DG_LEN_FIELD)
             report(st, tree, &st->p->ei->past_end, *offset, left,
                    "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)", n->name,
                    length, left);
@@ -337,13 +523,29 @@ void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
     gint len = (gint)length;
     guint64 value = 0;
     proto_item *item = NULL;
+    if (n->extra && (n->extra->dissector || n->extra->reassemble_id >= 0) && len > 0) {
+        dissect_handoff(st, n, tree, *offset, len); /* issue 10a */
+        store(st, n, 0, *offset, len);
+        *offset += len;
+        return;
+    }
     /* The value is read only when store() uses it, the item added only when
      * there is a tree. */
-    if (n->flags & DG_NUMERIC) {
+    if (n->show == DG_SHOW_TIME) {
+        /* issue 10a: a count of units; the item shows it as seconds. */
+        value = read_uint(st->tvb, *offset, (guint)len, encoding_of(n));
+        if (tree) {
+            nstime_t t = time_of(n, value);
+            item = proto_tree_add_time(tree, *n->hf, st->tvb, *offset, len, &t);
+        }
+    } else if (n->show == DG_SHOW_IPV4) {
+        if (value_wanted(st, n)) value = read_uint(st->tvb, *offset, 4, encoding_of(n));
+        if (tree) item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, encoding_of(n));
+    } else if (n->flags & DG_NUMERIC) {
         if (value_wanted(st, n)) value = read_uint(st->tvb, *offset, (guint)len, encoding_of(n));
         if (tree) item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, encoding_of(n));
     } else if (len > 0 && tree) {
-        item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, ENC_NA);
+        item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, item_encoding(n));
     }
     if (item && (n->flags & DG_HIDDEN)) proto_item_set_hidden(item);
     store(st, n, value, *offset, len);
@@ -447,6 +649,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
             st->stopped = FALSE; /* the data simply ended: siblings may still be empty-length */
             break;
         }
+        if (n->extra && n->extra->repeat_rest && *offset >= end) break; /* issue 10a: repeat="rest" */
         clear_slots(st, n);
         gint before = *offset;
         dissect_instance(st, n, tree, offset, end, in_summary, collect ? &summaries : NULL);
@@ -490,7 +693,8 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
         const dg_node *n = &st->p->nodes[st->p->children[first + i]];
         if (n->hook_count && !hook_holds(st, n)) continue;
         if (n->if_slot >= 0 && !condition_holds(st, n)) continue;
-        if (n->count.slot >= 0 || n->repeat_slot >= 0)
+        if (n->extra && n->extra->direction && n->extra->direction != st->direction) continue; /* issue 10a */
+        if (n->count.slot >= 0 || n->repeat_slot >= 0 || (n->extra && n->extra->repeat_rest))
             dissect_repeated(st, n, tree, offset, end, in_summary);
         else
             dissect_instance(st, n, tree, offset, end, in_summary, NULL);
@@ -553,7 +757,7 @@ void stats_init(stats_tree *st)
     for (guint i = 0; i < n_nodes; i++) {
         const dg_node *n = &p->nodes[i];
         const char *what = NULL;
-        if (n->count.slot >= 0 || n->repeat_slot >= 0) what = " per message";
+        if (n->count.slot >= 0 || n->repeat_slot >= 0 || (n->extra && n->extra->repeat_rest)) what = " per message";
         else if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM) what = "";
         if (!what) continue;
         stats_node_names[i] = (char *)stats_node_name(n, what);
@@ -572,10 +776,10 @@ tap_packet_status stats_packet(stats_tree *st, packet_info *, epan_dissect_t *, 
         const dg_node *n = &p->nodes[r->node];
         if (!stats_node_ids[r->node]) continue;
         const char *label = NULL;
-        if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM && n->count.slot < 0 && n->repeat_slot < 0) {
+        if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM && n->count.slot < 0 && n->repeat_slot < 0 &&
+            !(n->extra && n->extra->repeat_rest)) {
             header_field_info *hfi = proto_registrar_get_nth(*n->hf);
-            label = (hfi->display & BASE_VAL64_STRING) ? try_val64_to_str(r->value, (const val64_string *)hfi->strings)
-                                                       : try_val_to_str((guint32)r->value, (const value_string *)hfi->strings);
+            label = enum_name(hfi, r->value);
             if (!label) {
                 /* padded like the tree item: "Unknown (0x07)" for an 8-bit field */
                 g_snprintf(buf, sizeof buf, "Unknown (0x%0*" G_GINT64_MODIFIER "x)", (int)((n->bits + 3) / 4), r->value);
@@ -643,6 +847,28 @@ void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett,
     expert_register_field_array(experts, ei, ei_count);
     register_dissector(p->filter, p->dissect, *p->proto);
     register_stats_tree(p);
+    if (p->reassembly) reassembly_table_register(p->reassembly, &addresses_reassembly_table_functions); /* issue 10a */
+}
+
+/* issue 10a: the dissectors that dissector= names. A name this Wireshark does
+ * not have is reported once, here, and that leaf's bytes are shown raw. */
+static void find_handoff_dissectors(const dg_protocol *p)
+{
+    for (guint i = 0; i < p->node_count; i++) {
+        const dg_extra *x = p->nodes[i].extra;
+        if (!x || (!x->dissector && x->reassemble_id < 0)) continue;
+        if (!handoff_handles) {
+            handoff_handles = g_new0(dissector_handle_t, p->node_count);
+            reassembled_names = g_new0(char *, p->node_count);
+        }
+        reassembled_names[i] = g_strdup_printf("Reassembled %s", p->nodes[i].name);
+        if (!x->dissector) continue;
+        handoff_handles[i] = find_dissector(x->dissector);
+        if (!handoff_handles[i])
+            ws_log("dissgen", LOG_LEVEL_WARNING,
+                   "%s: '%s' hands its bytes to the dissector \"%s\", which this Wireshark does not have; "
+                   "they are shown raw", p->name, p->nodes[i].name, x->dissector);
+    }
 }
 
 void dg_handoff(const dg_protocol *p)
@@ -654,6 +880,7 @@ void dg_handoff(const dg_protocol *p)
         claims = g_array_new(FALSE, FALSE, sizeof(dg_claim));
         register_final_registration_routine(claim_tables);
     }
+    find_handoff_dissectors(p);
     for (guint i = 0; i < p->hook_count; i++) {
         const dg_hook *h = &p->hooks[i];
         if (!find_dissector_table(h->table) || !table_accepts_integers(h->table)) {
@@ -666,6 +893,16 @@ void dg_handoff(const dg_protocol *p)
         dg_claim c = {h->table, h->value, h_handle};
         g_array_append_val(claims, c);
     }
+}
+
+/* issue 10a: request when the port the hook (or Decode As) matched is the
+ * destination port, response when it is only the source port. */
+static guint8 direction_of(const packet_info *pinfo)
+{
+    if (pinfo->ptype == PT_NONE) return DG_DIR_ANY;
+    if (pinfo->destport == pinfo->match_uint) return DG_DIR_REQUEST;
+    if (pinfo->srcport == pinfo->match_uint) return DG_DIR_RESPONSE;
+    return DG_DIR_ANY;
 }
 
 /* Key of the per-packet count of messages decoded (p_add_proto_data). */
@@ -691,6 +928,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     st.slots = wmem_alloc0_array(pinfo->pool, dg_slot, p->slot_count ? p->slot_count : 1);
     st.packet_end = (gint)tvb_captured_length(tvb);
     st.hook_value = pinfo->match_uint;
+    st.direction = direction_of(pinfo);
     /* Summaries are text for the Info column and for container items; build
      * them only when someone sees them: tshark -T fields and -V have a visible
      * tree and no columns, summary lines have columns and no tree, and a

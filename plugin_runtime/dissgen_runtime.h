@@ -21,7 +21,9 @@ enum dg_length_kind {
 };
 /* How a leaf's value is shown; used for summaries and the Info column. */
 enum dg_show {
-    DG_SHOW_HEX = 0, DG_SHOW_DEC, DG_SHOW_BOOL, DG_SHOW_ENUM, DG_SHOW_ADDRESS, DG_SHOW_BYTES, DG_SHOW_HIDDEN
+    DG_SHOW_HEX = 0, DG_SHOW_DEC, DG_SHOW_BOOL, DG_SHOW_ENUM, DG_SHOW_ADDRESS, DG_SHOW_BYTES, DG_SHOW_HIDDEN,
+    /* issue 10a */
+    DG_SHOW_STRING, DG_SHOW_STRINGZ, DG_SHOW_IPV4, DG_SHOW_INT, DG_SHOW_FLOAT, DG_SHOW_TIME
 };
 enum dg_flags {
     DG_LITTLE = 1 << 0,      /* little-endian value */
@@ -49,6 +51,24 @@ typedef struct dg_summary_piece {
     gint16 slot;
 } dg_summary_piece;
 
+/* issue 10a: what few nodes need (direction, repeat="rest", strings, times,
+ * hand-off, reassembly), kept out of dg_node so that it costs the others one
+ * pointer. */
+enum dg_direction { DG_DIR_ANY = 0, DG_DIR_REQUEST = 1, DG_DIR_RESPONSE = 2 };
+
+typedef struct dg_extra {
+    guint32 encoding;         /* string, stringz: ENC_ASCII or ENC_UTF_8 */
+    guint32 units_per_second; /* time: 1000000000 (ns), 1000000 (us), 1000 (ms) or 1 (s) */
+    guint8 repeat_rest;       /* repeat="rest": instances until the enclosing container ends */
+    guint8 direction;         /* dg_direction */
+    const char *dissector;    /* dissector="NAME": hand the bytes to it; NULL: none */
+    gint16 reassemble_id;     /* slot of reassemble-id; -1: no reassembly */
+    dg_ref reassemble_offset; /* byte offset of the fragment (slot -1: numbered instead) */
+    gint16 reassemble_seq;    /* slot of the fragment number, or -1 */
+    gint16 reassemble_last;   /* slot of the "last fragment" flag, or -1 */
+    gint16 reassemble_more;   /* slot of the "more fragments" flag, or -1 */
+} dg_extra;
+
 typedef struct dg_node {
     const char *name;
     int *hf;            /* NULL for a container left out of filter names */
@@ -75,6 +95,13 @@ typedef struct dg_node {
     guint16 hook_first = 0, hook_count = 0;
 #else
     guint16 hook_first, hook_count;
+#endif
+    /* issue 10a: NULL for nodes without string/time/int/float/ipv4 attributes,
+     * repeat="rest", direction, dissector or reassembly. */
+#ifdef __cplusplus
+    const dg_extra *extra = NULL;
+#else
+    const dg_extra *extra;
 #endif
 } dg_node;
 
@@ -116,6 +143,14 @@ typedef struct dg_protocol {
     gint16 pdu_node;         /* -1 when the protocol has no pdulength */
     guint32 pdu_offset;
     gint64 pdu_add;
+    /* issue 10a: reassembly across frames (NULL when no node reassembles). */
+#ifdef __cplusplus
+    reassembly_table *reassembly = NULL;
+    const fragment_items *fragments = NULL;
+#else
+    reassembly_table *reassembly;
+    const fragment_items *fragments;
+#endif
 } dg_protocol;
 
 #ifdef __cplusplus

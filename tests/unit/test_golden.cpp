@@ -32,6 +32,9 @@ TEST(Golden, ShippedEthercatRules) { check_golden("rules/ethercat.xml", "dissgen
 
 TEST(Golden, PaperExample) { check_golden("tests/rules/paper_example.xml", "dissgen_paper_example.cpp.golden"); }
 
+// issue 10a: typed values, range enums, repeat="rest", direction, hand-off, reassembly.
+TEST(Golden, Display10a) { check_golden("tests/rules/display10a.xml", "dissgen_display10a.cpp.golden"); }
+
 TEST(Golden, OutputIsDeterministicAndHasNoPaths) {
     Front f = front_end(read_file(source_path("rules/ethercat.xml")));
     ASSERT_TRUE(f.ok()) << f.messages();

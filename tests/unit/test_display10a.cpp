@@ -1,0 +1,150 @@
+// Issue 10a in the generator: string/stringz/ipv4/int/float/time displays,
+// range enums, repeat="rest", direction, dissector= and reassembly, from the
+// parsed model to the registered field types and the emitted tables.
+#include <gtest/gtest.h>
+
+#include "emit_cpp.h"
+#include "test_support.h"
+
+namespace dissgen::testing {
+namespace {
+
+FieldType type_of(const Protocol& p, const std::string& name) {
+    const Node* n = find(p, name);
+    EXPECT_NE(n, nullptr) << name;
+    return n ? field_type(*n) : FieldType{};
+}
+
+TEST(Display10a, FieldTypesOfTheNewDisplays) {
+    Front f = front_end(rules("  <node name=\"text\" length=\"8byte\" displaytype=\"string\"/>\n"
+                              "  <node name=\"z\" displaytype=\"stringz\"/>\n"
+                              "  <node name=\"zfixed\" length=\"4byte\" displaytype=\"stringz\" encoding=\"ascii\"/>\n"
+                              "  <node name=\"ip\" length=\"4byte\" displaytype=\"ipv4\"/>\n"
+                              "  <node name=\"i8\" length=\"1byte\" displaytype=\"int\"/>\n"
+                              "  <node name=\"i24\" length=\"3byte\" displaytype=\"int\"/>\n"
+                              "  <node name=\"i64\" length=\"8byte\" displaytype=\"int\"/>\n"
+                              "  <node name=\"lo\" length=\"3bit\" displaytype=\"int\"/>\n"
+                              "  <node name=\"hi\" length=\"5bit\" displaytype=\"int\"/>\n"
+                              "  <node name=\"real\" length=\"4byte\" displaytype=\"float\"/>\n"
+                              "  <node name=\"lreal\" length=\"64bit\" displaytype=\"float\"/>\n"
+                              "  <node name=\"t\" length=\"8byte\" displaytype=\"time\"/>\n"
+                              "  <node name=\"ts\" length=\"2byte\" displaytype=\"time\" unit=\"s\"/>\n",
+                              "ethertype=\"0x88b5\" byteorder=\"little\""));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Protocol& p = *f.proto;
+    EXPECT_EQ(type_of(p, "text").type, "FT_STRING");
+    EXPECT_EQ(type_of(p, "z").type, "FT_STRINGZ");
+    EXPECT_EQ(type_of(p, "zfixed").type, "FT_STRINGZ");
+    EXPECT_EQ(type_of(p, "ip").type, "FT_IPv4");
+    EXPECT_EQ(type_of(p, "i8").type, "FT_INT8");
+    EXPECT_EQ(type_of(p, "i24").type, "FT_INT24");
+    EXPECT_EQ(type_of(p, "i64").type, "FT_INT64");
+    EXPECT_EQ(type_of(p, "i64").display, "BASE_DEC");
+    // Bit fields: the group's width, the field's mask (little: first takes the low bits).
+    EXPECT_EQ(type_of(p, "lo").type, "FT_INT8");
+    EXPECT_EQ(type_of(p, "lo").mask, 0x07u);
+    EXPECT_EQ(type_of(p, "hi").mask, 0xf8u);
+    EXPECT_EQ(type_of(p, "real").type, "FT_FLOAT");
+    EXPECT_EQ(type_of(p, "lreal").type, "FT_DOUBLE");
+    EXPECT_EQ(type_of(p, "t").type, "FT_RELATIVE_TIME");
+    // int and time are numeric: lengths, counts and conditions may read them.
+    EXPECT_TRUE(find(p, "i8")->is_numeric());
+    EXPECT_TRUE(find(p, "ts")->is_numeric());
+    EXPECT_FALSE(find(p, "real")->is_numeric());
+    EXPECT_FALSE(find(p, "ip")->is_numeric());
+
+    std::string code = emit_cpp(p, "t.xml");
+    EXPECT_TRUE(contains(code, "DG_SHOW_STRINGZ")) << code;
+    EXPECT_TRUE(contains(code, "{ ENC_ASCII, 1000000000, 0, DG_DIR_ANY, NULL, -1, {-1, 0, 0}, -1, -1, -1 }"));
+    EXPECT_TRUE(contains(code, "{ ENC_UTF_8, 1, 0, DG_DIR_ANY, NULL, -1, {-1, 0, 0}, -1, -1, -1 }"));
+}
+
+TEST(Display10a, LengthsFromAnIntOrTimeField) {
+    Front f = front_end(rules("  <node name=\"n\" length=\"1byte\" displaytype=\"int\"/>\n"
+                              "  <node name=\"data\" length=\"../node[@name='n']\"/>\n"));
+    EXPECT_TRUE(f.ok()) << f.messages();
+}
+
+TEST(Display10a, RangeEnumsBecomeARangeString) {
+    Front f = front_end(rules("  <node name=\"code\" length=\"2byte\" displaytype=\"enum\">\n"
+                              "    <enum value=\"0\" name=\"OK\"/>\n"
+                              "    <enum value=\"0x0011-0x001f\" name=\"State\"/>\n"
+                              "    <enum value=\"32-47\" name=\"Config\"/>\n"
+                              "  </node>\n"
+                              "  <node name=\"plain\" length=\"1byte\" displaytype=\"enum\">\n"
+                              "    <enum value=\"1\" name=\"One\"/>\n"
+                              "  </node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_EQ(type_of(*f.proto, "code").display, "BASE_HEX|BASE_RANGE_STRING");
+    EXPECT_EQ(type_of(*f.proto, "plain").display, "BASE_HEX");
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_TRUE(contains(code, "static const range_string tst_code_rvals[] = {\n"
+                               "    { 0x0000, 0x0000, \"OK\" },\n"
+                               "    { 0x0011, 0x001f, \"State\" },\n"
+                               "    { 0x0020, 0x002f, \"Config\" },\n"
+                               "    { 0, 0, NULL }\n};"))
+        << code;
+    EXPECT_TRUE(contains(code, "RVALS(tst_code_rvals)"));
+    EXPECT_TRUE(contains(code, "VALS(tst_plain_vals)"));
+}
+
+TEST(Display10a, RepeatRestIsARepetition) {
+    Front f = front_end(rules("  <node name=\"item\" length=\"2byte\" displaytype=\"numberhex\" repeat=\"rest\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Node* n = find(*f.proto, "item");
+    EXPECT_TRUE(n->repeat_rest);
+    EXPECT_FALSE(n->repeat.has_value());  // "rest" is not an XPath here
+    EXPECT_TRUE(n->is_repeated());
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "{ ENC_UTF_8, 1000000000, 1, DG_DIR_ANY, NULL"));
+}
+
+TEST(Display10a, DirectionIsAConditionAndIsEmitted) {
+    Front f = front_end(rules("  <hook table=\"udp.port\" value=\"502\"/>\n"
+                              "  <node name=\"ask\" length=\"2byte\" direction=\"request\"/>\n"
+                              "  <node name=\"box\" length=\"4byte\">\n"
+                              "    <node name=\"answer\" length=\"2byte\" direction=\"response\"/>\n"
+                              "    <node name=\"tail\" length=\"2byte\"/>\n"
+                              "  </node>\n",
+                              ""));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_TRUE(find(*f.proto, "ask")->is_conditional());
+    EXPECT_EQ(f.diags.format("rules.xml").find("warning"), std::string::npos) << f.messages();
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_TRUE(contains(code, "DG_DIR_REQUEST"));
+    EXPECT_TRUE(contains(code, "DG_DIR_RESPONSE"));
+}
+
+TEST(Display10a, HandOffAndReassemblyTables) {
+    Front f = front_end(rules("  <node name=\"id\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"offset\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"last\" length=\"1byte\" displaytype=\"bool\"/>\n"
+                              "  <node name=\"frame\" length=\"rest\" dissector=\"eth_withoutfcs\"\n"
+                              "        reassemble-id=\"../node[@name='id']\" reassemble-offset=\"../node[@name='offset'] * 32\"\n"
+                              "        reassemble-last=\"../node[@name='last']\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Node* frame = find(*f.proto, "frame");
+    ASSERT_TRUE(frame->reassemble_offset.has_value());
+    EXPECT_EQ(frame->reassemble_offset->op, '*');
+    EXPECT_EQ(frame->reassemble_offset->operand, 32);
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    // The id, offset and last fields get value slots 0, 1 and 2.
+    EXPECT_TRUE(contains(code, "\"eth_withoutfcs\", 0, {1, '*', 32}, -1, 2, -1 }")) << code;
+    EXPECT_TRUE(contains(code, "static reassembly_table tst_reassembly;"));
+    EXPECT_TRUE(contains(code, "&tst_reassembly, &tst_fragment_items"));
+    std::string fields = list_fields(*f.proto);
+    EXPECT_TRUE(contains(fields, "tst.reassembled_in\tFT_FRAMENUM\t"));
+    EXPECT_TRUE(contains(fields, "tst.fragment.count\tFT_UINT32\t"));
+}
+
+TEST(Display10a, NoReassemblyNoFragmentFields) {
+    Front f = front_end(rules("  <node name=\"frame\" length=\"rest\" dissector=\"eth_withoutfcs\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_FALSE(contains(list_fields(*f.proto), "fragment"));
+    EXPECT_FALSE(contains(emit_cpp(*f.proto, "t.xml"), "reassembly_table"));
+    // Without the constructs, nodes carry no dg_extra (the golden files of older rules stay as they were).
+    Front plain = front_end(rules("  <node name=\"x\" length=\"2byte\"/>\n"));
+    EXPECT_FALSE(contains(emit_cpp(*plain.proto, "t.xml"), "dg_extra"));
+}
+
+}  // namespace
+}  // namespace dissgen::testing
