@@ -31,6 +31,9 @@ TEST(Golden, ShippedEthercatRules) { check_golden("rules/ethercat.xml", "dissgen
 
 TEST(Golden, PaperExample) { check_golden("tests/rules/paper_example.xml", "dissgen_paper_example.cpp.golden"); }
 
+// issue 10b: <when>, peek, otherwise and register windows.
+TEST(Golden, LayoutRules) { check_golden("tests/rules/layout.xml", "dissgen_layout.cpp.golden"); }
+
 TEST(Golden, OutputIsDeterministicAndHasNoPaths) {
     Front f = front_end(read_file(source_path("rules/ethercat.xml")));
     ASSERT_TRUE(f.ok()) << f.messages();
