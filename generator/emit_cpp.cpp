@@ -127,7 +127,8 @@ void layout_10b(Layout& l) {
             }
             l.whens.push_back("{ -1, " + std::to_string(l.peeks.size()) + ", " + ranges + " }");
             l.peeks.push_back("{ " + std::to_string(w.ref.target->doc_index - 1) + ", " + std::to_string(w.offset) + ", " +
-                              std::to_string(l.peek_lengths.size()) + ", " + std::to_string(w.lengths.size()) + " }");
+                              std::to_string(l.peek_lengths.size()) + ", " + std::to_string(w.lengths.size()) + ", " +
+                              std::to_string(w.up) + " }");
             for (const FieldRef* r : w.lengths) l.peek_lengths.push_back(ref_of(r));
         }
     }
@@ -323,7 +324,7 @@ void Emitter::tables_10b() {
         o_ << "\n};\n\n";
     };
     table("dg_when", "whens", l_.whens, "<when> conditions: field slot, peek, in ranges (first, count)");
-    table("dg_peek", "peeks", l_.peeks, "Look-ahead: target node, fixed offset, field lengths (first, count)");
+    table("dg_peek", "peeks", l_.peeks, "Look-ahead: target node, offset, field lengths (first, count), from the node (0) or its Nth container");
     table("dg_ref", "peek_lengths", l_.peek_lengths, "Field lengths between a node and the field it peeks at");
     table("dg_window", "windows", l_.windows, "Windows: base address, places (first, count), largest span, document order");
     table("dg_place", "places", l_.places, "Window children by address: node, address, size, stride, instances");

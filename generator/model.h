@@ -62,6 +62,7 @@ struct When {
     // values of `lengths` after the start of the node.
     uint64_t offset = 0;
     std::vector<const FieldRef*> lengths;
+    unsigned up = 0;  // 0: from the node's start; k: from the start of its k-th container
 };
 
 struct Node {

@@ -513,11 +513,14 @@ void Validator::check_peek(Node& n, When& w) {
     }
     uint64_t offset = 0;
     std::vector<const FieldRef*> lengths;
-    // Adds the bytes of s (n itself when self) to the offset; false when not known.
+    // Why the offset is not known (first reason), until counting restarts at
+    // a container that ends where its own length says.
+    std::string why;
+    // Adds the bytes of s (n itself when self) to the offset.
     auto add = [&](const Node& s, bool self) {
-        std::string why;
+        std::string not_known;
         if ((!self && s.is_conditional()) || s.is_repeated())
-            why = lines_of(s) + " is " + (s.is_repeated() ? "repeated" : "conditional");
+            not_known = lines_of(s) + " is " + (s.is_repeated() ? "repeated" : "conditional");
         else if (s.has_fixed_length())
             offset += s.fixed_bits / 8;
         else if (s.length_kind == LengthKind::Field && known_before(s.length_ref.target, n))
@@ -525,11 +528,11 @@ void Validator::check_peek(Node& n, When& w) {
         else if (auto sum = s.length_kind == LengthKind::Children ? children_fixed_bytes(s) : std::nullopt)
             offset += *sum;
         else
-            why = lines_of(s) + " has a length not known before then";
-        if (!why.empty()) diags_.error(w.line, unknown + why);
-        return why.empty();
+            not_known = lines_of(s) + " has a length not known before then";
+        if (why.empty()) why = not_known;
     };
-    if (!add(n, true)) return;
+    add(n, true);
+    unsigned up = 0, anchor = 0;  // containers climbed; the one whose start the offset counts from
     for (const Node* level = &n;; level = level->parent) {
         if (level->parent && level->parent->is_window()) {
             diags_.error(w.line, unknown + lines_of(*level) + " is placed by address in a window");
@@ -544,8 +547,13 @@ void Validator::check_peek(Node& n, When& w) {
             if (chain && s.otherwise) continue;
             chain = false;
             if (&s == t) {
+                if (!why.empty()) {
+                    diags_.error(w.line, unknown + why);
+                    return;
+                }
                 w.offset = offset;
                 w.lengths = lengths;
+                w.up = anchor;
                 for (const FieldRef* r : lengths) mark_slot(r->target);
                 return;
             }
@@ -556,8 +564,8 @@ void Validator::check_peek(Node& n, When& w) {
             }
             if (s.in_bit_group) {
                 if (s.group_last) offset += s.group_bytes;
-            } else if (!add(s, false)) {
-                return;
+            } else {
+                add(s, false);
             }
         }
         const Node* p = level->parent;
@@ -565,13 +573,26 @@ void Validator::check_peek(Node& n, When& w) {
             diags_.error(w.line, unknown + "it is not a later sibling of " + quote(n) + " or of one of its containers");
             return;
         }
-        if (p->is_repeated() || p->is_window() ||
-            !(p->length_kind == LengthKind::Children || (p->has_fixed_length() && children_fixed_bytes(*p)))) {
+        ++up;
+        if (p->is_repeated() || p->is_window()) {
             diags_.error(w.line, unknown + "container " + lines_of(*p) +
-                                     (p->is_repeated() ? " is repeated" : " has a length of its own, so its children "
-                                                                          "need not end where it ends"));
+                                     (p->is_repeated() ? " is repeated" : " is a window"));
             return;
         }
+        if (p->length_kind == LengthKind::Children) continue;  // it ends where its children do
+        // It ends `length` bytes after its own start: count from there.
+        offset = 0;
+        lengths.clear();
+        why.clear();
+        if (p->has_fixed_length()) {
+            offset = p->fixed_bits / 8;
+        } else if (p->length_kind == LengthKind::Field && known_before(p->length_ref.target, n)) {
+            lengths.push_back(&p->length_ref);
+        } else {
+            diags_.error(w.line, unknown + "container " + lines_of(*p) + " has a length not known before then");
+            return;
+        }
+        anchor = up;
     }
 }
 

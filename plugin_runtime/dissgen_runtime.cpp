@@ -47,6 +47,8 @@ struct dg_summaries {
     guint count;
 };
 
+#define DG_MAX_LISTS 80 /* nesting is at most 64 levels (parser.h kMaxNesting) */
+
 struct dg_state {
     const dg_protocol *p;
     tvbuff_t *tvb;
@@ -61,6 +63,10 @@ struct dg_state {
     guint64 group_value;  /* the bit group being decoded */
     guint32 hook_value;   /* pinfo->match_uint on entry: the hook (or Decode As) value, for ifhook */
     dg_tap_data *tap;     /* what the stats tree counts; NULL when nobody listens */
+    /* issue 10b: where each list of siblings being decoded started (the
+     * message, then each open container), for peeks counted from a container */
+    gint list_starts[DG_MAX_LISTS];
+    guint lists;
 };
 
 void tap_record(dg_state *st, const dg_node *n, guint64 value)
@@ -499,7 +505,8 @@ gboolean hook_holds(const dg_state *st, const dg_node *n)
 /* The value of the leaf a peek reads ahead, when its bytes are there. */
 gboolean peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guint64 *out)
 {
-    gint64 at = (gint64)node_start + pk->offset;
+    if (pk->up > st->lists || st->lists - pk->up >= DG_MAX_LISTS) return FALSE;
+    gint64 at = (gint64)(pk->up ? st->list_starts[st->lists - pk->up] : node_start) + pk->offset;
     for (guint i = 0; i < pk->length_count; i++) {
         const dg_ref *ref = &st->p->peek_lengths[pk->length_first + i];
         const dg_slot *s = &st->slots[ref->slot];
@@ -673,6 +680,8 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
                   gboolean in_summary)
 {
     gboolean chain_taken = FALSE; /* issue 10b */
+    if (st->lists < DG_MAX_LISTS) st->list_starts[st->lists] = *offset;
+    st->lists++;
     for (guint16 i = 0; i < count && !st->stopped; i++) {
         const dg_node *n = &st->p->nodes[st->p->children[first + i]];
         if (!selected(st, n, *offset, &chain_taken)) continue;
@@ -681,6 +690,7 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
         else
             dissect_instance(st, n, tree, offset, end, in_summary, NULL);
     }
+    st->lists--;
 }
 
 /* --- registration ------------------------------------------------------- */

@@ -61,11 +61,13 @@ typedef struct dg_when {
 } dg_when;
 
 /* Where a peeked leaf sits: `offset` bytes plus the values of the length
- * references peek_lengths[length_first ..] after the start of the node. */
+ * references peek_lengths[length_first ..] after the start of the node
+ * (up == 0) or of its up-th enclosing container. */
 typedef struct dg_peek {
     guint16 target;                     /* the numeric leaf (node index) */
     guint32 offset;
     guint16 length_first, length_count;
+    guint8 up;
 } dg_peek;
 
 /* A child of a window, at an absolute address; stride > 0: `instances`

@@ -78,8 +78,15 @@ class Record:
         self.counter, self.more = counter, more
         self.length = len(data) if length is None else length
 
+    def echo(self):
+        """The Echo byte, written only when the counter after the data is 2."""
+        return b"\xe5" if self.counter == 2 else b""
+
+    def size(self):
+        return 6 + len(self.echo()) + self.length + 3
+
     def encode(self):
-        return (struct.pack("<BBHH", self.kind, self.mode, self.address, self.length) + self.data +
+        return (struct.pack("<BBHH", self.kind, self.mode, self.address, self.length) + self.echo() + self.data +
                 struct.pack("<HB", self.counter, self.more))
 
 
@@ -118,7 +125,7 @@ class Expected:
         for r in records:
             if not self.record(r, off, end):
                 break
-            off += 6 + r.length + 3
+            off += r.size()
 
     def add(self, name, pos, size, show=None, label=None):
         self.items.append(Item(name, pos, size, show, label))
@@ -135,26 +142,28 @@ class Expected:
                 return False
             self.num("lyt.rec." + name, o + p, s)
         d = o + 6
+        # Echo: present when the counter, 1 + Length bytes on, is 2 (and there)
+        at = d + 1 + r.length
+        if at + 2 <= end and le(self.payload[at:at + 2]) == 2:
+            self.num("lyt.rec.echo", d, 1)
+            d += 1
+        # Data: its children end where Length says; the mailbox peeks at the counter after it
         counter_there = d + r.length + 2 <= end
         counter = le(self.payload[d + r.length:d + r.length + 2]) if counter_there else None
         avail = min(r.length, end - d)
         past = r.length > end - d
+        if past:
+            self.experts.append("lyt.expert.past_end")
         if r.kind in (1, 2) and r.address <= 0x0FFF and r.mode == 0:
             self.add("lyt.rec.reg", d, avail)
-            if past:
-                self.experts.append("lyt.expert.past_end")
             for name, pos, size, i, text in window_items(self, r.address, d, avail, REGISTERS):
                 self.register(name, pos, size, text)
         elif r.kind == 4:
             self.add("lyt.rec.words", d, avail)
-            if past:
-                self.experts.append("lyt.expert.past_end")
             for name, pos, size, i, text in window_items(self, r.address * 2, d, avail, [WORDS]):
                 self.add(name, pos, size, le(self.payload[pos:pos + size]), text)
         elif r.kind in (1, 2, 3) and counter == 1:
             self.add("lyt.rec.mbx", d, avail if avail >= 3 else None)
-            if past:
-                self.experts.append("lyt.expert.past_end")
             inner = d + avail
             if inner - d < 2:
                 self.experts.append("lyt.expert.truncated")
@@ -169,8 +178,6 @@ class Expected:
         else:
             if avail > 0:
                 self.add("lyt.rec.raw", d, avail)
-            if past:
-                self.experts.append("lyt.expert.past_end")
         if past:
             return False
         c = d + r.length
@@ -234,6 +241,8 @@ def malformed_packets():
         ([Record(4, 0, 0x0008, data, 0, 0)], 6 + 9),
         # the counter a mailbox peeks at is cut off: not a mailbox, raw bytes, then truncated
         ([Record(3, 0, 0x2000, data[:8], 1, 0)], 6 + 8 + 1),
+        # the counter Echo peeks at is cut off: no Echo, its byte is taken as data
+        ([Record(5, 0, 0x2000, data[:8], 2, 0)], 6 + 1 + 8 + 1),
         # a mailbox too short for its header
         ([Record(2, 0, 0x2000, data[:1], 1, 0)], None),
         # a length past the end of the packet: the peek finds no counter, raw bytes and past_end

@@ -70,6 +70,30 @@ TEST(Layout, PeekSkipsLaterMembersOfItsChainAndClimbsSummedContainers) {
     ASSERT_EQ(w.lengths.size(), 1u);
 }
 
+TEST(Layout, PeekCountsFromAContainerThatEndsWhereItsLengthSays) {
+    // EtherCAT's shape: the data (its length from the header) holds the
+    // alternatives, each 'rest'; the working counter follows the data.
+    Front f = front_end(rules(std::string(kHeader) +
+                              "  <node name=\"Data\" length=\"../node[@name='Len']\">\n"
+                              "    <node name=\"Inner\">\n"
+                              "      <node name=\"Tag\" length=\"1byte\"/>\n"
+                              "      <node name=\"Mbx\" length=\"rest\">\n"
+                              "        <when peek=\"../../../node[@name='Wkc']\" in=\"1\"/>\n"
+                              "      </node>\n"
+                              "    </node>\n"
+                              "  </node>\n"
+                              "  <node name=\"Pad\" length=\"2byte\"/>\n"
+                              "  <node name=\"Wkc\" length=\"2byte\" displaytype=\"numberdec\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const When& w = find(*f.proto, "Mbx")->whens[0];
+    EXPECT_EQ(w.up, 2u);      // from the start of Data, Mbx's second container
+    EXPECT_EQ(w.offset, 2u);  // Pad
+    ASSERT_EQ(w.lengths.size(), 1u);
+    EXPECT_EQ(w.lengths[0]->target, find(*f.proto, "Len"));
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_TRUE(contains(code, "{ 8, 2, 0, 1, 2 }")) << code;
+}
+
 TEST(Layout, OtherwiseChains) {
     Front f = front_end(rules(std::string(kHeader) +
                               "  <node name=\"A\" length=\"1byte\" if=\"../node[@name='Kind']\" in=\"1\"/>\n"
