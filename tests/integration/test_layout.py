@@ -12,11 +12,16 @@ from the bytes written), and the label of every block instance ("Channel 2",
     fields) whose children sit at absolute addresses, some overlapping, a
     block of 4 channels at a stride of 8, shown only when wholly inside,
   - else a word window (kind 4, base = address * 2, otherwise + if),
-  - else a mailbox when the counter AFTER the data is 1 (peek),
-  - else raw bytes (otherwise).
-Malformed variants (windows past the end of the capture, a counter cut off so
-the peek cannot read it, a mailbox too short for its header) must give our
-expert infos where the fault is and the tree so far.
+  - else a page window (kind 6, base = address - 16, a child with its own if),
+  - else a window whose base is the Echo byte (kind 7),
+  - else a mailbox when the counter AFTER the data is 1 (peek counted from the
+    start of the data container, whose length is known),
+  - else raw bytes (otherwise);
+and an Echo byte precedes the data when that counter is 2 (peek from the node
+itself, past the data). Malformed variants (windows past the end of the
+capture, counters cut off so a peek cannot read them, a mailbox too short for
+its header, a base below zero, a base from a field the record lacks) must give
+our expert infos where the fault is and the tree so far.
 
     test_layout.py --dissgen build/bin/dissgen --source-dir .
 """
@@ -49,6 +54,12 @@ REGISTERS = [
     ("lyt.rec.reg.scratch", 0x0F80, 16, 0, 1, "Scratch"),
 ]
 WORDS = ("lyt.rec.words.word", 0x0020, 2, 2, 8, "Word")
+PAGES = [
+    ("lyt.rec.pages.header", 0x0000, 2, 0, 1, "Page header"),
+    ("lyt.rec.pages.word", 0x0010, 4, 4, 4, "Page {i} word"),
+    ("lyt.rec.pages.wflag", 0x0002, 1, 0, 1, "Write flag"),      # only in mode 1
+]
+ECHOED = [("lyt.rec.echoed.reg", 0x00E5, 1, 0, 1, "Echo register")]
 
 
 def udp_frame(payload):
@@ -144,7 +155,8 @@ class Expected:
         d = o + 6
         # Echo: present when the counter, 1 + Length bytes on, is 2 (and there)
         at = d + 1 + r.length
-        if at + 2 <= end and le(self.payload[at:at + 2]) == 2:
+        echo = at + 2 <= end and le(self.payload[at:at + 2]) == 2
+        if echo:
             self.num("lyt.rec.echo", d, 1)
             d += 1
         # Data: its children end where Length says; the mailbox peeks at the counter after it
@@ -161,6 +173,21 @@ class Expected:
         elif r.kind == 4:
             self.add("lyt.rec.words", d, avail)
             for name, pos, size, i, text in window_items(self, r.address * 2, d, avail, [WORDS]):
+                self.add(name, pos, size, le(self.payload[pos:pos + size]), text)
+        elif r.kind == 6:
+            self.add("lyt.rec.pages", d, avail if r.address >= 16 else 0)   # stops at the window's start
+            if r.address < 16:
+                self.experts.append("lyt.expert.bad_length")     # base out of range
+                return False
+            for name, pos, size, i, text in window_items(self, r.address - 16, d, avail, PAGES):
+                if name != "lyt.rec.pages.wflag" or r.mode == 1:
+                    self.add(name, pos, size, le(self.payload[pos:pos + size]), text)
+        elif r.kind == 7:
+            self.add("lyt.rec.echoed", d, avail if echo else 0)
+            if not echo:
+                self.experts.append("lyt.expert.bad_length")     # base field not in this packet
+                return False
+            for name, pos, size, i, text in window_items(self, 0xE5, d, avail, ECHOED):
                 self.add(name, pos, size, le(self.payload[pos:pos + size]), text)
         elif r.kind in (1, 2, 3) and counter == 1:
             self.add("lyt.rec.mbx", d, avail if avail >= 3 else None)
@@ -206,7 +233,7 @@ class Expected:
 
 
 def random_record(rng, more):
-    kind = rng.choice([1, 1, 2, 3, 4, 5])
+    kind = rng.choice([1, 1, 2, 3, 4, 5, 6, 7])
     mode = rng.choice([0, 0, 0, 1])
     address = rng.choice([0, 0x0010, 0x0011, 0x0012, 0x00FC, 0x0100, 0x0104, 0x0110, 0x0118, 0x0F78,
                           0x0F80, 0x0FF0, 0x1000, 0x8000, rng.randrange(0x1000), rng.randrange(0x10000)])
@@ -215,6 +242,10 @@ def random_record(rng, more):
     counter = rng.choice([0, 1, 1, 2])
     if n < 3 and counter == 1:
         counter = 2     # a mailbox needs its 3-byte header (malformed_packets has the short one)
+    if kind == 6 and address < 16:
+        address += 16   # below 16 the base is out of range (malformed_packets)
+    if kind == 7:
+        counter = 2     # the Echoed window's base is the Echo byte, there only then
     return Record(kind, mode, address, data, counter, more)
 
 
@@ -226,8 +257,8 @@ def valid_packets(rng, count):
     # A read of 0x0000..0x0FFF shows every register it covers.
     whole = Record(1, 0, 0x0000, bytes(rng.randrange(256) for _ in range(0x1000)), 0, 0)
     out.append(([whole], None))
-    # Every branch once: registers, words, mailbox (peek 1), raw (peek 2, kind 5).
-    for kind, counter in ((2, 0), (4, 1), (3, 1), (3, 2), (5, 1)):
+    # Every branch once: registers, words, mailbox (peek 1), raw (peek 2, kind 5), pages, echoed.
+    for kind, counter in ((2, 0), (4, 1), (3, 1), (3, 2), (5, 1), (6, 0), (7, 2)):
         out.append(([Record(kind, 0, 0x0010, bytes(range(24)), counter, 0)], None))
     return out
 
@@ -243,6 +274,10 @@ def malformed_packets():
         ([Record(3, 0, 0x2000, data[:8], 1, 0)], 6 + 8 + 1),
         # the counter Echo peeks at is cut off: no Echo, its byte is taken as data
         ([Record(5, 0, 0x2000, data[:8], 2, 0)], 6 + 1 + 8 + 1),
+        # a window base below zero (address - 16)
+        ([Record(6, 1, 0x0008, data[:8], 0, 0)], None),
+        # a window base from a field this record does not have
+        ([Record(7, 0, 0x0000, data[:8], 0, 0)], None),
         # a mailbox too short for its header
         ([Record(2, 0, 0x2000, data[:1], 1, 0)], None),
         # a length past the end of the packet: the peek finds no counter, raw bytes and past_end
@@ -355,13 +390,13 @@ class Layout(unittest.TestCase):
             self.assertEqual(self.expected[i].experts, [], "valid packet %d has a fault in the model" % (i + 1))
 
     def test_whole_register_space_shows_every_register(self):
-        exp = self.expected[self.valid_count - 6]
+        exp = self.expected[self.valid_count - 8]
         names = [it.name for it in exp.items]
         for name in ("lyt.rec.reg.status", "lyt.rec.reg.ctl", "lyt.rec.reg.id", "lyt.rec.reg.status_low",
                      "lyt.rec.reg.scratch"):
             self.assertEqual(names.count(name), 1, name)
         self.assertEqual(names.count("lyt.rec.reg.ch"), 4)
-        labels = [f.get("showname") for f in pdml_items(self.proto(self.valid_count - 6))
+        labels = [f.get("showname") for f in pdml_items(self.proto(self.valid_count - 8))
                   if f.get("name") == "lyt.rec.reg.ch"]
         self.assertEqual([s.split(":")[0] for s in labels], ["Channel 0", "Channel 1", "Channel 2", "Channel 3"])
 
@@ -370,7 +405,8 @@ class Layout(unittest.TestCase):
         for exp in self.expected[:self.valid_count]:
             seen.update(it.name for it in exp.items)
         for name in ("lyt.rec.reg", "lyt.rec.words", "lyt.rec.mbx", "lyt.rec.raw", "lyt.rec.reg.ch",
-                     "lyt.rec.words.word"):
+                     "lyt.rec.words.word", "lyt.rec.echo", "lyt.rec.pages.word", "lyt.rec.pages.wflag",
+                     "lyt.rec.echoed.reg"):
             self.assertIn(name, seen)
 
 
