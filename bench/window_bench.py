@@ -25,7 +25,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "tests", "integration"))
-from pcapgen import ip_checksum  # noqa: E402
+from pcapgen import udp_ethernet_frame  # noqa: E402
 from tshark_env import TsharkEnv  # noqa: E402
 
 PORT = 47476
@@ -53,11 +53,7 @@ def rules(kind, registers):
 
 
 def udp_frame(payload):
-    u = struct.pack("!HHHH", PORT, PORT, 8 + len(payload), 0) + payload
-    ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0,
-                     bytes([10, 0, 0, 1]), bytes([10, 0, 0, 2]))
-    ip = ip[:10] + struct.pack("!H", ip_checksum(ip)) + ip[12:]
-    return b"\x02\xee\xee\xee\xee\xee\x02\x00\x00\x00\x00\x01\x08\x00" + ip + u
+    return udp_ethernet_frame(payload, PORT)
 
 
 def capture(packets, registers, seed=1):

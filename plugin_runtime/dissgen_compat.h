@@ -49,8 +49,9 @@
 #endif
 
 /* issue 10b: the text of an item without one set (the window instance
- * labels). 4.2 added an out-parameter for where the value starts. */
-#if DG_WS_AT_LEAST(4, 2)
+ * labels). 4.6 (4.5 development) added an out-parameter for where the value
+ * starts; 4.0 and 4.4 have two parameters. */
+#if DG_WS_AT_LEAST(4, 5)
 #define dg_fill_label(finfo, label) proto_item_fill_label((finfo), (label), NULL)
 #else
 #define dg_fill_label(finfo, label) proto_item_fill_label((finfo), (label))

@@ -33,7 +33,7 @@ import unittest
 import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from pcapgen import ip_checksum  # noqa: E402
+from pcapgen import udp_ethernet_frame  # noqa: E402
 from test_everything import pcap  # noqa: E402
 from tshark_env import TsharkEnv, run_unittests  # noqa: E402
 
@@ -63,11 +63,7 @@ ECHOED = [("lyt.rec.echoed.reg", 0x00E5, 1, 0, 1, "Echo register")]
 
 
 def udp_frame(payload):
-    u = struct.pack("!HHHH", PORT, PORT, 8 + len(payload), 0) + payload
-    ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0,
-                     bytes([10, 0, 0, 1]), bytes([10, 0, 0, 2]))
-    ip = ip[:10] + struct.pack("!H", ip_checksum(ip)) + ip[12:]
-    return b"\x02\xee\xee\xee\xee\xee\x02\x00\x00\x00\x00\x01\x08\x00" + ip + u
+    return udp_ethernet_frame(payload, PORT)
 
 
 class Item:
