@@ -3,6 +3,7 @@
 
 #include "validator.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <optional>
@@ -51,7 +52,15 @@ struct Layout {
     std::map<const Node*, int> hook_range_first;     // ifhook lists, after every 'in' list
     std::vector<std::pair<std::string, int>> pieces;  // (text, slot)
     std::map<const Node*, int> piece_first;
+    // issue 10b: table rows for <when>, peeks, windows and their places
+    std::map<const Node*, int> when_first;
+    std::map<const Node*, int> window_index;
+    std::vector<std::string> whens, peeks, peek_lengths, windows, places;
+    bool uses_10b() const { return !whens.empty() || !windows.empty(); }
+    bool node_uses_10b(const Node& n) const { return when_first.count(&n) || window_index.count(&n) || n.otherwise; }
 };
+
+void layout_10b(Layout& l);
 
 std::string ident_for(const Protocol& proto, const Node& n) {
     std::string base = n.filter_name.empty() ? proto.filter + "_" + (n.segment.empty() ? n.name : n.segment)
@@ -100,7 +109,55 @@ Layout make_layout(const Protocol& proto) {
                 l.pieces.push_back({p.text, p.leaf ? p.leaf->slot : -1});
         }
     }
+    layout_10b(l);
     return l;
+}
+
+std::string ref_of(const FieldRef* r);
+
+// issue 10b: <when> rows (their 'in' lists after every other list), peeks,
+// windows and their places sorted by address.
+void layout_10b(Layout& l) {
+    for (const Node* n : l.nodes) {
+        if (n->whens.empty()) continue;
+        l.when_first[n] = static_cast<int>(l.whens.size());
+        for (const When& w : n->whens) {
+            int in_first = static_cast<int>(l.ranges.size());
+            l.ranges.insert(l.ranges.end(), w.in_list.begin(), w.in_list.end());
+            std::string ranges = std::to_string(in_first) + ", " + std::to_string(w.in_list.size());
+            if (!w.peek) {
+                l.whens.push_back("{ " + std::to_string(w.ref.target ? w.ref.target->slot : -1) + ", -1, " + ranges + " }");
+                continue;
+            }
+            l.whens.push_back("{ -1, " + std::to_string(l.peeks.size()) + ", " + ranges + " }");
+            l.peeks.push_back("{ " + std::to_string(w.ref.target->doc_index - 1) + ", " + std::to_string(w.offset) + ", " +
+                              std::to_string(l.peek_lengths.size()) + ", " + std::to_string(w.lengths.size()) + ", " +
+                              std::to_string(w.up) + " }");
+            for (const FieldRef* r : w.lengths) l.peek_lengths.push_back(ref_of(r));
+        }
+    }
+    for (const Node* n : l.nodes) {
+        if (!n->is_window()) continue;
+        std::vector<const Node*> kids;
+        for (const auto& c : n->children) kids.push_back(c.get());
+        std::stable_sort(kids.begin(), kids.end(), [](const Node* a, const Node* b) { return *a->at < *b->at; });
+        bool document_order = true;
+        uint64_t max_span = 0;
+        for (size_t k = 0; k < kids.size(); ++k) {
+            const Node& c = *kids[k];
+            uint64_t instances = c.instances.value_or(1), stride = c.stride.value_or(0);
+            max_span = std::max(max_span, stride * (instances - 1) + c.place_bytes);
+            if (k && kids[k - 1]->doc_index > c.doc_index) document_order = false;
+        }
+        l.window_index[n] = static_cast<int>(l.windows.size());
+        l.windows.push_back("{ " + ref_of(&*n->base) + ", " + std::to_string(l.places.size()) + ", " +
+                            std::to_string(kids.size()) + ", " + std::to_string(max_span) + ", " +
+                            (document_order ? "TRUE" : "FALSE") + " }");
+        for (const Node* c : kids)
+            l.places.push_back("{ " + std::to_string(c->doc_index - 1) + ", " + hex(*c->at) + ", " +
+                               std::to_string(c->place_bytes) + ", " + std::to_string(c->stride.value_or(0)) + ", " +
+                               std::to_string(c->instances.value_or(1)) + " }");
+    }
 }
 
 const char* show_of(const Node& n) {
@@ -179,6 +236,7 @@ private:
     void value_strings();
     void tables();
     void node_table();
+    void tables_10b();  // issue 10b
     void protocol_struct();
     void register_functions();
     // issue 10a
@@ -281,6 +339,22 @@ void Emitter::tables() {
         first = false;
     }
     o_ << "\n};\n\n";
+    tables_10b();
+}
+
+// issue 10b: the tables of <when> conditions, peeks and windows, where used.
+void Emitter::tables_10b() {
+    auto table = [&](const char* type, const char* name, const std::vector<std::string>& rows, const char* comment) {
+        if (rows.empty()) return;
+        o_ << "/* " << comment << " */\nstatic const " << type << " " << p_.filter << "_" << name << "[] = {";
+        for (size_t i = 0; i < rows.size(); ++i) o_ << (i ? ",\n    " : "\n    ") << rows[i];
+        o_ << "\n};\n\n";
+    };
+    table("dg_when", "whens", l_.whens, "<when> conditions: field slot, peek, in ranges (first, count)");
+    table("dg_peek", "peeks", l_.peeks, "Look-ahead: target node, offset, field lengths (first, count), from the node (0) or its Nth container");
+    table("dg_ref", "peek_lengths", l_.peek_lengths, "Field lengths between a node and the field it peeks at");
+    table("dg_window", "windows", l_.windows, "Windows: base address, places (first, count), largest span, document order");
+    table("dg_place", "places", l_.places, "Window children by address: node, address, size, stride, instances");
 }
 
 void Emitter::node_table() {
@@ -308,9 +382,20 @@ void Emitter::node_table() {
            << n.summary_pieces.size();
         // ifhook ranges (first, count): only where given, the struct defaults them to none.
         if (n.has_hook) o_ << ", " << l_.hook_range_first.at(&n) << ", " << n.hook_list.size();
-        // issue 10a: the node's dg_extra, after the ifhook ranges.
-        if (extra_index_.count(&n))
-            o_ << (n.has_hook ? "" : ", 0, 0") << ", &" << p_.filter << "_extra[" << extra_index_.at(&n) << "]";
+        // Members after the ifhook ranges default to none; a node that uses them
+        // spells out everything before them.
+        const bool uses_extra = extra_index_.count(&n) > 0, uses_10b = l_.node_uses_10b(n);
+        if (!n.has_hook && (uses_extra || uses_10b)) o_ << ", 0, 0";
+        // issue 10a: the node's dg_extra
+        if (uses_extra)
+            o_ << ", &" << p_.filter << "_extra[" << extra_index_.at(&n) << "]";
+        else if (uses_10b)
+            o_ << ", NULL";
+        // issue 10b: <when> rows (first, count), alternative flags, window index
+        if (uses_10b)
+            o_ << ",\n      " << (l_.when_first.count(&n) ? l_.when_first.at(&n) : 0) << ", " << n.whens.size() << ", "
+               << (n.otherwise ? "DG_ALT_OTHERWISE" : "0") << ", "
+               << (l_.window_index.count(&n) ? l_.window_index.at(&n) : -1);
         o_ << " },\n";
     }
     if (l_.nodes.empty()) o_ << "    { NULL, NULL, NULL, 0, 0, 0, 0, 0, 0, 0, -1, {-1, 0, 0}, {-1, 0, 0}, -1, -1, 0, 0, 0, 0, 0, 0, 0, 0 }\n";
@@ -332,7 +417,16 @@ void Emitter::protocol_struct() {
        << "    " << f << "_hooks, " << hook_count << ",\n"
        << "    " << (pdu ? pdu->doc_index - 1 : -1) << ", "
        << (pdu ? p_.pdu_fixed_len - value_bytes(*pdu) : 0) << ", " << p_.pdulengthadd;
-    if (uses_reassembly()) o_ << ",\n    &" << f << "_reassembly, &" << f << "_fragment_items";  // issue 10a
+    if (uses_reassembly())  // issue 10a
+        o_ << ",\n    &" << f << "_reassembly, &" << f << "_fragment_items";
+    else if (l_.uses_10b())
+        o_ << ",\n    NULL, NULL";
+    if (l_.uses_10b()) {  // issue 10b
+        auto name = [&](const char* table, bool used) { return used ? f + "_" + table : std::string("NULL"); };
+        o_ << ",\n    " << name("whens", !l_.whens.empty()) << ", " << name("peeks", !l_.peeks.empty()) << ", "
+           << name("peek_lengths", !l_.peek_lengths.empty()) << ", " << name("windows", !l_.windows.empty()) << ", "
+           << name("places", !l_.places.empty());
+    }
     o_ << "\n};\n\n";
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
        << "    return dg_dissect(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";

@@ -62,6 +62,20 @@ struct SummaryPiece {
     Node* leaf = nullptr;
 };
 
+// issue 10b: one <when> condition of a node: an earlier field (`field`) or
+// a later one whose position is known when the node starts (`peek`).
+struct When {
+    FieldRef ref;
+    bool peek = false;
+    std::vector<ValueRange> in_list;
+    int line = 0;
+    // peek, derived by the validator: the target sits `offset` bytes plus the
+    // values of `lengths` after the start of the node.
+    uint64_t offset = 0;
+    std::vector<const FieldRef*> lengths;
+    unsigned up = 0;  // 0: from the node's start; k: from the start of its k-th container
+};
+
 struct Node {
     // --- as written ---
     std::string name;
@@ -119,12 +133,24 @@ struct Node {
             if (e.is_range) return true;
         return false;
     }
+    // --- issue 10b: alternatives, multi-field conditions, look-ahead, register maps ---
+    std::vector<When> whens;                // <when field|peek="XPATH" in="LIST"/> children, ANDed
+    bool otherwise = false;                 // otherwise="true": member of the previous sibling's chain
+    std::optional<FieldRef> base;           // base="XPATH [+-* N]": this container is a window
+    std::optional<uint64_t> at;             // at="ADDRESS": placed in the parent window
+    std::optional<uint64_t> stride;         // stride="N" instances="M": repeated block at a stride
+    std::optional<uint64_t> instances;
+    // derived by the validator
+    uint64_t place_bytes = 0;               // a window child's fixed size
+    bool is_window() const { return base.has_value(); }
 
     bool is_container() const { return !children.empty(); }
     bool is_leaf() const { return children.empty(); }
     bool is_repeated() const { return repeat.has_value() || count.has_value() || repeat_rest; }
     // Decoded only under a condition (if/in or ifhook): may take no bytes.
-    bool is_conditional() const { return if_field.has_value() || has_hook || direction != Direction::Any; }
+    bool is_conditional() const {
+        return if_field.has_value() || has_hook || direction != Direction::Any || !whens.empty() || otherwise;
+    }
     bool has_fixed_length() const {
         return length_kind == LengthKind::Bits || length_kind == LengthKind::Bytes;
     }

@@ -27,9 +27,12 @@ const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displa
                                                   // issue 10a
                                                   "encoding", "unit", "direction", "dissector", "reassemble-id",
                                                   "reassemble-offset", "reassemble-seq", "reassemble-last",
-                                                  "reassemble-more"};
+                                                  "reassemble-more",
+                                                  // issue 10b
+                                                  "otherwise", "base", "at", "stride", "instances"};
 const std::vector<std::string> kEnumAttributes = {"value", "name"};
 const std::vector<std::string> kHookAttributes = {"table", "value"};
+const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};  // issue 10b
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
                                                 "origin",  "enum",      "nondisplay",
                                                 // issue 10a
@@ -240,6 +243,8 @@ private:
     void parse_10a_attributes(std::map<std::string, std::string>& attrs, int line, Node& node);
     void defer_10a_refs(Node& node, xmlNode* el);
     bool parse_enum_range(const std::string& text, EnumItem& item);
+    void parse_when(xmlNode* el, Node& node, xmlNode* node_el);                   // issue 10b
+    void parse_layout_attributes(std::map<std::string, std::string>& attrs, Node& node);  // issue 10b
     void parse_length(const std::string& text, int line, Node& node, xmlNode* el);
     void parse_display(const std::string& text, int line, Node& node);
     void parse_in_list(const std::string& text, int line, Node& node);
@@ -416,15 +421,20 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
     }
     parse_length(attrs.count("length") ? attrs["length"] : "", node->line, *node, el);
     parse_10a_attributes(attrs, node->line, *node);
+    parse_layout_attributes(attrs, *node);
 
     for (xmlNode* c = el->children; c; c = c->next) {
         if (c->type == XML_ELEMENT_NODE && element_name(c) == "node")
             node->children.push_back(parse_node(c, node.get(), depth + 1));
         else if (c->type == XML_ELEMENT_NODE && element_name(c) == "enum")
             parse_enum(c, *node);
+        else if (c->type == XML_ELEMENT_NODE && element_name(c) == "when")
+            parse_when(c, *node, el);
         else
-            unexpected_child(c, "node", {"node", "enum"});
+            unexpected_child(c, "node", {"node", "enum", "when"});
     }
+    for (When& w : node->whens) defer(w.ref, el, w.line, w.peek ? "peek" : "field");
+    if (node->base) defer(*node->base, el, node->line, "base");
     if (node->repeat) defer(*node->repeat, el, node->line, "repeat");
     if (node->count) defer(*node->count, el, node->line, "count");
     if (node->if_field) defer(*node->if_field, el, node->line, "if");
@@ -450,6 +460,58 @@ void Parser::parse_enum(xmlNode* el, Node& node) {
     item.name = attrs["name"];
     for (xmlNode* c = el->children; c; c = c->next) unexpected_child(c, "enum", {});
     node.enums.push_back(item);
+}
+
+// issue 10b: <when field="XPATH" in="LIST"/> or <when peek="XPATH" in="LIST"/>.
+// The XPath is evaluated from the node, as 'if' is.
+void Parser::parse_when(xmlNode* el, Node& node, xmlNode*) {
+    When w;
+    w.line = line_of(el);
+    auto attrs = attributes(el, kWhenAttributes);
+    for (xmlNode* c = el->children; c; c = c->next) unexpected_child(c, "when", {});
+    bool field = attrs.count("field") > 0, peek = attrs.count("peek") > 0;
+    if (field == peek) {
+        diags_.error(w.line, field ? "<when> has both 'field' and 'peek'; use one of them"
+                                   : "<when> needs a 'field' (an earlier field) or a 'peek' (a later one) attribute");
+        return;
+    }
+    if (!attrs.count("in")) {
+        diags_.error(w.line, "<when> needs an 'in' list of values");
+        return;
+    }
+    w.peek = peek;
+    w.ref = make_ref(attrs[peek ? "peek" : "field"], w.line, peek ? "peek" : "field", false);
+    if (!parse_value_list(attrs["in"], w.line, "in", w.in_list)) return;
+    node.whens.push_back(std::move(w));
+}
+
+// issue 10b: otherwise="true", base="XPATH [op N]", at="ADDR", stride="N", instances="M".
+void Parser::parse_layout_attributes(std::map<std::string, std::string>& attrs, Node& node) {
+    if (attrs.count("otherwise")) {
+        if (trim(attrs["otherwise"]) == "true")
+            node.otherwise = true;
+        else
+            diags_.error(node.line, "bad otherwise '" + attrs["otherwise"] + "': the only value is 'true'");
+    }
+    if (attrs.count("base")) node.base = make_ref(attrs["base"], node.line, "base", true);
+    auto number = [&](const char* name, uint64_t max, std::optional<uint64_t>& out) {
+        if (!attrs.count(name)) return;
+        uint64_t v = 0;
+        if (!parse_number(attrs[name], v) || v > max) {
+            diags_.error(node.line, "bad " + std::string(name) + " '" + attrs[name] +
+                                        "': expected a number from " + (std::string(name) == "at" ? "0" : "1") +
+                                        " to " + std::to_string(max) + ", hex (0x0600) or decimal");
+            return;
+        }
+        if (v == 0 && std::string(name) != "at") {
+            diags_.error(node.line, "bad " + std::string(name) + " '" + attrs[name] + "': it must be at least 1");
+            return;
+        }
+        out = v;
+    };
+    number("at", 0xffffffffffffull, node.at);
+    number("stride", 0xffffffffull, node.stride);
+    number("instances", 65535, node.instances);
 }
 
 void Parser::parse_display(const std::string& text, int line, Node& node) {

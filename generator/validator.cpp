@@ -56,6 +56,10 @@ private:
     void check_handoff(const Node& n);
     void check_reassembly(Node& n);
     void check_fragment_names();
+    // issue 10b
+    void check_layout(Node& n);
+    void check_peek(Node& n, When& w);
+    bool known_before(const Node* t, const Node& n) const;
 
     Protocol& proto_;
     Diagnostics& diags_;
@@ -68,7 +72,7 @@ void Validator::run() {
     for (auto& n : proto_.nodes) inherit_and_check_node(*n, proto_.byteorder);
     layout_children(proto_.nodes);
     for_each_node(proto_.nodes, [&](Node& n) {
-        if (n.is_container()) check_fixed_container(n);
+        if (n.is_container() && !n.is_window()) check_fixed_container(n);
         if (n.length_kind == LengthKind::Field) check_reference(n, n.length_ref, "length");
         if (n.count) check_reference(n, *n.count, "count");
         if (n.repeat) check_reference(n, *n.repeat, "repeat");
@@ -76,6 +80,7 @@ void Validator::run() {
         if (n.has_hook) check_hook_list(n);
         if (n.summary) parse_summary(n);
         check_10a(n);
+        check_layout(n);  // issue 10b
     });
     check_pdulength();
     assign_filter_names(proto_.nodes, proto_.filter);
@@ -388,7 +393,7 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
         if (n.filter) {
             n.segment = *n.filter;
         } else {
-            n.segment = segment_from_name(n.name);
+            n.segment = segment_from_name(name_without_index(n.name));
             if (n.segment.empty()) {
                 n.segment = "f" + std::to_string(n.doc_index);
                 diags_.warning(n.line, "name " + quote(n) + " gives no filter name; using '" + n.segment +
@@ -553,7 +558,204 @@ void Validator::check_fragment_names() {
     }
 }
 
+// --- issue 10b: <when>, otherwise, windows ------------------------------
+
+std::string lines_of(const Node& n) { return quote(n) + at_line(n); }
+
+const std::vector<std::unique_ptr<Node>>& siblings_of(const Protocol& proto, const Node& n) {
+    return n.parent ? n.parent->children : proto.nodes;
+}
+
+const Node* previous_sibling(const Protocol& proto, const Node& n) {
+    const Node* prev = nullptr;
+    for (const auto& s : siblings_of(proto, n)) {
+        if (s.get() == &n) return prev;
+        prev = s.get();
+    }
+    return nullptr;
+}
+
+void Validator::check_layout(Node& n) {
+    for (When& w : n.whens) {
+        if (w.peek)
+            check_peek(n, w);
+        else
+            check_reference(n, w.ref, "when");
+    }
+    bool bit_field = n.is_leaf() && (n.in_bit_group || (n.length_kind == LengthKind::Bits && n.fixed_bits % 8 != 0));
+    if (bit_field && (!n.whens.empty() || n.otherwise))
+        diags_.error(n.line, "bit field " + quote(n) + " cannot have <when> or 'otherwise': it shares bytes with its "
+                             "neighbours in a bit group");
+    if (n.otherwise) {
+        const Node* prev = previous_sibling(proto_, n);
+        if (!prev)
+            diags_.error(n.line, "otherwise=\"true\" on " + quote(n) + " needs a previous sibling with a condition "
+                                 "(if, <when>, ifhook) to be the alternative of; it is the first of its siblings");
+        else if (!prev->is_conditional())
+            diags_.error(n.line, "otherwise=\"true\" on " + quote(n) + " needs a previous sibling with a condition "
+                                 "(if, <when>, ifhook) or otherwise; " + lines_of(*prev) + " is always decoded");
+    }
+    if (n.base) {
+        if (n.is_leaf())
+            diags_.error(n.line, "'base' on leaf " + quote(n) + ": a window is a container whose children have 'at' addresses");
+        else if (n.length_kind == LengthKind::Children)
+            diags_.error(n.line, "window " + quote(n) + " needs a length (fixed, from a field or 'rest'): the bytes "
+                                 "whose addresses start at 'base'");
+        check_reference(n, *n.base, "base");
+    }
+    const Node* window = n.parent && n.parent->is_window() ? n.parent : nullptr;
+    if (n.stride.has_value() != n.instances.has_value())
+        diags_.error(n.line, n.stride ? "'stride' on " + quote(n) + " needs 'instances' (how many blocks)"
+                                      : "'instances' on " + quote(n) + " needs 'stride' (the distance between blocks)");
+    if (!window) {
+        if (n.at)
+            diags_.error(n.line, "'at' on " + quote(n) + ", which is not a child of a window (a container with 'base')");
+        else if (n.stride || n.instances)
+            diags_.error(n.line, "'stride' and 'instances' on " + quote(n) + " need an 'at' address in a window");
+        return;
+    }
+    if (!n.at) {
+        diags_.error(n.line, quote(n) + " is a child of window " + lines_of(*window) +
+                                 " and needs an 'at' address");
+        return;
+    }
+    if (n.is_repeated())
+        diags_.error(n.line, "window child " + quote(n) + " cannot have 'repeat' or 'count'; use 'stride' and 'instances'");
+    if (n.otherwise)
+        diags_.error(n.line, "window child " + quote(n) + " cannot have 'otherwise': window children are placed by "
+                             "address, not one after another");
+    std::optional<uint64_t> size;
+    if (n.has_fixed_length() && n.fixed_bits % 8 == 0) size = n.fixed_bits / 8;
+    else if (n.length_kind == LengthKind::Children && n.is_container()) size = children_fixed_bytes(n);
+    if (!size || *size == 0)
+        diags_.error(n.line, "window child " + quote(n) + " needs a fixed length in whole bytes (its own 'Nbyte', or "
+                             "children that all have one)");
+    else
+        n.place_bytes = *size;
+}
+
+// Whether the value of t is known when n starts: decoded earlier, in the same
+// repeat instance or outside every repeat.
+bool Validator::known_before(const Node* t, const Node& n) const {
+    if (!t || t->doc_index >= n.doc_index) return false;
+    for (const Node* r = t; r; r = r->parent)
+        if (r->is_repeated() && !is_ancestor_or_self(r, &n)) return false;
+    return true;
+}
+
+// peek: the target is a later sibling of n or of an ancestor, and every node
+// from n up to it has a length known when n starts.
+void Validator::check_peek(Node& n, When& w) {
+    const Node* t = w.ref.target;
+    if (!t) return;
+    const std::string field = "'peek' field " + lines_of(*t);
+    if (!t->is_numeric()) {
+        diags_.error(w.line, field + " is not numeric: it must be a leaf of 1-64 bits shown as numberhex, numberdec, "
+                                     "bool, enum or nondisplay");
+        return;
+    }
+    if (t->doc_index <= n.doc_index) {
+        diags_.error(w.line, field + " is not after " + quote(n) + "; peek looks ahead, use <when field=...> for an "
+                                     "earlier field");
+        return;
+    }
+    const std::string unknown = field + " position is not known before " + quote(n) + " starts: ";
+    if (t->is_conditional() || t->is_repeated()) {
+        diags_.error(w.line, unknown + "it is conditional or repeated");
+        return;
+    }
+    uint64_t offset = 0;
+    std::vector<const FieldRef*> lengths;
+    // Why the offset is not known (first reason), until counting restarts at
+    // a container that ends where its own length says.
+    std::string why;
+    // Adds the bytes of s (n itself when self) to the offset.
+    auto add = [&](const Node& s, bool self) {
+        std::string not_known;
+        if ((!self && s.is_conditional()) || s.is_repeated())
+            not_known = lines_of(s) + " is " + (s.is_repeated() ? "repeated" : "conditional");
+        else if (s.has_fixed_length())
+            offset += s.fixed_bits / 8;
+        else if (s.length_kind == LengthKind::Field && known_before(s.length_ref.target, n))
+            lengths.push_back(&s.length_ref);
+        else if (auto sum = s.length_kind == LengthKind::Children ? children_fixed_bytes(s) : std::nullopt)
+            offset += *sum;
+        else
+            not_known = lines_of(s) + " has a length not known before then";
+        if (why.empty()) why = not_known;
+    };
+    add(n, true);
+    unsigned up = 0, anchor = 0;  // containers climbed; the one whose start the offset counts from
+    for (const Node* level = &n;; level = level->parent) {
+        if (level->parent && level->parent->is_window()) {
+            diags_.error(w.line, unknown + lines_of(*level) + " is placed by address in a window");
+            return;
+        }
+        const auto& siblings = siblings_of(proto_, *level);
+        size_t k = 0;
+        while (siblings[k].get() != level) ++k;
+        bool chain = true;  // later members of level's chain are skipped when level is decoded
+        for (++k; k < siblings.size(); ++k) {
+            const Node& s = *siblings[k];
+            if (chain && s.otherwise) continue;
+            chain = false;
+            if (&s == t) {
+                if (!why.empty()) {
+                    diags_.error(w.line, unknown + why);
+                    return;
+                }
+                w.offset = offset;
+                w.lengths = lengths;
+                w.up = anchor;
+                for (const FieldRef* r : lengths) mark_slot(r->target);
+                return;
+            }
+            if (is_ancestor_or_self(&s, t)) {
+                diags_.error(w.line, unknown + "it is inside " + lines_of(s) + "; it must be a later sibling of " +
+                                         quote(n) + " or of one of its containers");
+                return;
+            }
+            if (s.in_bit_group) {
+                if (s.group_last) offset += s.group_bytes;
+            } else {
+                add(s, false);
+            }
+        }
+        const Node* p = level->parent;
+        if (!p) {
+            diags_.error(w.line, unknown + "it is not a later sibling of " + quote(n) + " or of one of its containers");
+            return;
+        }
+        ++up;
+        if (p->is_repeated() || p->is_window()) {
+            diags_.error(w.line, unknown + "container " + lines_of(*p) +
+                                     (p->is_repeated() ? " is repeated" : " is a window"));
+            return;
+        }
+        if (p->length_kind == LengthKind::Children) continue;  // it ends where its children do
+        // It ends `length` bytes after its own start: count from there.
+        offset = 0;
+        lengths.clear();
+        why.clear();
+        if (p->has_fixed_length()) {
+            offset = p->fixed_bits / 8;
+        } else if (p->length_kind == LengthKind::Field && known_before(p->length_ref.target, n)) {
+            lengths.push_back(&p->length_ref);
+        } else {
+            diags_.error(w.line, unknown + "container " + lines_of(*p) + " has a length not known before then");
+            return;
+        }
+        anchor = up;
+    }
+}
+
 }  // namespace
+
+std::string name_without_index(const std::string& name) {
+    std::string out = name;
+    for (size_t at; (at = out.find("{i}")) != std::string::npos;) out.erase(at, 3);
+    return out;
+}
 
 bool is_reserved_expert_name(const std::string& protocol_filter, const std::string& field_filter) {
     for (const char* expert : kExpertNames)

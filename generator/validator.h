@@ -19,6 +19,10 @@ std::string segment_from_name(const std::string& name);
 
 bool is_valid_filter_segment(const std::string& s);
 
+// issue 10b: a node's name without its "{i}" (instance number) markers, for
+// the filter name of a block repeated at a stride.
+std::string name_without_index(const std::string& name);
+
 // Every generated protocol registers these expert infos as P.expert.NAME
 // (emit_cpp.cpp), so no field may take those filter names.
 constexpr const char* kExpertNames[] = {"truncated", "past_end", "more_no_data", "count_short", "bad_length",

@@ -67,6 +67,15 @@ extern "C" {
 #define dg_tvb_find_uint8 tvb_find_guint8
 #endif
 
+/* issue 10b: the text of an item without one set (the window instance
+ * labels). 4.6 (4.5 development) added an out-parameter for where the value
+ * starts; 4.0 and 4.4 have two parameters. */
+#if DG_WS_AT_LEAST(4, 5)
+#define dg_fill_label(finfo, label) proto_item_fill_label((finfo), (label), NULL)
+#else
+#define dg_fill_label(finfo, label) proto_item_fill_label((finfo), (label))
+#endif
+
 /* Differences that need no code here, checked against 4.0, 4.4 and 4.6
  * (tests/multiversion/compile_all.sh):
  * - EI_INIT is {-1,-1} before 4.6 and {0,0} from 4.6: generated code leaves

@@ -13,6 +13,7 @@
 #include <epan/tap.h>
 
 #include <float.h>
+#include <stdlib.h>
 #include <string.h>
 
 namespace {
@@ -48,6 +49,8 @@ struct dg_summaries {
     guint count;
 };
 
+#define DG_MAX_LISTS 80 /* nesting is at most 64 levels (parser.h kMaxNesting) */
+
 struct dg_state {
     const dg_protocol *p;
     tvbuff_t *tvb;
@@ -63,6 +66,10 @@ struct dg_state {
     guint32 hook_value;   /* pinfo->match_uint on entry: the hook (or Decode As) value, for ifhook */
     dg_tap_data *tap;     /* what the stats tree counts; NULL when nobody listens */
     guint8 direction;     /* issue 10a: DG_DIR_REQUEST/RESPONSE when a port hook matched, else DG_DIR_ANY */
+    /* issue 10b: where each list of siblings being decoded started (the
+     * message, then each open container), for peeks counted from a container */
+    gint list_starts[DG_MAX_LISTS];
+    guint lists;
 };
 
 void tap_record(dg_state *st, const dg_node *n, guint64 value)
@@ -111,6 +118,21 @@ void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint 
     st->stopped = TRUE;
 }
 
+/* A reference's value with its arithmetic applied. Values beyond 2^31 are
+ * past any packet's end anyway; clamping there keeps even "* 999999999" (the
+ * largest operand the generator accepts) in range. */
+gint64 ref_arith(const dg_slot *s, const dg_ref *ref)
+{
+    gint64 v = s->value > (G_GUINT64_CONSTANT(1) << 31) ? (G_GINT64_CONSTANT(1) << 31) : (gint64)s->value;
+    switch (ref->op) {
+    case '+': v += ref->operand; break;
+    case '-': v -= ref->operand; break;
+    case '*': v *= ref->operand; break;
+    default: break;
+    }
+    return v;
+}
+
 /* The value of a length or count reference, or FALSE (reported) when it is
  * missing or negative. */
 gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char *what, proto_tree *tree,
@@ -122,15 +144,7 @@ gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char
                what, n->name);
         return FALSE;
     }
-    /* Values beyond 2^31 are past any packet's end anyway; clamping there keeps
-     * even "* 999999999" (the largest operand the generator accepts) in range. */
-    gint64 v = s->value > (G_GUINT64_CONSTANT(1) << 31) ? (G_GINT64_CONSTANT(1) << 31) : (gint64)s->value;
-    switch (ref->op) {
-    case '+': v += ref->operand; break;
-    case '-': v -= ref->operand; break;
-    case '*': v *= ref->operand; break;
-    default: break;
-    }
+    gint64 v = ref_arith(s, ref);
     if (v < 0) {
         report(st, tree, &st->p->ei->bad_length, offset, 0, "The %s of '%s' is negative (%" G_GINT64_MODIFIER "d)",
                what, n->name, v);
@@ -341,6 +355,7 @@ void info_append(dg_state *st, const char *text, gsize len)
 
 void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
                   gboolean in_summary);
+void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary);
 
 void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end)
 {
@@ -587,8 +602,11 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     /* Decode what is there even when the length overruns. */
     gboolean was_stopped = st->stopped;
     st->stopped = FALSE;
-    dissect_list(st, n->first_child, n->child_count, subtree, offset, inner_end,
-                 in_summary || n->summary_count > 0);
+    if (n->window >= 0) /* issue 10b: children at addresses, not one after another */
+        dissect_window(st, n, subtree, offset, inner_end, in_summary || n->summary_count > 0);
+    else
+        dissect_list(st, n->first_child, n->child_count, subtree, offset, inner_end,
+                     in_summary || n->summary_count > 0);
     st->stopped = st->stopped || was_stopped;
     if (!st->stopped && length >= 0 && *offset < inner_end &&
         (n->length_kind == DG_LEN_FIXED || n->length_kind == DG_LEN_FIELD)) {
@@ -686,19 +704,198 @@ gboolean hook_holds(const dg_state *st, const dg_node *n)
     return in_ranges(st->p, n->hook_first, n->hook_count, st->hook_value);
 }
 
+/* --- issue 10b: <when>, otherwise, windows ----------------------------- */
+
+/* The value of the leaf a peek reads ahead, when its bytes are there. */
+gboolean peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guint64 *out)
+{
+    if (pk->up > st->lists || st->lists - pk->up >= DG_MAX_LISTS) return FALSE;
+    gint64 at = (gint64)(pk->up ? st->list_starts[st->lists - pk->up] : node_start) + pk->offset;
+    for (guint i = 0; i < pk->length_count; i++) {
+        const dg_ref *ref = &st->p->peek_lengths[pk->length_first + i];
+        const dg_slot *s = &st->slots[ref->slot];
+        if (!s->present) return FALSE;
+        gint64 v = ref_arith(s, ref);
+        if (v < 0) return FALSE;
+        at += v;
+        if (at > st->packet_end) return FALSE;
+    }
+    const dg_node *t = &st->p->nodes[pk->target];
+    if (at + t->length > st->packet_end) return FALSE;
+    guint64 v = read_uint(st->tvb, (gint)at, t->length, encoding_of(t));
+    *out = (t->flags & DG_GROUP) ? (v >> t->shift) & bit_mask(t->bits) : v;
+    return TRUE;
+}
+
+/* Whether every <when> of n holds; node_start is where n would begin. */
+gboolean whens_hold(const dg_state *st, const dg_node *n, gint node_start)
+{
+    for (guint i = 0; i < n->when_count; i++) {
+        const dg_when *w = &st->p->whens[n->when_first + i];
+        guint64 value;
+        if (w->peek >= 0) {
+            if (!peek_value(st, &st->p->peeks[w->peek], node_start, &value)) return FALSE;
+        } else {
+            const dg_slot *s = &st->slots[w->slot];
+            if (!s->present) return FALSE;
+            value = s->value;
+        }
+        if (!in_ranges(st->p, w->in_first, w->in_count, value)) return FALSE;
+    }
+    return TRUE;
+}
+
+/* Whether n is decoded at `offset`. *chain_taken says whether a member of the
+ * current chain of alternatives (a conditional node and the otherwise nodes
+ * after it) was decoded; an otherwise node is skipped when one was. */
+gboolean selected(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken)
+{
+    gboolean otherwise = (n->alt & DG_ALT_OTHERWISE) != 0;
+    if (otherwise && *chain_taken) return FALSE;
+    guint8 direction = n->extra ? n->extra->direction : (guint8)DG_DIR_ANY; /* issue 10a */
+    gboolean conditional = otherwise || n->hook_count || n->if_slot >= 0 || n->when_count || direction;
+    gboolean holds = (!n->hook_count || hook_holds(st, n)) && (n->if_slot < 0 || condition_holds(st, n)) &&
+                     (!direction || direction == st->direction) && whens_hold(st, n, offset);
+    *chain_taken = conditional && holds;
+    return holds;
+}
+
+/* The name of instance i of a block at a stride: "{i}" replaced by i, or " i" appended. */
+const char *instance_name(const dg_state *st, const dg_node *n, guint i)
+{
+    wmem_strbuf_t *out = wmem_strbuf_new(st->pinfo->pool, "");
+    const char *name = n->name, *mark;
+    gboolean marked = FALSE;
+    while ((mark = strstr(name, "{i}")) != NULL) {
+        wmem_strbuf_append_len(out, name, (gsize)(mark - name));
+        append_dec(out, i);
+        name = mark + 3;
+        marked = TRUE;
+    }
+    append_str(out, name);
+    if (!marked) {
+        wmem_strbuf_append_len(out, " ", 1);
+        append_dec(out, i);
+    }
+    return wmem_strbuf_get_str(out);
+}
+
+/* Renames the item a block instance added after `before` in tree: its label
+ * (name, value, summary) with the name replaced by the instance's name. */
+void label_instance(const dg_state *st, const dg_node *n, proto_tree *tree, proto_node *before, guint i)
+{
+    if (!tree || !PTREE_DATA(tree)->visible) return;
+    proto_node *item = before ? before->next : tree->first_child;
+    if (!item || !item->finfo) return;
+    char label[ITEM_LABEL_LENGTH];
+    const char *now = label;
+    if (item->finfo->rep)
+        now = item->finfo->rep->representation;
+    else
+        dg_fill_label(item->finfo, label);
+    gsize name_len = strlen(n->name);
+    if (strncmp(now, n->name, name_len) != 0) return;
+    proto_item_set_text(item, "%s%s", instance_name(st, n, i), now + name_len);
+}
+
+/* Decodes the instances of one window child that lie wholly inside the
+ * window's addresses [base, last); `start` is the window's first byte. */
+void dissect_place(dg_state *st, const dg_place *pl, proto_tree *tree, gint start, guint64 base, guint64 last,
+                   gboolean in_summary)
+{
+    const dg_node *c = &st->p->nodes[pl->node];
+    gboolean no_chain = FALSE;
+    if (!selected(st, c, start, &no_chain)) return;
+    guint32 i = 0;
+    if (pl->stride && base > pl->at) i = (guint32)MIN((base - pl->at + pl->stride - 1) / pl->stride, (guint64)pl->instances);
+    for (; i < pl->instances && !st->stopped; i++) {
+        guint64 a = pl->at + (guint64)pl->stride * i;
+        if (a < base) continue;
+        if (a + pl->size > last) break;
+        gint offset = start + (gint)(a - base);
+        proto_node *before = tree ? tree->last_child : NULL;
+        clear_slots(st, c);
+        dissect_instance(st, c, tree, &offset, offset + (gint)pl->size, in_summary, NULL);
+        if (pl->stride) label_instance(st, c, tree, before, i);
+    }
+}
+
+/* The first index in [l, h) whose place starts at or after addr. */
+guint first_at_or_after(const dg_place *places, guint l, guint h, guint64 addr)
+{
+    while (l < h) {
+        guint m = l + (h - l) / 2;
+        if (places[m].at < addr)
+            l = m + 1;
+        else
+            h = m;
+    }
+    return l;
+}
+
+int compare_node_index(const void *a, const void *b)
+{
+    return (int)((const dg_place *const *)a)[0]->node - (int)((const dg_place *const *)b)[0]->node;
+}
+
+/* A window's children: each place (each instance of a block) wholly inside
+ * [base, base + window length), in document order. Places are sorted by
+ * address, so a binary search finds the few that may be inside. */
+void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary)
+{
+    const dg_window *w = &st->p->windows[n->window];
+    const dg_slot *s = &st->slots[w->base.slot];
+    if (!s->present) {
+        report(st, tree, &st->p->ei->bad_length, *offset, 0,
+               "The base address of '%s' comes from a field that is not in this packet", n->name);
+        return;
+    }
+    guint64 base = s->value;
+    gboolean bad = FALSE;
+    switch (w->base.op) {
+    case '+': bad = __builtin_add_overflow(base, (guint64)w->base.operand, &base); break;
+    case '-': bad = base < (guint64)w->base.operand; base -= (guint64)w->base.operand; break;
+    case '*': bad = __builtin_mul_overflow(base, (guint64)w->base.operand, &base); break;
+    default: break;
+    }
+    if (bad) {
+        report(st, tree, &st->p->ei->bad_length, *offset, 0, "The base address of '%s' is out of range", n->name);
+        return;
+    }
+    gint start = *offset;
+    guint64 last = base + (guint64)(end - start);
+    if (last < base) last = G_MAXUINT64; /* the top of the address space */
+    const dg_place *places = &st->p->places[w->place_first];
+    /* Places starting at or before base - max_span end at or before base;
+     * those starting at or after last are past the window. */
+    guint lo = base > w->max_span ? first_at_or_after(places, 0, w->place_count, base - w->max_span + 1) : 0;
+    guint hi = first_at_or_after(places, lo, w->place_count, last);
+    if (w->address_order_is_document_order || hi - lo < 2) {
+        for (guint k = lo; k < hi && !st->stopped; k++) dissect_place(st, &places[k], tree, start, base, last, in_summary);
+    } else {
+        const dg_place **order = wmem_alloc_array(st->pinfo->pool, const dg_place *, hi - lo);
+        for (guint k = lo; k < hi; k++) order[k - lo] = &places[k];
+        qsort(order, hi - lo, sizeof *order, compare_node_index);
+        for (guint k = 0; k < hi - lo && !st->stopped; k++) dissect_place(st, order[k], tree, start, base, last, in_summary);
+    }
+    *offset = end;
+}
+
 void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
                   gboolean in_summary)
 {
+    gboolean chain_taken = FALSE; /* issue 10b */
+    if (st->lists < DG_MAX_LISTS) st->list_starts[st->lists] = *offset;
+    st->lists++;
     for (guint16 i = 0; i < count && !st->stopped; i++) {
         const dg_node *n = &st->p->nodes[st->p->children[first + i]];
-        if (n->hook_count && !hook_holds(st, n)) continue;
-        if (n->if_slot >= 0 && !condition_holds(st, n)) continue;
-        if (n->extra && n->extra->direction && n->extra->direction != st->direction) continue; /* issue 10a */
+        if (!selected(st, n, *offset, &chain_taken)) continue;
         if (n->count.slot >= 0 || n->repeat_slot >= 0 || (n->extra && n->extra->repeat_rest))
             dissect_repeated(st, n, tree, offset, end, in_summary);
         else
             dissect_instance(st, n, tree, offset, end, in_summary, NULL);
     }
+    st->lists--;
 }
 
 /* --- registration ------------------------------------------------------- */

@@ -68,6 +68,46 @@ typedef struct dg_extra {
     gint16 reassemble_last;   /* slot of the "last fragment" flag, or -1 */
     gint16 reassemble_more;   /* slot of the "more fragments" flag, or -1 */
 } dg_extra;
+/* issue 10b: <when> conditions, otherwise, windows (register maps). */
+enum dg_alt_flags {
+    DG_ALT_OTHERWISE = 1 << 0  /* otherwise="true": only when no earlier member of its chain was decoded */
+};
+
+/* One <when>: an earlier field's value (slot), or a later one read ahead (peek). */
+typedef struct dg_when {
+    gint16 slot;    /* field: the value's slot; -1 for a peek */
+    gint16 peek;    /* peek: index into dg_protocol.peeks; -1 for a field */
+    guint16 in_first, in_count;
+} dg_when;
+
+/* Where a peeked leaf sits: `offset` bytes plus the values of the length
+ * references peek_lengths[length_first ..] after the start of the node
+ * (up == 0) or of its up-th enclosing container. */
+typedef struct dg_peek {
+    guint16 target;                     /* the numeric leaf (node index) */
+    guint32 offset;
+    guint16 length_first, length_count;
+    guint8 up;
+} dg_peek;
+
+/* A child of a window, at an absolute address; stride > 0: `instances`
+ * blocks of `size` bytes, `stride` bytes apart. */
+typedef struct dg_place {
+    guint16 node;
+    guint64 at;
+    guint32 size;
+    guint32 stride;
+    guint32 instances;
+} dg_place;
+
+/* A container whose first byte has the address `base`; its places are sorted
+ * by address, and none spans more than max_span bytes. */
+typedef struct dg_window {
+    dg_ref base;
+    guint16 place_first, place_count;
+    guint64 max_span;
+    gboolean address_order_is_document_order;
+} dg_window;
 
 typedef struct dg_node {
     const char *name;
@@ -102,6 +142,18 @@ typedef struct dg_node {
     const dg_extra *extra = NULL;
 #else
     const dg_extra *extra;
+#endif
+    /* issue 10b: <when> conditions (dg_protocol.whens), DG_ALT_* flags, and
+     * the window (dg_protocol.windows) of a container with 'base'. Generated
+     * code gives them only for nodes that use them. */
+#ifdef __cplusplus
+    guint16 when_first = 0, when_count = 0;
+    guint8 alt = 0;
+    gint16 window = -1;
+#else
+    guint16 when_first, when_count;
+    guint8 alt;
+    gint16 window;
 #endif
 } dg_node;
 
@@ -150,6 +202,20 @@ typedef struct dg_protocol {
 #else
     reassembly_table *reassembly;
     const fragment_items *fragments;
+#endif
+    /* issue 10b: tables of <when> conditions, peeks and windows (NULL when unused). */
+#ifdef __cplusplus
+    const dg_when *whens = NULL;
+    const dg_peek *peeks = NULL;
+    const dg_ref *peek_lengths = NULL;
+    const dg_window *windows = NULL;
+    const dg_place *places = NULL;
+#else
+    const dg_when *whens;
+    const dg_peek *peeks;
+    const dg_ref *peek_lengths;
+    const dg_window *windows;
+    const dg_place *places;
 #endif
 } dg_protocol;
 

@@ -130,6 +130,14 @@ def ip_checksum(hdr):
     return (~s) & 0xFFFF
 
 
+def udp_ethernet_frame(payload, port, src_ip=b"\x0a\x00\x00\x01", dst_ip=b"\x0a\x00\x00\x02"):
+    """payload in UDP (source and destination `port`) in IPv4 in Ethernet II."""
+    u = struct.pack("!HHHH", port, port, 8 + len(payload), 0) + payload
+    ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src_ip, dst_ip)
+    ip = ip[:10] + struct.pack("!H", ip_checksum(ip)) + ip[12:]
+    return b"\x02\xee\xee\xee\xee\xee\x02\x00\x00\x00\x00\x01" + struct.pack("!H", ETHERTYPE_IPV4) + ip + u
+
+
 def encode_frame(f):
     """Return (captured bytes, original length) of an Ethernet frame."""
     payload = f.ecat_payload()
