@@ -99,6 +99,7 @@ bool DesignReader::resolve_type(const xmlNode* el, const std::string& type, NetS
     }
     const EsiDevice& d = cat_.devices[found];
     s.device = found;
+    s.type = d.type;
     s.vendor = d.vendor;
     s.product = d.product;
     s.revision = d.revision;
