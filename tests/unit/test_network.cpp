@@ -242,21 +242,18 @@ void check_bus_golden(const std::string& text, const std::string& name) {
     EXPECT_EQ(text, golden) << "bus tables differ from " << path << "; if intended, rerun with UPDATE_GOLDEN=1";
 }
 
-TEST(BusTables, GoldenSmallDesign) {
+// small_io.xml and small_design.xml, all devices or the compact catalogue.
+void check_small_design(bool compact, const std::string& golden) {
     Catalogue cat = small_catalogue();
     NetRead r = read_net(read_file(source_path("tests/network/small_design.xml")), cat);
     r.net.file = "small_design.xml";
     ASSERT_TRUE(r.ok);
-    check_bus_golden(bus_text(emit_bus(cat, {&r.net, false}, "ecatr")), "bus_small_design.golden");
+    check_bus_golden(bus_text(emit_bus(cat, {&r.net, compact}, "ecatr")), golden);
 }
 
-TEST(BusTables, GoldenSmallDesignCompact) {
-    Catalogue cat = small_catalogue();
-    NetRead r = read_net(read_file(source_path("tests/network/small_design.xml")), cat);
-    r.net.file = "small_design.xml";
-    ASSERT_TRUE(r.ok);
-    check_bus_golden(bus_text(emit_bus(cat, {&r.net, true}, "ecatr")), "bus_small_design_compact.golden");
-}
+TEST(BusTables, GoldenSmallDesign) { check_small_design(false, "bus_small_design.golden"); }
+
+TEST(BusTables, GoldenSmallDesignCompact) { check_small_design(true, "bus_small_design_compact.golden"); }
 
 TEST(BusTables, CompactKeepsOnlyTheModelsOfTheNetwork) {
     Catalogue cat = small_catalogue();
