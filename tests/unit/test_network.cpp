@@ -288,3 +288,41 @@ TEST(BusTables, FieldTypesFollowTheDataType) {
 
 }  // namespace
 }  // namespace dissgen::testing
+
+namespace dissgen::testing {
+namespace {
+
+// The block after `marker` up to the closing fence, in docs/manual.md.
+std::string manual_block(const std::string& marker) {
+    const std::string manual = read_file(source_path("docs/manual.md"));
+    size_t at = manual.find(marker);
+    if (at == std::string::npos) return "";
+    at += marker.size();
+    return manual.substr(at, manual.find("```", at) - at);
+}
+
+TEST(ManualBus, DesignExampleIsTheTestedFile) {
+    EXPECT_EQ(manual_block("$ cat soem_design.xml\n"), read_file(source_path("tests/network/soem_design.xml")));
+}
+
+TEST(ManualBus, WorkedExampleGivesTheFieldsItShows) {
+    const std::string ek = source_path("../shared/corpus/esi/Beckhoff_EK11xx.xml");
+    const std::string el = source_path("../shared/corpus/esi/Beckhoff_EL1xxx.xml");
+    if (!fs::exists(ek) || !fs::exists(el)) GTEST_SKIP() << "corpus absent";
+    Catalogue cat;
+    std::ostringstream err;
+    ASSERT_TRUE(load_catalogue({ek, el}, cat, err)) << err.str();
+    NetRead r = read_net(read_file(source_path("tests/network/soem_design.xml")), cat);
+    ASSERT_TRUE(r.ok) << r.diags.format("soem_design.xml");
+    EXPECT_EQ(manual_block("--network soem_design.xml | grep pdo\n"),
+              list_bus_fields(cat, {&r.net, false}, "ecatr"));
+    // The listing of `dissgen esi`, filtered as the manual does.
+    std::string listing = list_catalogue(cat), shown;
+    std::istringstream lines(listing);
+    for (std::string line; std::getline(lines, line);)
+        if (contains(line, "EK1100 ") || contains(line, "EL1004 ")) shown += line + "\n";
+    EXPECT_EQ(manual_block("grep -e 'EK1100 ' -e 'EL1004 '\n"), shown);
+}
+
+}  // namespace
+}  // namespace dissgen::testing
