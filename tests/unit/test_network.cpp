@@ -37,6 +37,18 @@ NetRead read_net(const std::string& text, const Catalogue& cat) {
     return r;
 }
 
+// The catalogue of corpus ESI files; false when the corpus is absent.
+bool corpus_catalogue(const std::vector<std::string>& names, Catalogue& cat) {
+    std::vector<std::string> paths;
+    for (const std::string& n : names) {
+        paths.push_back(source_path("../shared/corpus/esi/" + n));
+        if (!fs::exists(paths.back())) return false;
+    }
+    std::ostringstream err;
+    EXPECT_TRUE(load_catalogue(paths, cat, err)) << err.str();
+    return true;
+}
+
 TEST(Design, ResolvesTypesIdentitiesAndRevisions) {
     Catalogue cat = small_catalogue();
     NetRead r = read_net(read_file(source_path("tests/network/small_design.xml")), cat);
@@ -101,11 +113,8 @@ TEST(Design, TypeWithoutAnyEsiFile) {
 }
 
 TEST(Design, TypeNamingTwoProducts) {
-    const std::string path = source_path("../shared/corpus/esi/Elmo_ECAT_00010420_V11.xml");
-    if (!fs::exists(path)) GTEST_SKIP() << path << " absent";
     Catalogue cat;
-    std::ostringstream err;
-    ASSERT_TRUE(load_catalogue({path}, cat, err));
+    if (!corpus_catalogue({"Elmo_ECAT_00010420_V11.xml"}, cat)) GTEST_SKIP() << "corpus absent";
     NetRead r = read_net("<network>\n<slave type=\"Elmo Drive\"/>\n</network>", cat);
     EXPECT_FALSE(r.ok);
     EXPECT_TRUE(contains(r.diags.format("net.xml"), "net.xml:2: error: slave type 'Elmo Drive' names more than one "
@@ -171,11 +180,8 @@ TEST(Eni, TwinCatFiveSlaves) {
 
 TEST(Eni, SlavesOfCatalogueModelsGetTheirType) {
     const std::string eni = source_path("../shared/corpus/eni/twincat_5_slaves_eni.xml");
-    const std::string esi = source_path("../shared/corpus/esi/Elmo_ECAT_00010420_V11.xml");
-    if (!fs::exists(eni) || !fs::exists(esi)) GTEST_SKIP() << "corpus absent";
     Catalogue cat;
-    std::ostringstream err;
-    ASSERT_TRUE(load_catalogue({esi}, cat, err));
+    if (!fs::exists(eni) || !corpus_catalogue({"Elmo_ECAT_00010420_V11.xml"}, cat)) GTEST_SKIP() << "corpus absent";
     NetRead r = read_net(read_file(eni), cat);
     ASSERT_TRUE(r.ok) << r.diags.format("net.xml");
     EXPECT_EQ(r.net.slaves[0].device, -1);  // vendor 33: no ESI file
@@ -306,12 +312,8 @@ TEST(ManualBus, DesignExampleIsTheTestedFile) {
 }
 
 TEST(ManualBus, WorkedExampleGivesTheFieldsItShows) {
-    const std::string ek = source_path("../shared/corpus/esi/Beckhoff_EK11xx.xml");
-    const std::string el = source_path("../shared/corpus/esi/Beckhoff_EL1xxx.xml");
-    if (!fs::exists(ek) || !fs::exists(el)) GTEST_SKIP() << "corpus absent";
     Catalogue cat;
-    std::ostringstream err;
-    ASSERT_TRUE(load_catalogue({ek, el}, cat, err)) << err.str();
+    if (!corpus_catalogue({"Beckhoff_EK11xx.xml", "Beckhoff_EL1xxx.xml"}, cat)) GTEST_SKIP() << "corpus absent";
     NetRead r = read_net(read_file(source_path("tests/network/soem_design.xml")), cat);
     ASSERT_TRUE(r.ok) << r.diags.format("soem_design.xml");
     EXPECT_EQ(manual_block("--network soem_design.xml | grep pdo\n"),
