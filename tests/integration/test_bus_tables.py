@@ -87,6 +87,27 @@ class BusTables(unittest.TestCase):
             self.assertIn(message, p.stderr)
             self.assertEqual(os.listdir(self.env.plugin_dir), [])
 
+    def test_esi_command(self):
+        p = subprocess.run([ARGS.dissgen, "esi", src("tests", "esi_ok")], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertEqual(p.stdout.splitlines(), [
+            "0x00000002 0x03ec3052 0x00130000 EL1004 4Ch. Dig. Input 24V, 3ms",
+            "0x00000002 0x044c2c52 0x00120000 EtherCAT Coupler",
+            "0x00000002 0x07d43052 0x00100000 EL2004 4Ch. Dig. Output 24V, 0.5A",
+            "0x00000002 0x07d43052 0x00110000 EL2004 4Ch. Dig. Output 24V, 0.5A",
+            "0x0000001a 0x00000101 0x00000002 \u4e1c\u897f",
+            "0x0000001a 0x00000102 0x00000000 Eing\u00e4nge",
+        ])
+        p = subprocess.run([ARGS.dissgen, "esi", src("tests", "esi_err", "doctype.xml")],
+                           capture_output=True, text=True)
+        self.assertEqual((p.returncode, p.stdout), (1, ""))
+        self.assertIn("doctype.xml:2: error: DTDs and entity declarations are not allowed", p.stderr)
+        p = subprocess.run([ARGS.dissgen, "generate", self.rules, "--compact", "-o", self.env.path("out")],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 1)
+        self.assertIn("--compact keeps the models a network uses", p.stderr)
+        self.assertFalse(os.path.exists(self.env.path("out")))
+
     def test_decode_unchanged_on_a_real_capture(self):
         capture = src("..", "shared", "corpus", "ethercat", "soem-sdinfo-ek1100-el1004.pcapng")
         if not os.path.exists(capture):
