@@ -210,11 +210,26 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
     o << "};\n\n";
 
     size_t slave_count = net ? net->slaves.size() : 0, cyclic_count = net ? net->cyclic.size() : 0;
+    size_t sm_count = 0;
+    std::vector<size_t> sm_first;
     if (net) {
+        o << "/* SyncManagers of the network's slaves: number, control byte, start address, default length,\n"
+          << " * enabled, type. */\n"
+          << "static const dg_sync_manager " << filter << "_sync_managers[] = {\n";
+        for (const NetSlave& s : net->slaves) {
+            sm_first.push_back(sm_count);
+            if (!s.sms.empty()) o << "    /* " << sm_count << ": position " << s.position << " */\n";
+            for (const SyncManager& sm : s.sms)
+                o << "    { " << sm.index << ", " << hexn(sm.control, 2) << ", " << hexn(sm.start, 4) << ", " << sm.size
+                  << ", " << (sm.enable ? 1 : 0) << ", " << c_string(sm.type) << " },\n";
+            sm_count += s.sms.size();
+        }
+        if (!sm_count) o << "    { 0, 0, 0, 0, 0, NULL }\n";
+        o << "};\n\n";
         o << "/* The network of " << std::filesystem::path(net->file).filename().string()
           << " in bus order: position, station address, vendor, product code,\n"
-          << " * revision, revision checked, device, name, process data (first entry, count), input and output\n"
-          << " * bits, their first bit in the logical process image (-1: set at run time). */\n"
+          << " * revision, revision checked, device, name, process data (first entry, count), SyncManagers (first,\n"
+          << " * count), input and output bits, their first bit in the logical process image (-1: set at run time). */\n"
           << "static const dg_slave " << filter << "_slaves[] = {\n";
         for (size_t i = 0; i < net->slaves.size(); ++i) {
             const NetSlave& s = net->slaves[i];
@@ -224,7 +239,8 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
             o << "    { " << s.position << ", " << hexn(s.station, 4) << ", " << hexn(s.vendor, 8) << ", "
               << hexn(s.product, 8) << ", " << hexn(s.revision, 8) << ", " << (s.revision_given ? 1 : 0) << ", "
               << (row == l.device_row.end() ? -1 : row->second) << ", " << c_string(s.name) << ", "
-              << l.slave_entries[i].first << ", " << l.slave_entries[i].second << ", " << s.input_bits << ", "
+              << l.slave_entries[i].first << ", " << l.slave_entries[i].second << ", " << sm_first[i] << ", "
+              << s.sms.size() << ", " << s.input_bits << ", "
               << s.output_bits << ", " << s.input_logical_bit << ", " << s.output_logical_bit << " },\n";
         }
         o << "};\n\n";
@@ -244,6 +260,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
       << "const dg_bus " << t.bus_symbol << " = {\n"
       << "    " << filter << "_devices, " << l.devices.size() << ", " << filter << "_pdo_entries, " << l.entries.size()
       << ",\n    " << (net ? filter + "_slaves" : "NULL") << ", " << slave_count << ", "
+      << (net ? filter + "_sync_managers" : "NULL") << ", " << sm_count << ",\n    "
       << (cyclic_count ? filter + "_cyclic" : "NULL") << ", " << cyclic_count << "\n};\n\n";
     t.tables = o.str();
 

@@ -35,11 +35,23 @@ struct EsiPdo {
     int line = 0;
 };
 
+// A SyncManager as an ESI <Sm> or an ENI <SmN> describes it.
+struct SyncManager {
+    int index = 0;            // SM number (position among the device's <Sm>, N of <SmN>)
+    uint16_t start = 0;       // StartAddress in the slave's memory
+    uint16_t size = 0;        // DefaultSize, 0 when not given
+    uint8_t control = 0;      // ControlByte
+    bool enable = false;
+    std::string type;         // "Outputs", "Inputs", "MBoxOut", "MBoxIn", ...
+    int line = 0;
+};
+
 // One <Device> element: one revision of one product.
 struct EsiDevice {
     uint32_t vendor = 0, product = 0, revision = 0;
     std::string type;  // <Type> text, e.g. "EL1004": what a design names
     std::string name;  // <Name>, English (LcId 1033) when given, else the first
+    std::vector<SyncManager> sms;
     std::vector<EsiPdo> pdos;
     std::string file;
     int line = 0;
@@ -79,6 +91,7 @@ struct NetSlave {
     std::string type;            // model (<Type> of its ESI device), "" when unknown
     std::string name;            // instance name (ENI) or the model's name
     int device = -1;             // index into Catalogue::devices, -1 when not in the catalogue
+    std::vector<SyncManager> sms;
     std::vector<NetEntry> entries;
     uint32_t input_bits = 0, output_bits = 0;
     int64_t input_logical_bit = -1, output_logical_bit = -1;  // ENI <Recv>/<Send> BitStart

@@ -30,6 +30,7 @@ private:
     bool read_pdos(const xmlNode* owner, std::vector<EsiPdo>& pdos);
     bool read_pdo(const xmlNode* el, EsiPdo& pdo);
     bool read_device(const xmlNode* el, uint32_t vendor, EsiDevice& dev);
+    bool read_sync_manager(const xmlNode* el, int index, SyncManager& sm);
     bool read_module(const xmlNode* el, uint32_t vendor, EsiModule& mod);
 
     std::string file_;
@@ -135,6 +136,32 @@ bool EsiReader::read_pdos(const xmlNode* owner, std::vector<EsiPdo>& pdos) {
     return ok;
 }
 
+bool EsiReader::read_sync_manager(const xmlNode* el, int index, SyncManager& sm) {
+    sm.index = index;
+    sm.line = xml_line(el);
+    sm.type = xml_text(el);
+    bool ok = true;
+    uint64_t v = 0;
+    struct Attr {
+        const char* name;
+        uint64_t max;
+    };
+    for (const Attr& a : {Attr{"StartAddress", 0xffff}, Attr{"DefaultSize", 0xffff}, Attr{"ControlByte", 0xff},
+                          Attr{"Enable", 0xff}}) {
+        auto text = xml_attr(el, a.name);
+        if (!text) continue;
+        if (!number_text(el, a.name, *text, v, a.max)) {
+            ok = false;
+            continue;
+        }
+        if (a.name[0] == 'S') sm.start = static_cast<uint16_t>(v);
+        else if (a.name[0] == 'D') sm.size = static_cast<uint16_t>(v);
+        else if (a.name[0] == 'C') sm.control = static_cast<uint8_t>(v);
+        else sm.enable = v != 0;
+    }
+    return ok;
+}
+
 bool EsiReader::read_device(const xmlNode* el, uint32_t vendor, EsiDevice& dev) {
     dev.vendor = vendor;
     dev.file = file_;
@@ -162,6 +189,10 @@ bool EsiReader::read_device(const xmlNode* el, uint32_t vendor, EsiDevice& dev) 
     }
     dev.name = localised_name(el);
     if (dev.name.empty()) dev.name = dev.type;
+    for (const xmlNode* sm : xml_children(el, "Sm")) {
+        dev.sms.emplace_back();
+        ok = read_sync_manager(sm, static_cast<int>(dev.sms.size()) - 1, dev.sms.back()) && ok;
+    }
     return read_pdos(el, dev.pdos) && ok;
 }
 

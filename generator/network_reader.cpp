@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 
 #include "text_util.h"
@@ -158,6 +159,7 @@ bool DesignReader::read(const xmlNode* root, Network& net) {
         }
         if (s.device >= 0) {
             s.name = cat_.devices[s.device].name;
+            s.sms = cat_.devices[s.device].sms;
             default_process_data(cat_.devices[s.device], s);
         }
         if (auto name = xml_attr(c, "name")) s.name = *name;
@@ -225,6 +227,18 @@ bool EniReader::read_process_data(const xmlNode* pd, NetSlave& s) {
         std::string n = xml_name(c);
         if (n.size() < 3 || n.compare(0, 2, "Sm") != 0 || !std::isdigit(static_cast<unsigned char>(n[2]))) continue;
         bool output = xml_text(xml_child(c, "Type")) == "Outputs";
+        SyncManager sm;
+        sm.index = std::atoi(n.c_str() + 2);
+        sm.line = xml_line(c);
+        sm.type = xml_text(xml_child(c, "Type"));
+        uint64_t start = 0, size = 0, control = 0, enable = 0;
+        ok = number(c, "StartAddress", 0xffff, start, false) && number(c, "DefaultSize", 0xffff, size, false) &&
+             number(c, "ControlByte", 0xff, control, false) && number(c, "Enable", 0xff, enable, false) && ok;
+        sm.start = static_cast<uint16_t>(start);
+        sm.size = static_cast<uint16_t>(size);
+        sm.control = static_cast<uint8_t>(control);
+        sm.enable = enable != 0;
+        s.sms.push_back(sm);
         for (const xmlNode* p : xml_children(c, "Pdo")) {
             if (parse_esi_number(xml_text(p), v) && v <= 0xffff) assigned.push_back({output, static_cast<uint16_t>(v)});
             else {

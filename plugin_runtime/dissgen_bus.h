@@ -22,6 +22,16 @@ typedef struct dg_pdo_entry {
     int *hf;                 /* registered field, NULL when none (padding, catalogue-only models) */
 } dg_pdo_entry;
 
+/* A SyncManager of a slave of the network (ESI <Sm> defaults, or the ENI's <SmN>). */
+typedef struct dg_sync_manager {
+    guint8 index;            /* SM number */
+    guint8 control;          /* control byte (direction, mode) */
+    guint16 start;           /* physical start address */
+    guint16 size;            /* default length, 0 when not given */
+    guint8 enable;
+    const char *type;        /* "Outputs", "Inputs", "MBoxOut", "MBoxIn" */
+} dg_sync_manager;
+
 /* One device revision of the catalogue; its default process data (the PDOs
  * its ESI file assigns to a SyncManager) is entries[entry_first ..]. */
 typedef struct dg_device {
@@ -40,6 +50,7 @@ typedef struct dg_slave {
     gint32 device;           /* into dg_bus.devices, -1 when the model is not in the catalogue */
     const char *name;        /* instance name (ENI) or model name */
     guint32 entry_first, entry_count;  /* its process data */
+    guint32 sm_first, sm_count;        /* its SyncManagers */
     guint32 input_bits, output_bits;
     gint64 input_logical_bit, output_logical_bit;  /* -1: not known before run time */
 } dg_slave;
@@ -61,6 +72,8 @@ typedef struct dg_bus {
     guint32 entry_count;
     const dg_slave *slaves;          /* NULL when no network was given */
     guint32 slave_count;
+    const dg_sync_manager *sync_managers;
+    guint32 sync_manager_count;
     const dg_cyclic_cmd *cyclic;
     guint32 cyclic_count;
 } dg_bus;

@@ -55,6 +55,13 @@ TEST(EsiCorpus, BeckhoffEL1xxxLatin1Crlf4MB) {
     EXPECT_EQ(el1004->type, "EL1004");
     EXPECT_EQ(el1004->name, "EL1004 4Ch. Dig. Input 24V, 3ms");  // LcId 1033, not the German 1031
     EXPECT_EQ(el1004->line, 457);
+    // <Sm DefaultSize="1" StartAddress="#x1000" ControlByte="0" Enable="1">Inputs</Sm>
+    ASSERT_EQ(el1004->sms.size(), 1u);
+    EXPECT_EQ(el1004->sms[0].start, 0x1000);
+    EXPECT_EQ(el1004->sms[0].size, 1);
+    EXPECT_EQ(el1004->sms[0].control, 0);
+    EXPECT_TRUE(el1004->sms[0].enable);
+    EXPECT_EQ(el1004->sms[0].type, "Inputs");
     ASSERT_EQ(el1004->pdos.size(), 4u);
     for (int i = 0; i < 4; ++i) {
         const EsiPdo& p = el1004->pdos[i];

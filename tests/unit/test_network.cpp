@@ -83,6 +83,9 @@ TEST(Design, ResolvesTypesIdentitiesAndRevisions) {
     EXPECT_EQ(s[2].entries[2].bit_offset, 8u);  // after a BOOL and a BIT7
     EXPECT_TRUE(s[2].entries[2].output);
     EXPECT_EQ(s[2].entries[0].logical_bit, -1);  // the master maps it at run time
+    ASSERT_EQ(s[2].sms.size(), 1u);  // the model's <Sm>
+    EXPECT_EQ(s[2].sms[0].start, 0x0f00);
+    EXPECT_EQ(s[2].sms[0].control, 0x44);
     // A model without an ESI file: numbers only.
     EXPECT_EQ(s[3].vendor, 0x6au);
     EXPECT_EQ(s[3].product, 0x00414b44u);
@@ -151,6 +154,17 @@ TEST(Eni, TwinCatFiveSlaves) {
     EXPECT_EQ(imu.entries[0].logical_bit, 568);
     EXPECT_EQ(imu.entries[6].entry.name, "Error code");
     EXPECT_EQ(imu.entries[6].logical_bit, 664);
+    // <Sm2> Outputs 4096, ControlByte 100, Enable 0; <Sm3> Inputs, DefaultSize 14, 10240, 32, 1.
+    ASSERT_EQ(imu.sms.size(), 2u);
+    EXPECT_EQ(imu.sms[0].index, 2);
+    EXPECT_EQ(imu.sms[0].type, "Outputs");
+    EXPECT_EQ(imu.sms[0].start, 4096);
+    EXPECT_EQ(imu.sms[0].control, 100);
+    EXPECT_FALSE(imu.sms[0].enable);
+    EXPECT_EQ(imu.sms[1].index, 3);
+    EXPECT_EQ(imu.sms[1].size, 14);
+    EXPECT_EQ(imu.sms[1].start, 10240);
+    EXPECT_TRUE(imu.sms[1].enable);
     const NetSlave& wheel = r.net.slaves[1];
     EXPECT_EQ(wheel.output_logical_bit, 776);
     EXPECT_EQ(wheel.output_bits, 48u);
@@ -278,7 +292,7 @@ TEST(BusTables, CatalogueAloneRegistersNoFields) {
     Catalogue cat = small_catalogue();
     EmbeddedTables t = emit_bus(cat, {nullptr, false}, "ecatr");
     EXPECT_TRUE(t.hf_entries.empty());
-    EXPECT_TRUE(contains(t.tables, "ecatr_devices, 4, ecatr_pdo_entries, 7,\n    NULL, 0, NULL, 0"));
+    EXPECT_TRUE(contains(t.tables, "ecatr_devices, 4, ecatr_pdo_entries, 7,\n    NULL, 0, NULL, 0,\n    NULL, 0"));
 }
 
 TEST(BusTables, FieldTypesFollowTheDataType) {
