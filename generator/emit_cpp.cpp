@@ -13,8 +13,6 @@
 
 namespace dissgen {
 
-namespace {
-
 std::string c_string(const std::string& s) {
     std::string out = "\"";
     for (unsigned char c : s) {
@@ -31,6 +29,8 @@ std::string c_string(const std::string& s) {
     }
     return out + "\"";
 }
+
+namespace {
 
 std::string hex(uint64_t v, int digits = 0) {
     char buf[32];
@@ -227,7 +227,8 @@ std::pair<int, int> slot_span(const Node& n) {
 
 class Emitter {
 public:
-    Emitter(const Protocol& p, const std::string& source) : p_(p), source_(source), l_(make_layout(p)) {}
+    Emitter(const Protocol& p, const std::string& source, const EmbeddedTables* extra)
+        : p_(p), source_(source), extra_(extra), l_(make_layout(p)) {}
     std::string run();
 
 private:
@@ -254,6 +255,7 @@ private:
 
     const Protocol& p_;
     std::string source_;
+    const EmbeddedTables* extra_;
     Layout l_;
     std::ostringstream o_;
 };
@@ -281,7 +283,7 @@ void Emitter::header() {
        << " * GNU General Public License, version 2 or later: so is the plugin.\n"
        << " * SPDX-License-Identifier: GPL-2.0-or-later\n"
        << " */\n"
-       << "#include \"dissgen_runtime.h\"\n\n";
+       << "#include \"dissgen_runtime.h\"\n" << (extra_ ? extra_->includes : "") << "\n";
 }
 
 void Emitter::declarations() {
@@ -291,6 +293,7 @@ void Emitter::declarations() {
     o_ << "\nstatic gint ett_" << p_.filter << " = -1;\n";
     for (const Node* n : l_.nodes)
         if (n->is_container()) o_ << "static gint " << ett(*n) << " = -1;\n";
+    if (extra_ && !extra_->declarations.empty()) o_ << "\n" << extra_->declarations;
     o_ << "\nstatic dg_experts ei_" << p_.filter << ";\n\n";
 }
 
@@ -340,6 +343,7 @@ void Emitter::tables() {
     }
     o_ << "\n};\n\n";
     tables_10b();
+    if (extra_) o_ << extra_->tables;
 }
 
 // issue 10b: the tables of <when> conditions, peeks and windows, where used.
@@ -458,6 +462,10 @@ void Emitter::register_functions() {
                << ", " << c_string(fr.filter) << ", " << fr.type << ", " << fr.display << ", NULL, 0x0, NULL, HFILL } }";
             first = false;
         }
+    }
+    for (const std::string& entry : extra_ ? extra_->hf_entries : std::vector<std::string>{}) {
+        o_ << (first ? "" : ",\n") << "        " << entry;
+        first = false;
     }
     if (first) o_ << "        { NULL, { NULL, NULL, FT_NONE, BASE_NONE, NULL, 0x0, NULL, HFILL } }";
     o_ << "\n    };\n\n    static gint *ett[] = {\n        &ett_" << f;
@@ -611,8 +619,8 @@ FieldType field_type(const Node& n) {
     return {type, base, mask};
 }
 
-std::string emit_cpp(const Protocol& proto, const std::string& source_name) {
-    return Emitter(proto, source_name).run();
+std::string emit_cpp(const Protocol& proto, const std::string& source_name, const EmbeddedTables* extra) {
+    return Emitter(proto, source_name, extra).run();
 }
 
 std::string list_fields(const Protocol& proto) {

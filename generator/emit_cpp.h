@@ -28,8 +28,21 @@ struct FragmentField {
 };
 std::vector<FragmentField> fragment_fields(const Protocol& proto);
 
+// A C string literal of `s` (UTF-8 kept, control characters escaped).
+std::string c_string(const std::string& s);
+
+// Extra tables and fields from other inputs than the rule file (the ESI
+// catalogue and network design, emit_catalogue.h), placed by emit_cpp.
+struct EmbeddedTables {
+    std::string includes;                 // after the runtime's include
+    std::string declarations;             // hf variables
+    std::string tables;                   // constant data, before the protocol
+    std::vector<std::string> hf_entries;  // hf_register_info initializers
+    std::string bus_symbol;               // the dg_bus defined in `tables`
+};
+
 // `source_name` is the rule file's base name, quoted in the header comment.
-std::string emit_cpp(const Protocol& proto, const std::string& source_name);
+std::string emit_cpp(const Protocol& proto, const std::string& source_name, const EmbeddedTables* extra = nullptr);
 
 // One line per field: filter name, Wireshark type, display name.
 std::string list_fields(const Protocol& proto);

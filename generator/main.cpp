@@ -6,6 +6,10 @@
 //   dissgen fields FILE.xml                list the display-filter fields
 //   dissgen install FILE.xml [--dir DIR | --system]
 //                                          generate, build and install the plugin
+//   dissgen esi PATH...                    list the device catalogue of ESI files
+// check, generate, fields and install take --esi PATH (repeatable),
+// --network FILE and --compact: the catalogue and the designed network are
+// embedded into the plugin.
 #include <unistd.h>
 
 #include <cstring>
@@ -14,10 +18,14 @@
 #include <iostream>
 
 #include "build_plugin.h"
+#include "emit_catalogue.h"
 #include "emit_cpp.h"
+#include "esi_reader.h"
+#include "network_reader.h"
 #include "parser.h"
 #include "validator.h"
 #include "wireshark_env.h"
+#include "xml_input.h"
 
 namespace fs = std::filesystem;
 using namespace dissgen;
@@ -31,7 +39,9 @@ const char kUsage[] =
     "       dissgen generate FILE.xml -o DIR\n"
     "       dissgen fields FILE.xml\n"
     "       dissgen install FILE.xml [--dir DIR | --system]\n"
+    "       dissgen esi PATH...\n"
     "       dissgen --help | --version\n"
+    "  check, generate, fields and install also take [--esi PATH]... [--network FILE] [--compact]\n"
     "\n"
     "commands:\n"
     "  check     validate the rule file; diagnostics as FILE:LINE: error: MESSAGE\n"
@@ -39,14 +49,20 @@ const char kUsage[] =
     "  fields    one line per field: display-filter name, Wireshark type, name\n"
     "  install   generate, compile against the installed Wireshark and install the\n"
     "            plugin (dissgen_STEM.so), per user by default\n"
+    "  esi       list the devices of ESI files (a file or a folder of *.xml), one line\n"
+    "            per revision: 0xVENDOR 0xPRODUCT 0xREVISION NAME, sorted\n"
     "\n"
     "options:\n"
-    "  -o DIR      generate: the folder to write into\n"
-    "  --dir DIR   install: into DIR instead of the per-user plugin folder\n"
-    "  --system    install: into Wireshark's global plugin folder (needed when\n"
-    "              Wireshark runs as root: it ignores per-user plugins)\n"
-    "  -h, --help  print this help and exit\n"
-    "  --version   print dissgen's version and exit\n";
+    "  -o DIR          generate: the folder to write into\n"
+    "  --dir DIR       install: into DIR instead of the per-user plugin folder\n"
+    "  --system        install: into Wireshark's global plugin folder (needed when\n"
+    "                  Wireshark runs as root: it ignores per-user plugins)\n"
+    "  --esi PATH      embed the device catalogue of these ESI files (repeatable)\n"
+    "  --network FILE  embed the designed network: a design (<network><slave type=\"EK1100\"/>..)\n"
+    "                  or an ENI file; registers a field per PDO entry of its slaves\n"
+    "  --compact       embed only the device models the network uses\n"
+    "  -h, --help      print this help and exit\n"
+    "  --version       print dissgen's version and exit\n";
 
 struct Loaded {
     std::unique_ptr<Protocol> proto;
@@ -63,6 +79,48 @@ Loaded load(const std::string& path, Diagnostics& diags) {
 }
 
 void print(const Diagnostics& diags, const std::string& path) { std::cerr << diags.format(path); }
+
+// The ESI catalogue and network design to embed (--esi, --network, --compact).
+struct BusInput {
+    std::vector<std::string> esi;
+    std::string network_file;
+    bool compact = false;
+
+    Catalogue catalogue;
+    Network network;
+    bool given() const { return !esi.empty() || !network_file.empty(); }
+    BusOptions options() const { return {network_file.empty() ? nullptr : &network, compact}; }
+};
+
+// Reads the ESI files and the network; diagnostics on stderr. False on any error.
+bool load_bus(BusInput& bus) {
+    if (bus.compact && bus.network_file.empty()) {
+        std::cerr << "dissgen: --compact keeps the models a network uses: give --network FILE too\n";
+        return false;
+    }
+    if (!bus.esi.empty() && !load_catalogue(bus.esi, bus.catalogue, std::cerr)) return false;
+    if (bus.network_file.empty()) return true;
+    Diagnostics diags;
+    std::string text;
+    if (!read_whole_file(bus.network_file, text)) diags.error(0, "cannot read the network file");
+    else read_network(text, bus.network_file, bus.catalogue, bus.network, diags);
+    print(diags, bus.network_file);
+    return !diags.has_errors();
+}
+
+// The generated source, with the bus tables when --esi or --network was given.
+std::string generate_source(const Protocol& proto, const std::string& path, const BusInput& bus) {
+    if (!bus.given()) return emit_cpp(proto, fs::path(path).filename().string());
+    EmbeddedTables tables = emit_bus(bus.catalogue, bus.options(), proto.filter);
+    return emit_cpp(proto, fs::path(path).filename().string(), &tables);
+}
+
+int cmd_esi(const std::vector<std::string>& paths) {
+    Catalogue cat;
+    if (!load_catalogue(paths, cat, std::cerr)) return 1;
+    std::cout << list_catalogue(cat);
+    return 0;
+}
 
 // A protocol name already in the installed Wireshark makes the plugin refuse
 // to load there. Only a warning for check: the rules may target another Wireshark.
@@ -108,29 +166,31 @@ Packaged packaged_plugin_for(const Protocol& p, const std::string& system_dir, c
     return {};
 }
 
-int cmd_check(const std::string& path) {
+int cmd_check(const std::string& path, BusInput& bus) {
     Diagnostics diags;
     Loaded l = load(path, diags);
     if (l.ok) check_names_against_wireshark(*l.proto, diags, false);
     print(diags, path);
-    return l.ok ? 0 : 1;
+    bool bus_ok = load_bus(bus);
+    return l.ok && bus_ok ? 0 : 1;
 }
 
-int cmd_fields(const std::string& path) {
+int cmd_fields(const std::string& path, BusInput& bus) {
     Diagnostics diags;
     Loaded l = load(path, diags);
     print(diags, path);
-    if (!l.ok) return 1;
+    if (!l.ok || !load_bus(bus)) return 1;
     std::cout << list_fields(*l.proto);
+    if (bus.given()) std::cout << list_bus_fields(bus.catalogue, bus.options(), l.proto->filter);
     return 0;
 }
 
-int cmd_generate(const std::string& path, const std::string& out_dir) {
+int cmd_generate(const std::string& path, const std::string& out_dir, BusInput& bus) {
     Diagnostics diags;
     Loaded l = load(path, diags);
     print(diags, path);
-    if (!l.ok) return 1;
-    std::string code = emit_cpp(*l.proto, fs::path(path).filename().string());
+    if (!l.ok || !load_bus(bus)) return 1;
+    std::string code = generate_source(*l.proto, path, bus);
     std::error_code ec;
     fs::create_directories(out_dir, ec);
     fs::path target = fs::path(out_dir) / (plugin_basename(path) + ".cpp");
@@ -147,12 +207,13 @@ int cmd_generate(const std::string& path, const std::string& out_dir) {
     return 0;
 }
 
-int cmd_install(const std::string& path, const std::string& dir, bool system, const std::string& argv0) {
+int cmd_install(const std::string& path, const std::string& dir, bool system, const std::string& argv0,
+                BusInput& bus) {
     Diagnostics diags;
     Loaded l = load(path, diags);
     if (l.ok) check_names_against_wireshark(*l.proto, diags, system);
     print(diags, path);
-    if (!l.ok || diags.has_errors()) return 1;
+    if (!l.ok || diags.has_errors() || !load_bus(bus)) return 1;
 
     auto headers = headers_version();
     if (!headers) {
@@ -206,8 +267,7 @@ int cmd_install(const std::string& path, const std::string& dir, bool system, co
         std::cerr << "dissgen: cannot find the plugin runtime (dissgen_runtime.cpp); set DISSGEN_RUNTIME_DIR\n";
         return 1;
     }
-    BuildRequest req{emit_cpp(*l.proto, fs::path(path).filename().string()), plugin_basename(path), target_dir,
-                     runtime};
+    BuildRequest req{generate_source(*l.proto, path, bus), plugin_basename(path), target_dir, runtime};
     std::string installed;
     std::string error = build_and_install(req, installed);
     if (!error.empty()) {
@@ -232,43 +292,63 @@ int main(int argc, char** argv) {
         return 0;
     }
     const std::string command = args[0];
-    std::string file, out_dir, dir;
+    std::string out_dir, dir;
+    std::vector<std::string> files;
     bool system = false;
+    BusInput bus;
     for (size_t i = 1; i < args.size(); ++i) {
         const std::string& a = args[i];
-        if ((a == "-o" || a == "--dir") && i + 1 < args.size()) {
-            (a == "-o" ? out_dir : dir) = args[++i];
+        if ((a == "-o" || a == "--dir" || a == "--esi" || a == "--network") && i + 1 < args.size()) {
+            const std::string& v = args[++i];
+            if (a == "-o") out_dir = v;
+            else if (a == "--dir") dir = v;
+            else if (a == "--esi") bus.esi.push_back(v);
+            else if (!bus.network_file.empty()) {
+                std::cerr << "dissgen: one --network at a time\n";
+                return 2;
+            } else bus.network_file = v;
         } else if (a == "--system") {
             system = true;
+        } else if (a == "--compact") {
+            bus.compact = true;
         } else if (!a.empty() && a[0] == '-') {
             std::cerr << "dissgen: unknown option '" << a << "'\n" << kUsage;
             return 2;
-        } else if (file.empty()) {
-            file = a;
         } else {
-            std::cerr << "dissgen: one rule file at a time ('" << a << "' is extra)\n";
-            return 2;
+            files.push_back(a);
         }
     }
+    if (command == "esi") {
+        if (files.empty() || bus.given() || bus.compact) {
+            std::cerr << "dissgen: esi takes ESI files or folders only\n" << kUsage;
+            return 2;
+        }
+        return cmd_esi(files);
+    }
+    if (files.size() > 1) {
+        std::cerr << "dissgen: one rule file at a time ('" << files[1] << "' is extra)\n";
+        return 2;
+    }
+    const std::string file = files.empty() ? "" : files[0];
     if (file.empty()) {
         std::cerr << "dissgen: " << command << " needs a rule file\n" << kUsage;
         return 2;
     }
-    if (command == "check") return cmd_check(file);
-    if (command == "fields") return cmd_fields(file);
+    if (command == "check") return cmd_check(file, bus);
+    if (command == "fields") return cmd_fields(file, bus);
     if (command == "generate") {
         if (out_dir.empty()) {
             std::cerr << "dissgen: generate needs -o DIR\n";
             return 2;
         }
-        return cmd_generate(file, out_dir);
+        return cmd_generate(file, out_dir, bus);
     }
     if (command == "install") {
         if (system && !dir.empty()) {
             std::cerr << "dissgen: use either --dir or --system\n";
             return 2;
         }
-        return cmd_install(file, dir, system, argv[0]);
+        return cmd_install(file, dir, system, argv[0], bus);
     }
     std::cerr << "dissgen: unknown command '" << command << "'\n" << kUsage;
     return 2;

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-2.0-or-later
-# Builds the libFuzzer target for the rule-file front end (clang, with
-# AddressSanitizer and UndefinedBehaviorSanitizer) and runs it for a bounded
-# time, seeded with every rule file in the repository. The corpus lives in a
+# Builds the libFuzzer target for the rule-file, ESI and network front ends
+# (clang, with AddressSanitizer and UndefinedBehaviorSanitizer) and runs it for
+# a bounded time, seeded with every rule, ESI and network file of the tests. The corpus lives in a
 # temporary folder: nothing is written into the source tree.
 #
 #   tests/fuzz/run_fuzz.sh [SECONDS]      (default: $FUZZ_SECONDS or 180)
@@ -22,16 +22,18 @@ clang++ -std=c++17 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-reco
   -I"$src/generator" $(pkg-config --cflags libxml-2.0) \
   "$here/fuzz_rules.cpp" \
   "$src"/generator/{diagnostics,model,text_util,parser,validator,emit_cpp}.cpp \
+  "$src"/generator/{xml_input,esi_reader,network_reader,emit_catalogue}.cpp \
   $(pkg-config --libs libxml-2.0) -o "$work/fuzz_rules"
 
 mkdir -p "$work/corpus"
 n=0
-for f in "$src"/rules/*.xml "$src"/tests/rules/*.xml "$src"/tests/rules_ok/*.xml "$src"/tests/rules_err/*.xml; do
+for f in "$src"/rules/*.xml "$src"/tests/rules/*.xml "$src"/tests/rules_ok/*.xml "$src"/tests/rules_err/*.xml \
+         "$src"/tests/esi_ok/*.xml "$src"/tests/esi_err/*.xml "$src"/tests/network/*.xml "$src"/tests/network_err/*.xml; do
   [ -f "$f" ] || continue
   cp "$f" "$work/corpus/seed_$n.xml"
   n=$((n + 1))
 done
-echo "fuzz: $n seed rule files, $seconds seconds"
+echo "fuzz: $n seed files, $seconds seconds"
 
 # -max_len keeps inputs near rule-file size; -timeout flags a hang of 10 s on one input.
 "$work/fuzz_rules" "$work/corpus" -max_total_time="$seconds" -max_len=16384 -timeout=10 \

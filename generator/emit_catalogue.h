@@ -1,0 +1,24 @@
+// Stage 3b: the ESI catalogue and the network design -> the plugin's static
+// bus tables (plugin_runtime/dissgen_bus.h) and a registered field for every
+// PDO entry of the designed slaves. emit_cpp() places the pieces.
+#pragma once
+
+#include <string>
+
+#include "emit_cpp.h"
+#include "esi_model.h"
+
+namespace dissgen {
+
+struct BusOptions {
+    const Network* network = nullptr;  // nullptr: catalogue only
+    bool compact = false;              // embed only the models the network uses
+};
+
+// `filter` is the protocol's filter name: fields are FILTER.pdo.OWNER.PDO.ENTRY.
+EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& options, const std::string& filter);
+
+// One line per PDO field, as list_fields() prints the rule fields.
+std::string list_bus_fields(const Catalogue& cat, const BusOptions& options, const std::string& filter);
+
+}  // namespace dissgen
