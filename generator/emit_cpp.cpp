@@ -113,7 +113,7 @@ const char* show_of(const Node& n) {
     return "DG_SHOW_HIDDEN";
 }
 
-std::string flags_of(const Node& n) {
+std::string flags_of(const Node& n, bool pairing_key) {
     std::vector<std::string> f;
     if (n.byteorder == ByteOrder::Little) f.push_back("DG_LITTLE");
     if (n.is_numeric()) f.push_back("DG_NUMERIC");
@@ -121,6 +121,7 @@ std::string flags_of(const Node& n) {
     if (n.in_bit_group) f.push_back("DG_GROUP");
     if (n.group_first) f.push_back("DG_GROUP_FIRST");
     if (n.group_last) f.push_back("DG_GROUP_LAST");
+    if (pairing_key) f.push_back("DG_KEY");  // issue 11
     if (f.empty()) return "0";
     std::string out;
     for (size_t i = 0; i < f.size(); ++i) out += (i ? "|" : "") + f[i];
@@ -176,6 +177,12 @@ private:
     std::string vals(const Node& n) const { return l_.ident.at(&n) + "_vals"; }
     bool has_hf(const Node& n) const { return !n.filter_name.empty(); }
     bool uses_val64(const Node& n) const { return value_bytes(n) > 4; }
+    bool is_pairing_key(const Node& n) const {  // issue 11
+        if (!p_.pairing) return false;
+        for (const PairingKey& k : p_.pairing->keys)
+            if (k.field.target == &n) return true;
+        return false;
+    }
 
     const Protocol& p_;
     std::string source_;
@@ -269,7 +276,7 @@ void Emitter::node_table() {
         o_ << "    /* " << n.doc_index - 1 << ": line " << n.line << " */\n"
            << "    { " << c_string(n.name) << ", " << (has_hf(n) ? "&" + hf(n) : "NULL") << ", "
            << (n.is_container() ? "&" + ett(n) : "NULL") << ", " << (n.is_container() ? "DG_CONTAINER" : "DG_LEAF")
-           << ", " << length_kind_of(n) << ", " << show_of(n) << ", " << flags_of(n) << ",\n      " << length << ", "
+           << ", " << length_kind_of(n) << ", " << show_of(n) << ", " << flags_of(n, is_pairing_key(n)) << ",\n      " << length << ", "
            << n.shift << ", " << n.bits << ", " << n.slot << ", "
            << ref_of(n.length_kind == LengthKind::Field ? &n.length_ref : nullptr) << ", "
            << ref_of(n.count ? &*n.count : nullptr) << ", "
@@ -293,6 +300,14 @@ void Emitter::protocol_struct() {
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);\n";
     if (pdu) o_ << "static int dissect_" << f << "_stream(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);\n";
     size_t hook_count = p_.hooks.size() + (p_.ethertype ? 1 : 0);
+    if (p_.pairing) {  // issue 11
+        char timeout[32];
+        std::snprintf(timeout, sizeof timeout, "%.9g", p_.pairing->timeout);
+        o_ << "\n/* Request/response pairing (<pairing>, line " << p_.pairing->line
+           << "): timeout in seconds, analysis. */\n"
+           << "static const dg_pairing " << f << "_pairing = { " << timeout << ", "
+           << (p_.pairing->analysis.empty() ? "NULL" : c_string(p_.pairing->analysis)) << " };\n";
+    }
     o_ << "\nstatic dg_protocol " << f << "_protocol = {\n"
        << "    " << c_string(p_.name) << ", " << c_string(p_.abbreviation) << ", " << c_string(f) << ",\n"
        << "    &proto_" << f << ", &ett_" << f << ", dissect_" << f << ", "
@@ -301,7 +316,9 @@ void Emitter::protocol_struct() {
        << "    " << f << "_ranges, " << f << "_summary, " << p_.slot_count << ", &ei_" << f << ",\n"
        << "    " << f << "_hooks, " << hook_count << ",\n"
        << "    " << (pdu ? pdu->doc_index - 1 : -1) << ", "
-       << (pdu ? p_.pdu_fixed_len - value_bytes(*pdu) : 0) << ", " << p_.pdulengthadd << "\n};\n\n";
+       << (pdu ? p_.pdu_fixed_len - value_bytes(*pdu) : 0) << ", " << p_.pdulengthadd;
+    if (p_.pairing) o_ << ",\n    &" << f << "_pairing";  // issue 11
+    o_ << "\n};\n\n";
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
        << "    return dg_dissect(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";
     if (pdu)
