@@ -15,7 +15,10 @@
  *     analysis, or when it cannot tell, the order decides: the first message
  *     of a key is the request, the next one its response.
  *  4. Otherwise the message is a new request and waits, unless the analysis
- *     knows it for a response whose request was not captured (an orphan).
+ *     knows it for a response: then it answers the one request still
+ *     waiting, whatever its key (the analysis reports what changed), or, when
+ *     none or several are waiting, a request that was not captured (an
+ *     orphan).
  * Nothing here is touched on later passes.
  */
 #include "dissgen_pairing.h"
@@ -40,16 +43,26 @@ struct pair_key {
     guint64 *values;
 };
 
+/* A request waiting for its response. It is in two queues, oldest first:
+ * its key's and the capture's; answered or given-up ones are marked done and
+ * leave each queue when they reach its head. */
 struct pending {
-    pending *next;
+    pending *next;        /* in the key's queue */
+    pending *next_sent;   /* in the capture's queue */
+    guint8 queues;        /* how many queues still hold it */
+    gboolean done;
     dg_transaction *txn;
     address src;
     guint8 *bytes;  /* the request's bytes, kept for the analysis until answered */
     guint length;
 };
 
+struct queue {
+    pending *head, *tail;
+};
+
 struct key_entry {
-    pending *head, *tail;        /* unanswered requests, oldest first */
+    queue waiting;               /* this key's requests */
     guint32 last_frame;          /* the last message with this key (duplicates) */
     nstime_t last_time;
     guint8 last_role;
@@ -60,6 +73,8 @@ struct key_entry {
 
 struct capture_state {
     wmem_map_t *keys;            /* pair_key -> key_entry */
+    queue sent;                  /* every key's requests, in capture order */
+    guint waiting;               /* requests not yet answered nor given up */
     guint64 requests;            /* the last request's seq */
     guint64 answered_max;        /* the highest seq answered so far */
     guint32 last_frame;          /* the last message paired (its frame) */
@@ -140,11 +155,20 @@ void remember_last(key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length
     e->last_length = length;
 }
 
-void drop_pending(pending *q)
+/* Answered or given up: what it kept goes now, the rest once both queues let go. */
+void retire(capture_state *c, pending *q)
 {
+    if (q->done) return;
+    q->done = TRUE;
+    c->waiting--;
     wmem_free(wmem_file_scope(), q->bytes);
+    q->bytes = NULL;
     free_address_wmem(wmem_file_scope(), &q->src);
-    wmem_free(wmem_file_scope(), q);
+}
+
+void release(pending *q)
+{
+    if (--q->queues == 0) wmem_free(wmem_file_scope(), q);
 }
 
 /* A response may come back after those of later requests (a reordering, or
@@ -159,20 +183,32 @@ gboolean given_up(const capture_state *c, const pending *q, const packet_info *p
     return nstime_to_sec(&age) > timeout;
 }
 
-/* The pending request this message answers, unlinked from the queue (the
- * ones before it are given up), or NULL when the message is a new request. */
+/* The oldest request of a queue still waiting (given-up ones retired on the
+ * way), or NULL. `in_key` says which link the queue uses. */
+pending *oldest_waiting(capture_state *c, queue *qu, gboolean in_key, const packet_info *pinfo)
+{
+    while (qu->head) {
+        pending *q = qu->head;
+        if (!q->done && given_up(c, q, pinfo, protocol->pairing->timeout)) retire(c, q);
+        if (!q->done) return q;
+        qu->head = in_key ? q->next : q->next_sent;
+        if (!qu->head) qu->tail = NULL;
+        release(q);
+    }
+    return NULL;
+}
+
+void retire_all(capture_state *c, queue *qu, const packet_info *pinfo)
+{
+    for (pending *q; (q = oldest_waiting(c, qu, TRUE, pinfo));) retire(c, q);
+}
+
+/* The pending request of this key that this message answers, or NULL when
+ * the message is a new request. */
 pending *take_answered(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length)
 {
-    while (e->head && given_up(c, e->head, pinfo, protocol->pairing->timeout)) {
-        pending *old = e->head;
-        e->head = old->next;
-        drop_pending(old);
-    }
-    if (!e->head) {
-        e->tail = NULL;
-        return NULL;
-    }
-    pending *q = e->head;
+    pending *q = oldest_waiting(c, &e->waiting, TRUE, pinfo);
+    if (!q) return NULL;
     int verdict = analysis && analysis->is_response ? analysis->is_response(c->analysis, &q->src, &pinfo->src) : -1;
     /* The very request again, from its sender: a repetition, not an answer. */
     if (e->last_frame == q->txn->request_frame && e->last_length == length &&
@@ -180,17 +216,36 @@ pending *take_answered(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_inf
         verdict = 0;
     if (verdict == 0) {
         /* The sender sent the same key again: what was pending is given up. */
-        while (e->head) {
-            pending *old = e->head;
-            e->head = old->next;
-            drop_pending(old);
-        }
-        e->tail = NULL;
+        retire_all(c, &e->waiting, pinfo);
         return NULL;
     }
-    e->head = q->next;
-    if (!e->head) e->tail = NULL;
     return q;
+}
+
+/* A response that answers nothing pending of its key (its key came back
+ * changed): when exactly one request is waiting, and its sender fits, it is
+ * that one's. (With several waiting, a capture that missed frames could not
+ * be told from one whose keys changed.) */
+pending *take_oldest(capture_state *c, packet_info *pinfo)
+{
+    pending *q = oldest_waiting(c, &c->sent, FALSE, pinfo);
+    if (!q || c->waiting != 1 || !analysis || !analysis->is_response || analysis->is_response(c->analysis, &q->src, &pinfo->src) != 1)
+        return NULL;
+    return q;
+}
+
+void enqueue(queue *qu, pending *q, gboolean in_key)
+{
+    if (qu->tail) {
+        if (in_key)
+            qu->tail->next = q;
+        else
+            qu->tail->next_sent = q;
+    } else {
+        qu->head = q;
+    }
+    qu->tail = q;
+    q->queues++;
 }
 
 dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count, guint length)
@@ -208,6 +263,8 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     }
 
     pending *q = take_answered(c, e, tvb, pinfo, length);
+    gboolean returned = !q && analysis && analysis->is_returned && analysis->is_returned(c->analysis, &pinfo->src);
+    if (returned) q = take_oldest(c, pinfo);
     remember_last(e, tvb, pinfo, length, q ? DG_ROLE_RESPONSE : DG_ROLE_REQUEST); /* an orphan: a request for step 2 */
     if (q) {
         dg_transaction *t = q->txn;
@@ -222,11 +279,11 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
             fp->analysis = analysis->compare(c->analysis, request, tvb, pinfo);
             tvb_free(request);
         }
-        drop_pending(q);
+        retire(c, q);
         return fp;
     }
 
-    if (analysis && analysis->is_returned && analysis->is_returned(c->analysis, &pinfo->src)) {
+    if (returned) {
         fp->role = DG_ROLE_ORPHAN;
         return fp;
     }
@@ -243,11 +300,9 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
         n->bytes = (guint8 *)tvb_memdup(wmem_file_scope(), tvb, 0, length);
         n->length = length;
     }
-    if (e->tail)
-        e->tail->next = n;
-    else
-        e->head = n;
-    e->tail = n;
+    enqueue(&e->waiting, n, TRUE);
+    enqueue(&c->sent, n, FALSE);
+    c->waiting++;
     return fp;
 }
 
