@@ -341,14 +341,15 @@ void show(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, proto_t
 
 /* --- statistics ---------------------------------------------------------- */
 
-const char *const st_pairing = "Request/response pairing";
+const char *const st_pairing = "Requests and responses";
 const char *const st_requests = "Requests";
 const char *const st_responses = "Responses";
-const char *const st_lost = "No response (with tshark -2)";
+const char *const st_lost = "No response";
 const char *const st_duplicates = "Duplicates";
 const char *const st_orphans = "Responses to requests not captured";
 const char *const st_rtt = "Round trip (ms)";
 int st_pairing_id;
+guint64 st_request_count, st_answered_count; /* for "No response": requests not answered by the end */
 
 } /* namespace */
 
@@ -409,6 +410,7 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, 
 void dg_pairing_stats_init(const dg_protocol *, stats_tree *st)
 {
     st_pairing_id = stats_tree_create_node(st, st_pairing, 0, STAT_DT_INT, TRUE);
+    st_request_count = st_answered_count = 0;
     stats_tree_create_node(st, st_requests, st_pairing_id, STAT_DT_INT, FALSE);
     stats_tree_create_node(st, st_responses, st_pairing_id, STAT_DT_INT, FALSE);
     stats_tree_create_node(st, st_lost, st_pairing_id, STAT_DT_INT, FALSE);
@@ -418,18 +420,18 @@ void dg_pairing_stats_init(const dg_protocol *, stats_tree *st)
     if (analysis && analysis->stats_init) analysis->stats_init(st, st_pairing_id);
 }
 
-void dg_pairing_stats_packet(const dg_protocol *, stats_tree *st, packet_info *pinfo, const dg_frame_pairing *fp)
+void dg_pairing_stats_packet(const dg_protocol *, stats_tree *st, packet_info *, const dg_frame_pairing *fp)
 {
     if (!fp) return;
     tick_stat_node(st, st_pairing, 0, TRUE);
     switch (fp->role) {
     case DG_ROLE_REQUEST:
         tick_stat_node(st, st_requests, st_pairing_id, FALSE);
-        /* "Never came back" is known once the whole capture was read: tshark -2. */
-        if (!fp->txn->response_frame && PINFO_FD_VISITED(pinfo)) tick_stat_node(st, st_lost, st_pairing_id, FALSE);
+        st_request_count++;
         break;
     case DG_ROLE_RESPONSE:
         tick_stat_node(st, st_responses, st_pairing_id, FALSE);
+        st_answered_count++;
         avg_stat_node_add_value_float(st, st_rtt, st_pairing_id, FALSE,
                                       (gfloat)(nstime_to_sec(&fp->txn->round_trip) * 1000.0));
         if (analysis && analysis->stats_response && fp->analysis)
@@ -443,6 +445,9 @@ void dg_pairing_stats_packet(const dg_protocol *, stats_tree *st, packet_info *p
         break;
     default: break;
     }
+    /* Every response answers one request, so once the capture has been read
+     * the requests not answered are the difference (one pass or two). */
+    set_stat_node(st, st_lost, st_pairing_id, FALSE, (gint)(st_request_count - st_answered_count));
 }
 
 } /* extern "C" */
