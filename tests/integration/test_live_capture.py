@@ -26,7 +26,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import NOBODY, TsharkEnv  # noqa: E402
+from tshark_env import NOBODY, Checks, TsharkEnv  # noqa: E402
 import pcaprewrite as pr  # noqa: E402
 
 SKIP = 77
@@ -38,14 +38,7 @@ FIELDS = ["frame.number", "ecatr.header.length", "ecatr.datagram.cmd", "ecatr.da
           "ecatr.esc.slaves_passed", "ecatr.esc.data_changed", "ecatr.expert.duplicate",
           "ecatr.expert.out_of_order", "ecatr.expert.changed", "ecatr.expert.frame_length",
           "ecatr.expert.write_changed", "ecatr.expert.wkc_down", "ecatr.expert.forwarding"]
-FAILURES = []
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        FAILURES.append(what)
-    return cond
+check = Checks()
 
 
 def ethercat_frames(path):
@@ -222,8 +215,8 @@ def main():
                                   diff[0], got[diff[0]], want[diff[0]]) if diff else ""))
     finally:
         ns.__exit__()
-    print("\n%d failed" % len(FAILURES))
-    return 1 if FAILURES else 0
+    print("\n%d failed" % len(check.failed))
+    return 1 if check.failed else 0
 
 
 if __name__ == "__main__":

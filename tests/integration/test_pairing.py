@@ -27,7 +27,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import TsharkEnv  # noqa: E402
+from tshark_env import Checks, TsharkEnv  # noqa: E402
 import pcaprewrite as pr  # noqa: E402
 
 SKIP = 77
@@ -39,14 +39,7 @@ RESPONSE_FIELDS = ["ecatr.request_in", "ecatr.time", "ecatr.esc.wkc_added", "eca
 FIELDS = ["frame.number", "ecatr.response_in", "ecatr.expert.no_response"] + RESPONSE_FIELDS
 WRITES = {2, 5, 8, 11}            # APWR FPWR BWR LWR
 ADVANCING = {1, 2, 3, 7, 8, 9, 13}  # auto-increment and broadcast commands
-FAILURES = []
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        FAILURES.append(what)
-    return cond
+check = Checks()
 
 
 def decode(env, path, two_pass=True, display_filter=None):
@@ -138,10 +131,47 @@ def corpus_checks(env, corpus_dir, files):
         diff = [n for n in rows if any(rows[n][f] != one[n][f] for f in RESPONSE_FIELDS)]
         check(not diff, "%s: one pass shows the same items on returned frames as -2%s" % (
             name, ": %s" % diff[:5] if diff else ""))
+        stats_checks(env, path, name, rows)
         filtered = decode(env, path, display_filter="ecatr.request_in || ecatr.expert.no_response")
         diff = [n for n in filtered if filtered[n] != rows[n]]
         check(filtered and not diff, "%s: a display filter keeps the same items (%d frames)%s" % (
             name, len(filtered), ": %s" % diff[:5] if diff else ""))
+
+
+def stats_tree(env, path, two_pass):
+    """{item: [count, average, min, max]} of the "Requests and responses" part of -z ecatr,tree."""
+    args = ["-r", path, "-q", "-z", "ecatr,tree"] + (["-2"] if two_pass else [])
+    items, inside = {}, False
+    for line in env.tshark(args).stdout.splitlines():
+        if line.startswith("Requests and responses"):
+            inside = True
+            continue
+        if inside and not line.startswith(" "):
+            break
+        if inside and line.startswith(" ") and not line.startswith("  "):
+            label = line[:41].strip()
+            cols = line[41:].split()
+            items[label] = cols
+    return items
+
+
+def stats_checks(env, path, name, rows):
+    requests = sum(1 for r in rows.values() if r["ecatr.response_in"] or r["ecatr.expert.no_response"])
+    responses = sum(1 for r in rows.values() if r["ecatr.request_in"])
+    lost = len(with_expert(rows, "no_response"))
+    times = [float(r["ecatr.time"]) * 1000 for r in rows.values() if r["ecatr.time"]]
+    for two_pass in (False, True):
+        st = stats_tree(env, path, two_pass)
+        got = (int(st["Requests"][0]), int(st["Responses"][0]), int(st["No response"][0]))
+        ok = got == (requests, responses, lost)
+        if times:
+            count, avg, low, high = st["Round trip (ms)"][:4]
+            ok = ok and int(count) == len(times) and abs(float(low) - min(times)) < 0.001 and \
+                abs(float(high) - max(times)) < 0.001 and abs(float(avg) - sum(times) / len(times)) < 0.01
+        check(ok, "%s: -z ecatr,tree%s: sent %d, returned %d, lost %d, round trip min/avg/max %s (tree: %s)" % (
+            name, " -2" if two_pass else "", requests, responses, lost,
+            "%.3f/%.3f/%.3f ms" % (min(times), sum(times) / len(times), max(times)) if times else "-",
+            {k: v[:4] for k, v in st.items() if k in ("Requests", "Responses", "No response", "Round trip (ms)")}))
 
 
 # ----------------------------------------------------------------------------- faults
@@ -333,8 +363,8 @@ def main():
         fault_checks(env, env.home, [f for f in ("soem-sdinfo-ek1100-el1004.pcapng",
                                                  "replay-ek1100-el2828-el2889.pcapng",
                                                  "twincat-scan-boxes.pcapng") if f in local])
-    print("\n%d failed" % len(FAILURES))
-    return 1 if FAILURES else 0
+    print("\n%d failed" % len(check.failed))
+    return 1 if check.failed else 0
 
 
 if __name__ == "__main__":
