@@ -25,9 +25,14 @@ std::vector<std::string> split_words(const std::string& s) {
     return words;
 }
 
+// The runtime's sources, compiled into every plugin.
+const char* const kRuntimeSources[] = {"dissgen_runtime.cpp", "dissgen_pairing.cpp", "ethercat_esc.cpp"};
+
 bool has_runtime(const fs::path& dir) {
     std::error_code ec;
-    return fs::exists(dir / "dissgen_runtime.cpp", ec) && fs::exists(dir / "dissgen_runtime.h", ec);
+    for (const char* source : kRuntimeSources)
+        if (!fs::exists(dir / source, ec)) return false;
+    return fs::exists(dir / "dissgen_runtime.h", ec);
 }
 
 }  // namespace
@@ -87,7 +92,7 @@ std::string build_and_install(const BuildRequest& req, std::string& installed_pa
     if (const char* extra = std::getenv("DISSGEN_CXXFLAGS"))
         for (const std::string& w : split_words(extra)) cmd.push_back(w);
     cmd.push_back(source.string());
-    cmd.push_back(req.runtime_dir + "/dissgen_runtime.cpp");
+    for (const char* runtime_source : kRuntimeSources) cmd.push_back(req.runtime_dir + "/" + runtime_source);
     cmd.push_back("-o");
     cmd.push_back(output.string());
     cmd.push_back("-Wl,--no-undefined");

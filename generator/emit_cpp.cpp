@@ -180,7 +180,7 @@ const char* show_of(const Node& n) {
     return "DG_SHOW_HIDDEN";
 }
 
-std::string flags_of(const Node& n) {
+std::string flags_of(const Node& n, bool pairing_key) {
     std::vector<std::string> f;
     if (n.byteorder == ByteOrder::Little) f.push_back("DG_LITTLE");
     if (n.is_numeric()) f.push_back("DG_NUMERIC");
@@ -188,6 +188,7 @@ std::string flags_of(const Node& n) {
     if (n.in_bit_group) f.push_back("DG_GROUP");
     if (n.group_first) f.push_back("DG_GROUP_FIRST");
     if (n.group_last) f.push_back("DG_GROUP_LAST");
+    if (pairing_key) f.push_back("DG_KEY");  // issue 11
     if (f.empty()) return "0";
     std::string out;
     for (size_t i = 0; i < f.size(); ++i) out += (i ? "|" : "") + f[i];
@@ -252,6 +253,12 @@ private:
     std::string vals(const Node& n) const { return l_.ident.at(&n) + "_vals"; }
     bool has_hf(const Node& n) const { return !n.filter_name.empty(); }
     bool uses_val64(const Node& n) const { return value_bytes(n) > 4; }
+    bool is_pairing_key(const Node& n) const {  // issue 11
+        if (!p_.pairing) return false;
+        for (const PairingKey& k : p_.pairing->keys)
+            if (k.field.target == &n) return true;
+        return false;
+    }
 
     const Protocol& p_;
     std::string source_;
@@ -374,7 +381,7 @@ void Emitter::node_table() {
         o_ << "    /* " << n.doc_index - 1 << ": line " << n.line << " */\n"
            << "    { " << c_string(n.name) << ", " << (has_hf(n) ? "&" + hf(n) : "NULL") << ", "
            << (n.is_container() ? "&" + ett(n) : "NULL") << ", " << (n.is_container() ? "DG_CONTAINER" : "DG_LEAF")
-           << ", " << length_kind_of(n) << ", " << show_of(n) << ", " << flags_of(n) << ",\n      " << length << ", "
+           << ", " << length_kind_of(n) << ", " << show_of(n) << ", " << flags_of(n, is_pairing_key(n)) << ",\n      " << length << ", "
            << n.shift << ", " << n.bits << ", " << n.slot << ", "
            << ref_of(n.length_kind == LengthKind::Field ? &n.length_ref : nullptr) << ", "
            << ref_of(n.count ? &*n.count : nullptr) << ", "
@@ -412,6 +419,14 @@ void Emitter::protocol_struct() {
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);\n";
     if (pdu) o_ << "static int dissect_" << f << "_stream(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);\n";
     size_t hook_count = p_.hooks.size() + (p_.ethertype ? 1 : 0);
+    if (p_.pairing) {  // issue 11
+        char timeout[32];
+        std::snprintf(timeout, sizeof timeout, "%.9g", p_.pairing->timeout);
+        o_ << "\n/* Request/response pairing (<pairing>, line " << p_.pairing->line
+           << "): timeout in seconds, analysis. */\n"
+           << "static const dg_pairing " << f << "_pairing = { " << timeout << ", "
+           << (p_.pairing->analysis.empty() ? "NULL" : c_string(p_.pairing->analysis)) << " };\n";
+    }
     o_ << "\nstatic dg_protocol " << f << "_protocol = {\n"
        << "    " << c_string(p_.name) << ", " << c_string(p_.abbreviation) << ", " << c_string(f) << ",\n"
        << "    &proto_" << f << ", &ett_" << f << ", dissect_" << f << ", "
@@ -421,16 +436,20 @@ void Emitter::protocol_struct() {
        << "    " << f << "_hooks, " << hook_count << ",\n"
        << "    " << (pdu ? pdu->doc_index - 1 : -1) << ", "
        << (pdu ? p_.pdu_fixed_len - value_bytes(*pdu) : 0) << ", " << p_.pdulengthadd;
+    // Members after pdu_add default to none; a protocol that uses later ones
+    // spells out everything before them.
+    const bool pairing = p_.pairing != nullptr, after_10b = l_.uses_10b() || pairing;
     if (uses_reassembly())  // issue 10a
         o_ << ",\n    &" << f << "_reassembly, &" << f << "_fragment_items";
-    else if (l_.uses_10b())
+    else if (after_10b)
         o_ << ",\n    NULL, NULL";
-    if (l_.uses_10b()) {  // issue 10b
+    if (after_10b) {  // issue 10b
         auto name = [&](const char* table, bool used) { return used ? f + "_" + table : std::string("NULL"); };
         o_ << ",\n    " << name("whens", !l_.whens.empty()) << ", " << name("peeks", !l_.peeks.empty()) << ", "
            << name("peek_lengths", !l_.peek_lengths.empty()) << ", " << name("windows", !l_.windows.empty()) << ", "
            << name("places", !l_.places.empty());
     }
+    if (pairing) o_ << ",\n    &" << f << "_pairing";  // issue 11
     o_ << "\n};\n\n";
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
        << "    return dg_dissect(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";

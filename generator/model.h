@@ -164,6 +164,25 @@ struct Hook {
     int line = 0;
 };
 
+// --- issue 11: request/response pairing (<pairing> in <root>) ---
+// A message is a request until a later one with the same key values answers
+// it. Key fields are numeric leaves; in a repeated node every instance's
+// value is part of the key, in order.
+struct PairingKey {
+    FieldRef field;
+    int line = 0;
+};
+
+struct Pairing {
+    int line = 0;
+    std::vector<PairingKey> keys;
+    double timeout = 1.0;   // seconds a request waits for its response
+    std::string analysis;   // "" or a protocol analysis of the runtime ("ethercat-esc")
+};
+
+// Analyses the runtime knows (plugin_runtime/dissgen_pairing.cpp).
+constexpr const char* kPairingAnalyses[] = {"ethercat-esc"};
+
 struct Protocol {
     std::string name;
     std::string abbreviation;
@@ -176,6 +195,8 @@ struct Protocol {
     int64_t pdulengthadd = 0;
     int line = 0;
     std::vector<std::unique_ptr<Node>> nodes;
+    // issue 11: request/response pairing, when the file declares it
+    std::unique_ptr<Pairing> pairing;
 
     // --- derived by the validator ---
     int slot_count = 0;

@@ -33,6 +33,8 @@ const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displa
 const std::vector<std::string> kEnumAttributes = {"value", "name"};
 const std::vector<std::string> kHookAttributes = {"table", "value"};
 const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};  // issue 10b
+const std::vector<std::string> kPairingAttributes = {"timeout", "analysis"};  // issue 11
+const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
                                                 "origin",  "enum",      "nondisplay",
                                                 // issue 10a
@@ -245,6 +247,7 @@ private:
     bool parse_enum_range(const std::string& text, EnumItem& item);
     void parse_when(xmlNode* el, Node& node, xmlNode* node_el);                   // issue 10b
     void parse_layout_attributes(std::map<std::string, std::string>& attrs, Node& node);  // issue 10b
+    void parse_pairing(xmlNode* el, Protocol& proto);
     void parse_length(const std::string& text, int line, Node& node, xmlNode* el);
     void parse_display(const std::string& text, int line, Node& node);
     void parse_in_list(const std::string& text, int line, Node& node);
@@ -364,8 +367,10 @@ std::unique_ptr<Protocol> Parser::parse_root(xmlNode* root) {
             proto->nodes.push_back(parse_node(c, nullptr, 1));
         else if (c->type == XML_ELEMENT_NODE && element_name(c) == "hook")
             parse_hook(c, *proto);
+        else if (c->type == XML_ELEMENT_NODE && element_name(c) == "pairing")
+            parse_pairing(c, *proto);
         else
-            unexpected_child(c, "root", {"node", "hook"});
+            unexpected_child(c, "root", {"node", "hook", "pairing"});
     }
     if (proto->pdulength) defer(*proto->pdulength, root, proto->line, "pdulength");
     resolve_all();
@@ -384,6 +389,60 @@ void Parser::parse_hook(xmlNode* el, Protocol& proto) {
         diags_.error(hook.line, "bad hook value '" + attrs["value"] + "': expected a 32-bit number");
     for (xmlNode* c = el->children; c; c = c->next) unexpected_child(c, "hook", {});
     proto.hooks.push_back(hook);
+}
+
+// issue 11: <pairing timeout="0.1" analysis="ethercat-esc"><key field="XPATH"/>...</pairing>
+void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
+    int line = line_of(el);
+    if (proto.pairing) {
+        diags_.error(line, "only one <pairing> per protocol (the first is on line " +
+                               std::to_string(proto.pairing->line) + "); list all key fields in it");
+        return;
+    }
+    proto.pairing = std::make_unique<Pairing>();
+    Pairing& pairing = *proto.pairing;
+    pairing.line = line;
+    auto attrs = attributes(el, kPairingAttributes);
+    if (attrs.count("timeout")) {
+        const std::string t = trim(attrs["timeout"]);
+        char* end = nullptr;
+        double v = t.empty() ? 0 : std::strtod(t.c_str(), &end);
+        if (t.empty() || *end != '\0' || !(v > 0) || v > 3600)
+            diags_.error(line, "bad timeout '" + attrs["timeout"] +
+                                   "': expected seconds, more than 0 and at most 3600 (e.g. 0.1)");
+        else
+            pairing.timeout = v;
+    }
+    if (attrs.count("analysis")) {
+        pairing.analysis = trim(attrs["analysis"]);
+        std::vector<std::string> known(std::begin(kPairingAnalyses), std::end(kPairingAnalyses));
+        if (std::find(known.begin(), known.end(), pairing.analysis) == known.end())
+            diags_.error(line, "unknown analysis '" + attrs["analysis"] + "'; valid: " + join(known, ", "));
+    }
+    std::vector<xmlNode*> key_elements;
+    for (xmlNode* c = el->children; c; c = c->next) {
+        if (c->type == XML_ELEMENT_NODE && element_name(c) == "key")
+            key_elements.push_back(c);
+        else
+            unexpected_child(c, "pairing", {"key"});
+    }
+    // All keys first, then their references: defer() keeps pointers into the vector.
+    for (xmlNode* c : key_elements) {
+        PairingKey key;
+        key.line = line_of(c);
+        auto kattrs = attributes(c, kKeyAttributes);
+        if (!kattrs.count("field") || trim(kattrs["field"]).empty())
+            diags_.error(key.line, "<key> needs a 'field' attribute: an XPath to a numeric field, from <root>");
+        else
+            key.field = make_ref(kattrs["field"], key.line, "field", false);
+        for (xmlNode* k = c->children; k; k = k->next) unexpected_child(k, "key", {});
+        pairing.keys.push_back(key);
+    }
+    if (pairing.keys.empty())
+        diags_.error(line, "<pairing> needs at least one <key field=\"XPATH\"/>: the fields a response repeats "
+                           "from its request");
+    for (size_t i = 0; i < pairing.keys.size(); ++i)
+        defer(pairing.keys[i].field, el->parent, pairing.keys[i].line, "field");
 }
 
 std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {

@@ -42,6 +42,7 @@ private:
     void check_fixed_container(const Node& n);
     void check_reference(Node& n, const FieldRef& ref, const std::string& what);
     void check_pdulength();
+    void check_pairing();  // issue 11
     void check_hook_list(const Node& n);
     bool offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const Node* t, uint64_t& offset,
                    bool& fixed) const;
@@ -83,6 +84,7 @@ void Validator::run() {
         check_layout(n);  // issue 10b
     });
     check_pdulength();
+    check_pairing();
     assign_filter_names(proto_.nodes, proto_.filter);
     check_fragment_names();
     assign_slots();
@@ -405,6 +407,9 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
         if (!own.empty() && is_reserved_expert_name(proto_.filter, own))
             diags_.error(n.line, "filter name '" + own + "' is reserved for the protocol's expert infos; "
                                  "give " + quote(n) + " or its container another 'filter'");
+        if (!own.empty() && !reserved_pairing_name(proto_, own).empty())
+            diags_.error(n.line, "filter name '" + own + "' is reserved for " + reserved_pairing_name(proto_, own) +
+                                 "; give " + quote(n) + " or its container another 'filter'");
         if (!own.empty()) {
             auto [it, inserted] = filter_owner_.emplace(own, &n);
             if (!inserted)
@@ -412,6 +417,26 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
                                          at_line(*it->second) + "); give one of them a 'filter' attribute");
         }
         assign_filter_names(n.children, own.empty() ? prefix : own);
+    }
+}
+
+// issue 11: key fields are numeric leaves, each named once.
+void Validator::check_pairing() {
+    if (!proto_.pairing) return;
+    std::map<const Node*, int> seen;
+    for (const PairingKey& key : proto_.pairing->keys) {
+        const Node* t = key.field.target;
+        if (!t) continue;  // the parser reported the XPath
+        if (!t->is_numeric()) {
+            diags_.error(key.line, "key field " + quote(*t) + at_line(*t) +
+                                       " is not numeric: a key is a leaf of 1-64 bits shown as a number, bool, "
+                                       "enum or nondisplay");
+            continue;
+        }
+        auto [it, inserted] = seen.emplace(t, key.line);
+        if (!inserted)
+            diags_.error(key.line, "key field " + quote(*t) + " is already a key (line " + std::to_string(it->second) +
+                                       ")");
     }
 }
 
@@ -761,6 +786,17 @@ bool is_reserved_expert_name(const std::string& protocol_filter, const std::stri
     for (const char* expert : kExpertNames)
         if (field_filter == protocol_filter + ".expert." + expert) return true;
     return false;
+}
+
+std::string reserved_pairing_name(const Protocol& proto, const std::string& field_filter) {
+    if (!proto.pairing) return "";
+    for (const char* name : kPairingNames)
+        if (field_filter == proto.filter + "." + name) return "the request/response pairing (<pairing>)";
+    if (proto.pairing->analysis == "ethercat-esc") {
+        for (const char* name : kEthercatEscNames)
+            if (field_filter == proto.filter + "." + name) return "the ethercat-esc analysis";
+    }
+    return "";
 }
 
 std::string segment_from_name(const std::string& name) {

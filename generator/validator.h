@@ -38,4 +38,22 @@ constexpr const char* kFragmentNames[] = {"fragments",        "fragment",
 
 bool is_reserved_expert_name(const std::string& protocol_filter, const std::string& field_filter);
 
+// issue 11: fields and expert infos the runtime registers as P.NAME for a
+// protocol with <pairing> (plugin_runtime/dissgen_pairing.cpp), and for the
+// "ethercat-esc" analysis (plugin_runtime/ethercat_esc.cpp).
+constexpr const char* kPairingNames[] = {"response_in", "request_in", "time", "expert.no_response",
+                                         "expert.duplicate", "expert.out_of_order"};
+constexpr const char* kEthercatEscNames[] = {"esc",
+                                             "esc.datagram",
+                                             "esc.wkc_added",
+                                             "esc.slaves_passed",
+                                             "esc.data_changed",
+                                             "expert.changed",
+                                             "expert.frame_length",
+                                             "expert.write_changed",
+                                             "expert.wkc_down",
+                                             "expert.forwarding"};
+// The name a field may not take because <pairing> (or its analysis) uses it; "" if none.
+std::string reserved_pairing_name(const Protocol& proto, const std::string& field_filter);
+
 }  // namespace dissgen

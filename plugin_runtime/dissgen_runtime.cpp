@@ -8,6 +8,8 @@
  */
 #include "dissgen_runtime.h"
 
+#include "dissgen_pairing.h"
+
 #include <epan/proto_data.h>
 #include <epan/stats_tree.h>
 #include <epan/tap.h>
@@ -36,6 +38,7 @@ struct dg_tap_record {
 struct dg_tap_data {
     dg_tap_record *records;
     guint count, capacity;
+    const dg_frame_pairing *pairing; /* issue 11: what the pairing found, or NULL */
 };
 
 /* Each plugin links its own copy of the runtime and holds one protocol, so
@@ -70,7 +73,19 @@ struct dg_state {
      * message, then each open container), for peeks counted from a container */
     gint list_starts[DG_MAX_LISTS];
     guint lists;
+    /* issue 11: the values of the <pairing> key fields (DG_KEY), in decoding order */
+    guint64 *keys;
+    guint key_count, key_capacity;
 };
+
+void key_append(dg_state *st, guint64 value)
+{
+    if (st->key_count == st->key_capacity) {
+        st->key_capacity = st->key_capacity ? 2 * st->key_capacity : 16;
+        st->keys = (guint64 *)wmem_realloc(st->pinfo->pool, st->keys, st->key_capacity * sizeof(guint64));
+    }
+    st->keys[st->key_count++] = value;
+}
 
 void tap_record(dg_state *st, const dg_node *n, guint64 value)
 {
@@ -157,6 +172,7 @@ gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char
 void store(dg_state *st, const dg_node *n, guint64 value, gint offset, gint length)
 {
     if (st->tap && n->show == DG_SHOW_ENUM) tap_record(st, n, value);
+    if (n->flags & DG_KEY) key_append(st, value);
     if (n->slot < 0) return;
     dg_slot *s = &st->slots[n->slot];
     s->value = value;
@@ -170,7 +186,7 @@ void store(dg_state *st, const dg_node *n, guint64 value, gint offset, gint leng
  * stats tree counts it. Otherwise the walk need not read it from the tvb. */
 gboolean value_wanted(const dg_state *st, const dg_node *n)
 {
-    return n->slot >= 0 || (st->tap && n->show == DG_SHOW_ENUM);
+    return n->slot >= 0 || (st->tap && n->show == DG_SHOW_ENUM) || (n->flags & DG_KEY);
 }
 
 /* Whether value lies in one of the `count` ranges from ranges[first] on. */
@@ -960,9 +976,10 @@ void stats_init(stats_tree *st)
         stats_node_names[i] = (char *)stats_node_name(n, what);
         stats_node_ids[i] = stats_tree_create_node(st, stats_node_names[i], 0, STAT_DT_INT, TRUE);
     }
+    if (p->pairing) dg_pairing_stats_init(p, st);
 }
 
-tap_packet_status stats_packet(stats_tree *st, packet_info *, epan_dissect_t *, const void *data, tap_flags_t)
+tap_packet_status stats_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *, const void *data, tap_flags_t)
 {
     const dg_tap_data *t = (const dg_tap_data *)data;
     const dg_protocol *p = stats_protocol;
@@ -989,6 +1006,7 @@ tap_packet_status stats_packet(stats_tree *st, packet_info *, epan_dissect_t *, 
         tick_stat_node(st, stats_node_names[r->node], 0, TRUE);
         tick_stat_node(st, label, stats_node_ids[r->node], FALSE);
     }
+    if (p->pairing) dg_pairing_stats_packet(p, st, pinfo, t->pairing);
     return TAP_PACKET_REDRAW;
 }
 
@@ -1045,6 +1063,7 @@ void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett,
     register_dissector(p->filter, p->dissect, *p->proto);
     register_stats_tree(p);
     if (p->reassembly) reassembly_table_register(p->reassembly, &addresses_reassembly_table_functions); /* issue 10a */
+    if (p->pairing) dg_pairing_register(p);
 }
 
 /* issue 10a: the dissectors that dissector= names. A name this Wireshark does
@@ -1141,6 +1160,11 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     gint offset = 0;
     dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
     proto_item_set_len(root, offset);
+    if (p->pairing) {
+        const dg_frame_pairing *fp =
+            dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, *messages - 1);
+        if (st.tap) st.tap->pairing = fp;
+    }
 
     if (st.tap) tap_queue_packet(stats_tap, pinfo, st.tap);
     const char *info = st.info && wmem_strbuf_get_len(st.info) > 0 ? wmem_strbuf_get_str(st.info) : p->name;

@@ -31,7 +31,8 @@ enum dg_flags {
     DG_HIDDEN = 1 << 2,      /* nondisplay leaf: hidden but filterable */
     DG_GROUP = 1 << 3,       /* member of a bit group */
     DG_GROUP_FIRST = 1 << 4, /* first member: reads the group's bytes */
-    DG_GROUP_LAST = 1 << 5   /* last member: moves past the group's bytes */
+    DG_GROUP_LAST = 1 << 5,  /* last member: moves past the group's bytes */
+    DG_KEY = 1 << 6          /* issue 11: a <pairing> key field (dissgen_pairing.h) */
 };
 
 /* A run-time value taken from an earlier field, with optional arithmetic. */
@@ -172,6 +173,13 @@ typedef struct dg_hook {
     guint32 value;
 } dg_hook;
 
+/* issue 11: request/response pairing declared by <pairing> in the rule file
+ * (dissgen_pairing.cpp). Key fields carry DG_KEY. */
+typedef struct dg_pairing {
+    double timeout;          /* seconds a request waits for its response */
+    const char *analysis;    /* NULL, or a protocol analysis ("ethercat-esc") */
+} dg_pairing;
+
 typedef struct dg_protocol {
     const char *name;        /* long name, e.g. "EtherCAT" */
     const char *short_name;  /* Protocol column, e.g. "ECATR" */
@@ -216,6 +224,13 @@ typedef struct dg_protocol {
     const dg_ref *peek_lengths;
     const dg_window *windows;
     const dg_place *places;
+#endif
+    /* issue 11: request/response pairing, NULL when the rule file has none.
+     * Generated code gives it only for protocols that have one. */
+#ifdef __cplusplus
+    const dg_pairing *pairing = nullptr;
+#else
+    const dg_pairing *pairing;
 #endif
 } dg_protocol;
 

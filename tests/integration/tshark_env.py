@@ -39,6 +39,24 @@ class TsharkError(RuntimeError):
     pass
 
 
+class Checks:
+    """Prints one "ok"/"FAIL" line per check; `failed` lists the failed ones.
+
+        check = Checks()
+        check(a == b, "what a == b means")
+        return 1 if check.failed else 0
+    """
+
+    def __init__(self):
+        self.failed = []
+
+    def __call__(self, cond, what):
+        print(("ok   " if cond else "FAIL ") + what)
+        if not cond:
+            self.failed.append(what)
+        return cond
+
+
 def wireshark_abi():
     """Major.minor of the installed Wireshark, e.g. "4.0" (the per-user plugin folder name)."""
     try:

@@ -44,6 +44,8 @@ suites="${DISSGEN_MULTIVERSION_SUITES:-trixie sid}"
 packages=(libwireshark-dev libwsutil-dev libwiretap-dev)
 # The flags a plugin is built with (CMakeLists.txt, generator/build_plugin.cpp)
 # plus -Wall -Wextra -Werror: a deprecation is an error here.
+# The runtime's sources (every plugin is compiled with all of them).
+runtime_sources=(plugin_runtime/dissgen_runtime.cpp plugin_runtime/dissgen_pairing.cpp plugin_runtime/ethercat_esc.cpp)
 flags=(-std=c++17 -O2 -fPIC -DWS_BUILD_DLL -Wall -Wextra -Werror -Werror=attributes -I"$root/plugin_runtime")
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/dissgen-multiversion-XXXXXX")
@@ -254,18 +256,20 @@ check_plugin_object() {
 check_version() { # LABEL DEST-OR-EMPTY
   local label="$1" dest="$2" rel obj log n=0
   if ! cflags_for "$dest"; then
-    for rel in plugin_runtime/dissgen_runtime.cpp "${rule_files[@]}"; do report FAIL "$label" "$rel" "$fetch_error"; done
+    for rel in "${runtime_sources[@]}" "${rule_files[@]}"; do report FAIL "$label" "$rel" "$fetch_error"; done
     return
   fi
   label="$ws_version ($label)"
   read -r -a cf <<<"$ws_cflags"
   mkdir -p "$work/obj"
-  obj="$work/obj/runtime.o"
-  if log=$("$cxx" "${flags[@]}" "${cf[@]}" -c "$root/plugin_runtime/dissgen_runtime.cpp" -o "$obj" 2>&1); then
-    report PASS "$label" plugin_runtime/dissgen_runtime.cpp
-  else
-    report FAIL "$label" plugin_runtime/dissgen_runtime.cpp "$log"
-  fi
+  for rel in "${runtime_sources[@]}"; do
+    obj="$work/obj/$(basename "$rel" .cpp).o"
+    if log=$("$cxx" "${flags[@]}" "${cf[@]}" -c "$root/$rel" -o "$obj" 2>&1); then
+      report PASS "$label" "$rel"
+    else
+      report FAIL "$label" "$rel" "$log"
+    fi
+  done
   for rel in "${rule_files[@]}"; do
     n=$((n + 1))
     if [ -n "${gen_error[$rel]:-}" ]; then report FAIL "$label" "$rel" "${gen_error[$rel]}"; continue; fi
@@ -293,7 +297,7 @@ else
   status=$?
   if [ $status -eq 2 ]; then
     for suite in $suites; do
-      for rel in plugin_runtime/dissgen_runtime.cpp "${rule_files[@]}"; do report FAIL "$suite" "$rel" "apt-get update failed"; done
+      for rel in "${runtime_sources[@]}" "${rule_files[@]}"; do report FAIL "$suite" "$rel" "apt-get update failed"; done
     done
   elif [ $status -eq 0 ]; then
     for suite in $suites; do
@@ -302,7 +306,7 @@ else
       elif grep -Eq "$network_trouble" "$work/debs-$suite/download.log"; then
         skip_reason="the Debian archive at $mirror cannot be reached (downloading $suite's packages)"
       else
-        for rel in plugin_runtime/dissgen_runtime.cpp "${rule_files[@]}"; do report FAIL "$suite" "$rel" "$fetch_error"; done
+        for rel in "${runtime_sources[@]}" "${rule_files[@]}"; do report FAIL "$suite" "$rel" "$fetch_error"; done
       fi
     done
   fi

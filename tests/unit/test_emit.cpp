@@ -310,5 +310,43 @@ TEST(Emit, ExpertInfosAreExactlyTheReservedNames) {
         EXPECT_TRUE(contains(code, std::string("\"tst.expert.") + name + "\"")) << name;
 }
 
+// issue 11: <pairing> marks its key fields DG_KEY (every instance of a
+// repeated one) and gives the protocol a dg_pairing; without it nothing changes.
+TEST(Pairing, KeysAreFlaggedAndThePairingIsEmitted) {
+    Front f = front_end(rules("  <pairing timeout=\"0.25\" analysis=\"ethercat-esc\">\n"
+                              "    <key field=\"node[@name='Item']/node[@name='Id']\"/>\n"
+                              "  </pairing>\n"
+                              "  <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"Item\" count=\"../node[@name='Count']\">\n"
+                              "    <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+                              "    <node name=\"Value\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
+                              "  </node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    ASSERT_TRUE(f.proto->pairing);
+    EXPECT_DOUBLE_EQ(f.proto->pairing->timeout, 0.25);
+    ASSERT_EQ(f.proto->pairing->keys.size(), 1u);
+    EXPECT_EQ(f.proto->pairing->keys[0].field.target, find(*f.proto, "Id"));
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_TRUE(contains(code, "static const dg_pairing tst_pairing = { 0.25, \"ethercat-esc\" };")) << code;
+    EXPECT_TRUE(contains(code, "&tst_pairing\n};")) << code;
+    EXPECT_TRUE(contains(code, "DG_SHOW_HEX, DG_NUMERIC|DG_KEY,")) << code;
+    EXPECT_EQ(code.find("DG_SHOW_DEC, DG_NUMERIC|DG_KEY"), std::string::npos) << "only the key is flagged";
+}
+
+TEST(Pairing, AbsentMeansNoPairingCode) {
+    Front f = front_end(rules("  <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_EQ(code.find("dg_pairing"), std::string::npos);
+    EXPECT_EQ(code.find("DG_KEY"), std::string::npos);
+}
+
+TEST(Pairing, DefaultTimeoutIsOneSecondAndNoAnalysis) {
+    Front f = front_end(rules("  <pairing><key field=\"node[@name='Id']\"/></pairing>\n"
+                              "  <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL };"));
+}
+
 }  // namespace
 }  // namespace dissgen::testing

@@ -1,0 +1,453 @@
+/* Request/response pairing across frames: see dissgen_pairing.h.
+ *
+ * First pass, per message, in capture order:
+ *  1. The key: the values of the rule file's key fields.
+ *  2. The same bytes from the same source as the last message with that key,
+ *     within a hundredth of the timeout, when that message was a response or
+ *     the message just before: a duplicate (a frame captured twice); it is not
+ *     paired. (A sender repeating a request it got no answer to repeats it
+ *     later, or after other messages: that is a new request. So is the very
+ *     request again from its sender, at any time: never its own answer.)
+ *  3. Pending requests of that key older than the timeout, or overtaken by
+ *     the responses to more than max_overtaken later requests, are given up
+ *     (they keep "no response"). The oldest remaining one whose source the
+ *     analysis does not rule out is answered by this message. Without an
+ *     analysis, or when it cannot tell, the order decides: the first message
+ *     of a key is the request, the next one its response.
+ *  4. Otherwise the message is a new request and waits, unless the analysis
+ *     knows it for a response: then it answers the one request still
+ *     waiting, whatever its key (the analysis reports what changed), or, when
+ *     none or several are waiting, a request that was not captured (an
+ *     orphan).
+ * Nothing here is touched on later passes.
+ */
+#include "dissgen_pairing.h"
+
+#include "ethercat_esc.h"
+
+#include <epan/proto_data.h>
+#include <epan/expert.h>
+
+#include <string.h>
+
+namespace {
+
+/* The analyses the runtime knows, by the name the rule file gives. */
+const dg_analysis *const analyses[] = {&dg_ethercat_esc};
+
+/* Key of the per-frame state (p_add_proto_data), plus the message number. */
+const guint32 frame_key = 0x70616972u; /* "pair" */
+
+struct pair_key {
+    guint count;
+    guint64 *values;
+};
+
+/* A request waiting for its response. It is in two queues, oldest first:
+ * its key's and the capture's; answered or given-up ones are marked done and
+ * leave each queue when they reach its head. */
+struct pending {
+    pending *next;        /* in the key's queue */
+    pending *next_sent;   /* in the capture's queue */
+    guint8 queues;        /* how many queues still hold it */
+    gboolean done;
+    dg_transaction *txn;
+    address src;
+    guint8 *bytes;  /* the request's bytes, kept for the analysis until answered */
+    guint length;
+};
+
+struct queue {
+    pending *head, *tail;
+};
+
+struct key_entry {
+    queue waiting;               /* this key's requests */
+    guint32 last_frame;          /* the last message with this key (duplicates) */
+    nstime_t last_time;
+    guint8 last_role;
+    address last_src;
+    guint8 *last_bytes;
+    guint last_length;
+};
+
+struct capture_state {
+    wmem_map_t *keys;            /* pair_key -> key_entry */
+    queue sent;                  /* every key's requests, in capture order */
+    guint waiting;               /* requests not yet answered nor given up */
+    guint64 requests;            /* the last request's seq */
+    guint64 answered_max;        /* the highest seq answered so far */
+    guint32 last_frame;          /* the last message paired (its frame) */
+    void *analysis;              /* the analysis's capture-wide state */
+};
+
+/* One protocol per plugin, and each plugin links its own runtime. */
+const dg_protocol *protocol;
+const dg_analysis *analysis;
+capture_state *capture; /* NULL between captures */
+
+int hf_response_in = -1, hf_request_in = -1, hf_time = -1;
+expert_field ei_no_response = EI_INIT, ei_duplicate = EI_INIT, ei_out_of_order = EI_INIT;
+
+guint key_hash(gconstpointer v)
+{
+    const pair_key *k = (const pair_key *)v;
+    guint h = 2166136261u ^ k->count;
+    for (guint i = 0; i < k->count; i++) {
+        guint64 x = k->values[i];
+        h = (h ^ (guint)x) * 16777619u;
+        h = (h ^ (guint)(x >> 32)) * 16777619u;
+    }
+    return h;
+}
+
+gboolean key_equal(gconstpointer a, gconstpointer b)
+{
+    const pair_key *x = (const pair_key *)a, *y = (const pair_key *)b;
+    return x->count == y->count && memcmp(x->values, y->values, x->count * sizeof(guint64)) == 0;
+}
+
+void capture_init(void) { capture = NULL; }
+void capture_cleanup(void) { capture = NULL; /* its memory goes with wmem_file_scope */ }
+
+capture_state *current_capture(void)
+{
+    if (!capture) {
+        capture = wmem_new0(wmem_file_scope(), capture_state);
+        capture->keys = wmem_map_new(wmem_file_scope(), key_hash, key_equal);
+        if (analysis && analysis->capture_new) capture->analysis = analysis->capture_new();
+    }
+    return capture;
+}
+
+key_entry *entry_for(capture_state *c, const guint64 *keys, guint key_count)
+{
+    pair_key probe = {key_count, (guint64 *)keys};
+    key_entry *e = (key_entry *)wmem_map_lookup(c->keys, &probe);
+    if (e) return e;
+    pair_key *k = wmem_new(wmem_file_scope(), pair_key);
+    k->count = key_count;
+    k->values = (guint64 *)wmem_memdup(wmem_file_scope(), keys, key_count * sizeof(guint64));
+    e = wmem_new0(wmem_file_scope(), key_entry);
+    wmem_map_insert(c->keys, k, e);
+    return e;
+}
+
+gboolean is_duplicate(const capture_state *c, const key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length)
+{
+    if (!e->last_frame || e->last_length != length || !addresses_equal(&e->last_src, &pinfo->src)) return FALSE;
+    if (e->last_role != DG_ROLE_RESPONSE && e->last_frame != c->last_frame) return FALSE;
+    nstime_t gap;
+    nstime_delta(&gap, &pinfo->abs_ts, &e->last_time);
+    if (nstime_to_sec(&gap) > protocol->pairing->timeout / 100) return FALSE;
+    return tvb_memeql(tvb, 0, e->last_bytes, length) == 0;
+}
+
+void remember_last(key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length, guint8 role)
+{
+    e->last_time = pinfo->abs_ts;
+    e->last_role = role;
+    wmem_free(wmem_file_scope(), e->last_bytes);
+    free_address_wmem(wmem_file_scope(), &e->last_src);
+    e->last_frame = pinfo->num;
+    copy_address_wmem(wmem_file_scope(), &e->last_src, &pinfo->src);
+    e->last_bytes = (guint8 *)tvb_memdup(wmem_file_scope(), tvb, 0, length);
+    e->last_length = length;
+}
+
+/* Answered or given up: what it kept goes now, the rest once both queues let go. */
+void retire(capture_state *c, pending *q)
+{
+    if (q->done) return;
+    q->done = TRUE;
+    c->waiting--;
+    wmem_free(wmem_file_scope(), q->bytes);
+    q->bytes = NULL;
+    free_address_wmem(wmem_file_scope(), &q->src);
+}
+
+void release(pending *q)
+{
+    if (--q->queues == 0) wmem_free(wmem_file_scope(), q);
+}
+
+/* A response may come back after those of later requests (a reordering, or
+ * capture interfaces with their own clocks), but not after this many. */
+const guint64 max_overtaken = 16;
+
+gboolean given_up(const capture_state *c, const pending *q, const packet_info *pinfo, double timeout)
+{
+    if (c->answered_max > q->txn->seq + max_overtaken) return TRUE;
+    nstime_t age;
+    nstime_delta(&age, &pinfo->abs_ts, &q->txn->request_time);
+    return nstime_to_sec(&age) > timeout;
+}
+
+/* The oldest request of a queue still waiting (given-up ones retired on the
+ * way), or NULL. `in_key` says which link the queue uses. */
+pending *oldest_waiting(capture_state *c, queue *qu, gboolean in_key, const packet_info *pinfo)
+{
+    while (qu->head) {
+        pending *q = qu->head;
+        if (!q->done && given_up(c, q, pinfo, protocol->pairing->timeout)) retire(c, q);
+        if (!q->done) return q;
+        qu->head = in_key ? q->next : q->next_sent;
+        if (!qu->head) qu->tail = NULL;
+        release(q);
+    }
+    return NULL;
+}
+
+void retire_all(capture_state *c, queue *qu, const packet_info *pinfo)
+{
+    for (pending *q; (q = oldest_waiting(c, qu, TRUE, pinfo));) retire(c, q);
+}
+
+/* The pending request of this key that this message answers, or NULL when
+ * the message is a new request. */
+pending *take_answered(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length)
+{
+    pending *q = oldest_waiting(c, &e->waiting, TRUE, pinfo);
+    if (!q) return NULL;
+    int verdict = analysis && analysis->is_response ? analysis->is_response(c->analysis, &q->src, &pinfo->src) : -1;
+    /* The very request again, from its sender: a repetition, not an answer. */
+    if (e->last_frame == q->txn->request_frame && e->last_length == length &&
+        addresses_equal(&q->src, &pinfo->src) && tvb_memeql(tvb, 0, e->last_bytes, length) == 0)
+        verdict = 0;
+    if (verdict == 0) {
+        /* The sender sent the same key again: what was pending is given up. */
+        retire_all(c, &e->waiting, pinfo);
+        return NULL;
+    }
+    return q;
+}
+
+/* A response that answers nothing pending of its key (its key came back
+ * changed): when exactly one request is waiting, and its sender fits, it is
+ * that one's. (With several waiting, a capture that missed frames could not
+ * be told from one whose keys changed.) */
+pending *take_oldest(capture_state *c, packet_info *pinfo)
+{
+    pending *q = oldest_waiting(c, &c->sent, FALSE, pinfo);
+    if (!q || c->waiting != 1 || !analysis || !analysis->is_response || analysis->is_response(c->analysis, &q->src, &pinfo->src) != 1)
+        return NULL;
+    return q;
+}
+
+void enqueue(queue *qu, pending *q, gboolean in_key)
+{
+    if (qu->tail) {
+        if (in_key)
+            qu->tail->next = q;
+        else
+            qu->tail->next_sent = q;
+    } else {
+        qu->head = q;
+    }
+    qu->tail = q;
+    q->queues++;
+}
+
+dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count, guint length)
+{
+    capture_state *c = current_capture();
+    dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
+    if (analysis && analysis->see) analysis->see(c->analysis, tvb, pinfo);
+    key_entry *e = entry_for(c, keys, key_count);
+    gboolean duplicate = is_duplicate(c, e, tvb, pinfo, length);
+    c->last_frame = pinfo->num;
+    if (duplicate) {
+        fp->role = DG_ROLE_DUPLICATE;
+        fp->duplicate_of = e->last_frame;
+        return fp;
+    }
+
+    pending *q = take_answered(c, e, tvb, pinfo, length);
+    gboolean returned = !q && analysis && analysis->is_returned && analysis->is_returned(c->analysis, &pinfo->src);
+    if (returned) q = take_oldest(c, pinfo);
+    remember_last(e, tvb, pinfo, length, q ? DG_ROLE_RESPONSE : DG_ROLE_REQUEST); /* an orphan: a request for step 2 */
+    if (q) {
+        dg_transaction *t = q->txn;
+        t->response_frame = pinfo->num;
+        nstime_delta(&t->round_trip, &pinfo->abs_ts, &t->request_time);
+        fp->role = DG_ROLE_RESPONSE;
+        fp->txn = t;
+        fp->out_of_order = t->seq < c->answered_max;
+        if (t->seq > c->answered_max) c->answered_max = t->seq;
+        if (analysis && analysis->compare) {
+            tvbuff_t *request = tvb_new_real_data(q->bytes, q->length, (gint)q->length);
+            fp->analysis = analysis->compare(c->analysis, request, tvb, pinfo);
+            tvb_free(request);
+        }
+        retire(c, q);
+        return fp;
+    }
+
+    if (returned) {
+        fp->role = DG_ROLE_ORPHAN;
+        return fp;
+    }
+    dg_transaction *t = wmem_new0(wmem_file_scope(), dg_transaction);
+    t->request_frame = pinfo->num;
+    t->request_time = pinfo->abs_ts;
+    t->seq = ++c->requests;
+    fp->role = DG_ROLE_REQUEST;
+    fp->txn = t;
+    pending *n = wmem_new0(wmem_file_scope(), pending);
+    n->txn = t;
+    copy_address_wmem(wmem_file_scope(), &n->src, &pinfo->src);
+    if (analysis && analysis->compare) {
+        n->bytes = (guint8 *)tvb_memdup(wmem_file_scope(), tvb, 0, length);
+        n->length = length;
+    }
+    enqueue(&e->waiting, n, TRUE);
+    enqueue(&c->sent, n, FALSE);
+    c->waiting++;
+    return fp;
+}
+
+void show(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    proto_item *item;
+    const dg_transaction *t = fp->txn;
+    switch (fp->role) {
+    case DG_ROLE_REQUEST:
+        if (t->response_frame) {
+            item = proto_tree_add_uint(tree, hf_response_in, tvb, 0, 0, t->response_frame);
+            proto_item_set_generated(item);
+        } else if (PINFO_FD_VISITED(pinfo)) {
+            /* Only once the whole capture has been read can "never" be said. */
+            proto_tree_add_expert(tree, pinfo, &ei_no_response, tvb, 0, 0);
+        }
+        break;
+    case DG_ROLE_RESPONSE:
+        item = proto_tree_add_uint(tree, hf_request_in, tvb, 0, 0, t->request_frame);
+        proto_item_set_generated(item);
+        item = proto_tree_add_time(tree, hf_time, tvb, 0, 0, &t->round_trip);
+        proto_item_set_generated(item);
+        if (fp->out_of_order)
+            proto_tree_add_expert_format(tree, pinfo, &ei_out_of_order, tvb, 0, 0,
+                                         "Response to frame %u came back after the response to a later request",
+                                         t->request_frame);
+        if (analysis && analysis->show && fp->analysis) analysis->show(fp->analysis, tvb, pinfo, tree);
+        break;
+    case DG_ROLE_DUPLICATE:
+        proto_tree_add_expert_format(tree, pinfo, &ei_duplicate, tvb, 0, 0,
+                                     "Duplicate of frame %u (same source, same bytes); not paired", fp->duplicate_of);
+        break;
+    default: break;
+    }
+}
+
+/* --- statistics ---------------------------------------------------------- */
+
+const char *const st_pairing = "Requests and responses";
+const char *const st_requests = "Requests";
+const char *const st_responses = "Responses";
+const char *const st_lost = "No response";
+const char *const st_duplicates = "Duplicates";
+const char *const st_orphans = "Responses to requests not captured";
+const char *const st_rtt = "Round trip (ms)";
+int st_pairing_id;
+guint64 st_request_count, st_answered_count; /* for "No response": requests not answered by the end */
+
+} /* namespace */
+
+extern "C" {
+
+void dg_pairing_register(const dg_protocol *p)
+{
+    protocol = p;
+    analysis = NULL;
+    for (const dg_analysis *a : analyses)
+        if (p->pairing->analysis && strcmp(a->name, p->pairing->analysis) == 0) analysis = a;
+
+    /* Wireshark keeps pointers to these: static arrays, names that live until exit. */
+    static hf_register_info hf[] = {
+        {&hf_response_in, {"Response in", NULL, FT_FRAMENUM, BASE_NONE, FRAMENUM_TYPE(FT_FRAMENUM_RESPONSE), 0x0,
+                           "The frame that answers this one", HFILL}},
+        {&hf_request_in, {"Request in", NULL, FT_FRAMENUM, BASE_NONE, FRAMENUM_TYPE(FT_FRAMENUM_REQUEST), 0x0,
+                          "The frame this one answers", HFILL}},
+        {&hf_time, {"Round trip", NULL, FT_RELATIVE_TIME, BASE_NONE, NULL, 0x0,
+                    "Time from the request to this response", HFILL}},
+    };
+    hf[0].hfinfo.abbrev = g_strdup_printf("%s.response_in", p->filter);
+    hf[1].hfinfo.abbrev = g_strdup_printf("%s.request_in", p->filter);
+    hf[2].hfinfo.abbrev = g_strdup_printf("%s.time", p->filter);
+    proto_register_field_array(*p->proto, hf, (int)G_N_ELEMENTS(hf));
+
+    static ei_register_info ei[] = {
+        {&ei_no_response, {NULL, PI_SEQUENCE, PI_WARN, "No response seen", EXPFILL}},
+        {&ei_duplicate, {NULL, PI_SEQUENCE, PI_NOTE, "Duplicate message", EXPFILL}},
+        {&ei_out_of_order, {NULL, PI_SEQUENCE, PI_WARN, "Response out of order", EXPFILL}},
+    };
+    ei[0].eiinfo.name = g_strdup_printf("%s.expert.no_response", p->filter);
+    ei[1].eiinfo.name = g_strdup_printf("%s.expert.duplicate", p->filter);
+    ei[2].eiinfo.name = g_strdup_printf("%s.expert.out_of_order", p->filter);
+    expert_module_t *experts = expert_register_protocol(*p->proto);
+    expert_register_field_array(experts, ei, (int)G_N_ELEMENTS(ei));
+
+    if (analysis && analysis->register_info) analysis->register_info(*p->proto, p->filter);
+    register_init_routine(capture_init);
+    register_cleanup_routine(capture_cleanup);
+}
+
+const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
+                                           const guint64 *keys, guint key_count, gint length, guint message)
+{
+    dg_frame_pairing *fp =
+        (dg_frame_pairing *)p_get_proto_data(wmem_file_scope(), pinfo, *p->proto, frame_key + message);
+    if (!fp) {
+        if (PINFO_FD_VISITED(pinfo)) return NULL; /* not paired on the first pass: nothing to show */
+        guint len = length > 0 ? (guint)length : tvb_captured_length(tvb);
+        fp = first_pass(tvb, pinfo, keys, key_count, len);
+        p_add_proto_data(wmem_file_scope(), pinfo, *p->proto, frame_key + message, fp);
+    }
+    show(fp, tvb, pinfo, tree);
+    return fp;
+}
+
+void dg_pairing_stats_init(const dg_protocol *, stats_tree *st)
+{
+    st_pairing_id = stats_tree_create_node(st, st_pairing, 0, STAT_DT_INT, TRUE);
+    st_request_count = st_answered_count = 0;
+    stats_tree_create_node(st, st_requests, st_pairing_id, STAT_DT_INT, FALSE);
+    stats_tree_create_node(st, st_responses, st_pairing_id, STAT_DT_INT, FALSE);
+    stats_tree_create_node(st, st_lost, st_pairing_id, STAT_DT_INT, FALSE);
+    stats_tree_create_node(st, st_duplicates, st_pairing_id, STAT_DT_INT, FALSE);
+    stats_tree_create_node(st, st_orphans, st_pairing_id, STAT_DT_INT, FALSE);
+    stats_tree_create_node(st, st_rtt, st_pairing_id, STAT_DT_FLOAT, FALSE);
+    if (analysis && analysis->stats_init) analysis->stats_init(st, st_pairing_id);
+}
+
+void dg_pairing_stats_packet(const dg_protocol *, stats_tree *st, packet_info *, const dg_frame_pairing *fp)
+{
+    if (!fp) return;
+    tick_stat_node(st, st_pairing, 0, TRUE);
+    switch (fp->role) {
+    case DG_ROLE_REQUEST:
+        tick_stat_node(st, st_requests, st_pairing_id, FALSE);
+        st_request_count++;
+        break;
+    case DG_ROLE_RESPONSE:
+        tick_stat_node(st, st_responses, st_pairing_id, FALSE);
+        st_answered_count++;
+        avg_stat_node_add_value_float(st, st_rtt, st_pairing_id, FALSE,
+                                      (gfloat)(nstime_to_sec(&fp->txn->round_trip) * 1000.0));
+        if (analysis && analysis->stats_response && fp->analysis)
+            analysis->stats_response(st, st_pairing_id, fp->analysis);
+        break;
+    case DG_ROLE_DUPLICATE:
+        tick_stat_node(st, st_duplicates, st_pairing_id, FALSE);
+        break;
+    case DG_ROLE_ORPHAN:
+        tick_stat_node(st, st_orphans, st_pairing_id, FALSE);
+        break;
+    default: break;
+    }
+    /* Every response answers one request, so once the capture has been read
+     * the requests not answered are the difference (one pass or two). */
+    set_stat_node(st, st_lost, st_pairing_id, FALSE, (gint)(st_request_count - st_answered_count));
+}
+
+} /* extern "C" */

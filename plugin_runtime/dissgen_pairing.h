@@ -1,0 +1,98 @@
+/* Request/response pairing across frames (issue 11), declared in the rule
+ * file by <pairing> (key fields) and used by every protocol the same way.
+ *
+ * State lives in Wireshark's per-capture memory (wmem_file_scope) and is
+ * computed once, on the first pass over each frame (!PINFO_FD_VISITED):
+ *
+ *   capture state (one per open capture, reset by the init routine)
+ *     key values -> pending requests (oldest first), the last message seen
+ *     the analysis's capture-wide state (e.g. a model of the EtherCAT bus)
+ *   frame state (p_add_proto_data, one per message of a frame)
+ *     dg_frame_pairing: role, the transaction, the analysis's result
+ *
+ * Later passes (tshark -2, the GUI in any order, display filters) only read
+ * what the first pass stored, so they show the same items. A protocol
+ * analysis (dg_analysis; the one for EtherCAT is ethercat_esc.cpp) adds what
+ * one protocol knows about how its responses relate to its requests.
+ */
+#pragma once
+
+#include "dissgen_runtime.h"
+
+#include <epan/stats_tree.h>
+
+/* One request and, once seen, its response. */
+typedef struct dg_transaction {
+    guint32 request_frame;
+    guint32 response_frame;  /* 0: no response seen */
+    nstime_t request_time;   /* pinfo->abs_ts of the request */
+    nstime_t round_trip;     /* response time - request time */
+    guint64 seq;             /* requests in capture order, from 1 */
+} dg_transaction;
+
+enum dg_role {
+    DG_ROLE_REQUEST = 1,
+    DG_ROLE_RESPONSE = 2,
+    DG_ROLE_DUPLICATE = 3,
+    DG_ROLE_ORPHAN = 4 /* a response (the analysis says so) whose request is not in the capture */
+};
+
+/* What the first pass found for one message of a frame. Later issues add
+ * their per-frame results here (as members at the end). */
+typedef struct dg_frame_pairing {
+    dg_transaction *txn;     /* NULL for a duplicate */
+    guint8 role;             /* dg_role */
+    gboolean out_of_order;   /* response: a later request was answered first */
+    guint32 duplicate_of;    /* duplicate: the frame it repeats */
+    void *analysis;          /* response: the analysis's comparison (wmem_file_scope) */
+} dg_frame_pairing;
+
+/* What one protocol knows about its requests and responses. Every callback
+ * may be NULL. */
+typedef struct dg_analysis {
+    const char *name;        /* the rule file's <pairing analysis="..."> */
+    /* Registers the analysis's own fields and expert infos (once, at start-up). */
+    void (*register_info)(int proto, const char *filter);
+    /* Capture-wide state, allocated in wmem_file_scope (the issue-12 slave
+     * model belongs here), or NULL. */
+    void *(*capture_new)(void);
+    /* First pass, every message in capture order, before pairing. */
+    void (*see)(void *capture, tvbuff_t *tvb, packet_info *pinfo);
+    /* Whether a message from `src` can be the response to a pending request
+     * from `request_src`: 1 yes, 0 no (it is a new request), -1 cannot tell. */
+    int (*is_response)(void *capture, const address *request_src, const address *src);
+    /* Whether a message from `src` that answers nothing pending is a response
+     * all the same (its request was not captured): TRUE, or FALSE when it may
+     * be a request. */
+    gboolean (*is_returned)(void *capture, const address *src);
+    /* First pass, once per pair: what the response changed; the result is
+     * allocated in wmem_file_scope. `request` holds the request's bytes. */
+    void *(*compare)(void *capture, tvbuff_t *request, tvbuff_t *response, packet_info *pinfo);
+    /* Every pass: shows a compare() result on the response. */
+    void (*show)(const void *result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+    /* Statistics (tshark -z FILTER,tree): nodes under the pairing's own. */
+    void (*stats_init)(stats_tree *st, int parent);
+    void (*stats_response)(stats_tree *st, int parent, const void *result);
+} dg_analysis;
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* At registration: the pairing's fields and expert infos, its analysis's,
+ * and the per-capture init/cleanup routines. */
+void dg_pairing_register(const dg_protocol *p);
+
+/* After a message was decoded: pairs it on the first pass, then shows the
+ * pairing in `tree`. `keys` are the values of the DG_KEY fields in decoding
+ * order; `length` the bytes the message took; `message` its number within the
+ * frame (0 for the first). Returns what was found, for the statistics. */
+const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
+                                           const guint64 *keys, guint key_count, gint length, guint message);
+
+void dg_pairing_stats_init(const dg_protocol *p, stats_tree *st);
+void dg_pairing_stats_packet(const dg_protocol *p, stats_tree *st, packet_info *pinfo, const dg_frame_pairing *fp);
+
+#ifdef __cplusplus
+}
+#endif

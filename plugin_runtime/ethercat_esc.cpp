@@ -1,0 +1,359 @@
+/* EtherCAT slave controller (ESC) forwarding rules: everything dissgen knows
+ * about what the segment does to a frame between the master sending it and
+ * the frame coming back. Used as the "ethercat-esc" analysis of a <pairing>;
+ * the pairing itself (which frame answers which) is generic.
+ *
+ * The frame (IEC 61158-4-12): a 16-bit little-endian header (length of the
+ * datagrams in bits 0-10, type in bits 12-15; type 1 = datagrams), then
+ * datagrams: command (1), index (1), address (4: ADP + ADO, or a 32-bit
+ * logical address), length/flags (2: length in bits 0-10, M = more in bit
+ * 15), interrupt (2), data (length), working counter (2).
+ *
+ * What every ESC does as the frame passes it:
+ *  - never changes a datagram's command, index or length, nor the frame's
+ *    length;
+ *  - auto-increment (APRD, APWR, APRW, ARMW) and broadcast (BRD, BWR, BRW)
+ *    commands: adds 1 to the ADP, so every such datagram of a frame comes
+ *    back advanced by the number of slaves the frame passed; the ADO is
+ *    unchanged;
+ *  - configured-address (FPRD, FPWR, FPRW, FRMW) and NOP: ADP and ADO
+ *    unchanged; logical (LRD, LWR, LRW): the logical address unchanged;
+ *  - writes (APWR, FPWR, BWR, LWR) leave the data as the master sent it; reads
+ *    and read/writes may change it;
+ *  - the working counter only grows (+1 per read, +1 per write, +3 per
+ *    read/write by one slave).
+ * The source MAC: the first ESC sets the locally administered bit
+ * (0x02 in the first byte) of the frame it returns; simulators may not, so
+ * the bit is a hint for the pairing, not a rule.
+ */
+#include "ethercat_esc.h"
+
+#include <epan/expert.h>
+
+#include <string.h>
+
+namespace {
+
+enum esc_change { CHANGED_CMD = 1, CHANGED_IDX = 2, CHANGED_LEN = 4, CHANGED_ADDR = 8 };
+
+/* One datagram as read from a frame. */
+struct datagram {
+    gint offset;        /* of the datagram in its tvb */
+    guint8 cmd, idx;
+    guint16 adp, ado;   /* the 32-bit address: ADP low half, ADO high half */
+    guint16 length;     /* of the data */
+    guint16 wkc;
+};
+
+/* One returned datagram compared with the one sent. */
+struct compared {
+    gint offset, length;    /* the returned datagram in the response */
+    guint8 cmd;
+    guint8 changed;         /* esc_change bits */
+    gboolean has_advance;   /* auto-increment/broadcast: advance is meaningful */
+    gboolean data_changed;
+    gboolean forwarding;    /* advanced differently from the frame's others */
+    guint16 advance;        /* ADP advance: slaves passed */
+    guint16 majority;       /* the frame's usual advance */
+    gint32 wkc_added;
+    datagram sent, back;
+};
+
+struct result {
+    guint count;
+    gboolean length_changed;
+    guint sent_length, back_length;   /* header lengths */
+    guint sent_count, back_count;     /* datagrams */
+    compared *d;
+};
+
+struct capture_hints {
+    gboolean marking_seen; /* a slave set the locally administered bit: the capture shows direction */
+    guint8 master[6];      /* the (unmarked) source of the frames answered so far */
+};
+
+int hf_esc = -1, hf_datagram = -1, hf_wkc_added = -1, hf_slaves_passed = -1, hf_data_changed = -1;
+gint ett_esc = -1, ett_datagram = -1;
+expert_field ei_changed = EI_INIT, ei_frame_length = EI_INIT, ei_write_changed = EI_INIT, ei_wkc_down = EI_INIT,
+             ei_forwarding = EI_INIT;
+
+const char *const command_names[] = {"NOP",  "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD",
+                                     "BWR",  "BRW",  "LRD",  "LWR",  "LRW",  "ARMW", "FRMW"};
+
+const char *command_name(guint8 cmd) { return cmd < G_N_ELEMENTS(command_names) ? command_names[cmd] : "unknown"; }
+
+gboolean advances_adp(guint8 cmd)
+{
+    switch (cmd) {
+    case 1: case 2: case 3: case 13: /* APRD APWR APRW ARMW */
+    case 7: case 8: case 9:          /* BRD BWR BRW */
+        return TRUE;
+    default: return FALSE;
+    }
+}
+
+gboolean is_logical(guint8 cmd) { return cmd >= 10 && cmd <= 12; }
+
+gboolean is_write(guint8 cmd) { return cmd == 2 || cmd == 5 || cmd == 8 || cmd == 11; }
+
+/* The frame's header length, and its datagrams (up to `max`); every read is
+ * checked against the bytes there are. */
+guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max)
+{
+    gint end = (gint)tvb_captured_length(tvb);
+    *header_length = 0;
+    if (end < 2) return 0;
+    guint16 header = dg_tvb_get_uint16(tvb, 0, ENC_LITTLE_ENDIAN);
+    *header_length = header & 0x7ff;
+    if ((header >> 12) != 1) return 0;
+    if ((gint)(2 + *header_length) < end) end = 2 + (gint)*header_length;
+    guint n = 0;
+    gint offset = 2;
+    while (n < max && offset + 12 <= end) {
+        datagram *d = &out[n];
+        d->offset = offset;
+        d->cmd = dg_tvb_get_uint8(tvb, offset);
+        d->idx = dg_tvb_get_uint8(tvb, offset + 1);
+        d->adp = dg_tvb_get_uint16(tvb, offset + 2, ENC_LITTLE_ENDIAN);
+        d->ado = dg_tvb_get_uint16(tvb, offset + 4, ENC_LITTLE_ENDIAN);
+        guint16 flags = dg_tvb_get_uint16(tvb, offset + 6, ENC_LITTLE_ENDIAN);
+        d->length = flags & 0x7ff;
+        if (offset + 12 + d->length > end) break;
+        d->wkc = dg_tvb_get_uint16(tvb, offset + 10 + d->length, ENC_LITTLE_ENDIAN);
+        n++;
+        offset += 12 + d->length;
+        if (!(flags & 0x8000)) break;
+    }
+    return n;
+}
+
+/* At most this many datagrams per frame: 1500 bytes hold at most 124. */
+const guint max_datagrams = 128;
+
+void compare_datagram(compared *c, const datagram *s, const datagram *b, tvbuff_t *request, tvbuff_t *response)
+{
+    c->sent = *s;
+    c->back = *b;
+    c->offset = b->offset;
+    c->length = 12 + b->length;
+    c->cmd = b->cmd;
+    if (s->cmd != b->cmd) c->changed |= CHANGED_CMD;
+    if (s->idx != b->idx) c->changed |= CHANGED_IDX;
+    if (s->length != b->length) c->changed |= CHANGED_LEN;
+    if (is_logical(s->cmd)) {
+        if (s->adp != b->adp || s->ado != b->ado) c->changed |= CHANGED_ADDR;
+    } else if (advances_adp(s->cmd)) {
+        if (s->ado != b->ado) c->changed |= CHANGED_ADDR;
+        c->has_advance = TRUE;
+        c->advance = (guint16)(b->adp - s->adp);
+    } else if (s->adp != b->adp || s->ado != b->ado) {
+        c->changed |= CHANGED_ADDR;
+    }
+    guint16 common = MIN(s->length, b->length);
+    c->data_changed = s->length != b->length ||
+                      (common > 0 && tvb_memeql(response, b->offset + 10,
+                                                (const guint8 *)tvb_get_ptr(request, s->offset + 10, common), common) != 0);
+    c->wkc_added = (gint32)b->wkc - (gint32)s->wkc;
+}
+
+/* The frame's usual advance is the most common one among its auto-increment
+ * and broadcast datagrams (a tie goes to the earliest); a datagram that
+ * advanced otherwise did not pass the same slaves. */
+void check_forwarding(result *r)
+{
+    guint best_votes = 0;
+    guint16 usual = 0;
+    for (guint i = 0; i < r->count; i++) {
+        if (!r->d[i].has_advance) continue;
+        guint votes = 0;
+        for (guint j = 0; j < r->count; j++)
+            if (r->d[j].has_advance && r->d[j].advance == r->d[i].advance) votes++;
+        if (votes > best_votes) {
+            best_votes = votes;
+            usual = r->d[i].advance;
+        }
+    }
+    for (guint i = 0; i < r->count; i++) {
+        compared *c = &r->d[i];
+        c->majority = usual;
+        c->forwarding = c->has_advance && c->advance != usual;
+    }
+}
+
+void *esc_capture_new(void) { return wmem_new0(wmem_file_scope(), capture_hints); }
+
+int esc_is_response(void *capture, const address *request_src, const address *src)
+{
+    capture_hints *h = (capture_hints *)capture;
+    if (request_src->type != AT_ETHER || src->type != AT_ETHER || request_src->len != 6 || src->len != 6) return -1;
+    const guint8 *a = (const guint8 *)request_src->data, *b = (const guint8 *)src->data;
+    if (memcmp(a + 1, b + 1, 5) != 0) return -1;
+    if (!(a[0] & 0x02) && b[0] == (a[0] | 0x02)) {
+        h->marking_seen = TRUE;
+        memcpy(h->master, a, 6);
+        return 1;
+    }
+    /* The master's own address again, in a capture whose slaves mark returned frames: a new frame. */
+    if (a[0] == b[0] && !(a[0] & 0x02) && h->marking_seen) return 0;
+    return -1;
+}
+
+/* The master's address with the locally administered bit set: a returned frame. */
+gboolean esc_is_returned(void *capture, const address *src)
+{
+    const capture_hints *h = (const capture_hints *)capture;
+    if (!h->marking_seen || src->type != AT_ETHER || src->len != 6) return FALSE;
+    const guint8 *b = (const guint8 *)src->data;
+    return b[0] == (h->master[0] | 0x02) && memcmp(b + 1, h->master + 1, 5) == 0;
+}
+
+void *esc_compare(void *, tvbuff_t *request, tvbuff_t *response, packet_info *)
+{
+    datagram sent[max_datagrams], back[max_datagrams];
+    result *r = wmem_new0(wmem_file_scope(), result);
+    r->sent_count = read_frame(request, &r->sent_length, sent, max_datagrams);
+    r->back_count = read_frame(response, &r->back_length, back, max_datagrams);
+    r->length_changed = r->sent_length != r->back_length || r->sent_count != r->back_count;
+    r->count = MIN(r->sent_count, r->back_count);
+    r->d = wmem_alloc0_array(wmem_file_scope(), compared, r->count ? r->count : 1);
+    for (guint i = 0; i < r->count; i++) compare_datagram(&r->d[i], &sent[i], &back[i], request, response);
+    check_forwarding(r);
+    return r;
+}
+
+void show_datagram(const compared *c, guint i, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    proto_item *item = proto_tree_add_none_format(
+        tree, hf_datagram, tvb, c->offset, c->length, "Datagram %u (%s): working counter %+d%s%s", i + 1,
+        command_name(c->cmd), c->wkc_added, c->has_advance ? wmem_strdup_printf(pinfo->pool, ", %u slaves passed",
+                                                                                  c->advance)
+                                                          : "",
+        c->data_changed ? ", data changed" : ", data unchanged");
+    proto_item_set_generated(item);
+    proto_tree *sub = proto_item_add_subtree(item, ett_datagram);
+    proto_item *it = proto_tree_add_int(sub, hf_wkc_added, tvb, c->offset + c->length - 2, 2, c->wkc_added);
+    proto_item_set_generated(it);
+    if (c->has_advance) {
+        it = proto_tree_add_uint(sub, hf_slaves_passed, tvb, c->offset + 2, 2, c->advance);
+        proto_item_set_generated(it);
+    }
+    it = proto_tree_add_boolean(sub, hf_data_changed, tvb, c->offset + 10, c->length - 12, c->data_changed);
+    proto_item_set_generated(it);
+
+    if (c->changed) {
+        wmem_strbuf_t *what = wmem_strbuf_new(pinfo->pool, "");
+        if (c->changed & CHANGED_CMD)
+            wmem_strbuf_append_printf(what, ", command %s came back as %s", command_name(c->sent.cmd),
+                                      command_name(c->back.cmd));
+        if (c->changed & CHANGED_IDX)
+            wmem_strbuf_append_printf(what, ", index 0x%02x came back as 0x%02x", c->sent.idx, c->back.idx);
+        if (c->changed & CHANGED_LEN)
+            wmem_strbuf_append_printf(what, ", length %u came back as %u", c->sent.length, c->back.length);
+        if (c->changed & CHANGED_ADDR)
+            wmem_strbuf_append_printf(what, ", address 0x%04x%04x came back as 0x%04x%04x", c->sent.ado, c->sent.adp,
+                                      c->back.ado, c->back.adp);
+        expert_add_info_format(pinfo, item, &ei_changed, "Datagram %u (%s)%s", i + 1, command_name(c->sent.cmd),
+                               wmem_strbuf_get_str(what));
+    }
+    if (is_write(c->sent.cmd) && c->data_changed && !(c->changed & CHANGED_LEN))
+        expert_add_info_format(pinfo, item, &ei_write_changed, "Datagram %u (%s): the written data came back changed",
+                               i + 1, command_name(c->sent.cmd));
+    if (c->wkc_added < 0)
+        expert_add_info_format(pinfo, item, &ei_wkc_down, "Datagram %u (%s): working counter went down from %u to %u",
+                               i + 1, command_name(c->sent.cmd), c->sent.wkc, c->back.wkc);
+    if (c->forwarding)
+        expert_add_info_format(pinfo, item, &ei_forwarding,
+                               "Datagram %u (%s): auto-increment address advanced by %u, the frame's other datagrams by %u",
+                               i + 1, command_name(c->sent.cmd), c->advance, c->majority);
+}
+
+void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    const result *r = (const result *)data;
+    proto_item *item = proto_tree_add_item(tree, hf_esc, tvb, 0, 0, ENC_NA);
+    proto_item_set_generated(item);
+    proto_tree *sub = proto_item_add_subtree(item, ett_esc);
+    if (r->length_changed)
+        expert_add_info_format(pinfo, item, &ei_frame_length,
+                               "Frame length changed: sent with %u bytes of datagrams (%u datagrams), came back with "
+                               "%u (%u datagrams)",
+                               r->sent_length, r->sent_count, r->back_length, r->back_count);
+    for (guint i = 0; i < r->count; i++) show_datagram(&r->d[i], i, tvb, pinfo, sub);
+}
+
+/* --- statistics ---------------------------------------------------------- */
+
+const char *const st_wkc = "Working counter per command (returned)";
+const char *const st_wkc_down = "Working counter went down";
+int st_wkc_id;
+
+void esc_stats_init(stats_tree *st, int parent)
+{
+    st_wkc_id = stats_tree_create_node(st, st_wkc, parent, STAT_DT_INT, TRUE);
+    stats_tree_create_node(st, st_wkc_down, parent, STAT_DT_INT, FALSE);
+}
+
+void esc_stats_response(stats_tree *st, int parent, const void *data)
+{
+    const result *r = (const result *)data;
+    char label[32];
+    for (guint i = 0; i < r->count; i++) {
+        const compared *c = &r->d[i];
+        tick_stat_node(st, st_wkc, parent, TRUE);
+        int cmd_id = tick_stat_node(st, command_name(c->cmd), st_wkc_id, TRUE);
+        g_snprintf(label, sizeof label, "working counter %u", c->back.wkc);
+        tick_stat_node(st, label, cmd_id, FALSE);
+        if (c->wkc_added < 0) tick_stat_node(st, st_wkc_down, parent, FALSE);
+    }
+}
+
+void esc_register(int proto, const char *filter)
+{
+    static hf_register_info hf[] = {
+        {&hf_esc, {"Out and back (ESC forwarding)", NULL, FT_NONE, BASE_NONE, NULL, 0x0,
+                   "What the segment did to the frame, datagram by datagram", HFILL}},
+        {&hf_datagram, {"Datagram", NULL, FT_NONE, BASE_NONE, NULL, 0x0, "One returned datagram against the one sent",
+                        HFILL}},
+        {&hf_wkc_added, {"Working counter added", NULL, FT_INT32, BASE_DEC, NULL, 0x0,
+                         "Returned working counter minus the one sent", HFILL}},
+        {&hf_slaves_passed, {"Slaves passed", NULL, FT_UINT16, BASE_DEC, NULL, 0x0,
+                             "How far the auto-increment address advanced (auto-increment and broadcast commands)",
+                             HFILL}},
+        {&hf_data_changed, {"Data changed", NULL, FT_BOOLEAN, BASE_NONE, NULL, 0x0,
+                            "The data came back different from what was sent", HFILL}},
+    };
+    const char *names[] = {"esc", "esc.datagram", "esc.wkc_added", "esc.slaves_passed", "esc.data_changed"};
+    for (guint i = 0; i < G_N_ELEMENTS(hf); i++) hf[i].hfinfo.abbrev = g_strdup_printf("%s.%s", filter, names[i]);
+    proto_register_field_array(proto, hf, (int)G_N_ELEMENTS(hf));
+    static gint *ett[] = {&ett_esc, &ett_datagram};
+    proto_register_subtree_array(ett, (int)G_N_ELEMENTS(ett));
+
+    static ei_register_info ei[] = {
+        {&ei_changed, {NULL, PI_PROTOCOL, PI_ERROR, "Returned datagram's command, index, length or address changed",
+                       EXPFILL}},
+        {&ei_frame_length, {NULL, PI_PROTOCOL, PI_ERROR, "Returned frame's length changed", EXPFILL}},
+        {&ei_write_changed, {NULL, PI_PROTOCOL, PI_ERROR, "Written data came back changed", EXPFILL}},
+        {&ei_wkc_down, {NULL, PI_PROTOCOL, PI_ERROR, "Working counter went down", EXPFILL}},
+        {&ei_forwarding, {NULL, PI_PROTOCOL, PI_WARN,
+                          "Auto-increment address advanced differently from the frame's other datagrams", EXPFILL}},
+    };
+    const char *ei_names[] = {"changed", "frame_length", "write_changed", "wkc_down", "forwarding"};
+    for (guint i = 0; i < G_N_ELEMENTS(ei); i++)
+        ei[i].eiinfo.name = g_strdup_printf("%s.expert.%s", filter, ei_names[i]);
+    expert_register_field_array(expert_register_protocol(proto), ei, (int)G_N_ELEMENTS(ei));
+}
+
+} /* namespace */
+
+extern "C" const dg_analysis dg_ethercat_esc = {
+    "ethercat-esc",
+    esc_register,
+    esc_capture_new,
+    NULL, /* see */
+    esc_is_response,
+    esc_is_returned,
+    esc_compare,
+    esc_show,
+    esc_stats_init,
+    esc_stats_response,
+};

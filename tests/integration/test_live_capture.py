@@ -1,0 +1,223 @@
+#!/usr/bin/env python3
+"""Live capture (issue 11): real EtherCAT captures replayed on a veth pair, decoded live.
+
+  test_live_capture.py --dissgen build/bin/dissgen --source-dir . [--corpus DIR]
+
+The test makes its own network namespace (`ip netns add`) holding a veth pair va <-> vb,
+replays the EtherCAT frames of real captures from ../shared/corpus/ethercat onto va with a
+raw socket of its own (this script with --send, keeping the captures' spacing, stretched
+twice), and captures on vb with `tshark -i vb` and the installed plugin, once for `-c N`
+frames and once for `-a duration:T`. tshark runs as an ordinary user (as root it would
+ignore the per-user plugin) with the capture capabilities only (CAP_NET_RAW,
+CAP_NET_ADMIN, as the `wireshark` group gives dumpcap). The live decode must equal the
+decode of the same frames read from the file, the pairing included (ecatr.request_in,
+what the segment did, the expert infos), but for the round-trip times.
+
+Only traffic inside the namespace the test made. Exit 77 with "SKIPPED: ..." when not
+root or when network namespaces, veth or capabilities are not available.
+"""
+
+import argparse
+import os
+import select
+import socket
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from tshark_env import NOBODY, Checks, TsharkEnv  # noqa: E402
+import pcaprewrite as pr  # noqa: E402
+
+SKIP = 77
+CAPTURES = ["soem-sdinfo-ek1100-el1004.pcapng", "replay-sdo-error.pcapng"]
+STRETCH = 2.0
+FIELDS = ["frame.number", "ecatr.header.length", "ecatr.datagram.cmd", "ecatr.datagram.idx",
+          "ecatr.datagram.adp", "ecatr.datagram.ado", "ecatr.datagram.lad", "ecatr.datagram.len",
+          "ecatr.datagram.data", "ecatr.datagram.wkc", "ecatr.request_in", "ecatr.esc.wkc_added",
+          "ecatr.esc.slaves_passed", "ecatr.esc.data_changed", "ecatr.expert.duplicate",
+          "ecatr.expert.out_of_order", "ecatr.expert.changed", "ecatr.expert.frame_length",
+          "ecatr.expert.write_changed", "ecatr.expert.wkc_down", "ecatr.expert.forwarding"]
+check = Checks()
+
+
+def ethercat_frames(path):
+    cap = pr.Capture.read(path)
+    return cap, [k for k, p in enumerate(cap.packets) if pr.ecat_offset(p) == 14]
+
+
+# ----------------------------------------------------------------------------- sender
+
+def send(path, iface):
+    """Replay the capture's EtherCAT frames on iface, keeping their spacing (stretched)."""
+    cap, frames = ethercat_frames(path)
+    s = socket.socket(socket.AF_PACKET, socket.SOCK_RAW)
+    s.bind((iface, 0))
+    t0 = cap.seconds(cap.packets[frames[0]])
+    start = time.monotonic()
+    for k in frames:
+        due = start + (cap.seconds(cap.packets[k]) - t0) * STRETCH
+        while True:
+            left = due - time.monotonic()
+            if left <= 0:
+                break
+            time.sleep(min(left, 0.0005))
+        s.send(bytes(cap.packets[k].data))
+    s.close()
+    return 0
+
+
+# ----------------------------------------------------------------------------- namespace
+
+def run(cmd, check_rc=True):
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if check_rc and p.returncode != 0:
+        raise RuntimeError("%s: exit %d: %s" % (" ".join(cmd), p.returncode, p.stderr.strip()))
+    return p
+
+
+class Namespace:
+    def __init__(self):
+        self.name = "dissgen-live-%d" % os.getpid()
+
+    def __enter__(self):
+        run(["ip", "netns", "add", self.name])
+        try:
+            self.exec(["sysctl", "-qw", "net.ipv6.conf.all.disable_ipv6=1",
+                       "net.ipv6.conf.default.disable_ipv6=1"], check_rc=False)
+            self.exec(["ip", "link", "add", "va", "type", "veth", "peer", "name", "vb"])
+            self.exec(["ip", "link", "set", "va", "up"])
+            self.exec(["ip", "link", "set", "vb", "up"])
+        except Exception:
+            self.__exit__()
+            raise
+        return self
+
+    def exec(self, cmd, check_rc=True):
+        return run(["ip", "netns", "exec", self.name] + cmd, check_rc)
+
+    def prefix(self):
+        return ["ip", "netns", "exec", self.name]
+
+    def __exit__(self, *exc):
+        run(["ip", "netns", "del", self.name], check_rc=False)
+
+
+def capture_command(env, ns, stop):
+    """tshark in the namespace, as nobody with the capture capabilities only."""
+    cmd = ns.prefix() + ["setpriv", "--reuid=%d" % NOBODY, "--regid=%d" % NOBODY, "--clear-groups",
+                         "--inh-caps=+net_raw,+net_admin", "--ambient-caps=+net_raw,+net_admin",
+                         env.tshark_bin, "-i", "vb", "-f", "ether proto 0x88a4", "-l", "-T", "fields",
+                         "-E", "occurrence=a", "-E", "aggregator=,"] + stop
+    for f in FIELDS:
+        cmd += ["-e", f]
+    return cmd
+
+
+def file_decode(env, path):
+    args = ["-r", path, "-Y", "eth.type == 0x88a4", "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"]
+    for f in FIELDS:
+        args += ["-e", f]
+    return [line.split("\t") for line in env.tshark(args).stdout.splitlines()]
+
+
+def normalise(rows, numbers):
+    """Frame numbers (own and ecatr.request_in) as positions among the EtherCAT frames."""
+    pos = {n: k for k, n in enumerate(numbers)}
+    out = []
+    req = FIELDS.index("ecatr.request_in")
+    for r in rows:
+        r = r + [""] * (len(FIELDS) - len(r))
+        r = list(r)
+        r[0] = str(pos.get(int(r[0]), "?"))
+        if r[req]:
+            r[req] = str(pos.get(int(r[req]), "?"))
+        out.append(r)
+    return out
+
+
+def live(env, ns, path, stop, expect_frames):
+    cmd = capture_command(env, ns, stop)
+    p = subprocess.Popen(cmd, env=env.env(), cwd=env.home, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # Wait until dumpcap listens ("Capturing on 'vb'") before sending.
+    seen, deadline = "", time.monotonic() + 30
+    while "Capturing on" not in seen and time.monotonic() < deadline and p.poll() is None:
+        ready, _, _ = select.select([p.stderr], [], [], 1.0)
+        if ready:
+            seen += os.read(p.stderr.fileno(), 4096).decode(errors="replace")
+    if "Capturing on" not in seen:
+        p.kill()
+        out, err = p.communicate()
+        raise RuntimeError("tshark did not start capturing: %s%s" % (seen, err))
+    time.sleep(0.3)
+    ns.exec([sys.executable, os.path.abspath(__file__), "--send", path, "--iface", "va"])
+    try:
+        out, err = p.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        out, err = p.communicate()
+    rows = [line.split("\t") for line in out.splitlines()]
+    check(len(rows) == expect_frames, "%s %s: tshark -i saw %d frames of %d" % (
+        os.path.basename(path), " ".join(stop), len(rows), expect_frames))
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--dissgen")
+    ap.add_argument("--source-dir")
+    ap.add_argument("--corpus")
+    ap.add_argument("--send", help=argparse.SUPPRESS)
+    ap.add_argument("--iface", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.send:
+        return send(args.send, args.iface)
+
+    corpus_dir = args.corpus or os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus", "ethercat")
+    files = [f for f in CAPTURES if os.path.isfile(os.path.join(corpus_dir, f))]
+    if not files:
+        print("SKIPPED: no corpus captures at %s" % corpus_dir)
+        return SKIP
+    if os.geteuid() != 0:
+        print("SKIPPED: making a network namespace and a veth pair needs root")
+        return SKIP
+    try:
+        ns = Namespace().__enter__()
+    except (OSError, RuntimeError) as e:
+        print("SKIPPED: network namespaces or veth pairs are not allowed here (%s)" % e)
+        return SKIP
+    try:
+        with TsharkEnv() as env:
+            env.install_plugin(args.dissgen, os.path.join(args.source_dir, "rules", "ethercat.xml"))
+            env.assert_plugin_loaded("ecatr")
+            probe = subprocess.run(capture_command(env, ns, ["-c", "1", "-a", "duration:1"]), env=env.env(),
+                                   cwd=env.home, capture_output=True, text=True)
+            if "permission" in probe.stderr.lower() or "capabilit" in probe.stderr.lower():
+                print("SKIPPED: an ordinary user with CAP_NET_RAW cannot capture here: %s" % probe.stderr.strip())
+                return SKIP
+            for name in files:
+                with open(os.path.join(corpus_dir, name), "rb") as fh:
+                    path = env.add_file(name, fh.read())
+                cap, frames = ethercat_frames(path)
+                numbers = [k + 1 for k in frames]
+                want = normalise(file_decode(env, path), numbers)
+                check(len(want) == len(frames), "%s: the file holds %d EtherCAT frames" % (name, len(frames)))
+                duration = (cap.seconds(cap.packets[frames[-1]]) - cap.seconds(cap.packets[frames[0]])) * STRETCH
+                for stop in (["-c", str(len(frames))], ["-a", "duration:%d" % (int(duration) + 4)]):
+                    got = live(env, ns, path, stop, len(frames))
+                    got = normalise(got, list(range(1, len(got) + 1)))
+                    diff = [k for k, (a, b) in enumerate(zip(got, want)) if a != b]
+                    paired = sum(1 for r in got if r[FIELDS.index("ecatr.request_in")])
+                    check(not diff and len(got) == len(want),
+                          "%s %s: the live decode equals the file's, pairing included (%d frames, %d paired)%s" % (
+                              name, " ".join(stop), len(got), paired,
+                              "; first difference at EtherCAT frame %d:\n  live %s\n  file %s" % (
+                                  diff[0], got[diff[0]], want[diff[0]]) if diff else ""))
+    finally:
+        ns.__exit__()
+    print("\n%d failed" % len(check.failed))
+    return 1 if check.failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,371 @@
+#!/usr/bin/env python3
+"""Out and back (issue 11): EtherCAT frames paired with their returns, on the real captures
+of ../shared/corpus/ethercat and on copies of them with faults injected.
+
+  test_pairing.py --dissgen build/bin/dissgen --source-dir . [--corpus DIR]
+
+1. Every capture of the corpus, read with tshark -2: each returned frame that an independent
+   reading of the bytes pairs with its sent frame (the slaves set the locally administered
+   bit of the master's source MAC; same datagram commands, indexes and lengths; the latest
+   unanswered sent frame, at most 10 ms before) carries ecatr.request_in of that frame, and
+   the sent frame ecatr.response_in. Counts are printed per file. No expert info of the
+   pairing or of the ESC analysis appears on any of them, except "no response" on sent frames
+   that the bytes show never came back.
+2. One pass and two passes (-2) give the same items on returned frames, and a display filter
+   gives the same items on the frames it keeps.
+3. Faults injected into copies (pcaprewrite.py): returned frames deleted, a working counter
+   that came back lower than sent, an address, a length, an index changed, written data
+   altered, an auto-increment address advanced differently, frames reordered or duplicated.
+   Each expert info appears on exactly the frames changed and nowhere else, with -2 and
+   (for the returned-frame experts) in one pass.
+
+Exit 77 with "SKIPPED: ..." when the corpus is not there.
+"""
+
+import argparse
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from tshark_env import Checks, TsharkEnv  # noqa: E402
+import pcaprewrite as pr  # noqa: E402
+
+SKIP = 77
+EXPERTS = ["no_response", "duplicate", "out_of_order", "changed", "frame_length", "write_changed",
+           "wkc_down", "forwarding"]
+# Shown on the returned frame, so known in one pass already.
+RESPONSE_FIELDS = ["ecatr.request_in", "ecatr.time", "ecatr.esc.wkc_added", "ecatr.esc.slaves_passed",
+                   "ecatr.esc.data_changed"] + ["ecatr.expert." + e for e in EXPERTS if e != "no_response"]
+FIELDS = ["frame.number", "ecatr.response_in", "ecatr.expert.no_response"] + RESPONSE_FIELDS
+WRITES = {2, 5, 8, 11}            # APWR FPWR BWR LWR
+ADVANCING = {1, 2, 3, 7, 8, 9, 13}  # auto-increment and broadcast commands
+check = Checks()
+
+
+def decode(env, path, two_pass=True, display_filter=None):
+    """{frame number: {field: value}} for every frame, from tshark -T fields."""
+    args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"]
+    if two_pass:
+        args.append("-2")
+    if display_filter:
+        args += ["-Y", display_filter]
+    for f in FIELDS:
+        args += ["-e", f]
+    out = env.tshark(args).stdout
+    rows = {}
+    for line in out.splitlines():
+        cols = line.split("\t")
+        cols += [""] * (len(FIELDS) - len(cols))
+        rows[int(cols[0])] = dict(zip(FIELDS[1:], cols[1:]))
+    return rows
+
+
+def with_expert(rows, name):
+    return {n for n, r in rows.items() if r["ecatr.expert." + name]}
+
+
+# ----------------------------------------------------------------------------- the bytes' view
+
+def frame_info(pkt):
+    """(source MAC, key) of an EtherCAT frame on Ethernet, or None."""
+    if pr.ecat_offset(pkt) is None:
+        return None
+    dgs = pr.ecat_datagrams(pkt)
+    return bytes(pkt.data[6:12]), tuple((d["cmd"], d["idx"], d["length"]) for d in dgs)
+
+
+def oracle(cap):
+    """Pairs {returned index: sent index} and the sent indexes, from the bytes alone: a frame
+    from a master's address with the locally administered bit set is a return; any other
+    EtherCAT frame was sent."""
+    frames = [(i, frame_info(p)) for i, p in enumerate(cap.packets)]
+    frames = [(i, info) for i, info in frames if info]
+    masters = {src for i, (src, _key) in frames if not src[0] & 0x02 and pr.ecat_offset(cap.packets[i]) == 14}
+    marked = {bytes([m[0] | 0x02]) + m[1:]: m for m in masters}
+    pairs, sent, waiting = {}, [], {}
+    returned = 0
+    for i, (src, key) in frames:
+        returned += src in marked
+        if src not in marked:
+            sent.append(i)
+            waiting[(src, key)] = i
+            continue
+        j = waiting.get((marked[src], key))
+        if j is not None and cap.seconds(cap.packets[i]) - cap.seconds(cap.packets[j]) <= 0.010:
+            pairs[i] = j
+            del waiting[(marked[src], key)]
+    return pairs, sent, returned
+
+
+# ----------------------------------------------------------------------------- corpus
+
+def corpus_checks(env, corpus_dir, files):
+    print("\n== real captures: pairs per file (tshark -2)")
+    print("%-40s %7s %7s %7s %7s %7s" % ("file", "sent", "back", "paired", "bytes", "lost"))
+    print("(sent/back: frames from the master / returned, by their source address; paired: by the plugin;\n"
+          " bytes: pairs the bytes show within 10 ms; lost: ecatr.expert.no_response)")
+    for name in files:
+        path = os.path.join(corpus_dir, name)
+        cap = pr.Capture.read(path)
+        pairs, sent, returned = oracle(cap)
+        rows = decode(env, path)
+        ours = {n - 1: int(r["ecatr.request_in"]) - 1 for n, r in rows.items() if r["ecatr.request_in"]}
+        lost = with_expert(rows, "no_response")
+        print("%-40s %7d %7d %7d %7d %7d" % (name, len(sent), returned, len(ours), len(pairs), len(lost)))
+        missing = [(i + 1, j + 1) for i, j in pairs.items() if ours.get(i) != j]
+        check(not missing, "%s: every frame the bytes pair is paired the same way (%d pairs%s)" % (
+            name, len(pairs), ", wrong: %s" % missing[:5] if missing else ""))
+        back_links = [j + 1 for i, j in pairs.items() if rows[j + 1]["ecatr.response_in"] != str(i + 1)]
+        check(not back_links, "%s: each of those sent frames links to its return (ecatr.response_in)%s" % (
+            name, ": not %s" % back_links[:5] if back_links else ""))
+        for e in EXPERTS:
+            got = with_expert(rows, e)
+            if e == "no_response":
+                answered = {j + 1 for j in pairs.values()}
+                bad = sorted(n for n in got if n in answered or n - 1 not in sent)
+                check(not bad, "%s: no_response only on sent frames that never came back (%d)%s" % (
+                    name, len(got), ": %s" % bad[:5] if bad else ""))
+            else:
+                check(not got, "%s: no ecatr.expert.%s (%s)" % (name, e, sorted(got)[:5]))
+        one = decode(env, path, two_pass=False)
+        diff = [n for n in rows if any(rows[n][f] != one[n][f] for f in RESPONSE_FIELDS)]
+        check(not diff, "%s: one pass shows the same items on returned frames as -2%s" % (
+            name, ": %s" % diff[:5] if diff else ""))
+        stats_checks(env, path, name, rows)
+        filtered = decode(env, path, display_filter="ecatr.request_in || ecatr.expert.no_response")
+        diff = [n for n in filtered if filtered[n] != rows[n]]
+        check(filtered and not diff, "%s: a display filter keeps the same items (%d frames)%s" % (
+            name, len(filtered), ": %s" % diff[:5] if diff else ""))
+
+
+def stats_tree(env, path, two_pass):
+    """{item: [count, average, min, max]} of the "Requests and responses" part of -z ecatr,tree."""
+    args = ["-r", path, "-q", "-z", "ecatr,tree"] + (["-2"] if two_pass else [])
+    items, inside = {}, False
+    for line in env.tshark(args).stdout.splitlines():
+        if line.startswith("Requests and responses"):
+            inside = True
+            continue
+        if inside and not line.startswith(" "):
+            break
+        if inside and line.startswith(" ") and not line.startswith("  "):
+            label = line[:41].strip()
+            cols = line[41:].split()
+            items[label] = cols
+    return items
+
+
+def stats_checks(env, path, name, rows):
+    requests = sum(1 for r in rows.values() if r["ecatr.response_in"] or r["ecatr.expert.no_response"])
+    responses = sum(1 for r in rows.values() if r["ecatr.request_in"])
+    lost = len(with_expert(rows, "no_response"))
+    times = [float(r["ecatr.time"]) * 1000 for r in rows.values() if r["ecatr.time"]]
+    for two_pass in (False, True):
+        st = stats_tree(env, path, two_pass)
+        got = (int(st["Requests"][0]), int(st["Responses"][0]), int(st["No response"][0]))
+        ok = got == (requests, responses, lost)
+        if times:
+            count, avg, low, high = st["Round trip (ms)"][:4]
+            ok = ok and int(count) == len(times) and abs(float(low) - min(times)) < 0.001 and \
+                abs(float(high) - max(times)) < 0.001 and abs(float(avg) - sum(times) / len(times)) < 0.01
+        check(ok, "%s: -z ecatr,tree%s: sent %d, returned %d, lost %d, round trip min/avg/max %s (tree: %s)" % (
+            name, " -2" if two_pass else "", requests, responses, lost,
+            "%.3f/%.3f/%.3f ms" % (min(times), sum(times) / len(times), max(times)) if times else "-",
+            {k: v[:4] for k, v in st.items() if k in ("Requests", "Responses", "No response", "Round trip (ms)")}))
+
+
+# ----------------------------------------------------------------------------- faults
+
+class Fault:
+    """A copy of a capture with changes; `expect` maps expert -> set of packet tags."""
+
+    def __init__(self, name, cap):
+        self.name = name
+        self.cap = cap
+        self.expect = {e: set() for e in EXPERTS}
+
+
+def returned_frames(cap, pairs, want):
+    """Returned packet indexes whose datagrams satisfy want(datagrams, sent datagrams)."""
+    out = []
+    for i, j in sorted(pairs.items()):
+        dgs = pr.ecat_datagrams(cap.packets[i])
+        if dgs and want(dgs, pr.ecat_datagrams(cap.packets[j])):
+            out.append(i)
+    return out
+
+
+def spread(items, n):
+    if len(items) <= n:
+        return items
+    return [items[k * (len(items) - 1) // (n - 1)] for k in range(n)]
+
+
+def make_faults(base_cap, pairs):
+    faults = []
+    copy = lambda: pr.Capture.read(base_cap.path)  # noqa: E731
+
+    # returned frames deleted: their sent frames never came back
+    f = Fault("returned frames deleted", copy())
+    victims = spread(sorted(pairs), 3)
+    for i in victims:
+        f.expect["no_response"].add(pairs[i])
+    f.cap.packets = [p for k, p in enumerate(f.cap.packets) if k not in victims]
+    faults.append(f)
+
+    # a working counter that came back lower than it was sent
+    cands = returned_frames(base_cap, pairs, lambda d, s: d[0]["wkc"] >= 1)
+    if cands:
+        f = Fault("working counter came back lower than sent", copy())
+        for i in spread(cands, 2):
+            d = pr.ecat_datagrams(f.cap.packets[i])[0]
+            sent = f.cap.packets[pairs[i]]
+            pr.set_u16(sent, pr.ecat_datagrams(sent)[0]["wkc_offset"], d["wkc"] + 1)
+            f.expect["wkc_down"].add(i)
+        faults.append(f)
+
+    # an address changed (configured-address or logical command)
+    cands = returned_frames(base_cap, pairs, lambda d, s: d[0]["cmd"] in (4, 5, 6, 10, 11, 12, 14))
+    if cands:
+        f = Fault("address changed", copy())
+        for i in spread(cands, 2):
+            d = pr.ecat_datagrams(f.cap.packets[i])[0]
+            pr.set_u16(f.cap.packets[i], d["offset"] + 4, d["ado"] ^ 0x0100)
+            f.expect["changed"].add(i)
+        faults.append(f)
+
+    # an index changed in a single-datagram frame
+    cands = returned_frames(base_cap, pairs, lambda d, s: len(d) == 1)
+    if cands:
+        f = Fault("index changed", copy())
+        i = spread(cands, 3)[1]
+        d = pr.ecat_datagrams(f.cap.packets[i])[0]
+        f.cap.packets[i].data[d["offset"] + 1] ^= 0x80
+        f.expect["changed"].add(i)
+        faults.append(f)
+
+    # a length changed: the returned datagram (and so the frame) one byte shorter
+    cands = returned_frames(base_cap, pairs, lambda d, s: len(d) == 1 and d[0]["length"] >= 2)
+    if cands:
+        f = Fault("length changed", copy())
+        i = spread(cands, 3)[1]
+        pkt = f.cap.packets[i]
+        d = pr.ecat_datagrams(pkt)[0]
+        base = pr.ecat_offset(pkt)
+        pr.set_u16(pkt, base, pr.get_u16(pkt, base) - 1)
+        pr.set_u16(pkt, d["offset"] + 6, pr.get_u16(pkt, d["offset"] + 6) - 1)
+        del pkt.data[d["data_offset"]]
+        f.expect["changed"].add(i)
+        f.expect["frame_length"].add(i)
+        faults.append(f)
+
+    # written data altered
+    cands = returned_frames(base_cap, pairs, lambda d, s: d[0]["cmd"] in WRITES and d[0]["length"] >= 1)
+    if cands:
+        f = Fault("written data altered", copy())
+        for i in spread(cands, 2):
+            d = pr.ecat_datagrams(f.cap.packets[i])[0]
+            f.cap.packets[i].data[d["data_offset"]] ^= 0x5A
+            f.expect["write_changed"].add(i)
+        faults.append(f)
+
+    # an auto-increment address advanced differently from the frame's other datagrams
+    cands = returned_frames(base_cap, pairs, lambda d, s: sum(x["cmd"] in ADVANCING for x in d) >= 2)
+    if cands:
+        f = Fault("auto-increment address advanced differently", copy())
+        i = cands[len(cands) // 2]
+        adv = [x for x in pr.ecat_datagrams(f.cap.packets[i]) if x["cmd"] in ADVANCING]
+        pr.set_u16(f.cap.packets[i], adv[-1]["offset"] + 2, adv[-1]["adp"] + 1)
+        f.expect["forwarding"].add(i)
+        faults.append(f)
+    else:
+        print("note: %s has no returned frame with two auto-increment/broadcast datagrams" % base_cap.name)
+
+    # reordered: A A' B B' -> A B B' A' (A' comes back after a later frame's return)
+    order = sorted(pairs.items(), key=lambda kv: kv[1])
+    for (a1, a0), (b1, b0) in zip(order, order[1:]):
+        if a0 + 1 == a1 and a1 + 1 == b0 and b0 + 1 == b1:
+            f = Fault("returns reordered", copy())
+            p = f.cap.packets
+            times = [p[k].ts for k in (a0, a1, b0, b1)]
+            p[a0:b1 + 1] = [p[a0], p[b0], p[b1], p[a1]]
+            for k, t in zip(range(a0, b1 + 1), times):
+                p[k].ts = t
+            f.expect["out_of_order"].add(a1)
+            faults.append(f)
+            break
+
+    # duplicated: a returned frame and a sent frame captured twice
+    f = Fault("frames duplicated", copy())
+    i = spread(sorted(pairs), 3)[1]
+    j = pairs[spread(sorted(pairs), 3)[2]]
+    extra = len(f.cap.packets)
+    for pos, k in sorted(((i, i), (j, j)), reverse=True):
+        dup = f.cap.packets[k].copy()
+        dup.tag = extra
+        f.expect["duplicate"].add(extra)
+        extra += 1
+        f.cap.packets.insert(pos + 1, dup)
+    faults.append(f)
+    return faults
+
+
+def fault_checks(env, corpus_dir, files):
+    for name in files:
+        path = os.path.join(corpus_dir, name)
+        base = pr.Capture.read(path)
+        base.path, base.name = path, name
+        pairs, _, _ = oracle(base)
+        clean = decode(env, path)
+        baseline = {e: {n - 1 for n in with_expert(clean, e)} for e in EXPERTS}
+        print("\n== faults injected into copies of %s" % name)
+        for f in make_faults(base, pairs):
+            out = env.path("fault.pcapng" if f.cap.kind == "pcapng" else "fault.pcap")
+            f.cap.write(out)
+            os.chmod(out, 0o644)
+            tags = {k + 1: p.tag for k, p in enumerate(f.cap.packets)}
+            present = {p.tag for p in f.cap.packets}
+            rows = decode(env, out)
+            one = decode(env, out, two_pass=False)
+            for e in EXPERTS:
+                got = {tags[n] for n in with_expert(rows, e)}
+                want = (baseline[e] & present) | f.expect[e]
+                check(got == want, "%s: %s: ecatr.expert.%s exactly on %s (extra %s, missing %s)" % (
+                    name, f.name, e, sorted(f.expect[e]) or "none new",
+                    sorted(got - want)[:5], sorted(want - got)[:5]))
+                if e != "no_response":
+                    got1 = {tags[n] for n in with_expert(one, e)}
+                    check(got1 == got, "%s: %s: one pass gives ecatr.expert.%s on the same frames" % (
+                        name, f.name, e))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--dissgen", required=True)
+    ap.add_argument("--source-dir", required=True)
+    ap.add_argument("--corpus")
+    args = ap.parse_args()
+    corpus_dir = args.corpus or os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus", "ethercat")
+    files = sorted(f for f in os.listdir(corpus_dir) if f.endswith((".pcap", ".pcapng"))) \
+        if os.path.isdir(corpus_dir) else []
+    if not files:
+        print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng)" % corpus_dir)
+        return SKIP
+    with TsharkEnv() as env:
+        env.install_plugin(args.dissgen, os.path.join(args.source_dir, "rules", "ethercat.xml"))
+        env.assert_plugin_loaded("ecatr")
+        local = []
+        for f in files:  # readable by the tshark user
+            with open(os.path.join(corpus_dir, f), "rb") as fh:
+                env.add_file(f, fh.read())
+            local.append(f)
+        corpus_checks(env, env.home, local)
+        fault_checks(env, env.home, [f for f in ("soem-sdinfo-ek1100-el1004.pcapng",
+                                                 "replay-ek1100-el2828-el2889.pcapng",
+                                                 "twincat-scan-boxes.pcapng") if f in local])
+    print("\n%d failed" % len(check.failed))
+    return 1 if check.failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
