@@ -109,12 +109,14 @@ class Mutant:
 
 
 def run(cmd, cwd=None, timeout=None, log=None):
-    """(exit status, seconds); output to the log file. A timeout counts as a failure."""
+    """(exit status, seconds, output); output to the log file too. A timeout counts as a
+    failure; 77 (a test that skipped a part it cannot run here, e.g. one needing the corpus,
+    after all its other tests passed) as a pass."""
     start = time.monotonic()
     try:
         p = subprocess.run(cmd, cwd=cwd, timeout=timeout, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                            text=True, errors="replace")
-        status, out = p.returncode, p.stdout
+        status, out = (0 if p.returncode == SKIP_CODE else p.returncode), p.stdout
     except subprocess.TimeoutExpired as e:
         status, out = -1, (e.stdout or "") if isinstance(e.stdout, str) else ""
         out += "\n(timed out after %ss)\n" % timeout
