@@ -7,7 +7,9 @@ an `if`, a repeat, a summary. Here a numeric field of every width 1..8 bytes,
 in both byte orders, plain and inside a bit group, drives each of these, in
 one container per width and byte order (filter wdth.wNb / wdth.wNl):
 
-    Value          W bytes, numberhex        shown in the container's summary (Info column)
+    Value          W bytes, numberhex        shown in the container's summary (Info column),
+                                             if of Zero (in="0"; the first file's Value is the
+                                             first value the runtime keeps: slot 0)
     Length         W bytes                   length of Data
     Count          W bytes                   count of Item
     Selector       W bytes, numberhex        if of Low half (in="0-2^(8W-1)-1") and of
@@ -81,6 +83,7 @@ def render_rules():
             '  <node name="W%d %s" filter="%s" byteorder="%s"' % (w, order, s, order),
             '        summary="%s: {Value} {Selector} {Group value} {Group flag}">' % s,
             '    <node name="Value" length="%dbyte" displaytype="numberhex"/>' % w,
+            '    <node name="Zero" length="1byte" displaytype="numberhex" if="../node[@name=\'Value\']" in="0"/>',
             '    <node name="Length" length="%dbyte" displaytype="numberdec"/>' % w,
             '    <node name="Data" length="../node[@name=\'Length\']" displaytype="origin"/>',
             '    <node name="Count" length="%dbyte" displaytype="numberdec"/>' % w,
@@ -196,6 +199,8 @@ def build_message(g, note="valid", box_extra=None, last_record_more=False, end_a
         m.field(s, "1")
         value = g.val(bits, (pattern(w),))
         m.number(s + ".value", value, w, order, "hex")
+        if value == 0:
+            m.number(s + ".zero", g.val(8), 1, order, "hex")
         n = g.small(4)
         m.number(s + ".length", n, w, order, "dec")
         m.blob(s + ".data", g.bytes(n))
@@ -351,7 +356,7 @@ class Widths(TsharkTestCase, unittest.TestCase):
         valid = [c for c in self.cases if c.note == "valid"]
         for w, order in COMBOS:
             s = "%s.%s." % (PROTO, seg(w, order))
-            for name in ("low_half", "pattern", "flagged", "item", "data", "group_data"):
+            for name in ("zero", "low_half", "pattern", "flagged", "item", "data", "group_data"):
                 counts = {len(c.fields.get(s + name, [])) for c in valid}
                 self.assertIn(0, counts, s + name)
                 self.assertTrue(max(counts) > 0, s + name)

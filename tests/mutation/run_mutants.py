@@ -22,6 +22,7 @@ import argparse
 import glob
 import os
 import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -254,9 +255,11 @@ def main(argv=None):
 
     killed = sum(1 for _, v in results if v == "KILLED")
     total = len(results)
-    print("\nkilled %d of %d mutants (%.0f%%), %d survived, %d invalid; %.0fs in all" % (
-        killed, total, 100.0 * killed / max(total, 1), sum(1 for _, v in results if v == "SURVIVED"),
-        sum(1 for _, v in results if v == "INVALID"), time.monotonic() - t0))
+    cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
+    print("\nkilled %d of %d mutants (%.0f%%), %d survived, %d invalid; %.0fs in all, %.0fs of CPU "
+          "(builds, tests, tshark)" % (
+              killed, total, 100.0 * killed / max(total, 1), sum(1 for _, v in results if v == "SURVIVED"),
+              sum(1 for _, v in results if v == "INVALID"), time.monotonic() - t0, cpu.ru_utime + cpu.ru_stime))
     for m, v in results:
         if v != "KILLED":
             print("  %s %s (%s): %s" % (v, m.name, m.file, " ".join(m.why)))
