@@ -14,6 +14,7 @@ one container per width and byte order (filter wdth.wNb / wdth.wNl):
     Count          W bytes                   count of Item
     Selector       W bytes, numberhex        if of Low half (in="0-2^(8W-1)-1") and of
                                              Pattern (in = the bytes 01 02 .. W), summary
+    Pattern tail   if on Pattern, which is absent when its own if fails: no item then
     Group length / Group value / Group flag  a W-byte bit group (4 + 8W-5 + 1 bits): length
                                              of Group data, summary, if of Flagged
     Chunk          repeat on a 1-bit flag in a W-byte bit group whose other 8W-1 bits
@@ -93,6 +94,8 @@ def render_rules():
             '          if="../node[@name=\'Selector\']" in="0-0x%x"/>' % low_half_top(w),
             '    <node name="Pattern" length="2byte" displaytype="numberhex"',
             '          if="../node[@name=\'Selector\']" in="0x%x"/>' % pattern(w),
+            '    <node name="Pattern tail" length="1byte" displaytype="numberhex"',
+            '          if="../node[@name=\'Pattern\']" in="0-0xffff"/>',
             '    <node name="Group length" length="4bit" displaytype="numberdec"/>',
             '    <node name="Group value" length="%dbit" displaytype="numberhex"/>' % (8 * w - 5),
             '    <node name="Group flag" length="1bit" displaytype="bool"/>',
@@ -214,6 +217,7 @@ def build_message(g, note="valid", box_extra=None, last_record_more=False, end_a
             m.number(s + ".low_half", g.val(8), 1, order, "hex")
         if sel == pattern(w):
             m.number(s + ".pattern", g.val(16), 2, order, "hex")
+            m.number(s + ".pattern_tail", g.val(8), 1, order, "hex")
         summary = "%s: %s %s" % (s, show_hex(value, bits), show_hex(sel, bits))
         if last and cut_group is not None:
             m.data += g.bytes(cut_group)
