@@ -40,6 +40,12 @@ std::string hex(uint64_t v, int digits = 0) {
 
 unsigned value_bytes(const Node& n) { return n.in_bit_group ? n.group_bytes : n.bits / 8; }
 
+// A bit field's mask inside its group (0 for a whole-byte field).
+uint64_t group_mask(const Node& n) {
+    if (!n.in_bit_group) return 0;
+    return (n.bits >= 64 ? ~0ull : ((1ull << n.bits) - 1)) << n.shift;
+}
+
 // Everything the emitter names or numbers, worked out once.
 struct Layout {
     std::vector<const Node*> nodes;                  // document order; index = doc_index - 1
@@ -608,9 +614,7 @@ std::optional<FieldType> typed_field_type(const Node& n) {
         case Display::Float: return FieldType{n.fixed_bits == 64 ? "FT_DOUBLE" : "FT_FLOAT", "BASE_NONE", 0};
         case Display::Time: return FieldType{"FT_RELATIVE_TIME", "BASE_NONE", 0};
         case Display::Int: {
-            uint64_t mask = 0;
-            if (n.in_bit_group) mask = (n.bits >= 64 ? ~0ull : ((1ull << n.bits) - 1)) << n.shift;
-            return FieldType{"FT_INT" + std::to_string(bytes * 8), "BASE_DEC", mask};
+            return FieldType{"FT_INT" + std::to_string(bytes * 8), "BASE_DEC", group_mask(n)};
         }
         default: return std::nullopt;
     }
@@ -626,8 +630,7 @@ FieldType field_type(const Node& n) {
         return {"FT_BYTES", sep, 0};
     }
     unsigned bytes = value_bytes(n);
-    uint64_t mask = 0;
-    if (n.in_bit_group) mask = (n.bits >= 64 ? ~0ull : ((1ull << n.bits) - 1)) << n.shift;
+    uint64_t mask = group_mask(n);
     if (n.display == Display::Bool)
         return {"FT_BOOLEAN", n.in_bit_group ? std::to_string(bytes * 8) : "BASE_NONE", mask};
     std::string type = "FT_UINT" + std::to_string(bytes * 8);

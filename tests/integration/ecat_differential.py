@@ -35,6 +35,7 @@ import struct
 import subprocess
 import sys
 import time
+import xml.etree.ElementTree as ET
 from collections import OrderedDict, defaultdict
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -481,6 +482,135 @@ def model_matches(pred, val):
     return pred == val, None
 
 
+# --------------------------------------------------------------------------- ours: items, Info, experts
+
+OUR_EXPERTS = ("truncated", "past_end", "more_no_data", "count_short", "bad_length", "unused")
+DG_FIXED = [("Command", 1), ("Index", 1)]
+
+
+def ours_shows(payload):
+    """What the bytes imply ecatr shows besides the field values, by rules/ethercat.xml and
+    the runtime's rules (RULES-SPEC): the number of ecatr.datagram items, the Info column, and
+    the expert infos as (filter name, offset in the EtherCAT payload, message) in tree order."""
+    experts, summaries = [], []
+    size = len(payload)
+    if size < 2:
+        experts.append(("truncated", 0, "Truncated: 'Length' needs 2 bytes, only %d left" % size))
+        return 0, "EtherCAT", experts
+    h = struct.unpack("<H", payload[:2])[0]
+    length, ftype = h & 0x7FF, h >> 12
+    name = "Datagrams" if ftype == 1 else "Payload"
+    past_end = length > size - 2
+    if past_end:
+        experts.append(("past_end", 2, "'%s' has length %d, past the end of its data (%d bytes left)"
+                        % (name, length, size - 2)))
+    if ftype != 1:
+        return 0, "EtherCAT", experts
+    end = size if past_end else 2 + length
+    off, items, stopped = 2, 0, False
+
+    def leaf(what, n):
+        nonlocal off, stopped
+        if n > end - off:
+            experts.append(("truncated", off, "Truncated: '%s' needs %d bytes, only %d left" % (what, n, end - off)))
+            stopped = True
+            return None
+        v = payload[off:off + n]
+        off += n
+        return v
+
+    while True:
+        items += 1
+        shown = {"cmd": "-", "len": "-"}
+        more = False
+        v = leaf("Command", 1)
+        if v is not None:
+            cmd = v[0]
+            shown["cmd"] = pcapgen.CMD_NAMES.get(cmd, "Unknown (0x%02x)" % cmd)
+            parts = [("Index", 1)] + ([("Logical address", 4)] if is_logical(cmd) else
+                                      [("Slave address (ADP)", 2), ("Offset address (ADO)", 2)])
+            parts += [("Length", 2), ("Interrupt", 2)]
+            for what, n in parts:
+                v = leaf(what, n)
+                if v is None:
+                    break
+                if what == "Length":
+                    w = struct.unpack("<H", v)[0]
+                    dlen, more = w & 0x7FF, bool(w & 0x8000)
+                    shown["len"] = "%d" % dlen
+            if not stopped:
+                if dlen > end - off:
+                    experts.append(("past_end", off, "'Data' has length %d, past the end of its data (%d bytes left)"
+                                    % (dlen, end - off)))
+                    stopped = True
+                else:
+                    off += dlen
+                    leaf("Working counter", 2)
+        summaries.append("%s len %s" % (shown["cmd"], shown["len"]))
+        if stopped or not more:
+            break
+        if off >= end:
+            experts.append(("more_no_data", off, "'Datagram': the repeat flag 'More' says another follows, "
+                            "but no data is left"))
+            break
+    if not stopped and not past_end and off < end:
+        experts.append(("unused", off, "'Datagrams' is %d bytes, but its fields end after %d: %d bytes are not "
+                        "decoded" % (length, off - 2, end - off)))
+    if len(summaries) > 1:
+        info = "Datagram \u00d7%d: %s" % (len(summaries), ", ".join(summaries))
+    else:
+        info = summaries[0]
+    return items, info, experts
+
+
+def extras_command(cap):
+    return ["-r", cap, "-T", "fields", "-E", "header=n", "-E", "separator=/t", "-E", "quote=d",
+            "-E", "occurrence=a", "-E", "aggregator=,", "-e", "frame.number", "-e", "ecatr.datagram",
+            "-e", "_ws.col.Info"]
+
+
+def experts_command(cap):
+    """PDML of the frames with an expert info of ours: the only output that gives its position."""
+    return ["-r", cap, "-T", "pdml", "-Y", " || ".join("ecatr.expert." + e for e in OUR_EXPERTS)]
+
+
+def parse_extras(text, pdml_path):
+    """-> {frame: {"items": n, "info": text, "experts": [(name, offset, message)]}}"""
+    out = {}
+    for line in text.splitlines():
+        num, dgs, info = [c[1:-1] if len(c) >= 2 and c[0] == c[-1] == '"' else c for c in line.split("\t")]
+        out[int(num)] = {"items": len(dgs.split(",")) if dgs else 0, "info": info, "experts": []}
+    for _, packet in ET.iterparse(pdml_path):
+        if packet.tag != "packet":
+            continue
+        num = int(packet.find("proto[@name='geninfo']/field[@name='num']").get("show"))
+        ecat = packet.find(".//proto[@name='ecatr']")
+        base = int(ecat.get("pos")) if ecat is not None else 0
+        for item in packet.iter("field"):
+            if item.get("name") != "_ws.expert":
+                continue
+            for child in item.findall("field"):
+                if child.get("name", "").startswith("ecatr.expert."):
+                    out.setdefault(num, {"items": 0, "info": "", "experts": []})["experts"].append(
+                        (child.get("name")[len("ecatr.expert."):], int(item.get("pos")) - base, child.get("showname")))
+        packet.clear()
+    return out
+
+
+def compare_extras(num, payload, got):
+    """Problems of one frame: ecatr.datagram items, Info, expert infos against ours_shows()."""
+    items, info, experts = ours_shows(payload)
+    got = got or {"items": 0, "info": None, "experts": []}
+    problems = []
+    if got["items"] != items:
+        problems.append("ours: %d ecatr.datagram items, the bytes imply %d" % (got["items"], items))
+    if got["info"] != info:
+        problems.append("ours: Info %r, the bytes imply %r" % (got["info"], info))
+    if got["experts"] != experts:
+        problems.append("ours: expert infos %s, the bytes imply %s" % (got["experts"], experts))
+    return [{"frame": num, "what": p} for p in problems]
+
+
 # --------------------------------------------------------------------------- comparison
 
 class Stats:
@@ -495,6 +625,8 @@ class Stats:
         self.failures = []
         self.frames_with_explanations = defaultdict(int)
         self.notes = defaultdict(int)
+        self.extras_frames = 0      # frames whose ecatr.datagram items, Info and experts were checked
+        self.extras_experts = 0
 
     def table(self):
         w = max(len(k) for k in self.rows)
@@ -590,6 +722,8 @@ def compare_frame(num, exp, model, ours, ws, stats, context):
                     why = model["dropped_why"]
                 elif isinstance(e, Partial) and m is MISSING:
                     why = "ws-truncated: datagram cut short, Wireshark shows no partial tree"
+            if why is None and not _eq(e, m):
+                why = context.get("header_length_why")
             one("dg", key, i, e, o, w, m, why)
     return problems
 
@@ -600,14 +734,18 @@ FIELDS_BY_SCOPE = {(f[1], f[0]): f[2] for f in FIELDS}
 # --------------------------------------------------------------------------- running
 
 def run_sides(env, cap, fieldset, tag):
-    """Run both tshark sides at once; return (ours -T fields text or None, ws json path, seconds).
-    fieldset None (--simulate perfect) runs only the Wireshark side."""
+    """Run both tshark sides at once; return (ours -T fields text or None, ws json path,
+    ours items/Info/experts (parse_extras) or None, seconds). fieldset None (--simulate
+    perfect) runs only the Wireshark side; only the real plugin (ecatr) has the extras."""
     t0 = time.time()
     ws_out = env.path(tag + ".ws.json")
     ours_out = env.path(tag + ".ours.tsv")
+    extras_out, pdml_out = env.path(tag + ".extras.tsv"), env.path(tag + ".experts.pdml")
     runs = [("Wireshark", ws_command(cap), ws_out)]
     if fieldset is not None:
         runs.append(("ours", ours_command(cap, fieldset), ours_out))
+    if fieldset == "ecatr":
+        runs += [("ours", extras_command(cap), extras_out), ("ours", experts_command(cap), pdml_out)]
     procs = []
     for side, args, out in runs:
         fh = open(out, "w")
@@ -620,15 +758,18 @@ def run_sides(env, cap, fieldset, tag):
             raise tshark_env.TsharkError("tshark (%s side) exited %d on %s:\n%s" % (side, p.returncode, cap, err))
         if err.strip():
             print("note: tshark (%s side) stderr on %s:\n%s" % (side, os.path.basename(cap), err.strip()))
-    ours_text = None
+    ours_text, extras = None, None
     if fieldset is not None:
         with open(ours_out) as fh:
             ours_text = fh.read()
-    return ours_text, ws_out, time.time() - t0
+    if fieldset == "ecatr":
+        with open(extras_out) as fh:
+            extras = parse_extras(fh.read(), pdml_out)
+    return ours_text, ws_out, extras, time.time() - t0
 
 
-def compare_capture(packets, ours_text, ws_json, stats, label, truths=None):
-    """packets: [(linktype, bytes, orig_len)] in capture order."""
+def compare_capture(packets, ours_text, ws_json, stats, label, truths=None, extras=None):
+    """packets: [(linktype, bytes, orig_len)] in capture order; extras: parse_extras() of ours."""
     expected = {}
     models = {}
     payloads = {}
@@ -656,8 +797,12 @@ def compare_capture(packets, ours_text, ws_json, stats, label, truths=None):
         stats.failures.append(([{"frame": num, "what": "ours decoded a frame that is not EtherCAT by "
                                  "ethertype 0x88A4 / UDP port 34980"}], label, None, None))
     for num in sorted(expected):
-        context = {"explained": set()}
+        context = {"explained": set(), "header_length_why": header_length_why(payloads[num][0], expected[num])}
         probs = compare_frame(num, expected[num], models[num], ours.get(num), ws[num - 1], stats, context)
+        if extras is not None:
+            probs += compare_extras(num, payloads[num][0], extras.get(num))
+            stats.extras_frames += 1
+            stats.extras_experts += len((extras.get(num) or {"experts": []})["experts"])
         for e in context["explained"]:
             stats.frames_with_explanations[e] += 1
         if probs:
@@ -669,13 +814,25 @@ def compare_capture(packets, ours_text, ws_json, stats, label, truths=None):
     return len(expected)
 
 
+def header_length_why(payload, exp):
+    """Wireshark's plugin ignores the header's Length. When the datagrams decoded within it
+    are not those decoded to the end of the payload, that explains a difference."""
+    if exp["header"] is None or exp["header"]["type"] != 1:
+        return None
+    h = struct.unpack("<H", payload[:2])[0] | 0x7FF
+    if pcapgen.decode_ecat(struct.pack("<H", h) + payload[2:])["datagrams"] == exp["datagrams"]:
+        return None
+    return ("ws-ignores-header-length: the header's Length disagrees with the datagrams, Wireshark "
+            "decodes them to the end of the payload")
+
+
 def check_truth(expected, truths, payloads):
     """The reference decode of each generated frame equals what the generator wrote."""
     for num, t in enumerate(truths, 1):
         e = expected.get(num)
         assert e is not None, "generated frame %d is not EtherCAT?" % num
         assert e["header"] == t["header"] or "truncate_to" in t, (num, e["header"], t["header"])
-        if "truncate_to" in t or t["header"]["type"] != 1:
+        if "truncate_to" in t or "odd_lengths" in t or t["header"]["type"] != 1:
             continue
         want = pcapgen.expected_from_truth(t)
         if e["datagrams"] != want:
@@ -772,6 +929,10 @@ def report(stats, args, extra=""):
         print()
         print("First mismatches:")
         print_failures(stats, args.show)
+    if stats.extras_frames:
+        print()
+        print("ecatr.datagram items, Info column and expert infos (name, position, message) checked against "
+              "the bytes on %d frames (%d expert infos)" % (stats.extras_frames, stats.extras_experts))
     if extra:
         print(extra)
     print()
@@ -801,7 +962,8 @@ def generated(args):
     n = args.frames
     specials = max(1, n // 300) if args.malformed is None else args.malformed
     frames = pcapgen.random_frames(args.seed, n, args.max_datagrams, m_on_last=specials,
-                                   truncated=specials, other_types=min(specials, 3))
+                                   truncated=specials, other_types=min(specials, 3),
+                                   odd_lengths=specials)
     blob = pcapgen.pcap_bytes(frames)
     truths = [pcapgen.truth(f, i + 1) for i, f in enumerate(frames)]
     packets = []
@@ -815,12 +977,13 @@ def generated(args):
         if args.keep:
             with open(env.path("generated.truth.json"), "w") as fh:
                 json.dump(truths, fh)
-        print("generated %d frames (seed %d, up to %d datagrams, %d M=1-on-last, %d truncated) in %.2fs: %s"
-              % (n, args.seed, args.max_datagrams, specials, specials, t_gen, cap))
-        ours_text, ws_json, t_run = run_sides(env, cap, fieldset, "generated")
+        print("generated %d frames (seed %d, up to %d datagrams, %d each of M=1-on-last, truncated, header "
+              "reserved bit, header Length and datagram Length disagreeing with the bytes) in %.2fs: %s"
+              % (n, args.seed, args.max_datagrams, specials, t_gen, cap))
+        ours_text, ws_json, extras, t_run = run_sides(env, cap, fieldset, "generated")
         t1 = time.time()
         stats = Stats()
-        compare_capture(packets, ours_text, ws_json, stats, "generated", truths)
+        compare_capture(packets, ours_text, ws_json, stats, "generated", truths, extras)
         t_cmp = time.time() - t1
         report(stats, args, "timing: generate %.2fs, tshark (both sides, in parallel) %.2fs, compare %.2fs"
                % (t_gen, t_run, t_cmp))
@@ -843,9 +1006,9 @@ def corpus(args):
         for path in files:
             cap = env.readable(path)     # a copy in the temporary HOME if need be
             packets = list(pcapgen.read_capture(path))
-            ours_text, ws_json, _ = run_sides(env, cap, fieldset, "corpus")
+            ours_text, ws_json, extras, _ = run_sides(env, cap, fieldset, "corpus")
             before = (stats.frames_pass, stats.frames_fail)
-            n = compare_capture(packets, ours_text, ws_json, stats, os.path.basename(path))
+            n = compare_capture(packets, ours_text, ws_json, stats, os.path.basename(path), extras=extras)
             total += n
             print("%-40s %6d packets, %6d EtherCAT frames: %d passed, %d failed" %
                   (os.path.basename(path), len(packets), n, stats.frames_pass - before[0],

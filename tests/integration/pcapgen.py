@@ -102,6 +102,7 @@ class Frame:
     udp_dport: int = ECAT_UDP_PORT
     ts: float = 0.0
     note: str = ""                   # why this frame exists (e.g. "m_on_last", "truncated")
+    odd_lengths: bool = False        # a header or datagram Length disagrees with the bytes
 
     def more_bits(self):
         bits = []
@@ -192,6 +193,8 @@ def truth(f, number=None):
         t["m_on_last"] = True
     if f.truncate_to is not None:
         t["truncate_to"] = f.truncate_to
+    if f.odd_lengths:
+        t["odd_lengths"] = True
     return t
 
 
@@ -511,13 +514,16 @@ class RandomFrames:
         return f
 
 
-def random_frames(seed, n, max_datagrams=12, m_on_last=0, truncated=0, other_types=0):
+def random_frames(seed, n, max_datagrams=12, m_on_last=0, truncated=0, other_types=0, odd_lengths=0):
     """n frames: the valid ones first cover all 15 commands, then the malformed/odd ones
-    (m_on_last, truncated, other header types) are spread through the capture
-    deterministically.  Frame i has ts base+i ms."""
+    (m_on_last, truncated, other header types, and odd_lengths of each: the header's reserved
+    bit set, a header Length that disagrees with the datagrams, a datagram Length that
+    disagrees with its data) are spread through the capture deterministically.
+    Frame i has ts base+i ms."""
     g = RandomFrames(seed, max_datagrams)
     frames = []
     special = ["m_on_last"] * m_on_last + ["truncated"] * truncated + ["type"] * other_types
+    special += ["reserved_bit", "header_length", "datagram_length"] * odd_lengths
     special = special[:n]
     pool = range(15, n) if n - 15 >= len(special) else range(n)
     positions = g.rng.sample(pool, len(special))
@@ -534,6 +540,13 @@ def random_frames(seed, n, max_datagrams=12, m_on_last=0, truncated=0, other_typ
             make_m_on_last(f, g.rng)
         elif kind == "truncated":
             make_truncated(f, g.rng)
+        elif kind == "reserved_bit":
+            f.header_reserved = 1
+            f.note = "header reserved bit set"
+        elif kind == "header_length":
+            make_header_length(f, g.rng)
+        elif kind == "datagram_length":
+            make_datagram_length(f, g.rng)
         elif kind == "type":
             f.header_type = g.rng.choice([0, 4, 7, 0xD])
             f.note = "header type %d" % f.header_type
@@ -553,6 +566,30 @@ def make_m_on_last(f, rng):
     for d in f.datagrams:
         d.data = d.data[:rng.randint(0, 6)]
     f.note = "m_on_last"
+
+
+def make_header_length(f, rng):
+    """A header Length that disagrees with the datagrams: a little or a lot shorter (the last
+    datagrams are cut or missing), or longer (padding or nothing follows)."""
+    body = len(f.body())
+    delta = rng.choice([-1, -2, -12, -body // 2, 1, 2, 12, 40, 0x7FF - body])
+    f.header_length = max(0, min(0x7FF, body + delta))
+    if f.header_length == body:
+        f.header_length = body - 1 if body else 1
+    f.odd_lengths = True
+    f.note = "header Length %d for %d bytes of datagrams" % (f.header_length, body)
+
+
+def make_datagram_length(f, rng):
+    """One datagram's Length disagrees with its data: the datagrams after it are misread."""
+    k = rng.randrange(len(f.datagrams))
+    d = f.datagrams[k]
+    delta = rng.choice([-1, -2, 1, 2, 12, 100, 0x7FF])
+    d.len_field = max(0, min(0x7FF, len(d.data) + delta))
+    if d.len_field == len(d.data):
+        d.len_field = len(d.data) + 1
+    f.odd_lengths = True
+    f.note = "datagram %d has Length %d for %d bytes of data" % (k + 1, d.len_field, len(d.data))
 
 
 def make_truncated(f, rng):

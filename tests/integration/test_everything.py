@@ -28,7 +28,7 @@ import unittest
 import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import TsharkEnv, run_unittests  # noqa: E402
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 
 ARGS = None
 PROTO = "evry"
@@ -845,16 +845,7 @@ def naming_rule(xml_path, proto):
 
 # --------------------------------------------------------------------------- the tests
 
-class Everything(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.env = TsharkEnv()
-        try:
-            cls.prepare()
-        except BaseException:
-            cls.env.cleanup()     # tearDownClass does not run when setUpClass fails
-            raise
-
+class Everything(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
         cls.env.install_plugin(ARGS.dissgen, rules_path())
@@ -881,10 +872,6 @@ class Everything(unittest.TestCase):
         cls.verbose_text, cls.verbose_stderr = v.stdout, v.stderr
         cls.verbose = verbose_blocks(v.stdout)
         cls.capture = cap
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.env.cleanup()
 
     def where(self, i):
         c = self.cases[i]

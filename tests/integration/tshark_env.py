@@ -254,6 +254,23 @@ class TsharkEnv:
         return False
 
 
+class TsharkTestCase:
+    """Mixin for a unittest.TestCase class whose tests share one TsharkEnv (cls.env),
+    set up by the class's own `prepare()` classmethod."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.env = TsharkEnv()
+        try:
+            cls.prepare()
+        except BaseException:
+            cls.env.cleanup()     # tearDownClass does not run when setUpClass fails
+            raise
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.env.cleanup()
+
 
 def run_unittests(add_arguments=None):
     """The entry point of every tests/integration/test_*.py: parses --dissgen and

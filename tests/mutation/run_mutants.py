@@ -1,0 +1,270 @@
+#!/usr/bin/env python3
+"""Mutation check: does the test suite kill small, realistic bugs in the runtime and
+the generator?  Python 3 stdlib only.
+
+    run_mutants.py --source-dir .  [--only NAME ...] [--jobs 2] [--keep] [--list]
+
+Every tests/mutation/mutants/*.mut file is one mutant: in one source file, replace
+one snippet that occurs there exactly once by another (format: tests/mutation/README.md).
+The source tree (as it is on disk, uncommitted edits included; no build/ and no .git)
+is copied into a temporary folder, configured and built once (dissgen, unit_tests,
+dissgen_runtime); the checkout itself is never touched.  Then for each mutant: the
+mutated file is written, the build is brought up to date (only what the file feeds),
+and the mutant's tests run in the order given until one fails: the mutant is KILLED.
+When all pass it SURVIVED.  A mutant whose snippet is not found exactly once, or that
+does not build, is INVALID (the code moved on: refresh the mutant).  Before the
+mutants, the tests they name run once on the unmutated copy and must all pass.
+
+Exit status: 0 when every mutant is killed, 1 otherwise, 77 (skip) without tshark.
+"""
+
+import argparse
+import glob
+import os
+import re
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SKIP_CODE = 77
+TEST_TIMEOUT = 300   # seconds per test run: a mutant that hangs the decoder is killed by it
+
+
+def integration(script, *extra):
+    def command(src, build):
+        return [sys.executable, os.path.join(src, "tests", "integration", script),
+                "--dissgen", os.path.join(build, "bin", "dissgen"), "--source-dir", src] + list(extra)
+    return command
+
+
+def unit(gtest_filter):
+    def command(src, build):
+        return [os.path.join(build, "bin", "unit_tests"), "--gtest_brief=1", "--gtest_filter=" + gtest_filter]
+    return command
+
+
+# The tests a mutant may name, each short (seconds), each a real test of the suite.
+# Golden files are not among them: they record the emitter's output and a changed
+# output is regenerated on purpose, so a mutant must be killed by behaviour.
+TESTS = {
+    "unit": unit("-Golden*"),
+    "rules_err": unit("Files/RulesErr.*:Files/RulesOk.*:RuleFolders.*"),
+    "field_types": unit("FieldType.*:Emit.*:ListFields.*"),
+    "widths": integration("test_widths.py"),
+    "everything": integration("test_everything.py"),
+    "malformed": integration("test_malformed.py"),
+    "enip": integration("test_enip.py"),
+    "loading": integration("test_plugin_loading.py"),
+    "differential": integration("ecat_differential.py", "--frames", "2000", "--max-datagrams", "20",
+                                "--malformed", "200"),
+}
+
+
+class Mutant:
+    def __init__(self, path):
+        self.path = path
+        self.name = os.path.splitext(os.path.basename(path))[0]
+        self.why, self.file, self.tests, self.find, self.replace = [], None, [], None, None
+        self.problem = None
+        try:
+            self._parse(open(path, encoding="utf-8").read())
+        except ValueError as e:
+            self.problem = "%s: %s" % (path, e)
+
+    def _parse(self, text):
+        m = re.search(r"^<<<<\n(.*?)^====\n(.*?)^>>>>$", text, re.S | re.M)
+        if not m:
+            raise ValueError("no <<<< snippet ==== replacement >>>> block")
+        # The snippet is the text between the marker lines, without the last line break.
+        self.find, self.replace = m.group(1)[:-1], m.group(2)[:-1]
+        if not self.find:
+            raise ValueError("empty snippet")
+        for line in text[:m.start()].splitlines():
+            if line.startswith("#"):
+                self.why.append(line[1:].strip())
+            elif line.startswith("file:"):
+                self.file = line[5:].strip()
+            elif line.startswith("tests:"):
+                self.tests = line[6:].split()
+            elif line.strip():
+                raise ValueError("unexpected line %r" % line)
+        if not self.file or not self.tests:
+            raise ValueError("needs 'file:' and 'tests:' lines")
+        unknown = [t for t in self.tests if t not in TESTS]
+        if unknown:
+            raise ValueError("unknown tests %s (known: %s)" % (unknown, " ".join(sorted(TESTS))))
+        if self.find == self.replace:
+            raise ValueError("the replacement equals the snippet")
+
+    def mutate(self, original):
+        """The mutated text of the file, or raise ValueError when the snippet is not there once."""
+        n = original.count(self.find)
+        if n != 1:
+            raise ValueError("the snippet occurs %d times in %s (expected exactly once): refresh the mutant"
+                             % (n, self.file))
+        return original.replace(self.find, self.replace)
+
+
+def run(cmd, cwd=None, timeout=None, log=None):
+    """(exit status, seconds, output); output to the log file too. A timeout counts as a
+    failure; 77 (a test that skipped a part it cannot run here, e.g. one needing the corpus,
+    after all its other tests passed) as a pass."""
+    start = time.monotonic()
+    try:
+        p = subprocess.run(cmd, cwd=cwd, timeout=timeout, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                           text=True, errors="replace")
+        status, out = (0 if p.returncode == SKIP_CODE else p.returncode), p.stdout
+    except subprocess.TimeoutExpired as e:
+        status, out = -1, (e.stdout or "") if isinstance(e.stdout, str) else ""
+        out += "\n(timed out after %ss)\n" % timeout
+    if log:
+        with open(log, "a", encoding="utf-8") as fh:
+            fh.write("$ %s\n%s\n" % (" ".join(cmd), out))
+    return status, time.monotonic() - start, out
+
+
+def copy_tree(source, dest):
+    def ignore(folder, names):
+        if os.path.abspath(folder) == os.path.abspath(source):
+            return [n for n in names if n.startswith("build") or n == ".git"]
+        return [n for n in names if n == "__pycache__"]
+    shutil.copytree(source, dest, symlinks=True, ignore=ignore)
+
+
+def build(src, build_dir, jobs, log):
+    status, secs, out = run(["cmake", "--build", build_dir, "-j%d" % jobs, "--target", "dissgen", "unit_tests",
+                             "dissgen_runtime"], log=log)
+    return status == 0, secs, out
+
+
+def tail(text, lines=15):
+    return "\n".join("    " + l for l in text.strip().splitlines()[-lines:])
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--source-dir", default=os.path.normpath(os.path.join(HERE, "..", "..")))
+    ap.add_argument("--mutants", default=os.path.join(HERE, "mutants"), help="folder of *.mut files")
+    ap.add_argument("--only", nargs="*", help="mutant names (file names without .mut) to run")
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--keep", action="store_true", help="keep the temporary copy (and its log)")
+    ap.add_argument("--list", action="store_true", help="list the mutants and their tests, run nothing")
+    ap.add_argument("--check", action="store_true", help="only check that every mutant still applies")
+    ap.add_argument("--no-baseline", action="store_true", help="skip the run on the unmutated copy")
+    ap.add_argument("--without", nargs="*", default=[], metavar="TEST",
+                    help="leave these tests out (to measure what the others kill)")
+    args = ap.parse_args(argv)
+
+    mutants = [Mutant(p) for p in sorted(glob.glob(os.path.join(args.mutants, "*.mut")))]
+    if args.only:
+        missing = set(args.only) - {m.name for m in mutants}
+        if missing:
+            print("no such mutant: %s" % " ".join(sorted(missing)))
+            return 2
+        mutants = [m for m in mutants if m.name in args.only]
+    for m in mutants:
+        m.tests = [t for t in m.tests if t not in args.without]
+    if args.list:
+        for m in mutants:
+            print("%-34s %-36s %s" % (m.name, m.file, " ".join(m.tests)))
+        return 0
+    if args.check:
+        bad = 0
+        for m in mutants:
+            try:
+                if m.problem:
+                    raise ValueError(m.problem)
+                m.mutate(open(os.path.join(args.source_dir, m.file), encoding="utf-8").read())
+            except (OSError, ValueError) as e:
+                bad += 1
+                print("INVALID  %s: %s" % (m.name, e))
+        print("%d of %d mutants apply" % (len(mutants) - bad, len(mutants)))
+        return 1 if bad else 0
+    if shutil.which("tshark") is None:
+        print("SKIPPED: tshark is not installed (the mutants' tests need it)")
+        return SKIP_CODE
+
+    t0 = time.monotonic()
+    work = tempfile.mkdtemp(prefix="dissgen-mutation-")
+    src, build_dir, log = os.path.join(work, "src"), os.path.join(work, "build"), os.path.join(work, "log.txt")
+    print("mutation check: %d mutants, copy and log in %s" % (len(mutants), work), flush=True)
+    results = []
+    try:
+        copy_tree(os.path.abspath(args.source_dir), src)
+        status, secs, out = run(["cmake", "-S", src, "-B", build_dir, "-DCMAKE_BUILD_TYPE=RelWithDebInfo"], log=log)
+        ok, bsecs, bout = build(src, build_dir, args.jobs, log) if status == 0 else (False, 0, out)
+        print("build of the copy: %s (%.0fs)" % ("ok" if ok else "FAILED", secs + bsecs), flush=True)
+        if not ok:
+            print(tail(bout))
+            return 1
+
+        if not args.no_baseline:
+            needed = []
+            for m in mutants:
+                needed += [t for t in m.tests if t not in needed]
+            for t in needed:
+                status, secs, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log)
+                print("baseline %-13s %s (%.0fs)" % (t, "pass" if status == 0 else "FAIL", secs), flush=True)
+                if status != 0:
+                    print("the unmutated tree fails '%s': fix that first\n%s" % (t, tail(out)))
+                    return 1
+
+        originals = {}
+        for m in mutants:
+            start = time.monotonic()
+            verdict, detail = None, ""
+            if m.problem:
+                verdict, detail = "INVALID", m.problem
+            else:
+                path = os.path.join(src, m.file)
+                if m.file not in originals:
+                    originals[m.file] = open(path, encoding="utf-8").read() if os.path.isfile(path) else None
+                if originals[m.file] is None:
+                    verdict, detail = "INVALID", "no file %s: refresh the mutant" % m.file
+                else:
+                    try:
+                        mutated = m.mutate(originals[m.file])
+                    except ValueError as e:
+                        verdict, detail = "INVALID", str(e)
+            if verdict is None:
+                with open(path, "w", encoding="utf-8") as fh:
+                    fh.write(mutated)
+                ok, _, out = build(src, build_dir, args.jobs, log)
+                if not ok:
+                    verdict, detail = "INVALID", "does not build: refresh the mutant\n" + tail(out)
+                else:
+                    verdict = "SURVIVED"
+                    for t in m.tests:
+                        status, _, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log)
+                        if status != 0:
+                            verdict, detail = "KILLED", "by " + t
+                            break
+                    if verdict == "SURVIVED":
+                        detail = "passed: " + " ".join(m.tests)
+                with open(path, "w", encoding="utf-8") as fh:
+                    fh.write(originals[m.file])
+            results.append((m, verdict))
+            print("%-8s %-34s %s (%.0fs)" % (verdict, m.name, detail, time.monotonic() - start), flush=True)
+    finally:
+        if not args.keep:
+            shutil.rmtree(work, ignore_errors=True)
+
+    killed = sum(1 for _, v in results if v == "KILLED")
+    total = len(results)
+    cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
+    print("\nkilled %d of %d mutants (%.0f%%), %d survived, %d invalid; %.0fs in all, %.0fs of CPU "
+          "(builds, tests, tshark)" % (
+              killed, total, 100.0 * killed / max(total, 1), sum(1 for _, v in results if v == "SURVIVED"),
+              sum(1 for _, v in results if v == "INVALID"), time.monotonic() - t0, cpu.ru_utime + cpu.ru_stime))
+    for m, v in results:
+        if v != "KILLED":
+            print("  %s %s (%s): %s" % (v, m.name, m.file, " ".join(m.why)))
+    return 0 if total and killed == total else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
