@@ -221,14 +221,18 @@ void *esc_compare(void *, tvbuff_t *request, tvbuff_t *response, packet_info *)
     return r;
 }
 
-void show_datagram(const compared *c, guint i, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+/* The datagram's items, when someone looks at them; `tree` is the analysis's subtree. */
+proto_tree *show_datagram_items(const compared *c, guint i, tvbuff_t *tvb, proto_tree *tree)
 {
-    proto_item *item = proto_tree_add_none_format(
-        tree, hf_datagram, tvb, c->offset, c->length, "Datagram %u (%s): working counter %+d%s%s", i + 1,
-        command_name(c->cmd), c->wkc_added, c->has_advance ? wmem_strdup_printf(pinfo->pool, ", %u slaves passed",
-                                                                                  c->advance)
-                                                          : "",
-        c->data_changed ? ", data changed" : ", data unchanged");
+    const char *data = c->data_changed ? "data changed" : "data unchanged";
+    proto_item *item =
+        c->has_advance
+            ? proto_tree_add_none_format(tree, hf_datagram, tvb, c->offset, c->length,
+                                         "Datagram %u (%s): working counter %+d, %u slaves passed, %s", i + 1,
+                                         command_name(c->cmd), c->wkc_added, c->advance, data)
+            : proto_tree_add_none_format(tree, hf_datagram, tvb, c->offset, c->length,
+                                         "Datagram %u (%s): working counter %+d, %s", i + 1, command_name(c->cmd),
+                                         c->wkc_added, data);
     proto_item_set_generated(item);
     proto_tree *sub = proto_item_add_subtree(item, ett_datagram);
     proto_item *it = proto_tree_add_int(sub, hf_wkc_added, tvb, c->offset + c->length - 2, 2, c->wkc_added);
@@ -239,12 +243,17 @@ void show_datagram(const compared *c, guint i, tvbuff_t *tvb, packet_info *pinfo
     }
     it = proto_tree_add_boolean(sub, hf_data_changed, tvb, c->offset + 10, c->length - 12, c->data_changed);
     proto_item_set_generated(it);
+    return sub;
+}
 
+/* The expert infos of one datagram, over its bytes in `tree`. */
+void show_datagram_experts(const compared *c, guint i, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    const char *cmd = command_name(c->sent.cmd);
     if (c->changed) {
         wmem_strbuf_t *what = wmem_strbuf_new(pinfo->pool, "");
         if (c->changed & CHANGED_CMD)
-            wmem_strbuf_append_printf(what, ", command %s came back as %s", command_name(c->sent.cmd),
-                                      command_name(c->back.cmd));
+            wmem_strbuf_append_printf(what, ", command %s came back as %s", cmd, command_name(c->back.cmd));
         if (c->changed & CHANGED_IDX)
             wmem_strbuf_append_printf(what, ", index 0x%02x came back as 0x%02x", c->sent.idx, c->back.idx);
         if (c->changed & CHANGED_LEN)
@@ -252,33 +261,54 @@ void show_datagram(const compared *c, guint i, tvbuff_t *tvb, packet_info *pinfo
         if (c->changed & CHANGED_ADDR)
             wmem_strbuf_append_printf(what, ", address 0x%04x%04x came back as 0x%04x%04x", c->sent.ado, c->sent.adp,
                                       c->back.ado, c->back.adp);
-        expert_add_info_format(pinfo, item, &ei_changed, "Datagram %u (%s)%s", i + 1, command_name(c->sent.cmd),
-                               wmem_strbuf_get_str(what));
+        proto_tree_add_expert_format(tree, pinfo, &ei_changed, tvb, c->offset, c->length, "Datagram %u (%s)%s", i + 1,
+                                     cmd, wmem_strbuf_get_str(what));
     }
     if (is_write(c->sent.cmd) && c->data_changed && !(c->changed & CHANGED_LEN))
-        expert_add_info_format(pinfo, item, &ei_write_changed, "Datagram %u (%s): the written data came back changed",
-                               i + 1, command_name(c->sent.cmd));
+        proto_tree_add_expert_format(tree, pinfo, &ei_write_changed, tvb, c->offset + 10, c->length - 12,
+                                     "Datagram %u (%s): the written data came back changed", i + 1, cmd);
     if (c->wkc_added < 0)
-        expert_add_info_format(pinfo, item, &ei_wkc_down, "Datagram %u (%s): working counter went down from %u to %u",
-                               i + 1, command_name(c->sent.cmd), c->sent.wkc, c->back.wkc);
+        proto_tree_add_expert_format(tree, pinfo, &ei_wkc_down, tvb, c->offset + c->length - 2, 2,
+                                     "Datagram %u (%s): working counter went down from %u to %u", i + 1, cmd,
+                                     c->sent.wkc, c->back.wkc);
     if (c->forwarding)
-        expert_add_info_format(pinfo, item, &ei_forwarding,
-                               "Datagram %u (%s): auto-increment address advanced by %u, the frame's other datagrams by %u",
-                               i + 1, command_name(c->sent.cmd), c->advance, c->majority);
+        proto_tree_add_expert_format(tree, pinfo, &ei_forwarding, tvb, c->offset + 2, 2,
+                                     "Datagram %u (%s): auto-increment address advanced by %u, the frame's other "
+                                     "datagrams by %u",
+                                     i + 1, cmd, c->advance, c->majority);
+}
+
+gboolean is_shown(proto_tree *tree)
+{
+    /* proto_field_is_referenced: a visible tree, or a filter or column naming the field */
+    return tree && (proto_field_is_referenced(tree, hf_esc) || proto_field_is_referenced(tree, hf_datagram) ||
+                    proto_field_is_referenced(tree, hf_wkc_added) ||
+                    proto_field_is_referenced(tree, hf_slaves_passed) ||
+                    proto_field_is_referenced(tree, hf_data_changed));
 }
 
 void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     const result *r = (const result *)data;
-    proto_item *item = proto_tree_add_item(tree, hf_esc, tvb, 0, 0, ENC_NA);
-    proto_item_set_generated(item);
-    proto_tree *sub = proto_item_add_subtree(item, ett_esc);
+    /* Items only for whoever looks at them (e.g. not for tshark -T fields of other fields),
+     * expert infos always. */
+    gboolean items = is_shown(tree);
+    proto_tree *sub = tree;
+    if (items) {
+        proto_item *item = proto_tree_add_item(tree, hf_esc, tvb, 0, 0, ENC_NA);
+        proto_item_set_generated(item);
+        sub = proto_item_add_subtree(item, ett_esc);
+    }
     if (r->length_changed)
-        expert_add_info_format(pinfo, item, &ei_frame_length,
-                               "Frame length changed: sent with %u bytes of datagrams (%u datagrams), came back with "
-                               "%u (%u datagrams)",
-                               r->sent_length, r->sent_count, r->back_length, r->back_count);
-    for (guint i = 0; i < r->count; i++) show_datagram(&r->d[i], i, tvb, pinfo, sub);
+        proto_tree_add_expert_format(sub, pinfo, &ei_frame_length, tvb, 0, MIN(2, (gint)tvb_captured_length(tvb)),
+                                     "Frame length changed: sent with %u bytes of datagrams (%u datagrams), came "
+                                     "back with %u (%u datagrams)",
+                                     r->sent_length, r->sent_count, r->back_length, r->back_count);
+    for (guint i = 0; i < r->count; i++) {
+        const compared *c = &r->d[i];
+        proto_tree *dg = items ? show_datagram_items(c, i, tvb, sub) : sub;
+        show_datagram_experts(c, i, tvb, pinfo, dg);
+    }
 }
 
 /* --- statistics ---------------------------------------------------------- */
