@@ -104,7 +104,7 @@ guint key_hash(gconstpointer v)
 gboolean key_equal(gconstpointer a, gconstpointer b)
 {
     const pair_key *x = (const pair_key *)a, *y = (const pair_key *)b;
-    return x->count == y->count && memcmp(x->values, y->values, x->count * sizeof(guint64)) == 0;
+    return x->count == y->count && (x->count == 0 || memcmp(x->values, y->values, x->count * sizeof(guint64)) == 0);
 }
 
 void capture_init(void) { capture = NULL; }
@@ -395,6 +395,8 @@ void dg_pairing_register(const dg_protocol *p)
 const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
                                            const guint64 *keys, guint key_count, gint length, guint message)
 {
+    /* A message cut short before its first key field answers and asks nothing. */
+    if (key_count == 0) return NULL;
     dg_frame_pairing *fp =
         (dg_frame_pairing *)p_get_proto_data(wmem_file_scope(), pinfo, *p->proto, frame_key + message);
     if (!fp) {

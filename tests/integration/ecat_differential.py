@@ -590,7 +590,10 @@ def parse_extras(text, pdml_path):
             if item.get("name") != "_ws.expert":
                 continue
             for child in item.findall("field"):
-                if child.get("name", "").startswith("ecatr.expert."):
+                # Only the per-frame experts: the pairing's cross-frame ones
+                # (ecatr.expert.changed, ...) are test_pairing's to check.
+                name = child.get("name", "")
+                if name.startswith("ecatr.expert.") and name[len("ecatr.expert."):] in OUR_EXPERTS:
                     out.setdefault(num, {"items": 0, "info": "", "experts": []})["experts"].append(
                         (child.get("name")[len("ecatr.expert."):], int(item.get("pos")) - base, child.get("showname")))
         packet.clear()
