@@ -3,6 +3,8 @@
 """dissgen's EtherCAT plugin against Wireshark's own, a Lua dissector and the floor (Python 3 stdlib only).
 
     python3 bench/bench.py [--runs 3] [--frames 200000] [--json results.json]
+    python3 bench/bench.py --corpus ../shared/corpus/ethercat [--corpus-copies 3]   (real traffic:
+        register, mailbox and process-data datagrams, as Wireshark's plugin decodes them too)
 
 Expects build/bin/dissgen (build it first: bash scripts/build.sh); builds nothing
 itself. In one run it
@@ -146,6 +148,20 @@ def generate_capture(path, seed, n, max_datagrams, max_data):
     if p.returncode != 0:
         raise BenchError("generating the capture failed:\n" + p.stderr[-2000:])
     return json.loads(p.stdout)
+
+
+def merge_corpus(folder, copies, out):
+    """Concatenate (mergecap -a) every capture of folder, copies times, into the classic pcap out."""
+    import glob
+    files = sorted(glob.glob(os.path.join(folder, "*.pcapng")) + glob.glob(os.path.join(folder, "*.pcap")))
+    if not files:
+        raise BenchError("no *.pcap/*.pcapng in %s" % folder)
+    if shutil.which("mergecap") is None:
+        raise BenchError("--corpus needs mergecap (Debian package wireshark-common)")
+    p = subprocess.run(["mergecap", "-a", "-F", "pcap", "-w", out] + files * max(1, copies),
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        raise BenchError("mergecap failed:\n" + p.stderr[-2000:])
 
 
 def count_pcap_records(path):
@@ -421,6 +437,11 @@ def main(argv=None):
     ap.add_argument("--max-data", type=int, default=300, help="longest datagram data, bytes (default 300)")
     ap.add_argument("--max-datagrams", type=int, default=12)
     ap.add_argument("--capture", help="use this pcap instead of generating one")
+    ap.add_argument("--corpus", metavar="DIR",
+                    help="real traffic instead: the *.pcap/*.pcapng of DIR (e.g. ../shared/corpus/ethercat, with "
+                         "register and mailbox datagrams) concatenated with mergecap into one pcap")
+    ap.add_argument("--corpus-copies", type=int, default=1, metavar="N",
+                    help="with --corpus: concatenate the captures N times (a longer run; default 1)")
     ap.add_argument("--modes", default=",".join(MODES), help="of %s (default all)" % ",".join(MODES))
     ap.add_argument("--configs", default=",".join(CONFIGS), help="of %s (default all)" % ",".join(CONFIGS))
     ap.add_argument("--startup-runs", type=int, default=20, help="default 20; 0 skips start-up timing")
@@ -460,7 +481,13 @@ def main(argv=None):
         info["tshark"] = tv[0].split("(Wireshark) ")[-1].split(" ")[0] if tv else "?"
 
         # Inputs.
-        if a.capture:
+        if a.corpus:
+            capture = os.path.join(work, "bench.pcap")
+            merge_corpus(a.corpus, a.corpus_copies, capture)
+            info["capture"] = {"frames": count_pcap_records(capture), "datagrams": 0,
+                               "commands": [], "datagrams_per_frame": [0, 0], "data_len": [0, 0, 0],
+                               "encap": {}, "corpus": os.path.abspath(a.corpus), "copies": a.corpus_copies}
+        elif a.capture:
             capture = os.path.join(work, "bench.pcap")
             shutil.copy(a.capture, capture)
             info["capture"] = {"frames": count_pcap_records(capture), "datagrams": 0,

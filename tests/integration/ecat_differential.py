@@ -42,6 +42,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.dont_write_bytecode = True      # no __pycache__ in the source tree
 import pcapgen  # noqa: E402
+import ecat_deep  # noqa: E402
 from pcapgen import Partial, is_logical  # noqa: E402
 import tshark_env  # noqa: E402
 
@@ -64,17 +65,146 @@ FIELDS = [
     ("irq", "dg", "ecatr.datagram.irq", "ecat.int", "int"),
     ("data", "dg", "ecatr.datagram.data", "ecat.data", "bytes"),
     ("wkc", "dg", "ecatr.datagram.wkc", "ecat.cnt", "int"),
+    # The data of a read no slave answered (WKC 0): Wireshark has no such field.
+    ("unread", "dg", "ecatr.datagram.unread", None, "bytes"),
 ]
 HEADER_KEYS = [f[0] for f in FIELDS if f[1] == "header"]
 DG_KEYS = [f[0] for f in FIELDS if f[1] == "dg"]
 KIND = {(f[1], f[0]): f[4] for f in FIELDS}
-WS_DG_FIELD = {f[3]: f[0] for f in FIELDS if f[1] == "dg"}
+WS_DG_FIELD = {f[3]: f[0] for f in FIELDS if f[1] == "dg" and f[3]}
 WS_HDR_FIELD = {f[3]: f[0] for f in FIELDS if f[1] == "header"}
 # Fields that only exist for some commands (the others are one per datagram).
 ONLY_FOR = {"adp": lambda c: not is_logical(c), "ado": lambda c: not is_logical(c),
             "lad": is_logical}
 
 WS_DECODE_AS = ["-d", "ethertype==0x88a4,ecatf", "-d", "udp.port==34980,ecatf"]
+
+# True when rules/ethercat.xml decodes the data (registers, mailboxes): set by prepare_env from
+# `dissgen fields`; the datagram's Data field is then shown only where nothing decodes it.
+DEEP = False
+REG_VIEW_CMDS = (1, 2, 3, 4, 5, 6, 7, 8, 9, 13, 14)
+
+
+def shown_fields():
+    """FIELDS that our plugin has (ecatr.datagram.unread only in rules that decode the data)."""
+    return [f for f in FIELDS if DEEP or f[0] != "unread"]
+
+
+def ours_view(d):
+    """Which alternative of the datagram's data rules/ethercat.xml decodes: "unread" (a read with
+    WKC 0), "reg" (physical/broadcast below 0x1000), "mbx" (APRD..FPRW at 0x1000 and above, at
+    least 6 bytes) or "data" (everything else)."""
+    if not DEEP:
+        return "data"
+    cmd, n, ado, wkc = d.get("cmd"), d.get("len"), d.get("ado"), d.get("wkc")
+    if not isinstance(n, int) or not isinstance(cmd, int):
+        return "data"
+    if cmd in (1, 4, 7) and n >= 1 and wkc == 0:
+        return "unread"
+    if isinstance(ado, int) and cmd in REG_VIEW_CMDS and ado < 0x1000 and n >= 1:
+        return "reg"
+    if isinstance(ado, int) and 1 <= cmd <= 6 and ado >= 0x1000 and n >= 6:
+        return "mbx"
+    return "data"
+
+
+def _u16(b, o):
+    return struct.unpack_from("<H", b, o)[0] if o + 2 <= len(b) else 0
+
+
+def mailbox_fault(data):
+    """True when rules/ethercat.xml meets a fault inside this mailbox (a length past the end of
+    the datagram's data, or fixed fields that do not fit the mailbox length): by the project's
+    contract ours then shows the tree so far and stops (expert info), so the datagram's WKC and
+    the later datagrams are not shown.  Mirrors the rules' alternatives, for any bytes."""
+    n = len(data)
+    mlen, typ = _u16(data, 0), data[5] & 0x0F
+    if mlen > n - 6:
+        return True                 # every content alternative has the mailbox Length
+    c = data[6:6 + mlen]
+    need = 0
+
+    def fits(k):
+        nonlocal need
+        need += k
+        return need <= mlen
+    if typ == 0:
+        return not fits(4)
+    if typ == 2:
+        if not fits(4):
+            return True
+        ft = c[0] & 0x0F
+        if ft == 1:
+            return not fits(4)
+        if ft in (2, 7):
+            return not fits(4 + 6 + 16 + 32)
+        if ft in (4, 9):
+            if not fits(2):
+                return True
+            w = _u16(c, 4)
+            return not fits(6 * ((w >> 12) & 0x0F) + 6 * ((w >> 10) & 3))
+        return False
+    if typ == 3:
+        if not fits(2):
+            return True
+        svc = _u16(c, 0) >> 12
+        if svc == 1:
+            return not fits(8)
+        if svc in (2, 3):
+            if not fits(1):
+                return True
+            cs = c[2] >> 5
+            init = 1 if svc == 2 else 2
+            if cs in ((1, 2, 4) if svc == 2 else (2, 3, 4)) and not fits(3):
+                return True
+            if cs == init or cs == 4:
+                return not fits(4)
+            return False
+        if svc == 8:
+            if not fits(4):
+                return True
+            op = c[2] & 0x7F
+            if (op == 1 and not fits(2)) or (3 <= op <= 6 and not fits(2)):
+                return True
+            if op == 4:
+                return not fits(4)
+            if op in (5, 6):
+                return not fits(2 + (6 if op == 6 else 0))
+            if op == 7:
+                return not fits(4)
+        return False
+    if typ == 4:
+        if not fits(2):
+            return True
+        return c[0] in (1, 2, 3, 4, 5, 6) and not fits(4)
+    if typ == 5:
+        if not fits(4):
+            return True
+        return bool(c[0] & 0x10) and not fits(2)
+    if typ == 15:
+        return not fits(6)
+    return False
+
+
+STOP_WHY = ("ours-stops-in-mailbox: a length in this mailbox overruns its data; ours shows the tree so far "
+            "with an expert info (the project's contract), Wireshark decodes on in its subset buffer")
+
+
+def first_mailbox_fault(exp):
+    """Index of the first datagram whose mailbox makes ours stop, or None."""
+    for i, d in enumerate(exp["datagrams"]):
+        if isinstance(d.get("data"), bytes) and ours_view(d) == "mbx" and mailbox_fault(d["data"]):
+            return i
+    return None
+
+
+VIEW_WHY = {
+    "reg": "ours-registers: ours decodes these bytes as ESC registers (ecatr.datagram.reg), "
+           "Wireshark shows them raw (no register of its table lies wholly inside, or it ends at 0x09FF)",
+    "mbx": "ours-mailbox: ours decodes these bytes as a mailbox (ecatr.datagram.mbx); Wireshark "
+           "shows raw data for mailbox types outside 1-5, lengths above 1500 or reads with WKC above 1",
+    "unread": "ours-unread: ours shows the data of a read no slave answered as ecatr.datagram.unread",
+}
 
 
 class _Missing:
@@ -157,7 +287,7 @@ def ours_command(cap, fieldset):
     # zero-length FT_BYTES item prints as <MISSING>).
     args = ["-r", cap, "-T", "fields", "-E", "header=n", "-E", "separator=/t", "-E", "quote=d",
             "-E", "occurrence=a", "-E", "aggregator=,", "-e", "frame.number"]
-    for f in FIELDS:
+    for f in shown_fields():
         args += ["-e", f[2] if fieldset == "ecatr" else f[3]]
     return args
 
@@ -169,7 +299,7 @@ def parse_ours(text, expected_by_frame):
     result = {}
     for line in text.splitlines():
         cols = line.split("\t")
-        if len(cols) != len(FIELDS) + 1:
+        if len(cols) != len(shown_fields()) + 1:
             raise RuntimeError("unexpected -T fields line: %r" % line[:200])
         num = int(cols[0].strip('"'))
         cols = cols[1:]
@@ -178,7 +308,7 @@ def parse_ours(text, expected_by_frame):
         exp = expected_by_frame.get(num)
         rec = {"header": {}, "datagrams": [], "problems": []}
         lists = {}
-        for (key, scope, _, _, kind), col in zip(FIELDS, cols):
+        for (key, scope, _, _, kind), col in zip(shown_fields(), cols):
             if col == "":
                 raw = []
             elif len(col) >= 2 and col[0] == col[-1] == '"':
@@ -202,15 +332,18 @@ def parse_ours(text, expected_by_frame):
         for key in DG_KEYS:
             if key == "cmd":
                 continue
-            vals = lists[("dg", key)]
+            vals = lists.get(("dg", key), [])
             pred = ONLY_FOR.get(key, lambda c: True)
             idx = [i for i, d in enumerate(rec["datagrams"])
                    if not isinstance(d["cmd"], ReprError) and pred(d["cmd"])]
             targets = [rec["datagrams"][i] for i in idx]
-            if key == "data":
+            if key in ("data", "unread"):
                 # The contract: a zero-length Data field adds no item (as in Wireshark's plugin),
-                # so the values belong to the datagrams whose Length is not 0.
-                idx = [i for i in idx if rec["datagrams"][i].get("len") != 0]
+                # so the values belong to the datagrams whose Length is not 0; with decoded data,
+                # Data is shown only where nothing decodes it and Unread only for reads with WKC 0.
+                edg = exp["datagrams"] if exp else []
+                idx = [i for i in idx if rec["datagrams"][i].get("len") != 0 and
+                       (ours_view(edg[i]) if i < len(edg) else "data") == key]
                 targets = [rec["datagrams"][i] for i in idx]
             for d, v in zip(targets, vals):
                 d[key] = v
@@ -237,7 +370,7 @@ def perfect_fields_text(expected, nframes):
     for num in range(1, nframes + 1):
         e = expected.get(num)
         cols = ['"%d"' % num]
-        for key, scope, _, _, kind in FIELDS:
+        for key, scope, _, _, kind in shown_fields():
             if e is None or e["header"] is None:
                 vals = []
             elif scope == "header":
@@ -260,7 +393,12 @@ def perfect_fields_text(expected, nframes):
 # --------------------------------------------------------------------------- Wireshark side
 
 def ws_command(cap):
-    return ["-r", cap, "-T", "json", "-J", "ecatf ecat"] + WS_DECODE_AS
+    # -x: every field's position and length ("_raw"), for the register and mailbox comparison
+    return ["-r", cap, "-T", "json", "-x", "-J", "ecatf ecat ecat_mailbox"] + WS_DECODE_AS
+
+
+def ours_deep_command(cap):
+    return ["-r", cap, "-T", "json", "-x", "-J", "ecatr"]
 
 
 class _Obj(list):
@@ -630,6 +768,7 @@ class Stats:
         self.notes = defaultdict(int)
         self.extras_frames = 0      # frames whose ecatr.datagram items, Info and experts were checked
         self.extras_experts = 0
+        self.deep = ecat_deep.DeepStats()
 
     def table(self):
         w = max(len(k) for k in self.rows)
@@ -708,6 +847,7 @@ def compare_frame(num, exp, model, ours, ws, stats, context):
     edg, mdg = exp["datagrams"], model["datagrams"]
     odg, wdg = ours["datagrams"], ws["datagrams"]
     n = max(len(edg), len(mdg), len(odg), len(wdg))
+    stop = first_mailbox_fault(exp) if DEEP else None
     for i in range(n):
         e_d = edg[i] if i < len(edg) else None
         m_d = mdg[i] if i < len(mdg) else None
@@ -717,6 +857,18 @@ def compare_frame(num, exp, model, ours, ws, stats, context):
             o = odg[i].get(key, MISSING) if i < len(odg) else MISSING
             w = wdg[i].get(key, MISSING) if i < len(wdg) else MISSING
             why = model["why"].get((i, key))
+            if key in ("data", "unread") and e_d is not None:
+                view = ours_view(e_d)
+                if view != key:
+                    e = MISSING
+                elif key == "unread":
+                    e = e_d.get("data", MISSING)     # the bytes of Data, under another name
+                    why = VIEW_WHY["unread"]
+                if key == "data" and view != "data" and why is None:
+                    why = VIEW_WHY[view]
+            if stop is not None and (i > stop or (i == stop and key == "wkc")):
+                e = MISSING
+                why = why or STOP_WHY
             if why is None and not _eq(e, m) and not isinstance(m, OneOf):
                 if e_d is None and m_d is not None:
                     why = ("ws-invented-datagram: M=1 on the last datagram, Wireshark reads the bytes after "
@@ -749,6 +901,9 @@ def run_sides(env, cap, fieldset, tag):
         runs.append(("ours", ours_command(cap, fieldset), ours_out))
     if fieldset == "ecatr":
         runs += [("ours", extras_command(cap), extras_out), ("ours", experts_command(cap), pdml_out)]
+    deep_out = env.path(tag + ".ours.json")
+    if fieldset == "ecatr" and DEEP:
+        runs.append(("ours, registers and mailboxes", ours_deep_command(cap), deep_out))
     procs = []
     for side, args, out in runs:
         fh = open(out, "w")
@@ -765,6 +920,7 @@ def run_sides(env, cap, fieldset, tag):
     if fieldset is not None:
         with open(ours_out) as fh:
             ours_text = fh.read()
+    run_sides.deep_json = deep_out if fieldset == "ecatr" and DEEP else None
     if fieldset == "ecatr":
         with open(extras_out) as fh:
             extras = parse_extras(fh.read(), pdml_out)
@@ -799,6 +955,10 @@ def compare_capture(packets, ours_text, ws_json, stats, label, truths=None, extr
         stats.frames_fail += 1
         stats.failures.append(([{"frame": num, "what": "ours decoded a frame that is not EtherCAT by "
                                  "ethertype 0x88A4 / UDP port 34980"}], label, None, None))
+    deep_ws = deep_ours = None
+    if getattr(run_sides, "deep_json", None):
+        deep_ws = ecat_deep.items_per_packet(ws_json, ("ecat.", "ecat_mailbox.", "ecat.reg"))
+        deep_ours = ecat_deep.items_per_packet(run_sides.deep_json, ("ecatr.",))
     for num in sorted(expected):
         context = {"explained": set(), "header_length_why": header_length_why(payloads[num][0], expected[num])}
         probs = compare_frame(num, expected[num], models[num], ours.get(num), ws[num - 1], stats, context)
@@ -806,6 +966,18 @@ def compare_capture(packets, ours_text, ws_json, stats, label, truths=None, extr
             probs += compare_extras(num, payloads[num][0], extras.get(num))
             stats.extras_frames += 1
             stats.extras_experts += len((extras.get(num) or {"experts": []})["experts"])
+        if deep_ws is not None:
+            stop_at = None
+            i = first_mailbox_fault(expected[num])
+            if i is not None:     # where ours stops: the faulty datagram's data, in the frame
+                payload, pkt = payloads[num][0], payloads[num][1]
+                off = len(pkt) - len(payload) + 2
+                for d in expected[num]["datagrams"][:i]:
+                    off += 12 + d["len"]
+                stop_at = off + 10
+            for what in ecat_deep.compare_packet(num, deep_ws[num - 1], deep_ours[num - 1], stats.deep,
+                                                 stop_at, STOP_WHY):
+                probs.append({"frame": num, "what": "registers/mailboxes: " + what})
         for e in context["explained"]:
             stats.frames_with_explanations[e] += 1
         if probs:
@@ -936,6 +1108,9 @@ def report(stats, args, extra=""):
         print()
         print("ecatr.datagram items, Info column and expert infos (name, position, message) checked against "
               "the bytes on %d frames (%d expert infos)" % (stats.extras_frames, stats.extras_experts))
+    if DEEP:
+        print()
+        print(stats.deep.report())
     if extra:
         print(extra)
     print()
@@ -954,6 +1129,11 @@ def prepare_env(args):
     t0 = time.time()
     files = env.install_plugin(args.dissgen, rules)
     env.assert_plugin_loaded("ecatr")
+    global DEEP
+    names = subprocess.run([args.dissgen, "fields", rules], capture_output=True, text=True).stdout
+    DEEP = "\necatr.datagram.reg\t" in names
+    print("registers and mailboxes: %s" % ("compared value by value" if DEEP else
+                                           "not in these rules (Data compared as raw bytes)"))
     print("installed %s into %s in %.1fs (tshark runs as %s)" %
           (", ".join(os.path.basename(f) for f in files), env.plugin_dir, time.time() - t0,
            "uid 65534" if env.as_nobody else "the current user"))

@@ -483,12 +483,12 @@ TEST(Slots, OnlyReferencedFieldsInDocumentOrder) {
     EXPECT_EQ(header->children[2]->slot, 1);  // Header/Type: if
     std::map<std::string, int> slots;
     for (const auto& c : datagram->children) slots[c->name] = c->slot;
-    EXPECT_EQ(slots["Command"], 2);  // if and summary
+    EXPECT_EQ(slots["Command"], 2);  // if, <when> and summary
     EXPECT_EQ(slots["Index"], -1);
-    EXPECT_EQ(slots["Length"], 3);   // Data's length and summary
-    EXPECT_EQ(slots["More"], 4);     // repeat flag
-    EXPECT_EQ(slots["Working counter"], -1);
-    EXPECT_EQ(p.slot_count, 5);
+    EXPECT_EQ(find(p, "Offset address (ADO)")->slot, 3);  // <when> and the register window's base
+    EXPECT_EQ(slots["Length"], 4);   // the data's lengths, <when> and summary
+    EXPECT_EQ(slots["More"], 5);     // repeat flag
+    EXPECT_EQ(slots["Working counter"], -1);  // read ahead by <when peek>, not from a slot
 }
 
 TEST(Pdulength, FixedOffsetGivesBytesToRead) {
