@@ -1,0 +1,244 @@
+#!/usr/bin/env python3
+"""The bus as the capture shows it, and the network check (issue 12), with real tshark.
+
+1. Identities: on every real capture of ../shared/corpus/ethercat, the slaves the plugin
+   reports per position (ecatr.slave.position/station/vendor/product/revision) are the ones
+   the corpus README lists (read there from the SII EEPROM by other means). With
+   --esi Beckhoff_EK11xx.xml --esi Beckhoff_EL1xxx.xml the SOEM capture names both slaves
+   (ecatr.slave.name EK1100, EL1004); with `-2` every datagram addressed to a slave carries
+   its identity, also those before the scan.
+2. The network check on soem-sdinfo-ek1100-el1004 (EK1100 + EL1004) with four designs:
+   matching (one ecatr.expert.network.ok, no error), a slave dropped and one added
+   (ecatr.expert.network.count on the first broadcast read that shows the count, nothing
+   else), two models swapped (ecatr.expert.network.model on the two frames where the
+   identities are read, nothing else). The frames are those a reading of the bytes here
+   (not the plugin) finds; one pass and `-2` give the same experts.
+Skips (exit 77) when the corpus is absent.
+"""
+import argparse
+import os
+import struct
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pcaprewrite as pr  # noqa: E402
+from tshark_env import Checks, TsharkEnv  # noqa: E402
+
+SKIP = 77
+check = Checks()
+SLAVE = ["ecatr.slave.position", "ecatr.slave.station", "ecatr.slave.vendor", "ecatr.slave.product",
+         "ecatr.slave.revision", "ecatr.slave.name"]
+EXPERTS = ["ecatr.expert.network.count", "ecatr.expert.network.model", "ecatr.expert.network.ok"]
+
+# From ../shared/corpus/README.md: (vendor, product, revision) by position; None: not stated there.
+BECKHOFF = 2
+EK1100 = (BECKHOFF, 0x044c2c52, 0x00120000)
+EL1004 = (BECKHOFF, 0x03ec3052, 0x00130000)
+EXPECTED = {
+    "soem-sdinfo-ek1100-el1004.pcapng": [EK1100, EL1004],
+    "twincat-scan-boxes.pcapng": [EK1100, EL1004],
+    "replay-ek1100-el2828-el2889.pcapng": [EK1100, (BECKHOFF, 0x0b0c3052, None), (BECKHOFF, 0x0b493052, None)],
+    "replay-dc.pcapng": [EK1100, (BECKHOFF, 0x0b0c3052, None), (BECKHOFF, 0x0b493052, None)],
+    "replay-issue-255.pcapng": [EK1100, (BECKHOFF, 0x0b0c3052, None), (BECKHOFF, 0x0b493052, None)],
+    "replay-ek1914-segmented-upload.pcapng": [(BECKHOFF, 0x077a2c52, None), (BECKHOFF, 0x0bbc3052, None)],
+    "replay-sdo-error.pcapng": [(BECKHOFF, 0x077a2c52, None)],
+    "twincat-akd-nc-mode.pcapng": [(0x6a, 0x00414b44, None)],
+    "soem-sdinfo-no-slaves.pcapng": [],
+}
+
+
+def decode(env, path, fields, two_pass, display_filter=None):
+    """[(frame, {field: [values]})] from tshark -T fields (all occurrences)."""
+    args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=;", "-e", "frame.number"]
+    if two_pass:
+        args.append("-2")
+    if display_filter:
+        args += ["-Y", display_filter]
+    for f in fields:
+        args += ["-e", f]
+    rows = []
+    for line in env.tshark(args).stdout.splitlines():
+        cols = line.split("\t") + [""] * len(fields)
+        rows.append((int(cols[0]), {f: [v for v in cols[i + 1].split(";") if v] for i, f in enumerate(fields)}))
+    return rows
+
+
+def slaves_seen(rows):
+    """{position: {(station, vendor, product, revision, name)}} over every datagram."""
+    seen = {}
+    for _n, r in rows:
+        k = len(r["ecatr.slave.position"])
+        for i in range(k):
+            def col(f):
+                v = r[f]
+                return v[i] if len(v) == k else ("?" if v else "")
+            seen.setdefault(int(col("ecatr.slave.position")), set()).add(
+                tuple(col(f) for f in SLAVE[1:]))
+    return seen
+
+
+# ----------------------------------------------------------------------------- the bytes' view
+
+def returned_pairs(cap):
+    """[(frame number, sent datagrams, returned datagrams)] of returned frames, paired with the
+    latest sent frame of the same datagram commands and lengths (returned frames come from the
+    master's address with the locally administered bit set)."""
+    out, waiting = [], {}
+    for i, p in enumerate(cap.packets):
+        dgs = pr.ecat_datagrams(p)
+        if not dgs:
+            continue
+        key = tuple((d["cmd"], d["idx"], d["length"]) for d in dgs)
+        if p.data[6] & 0x02:
+            if key in waiting:
+                out.append((i + 1, waiting.pop(key), (p, dgs)))
+        else:
+            waiting[key] = (p, dgs)
+    return out
+
+
+def u16(p, off):
+    return struct.unpack("<H", bytes(p.data[off:off + 2]))[0]
+
+
+def oracle(cap):
+    """(frame of the first BRD with a working counter, {position: frame where vendor and
+    product had both been read from the SII EEPROM})."""
+    first_brd, station_pos, address, words, identity_frame = None, {}, {}, {}, {}
+    for n, (sp, sent), (bp, back) in returned_pairs(cap):
+        for s, b in zip(sent, back):
+            if b["wkc"] <= s["wkc"]:
+                continue
+            if s["cmd"] == 7 and first_brd is None:
+                first_brd = n
+            if s["cmd"] in (1, 2):  # APRD APWR
+                pos = (0x10000 - s["adp"]) & 0xFFFF
+            elif s["cmd"] in (4, 5):  # FPRD FPWR
+                pos = station_pos.get(s["adp"])
+            else:
+                continue
+            if s["cmd"] == 2 and s["ado"] == 0x0010:
+                station_pos[u16(sp, s["data_offset"])] = pos
+            if s["cmd"] in (2, 5) and s["ado"] <= 0x0504 <= s["ado"] + s["length"] - 2:
+                address[pos] = u16(sp, s["data_offset"] + 0x0504 - s["ado"])
+            if s["cmd"] in (1, 4) and s["ado"] == 0x0508 and pos in address:
+                for w in range(b["length"] // 2):
+                    words.setdefault(pos, set()).add(address[pos] + w)
+                if pos not in identity_frame and {8, 9, 10, 11} <= words.get(pos, set()):
+                    identity_frame[pos] = n
+    return first_brd, identity_frame
+
+
+# ----------------------------------------------------------------------------- checks
+
+def identity_checks(env, corpus, files):
+    print("\n== identities per capture (tshark -2)")
+    for name in files:
+        rows = decode(env, os.path.join(corpus, name), SLAVE, True, "ecatr.slave")
+        seen = slaves_seen(rows)
+        want = EXPECTED.get(name)
+        print("%s: %d datagram frames with slaves; %s" % (name, len(rows), {
+            p: sorted(v) for p, v in sorted(seen.items())}))
+        if want is None:
+            continue
+        check(sorted(seen) == list(range(len(want))), "%s: positions %s" % (name, list(range(len(want)))))
+        for pos, (vendor, product, revision) in enumerate(want):
+            ids = {(v, pr_, r) for _st, v, pr_, r, _name in seen.get(pos, set())}
+            got = ids == {("0x%08x" % vendor, "0x%08x" % product,
+                           "0x%08x" % revision if revision is not None else next(iter(ids))[2])} if ids else False
+            check(got, "%s: position %d is vendor 0x%x product 0x%08x%s on every datagram (-2): %s" % (
+                name, pos, vendor, product, "" if revision is None else " revision 0x%08x" % revision, sorted(ids)))
+            stations = {st for st, *_rest in seen.get(pos, set())}
+            check(len(stations) == 1 and "" not in stations, "%s: position %d has one station %s" % (
+                name, pos, sorted(stations)))
+
+
+def names_checks(env, corpus):
+    print("\n== names from the ESI files (soem-sdinfo-ek1100-el1004)")
+    path = os.path.join(corpus, "soem-sdinfo-ek1100-el1004.pcapng")
+    rows = decode(env, path, SLAVE, True, "ecatr.slave")
+    seen = slaves_seen(rows)
+    names = {p: {t[-1] for t in v} for p, v in seen.items()}
+    check(names == {0: {"EK1100"}, 1: {"EL1004"}}, "-2: every datagram to position 0 names EK1100, to 1 EL1004: %s"
+          % names)
+    one = decode(env, path, SLAVE, False, "ecatr.slave")
+    _brd, ident = oracle(pr.Capture.read(path))
+    for pos, want in ((0, "EK1100"), (1, "EL1004")):
+        named = [n for n, r in one if pos_name(r, pos) == want]
+        unnamed = [n for n, r in one if pos_name(r, pos) == ""]
+        check(named and min(named) == ident[pos] and (not unnamed or max(unnamed) < ident[pos]),
+              "one pass: position %d named %s from frame %s on (identity read there), not before" % (
+                  pos, want, ident.get(pos)))
+
+
+def pos_name(r, pos):
+    ps, ns = r["ecatr.slave.position"], r["ecatr.slave.name"]
+    if str(pos) not in ps:
+        return None
+    return ns[0] if ns and len(set(ps)) == 1 else ("" if not ns else None)
+
+
+def design(env, name, slaves):
+    body = "".join('  <slave vendor="0x%x" product="0x%08x"/>\n' % s[:2] for s in slaves)
+    return env.add_file(name, ("<network>\n%s</network>\n" % body).encode())
+
+
+def network_checks(dissgen, rules, corpus):
+    print("\n== the network check (soem-sdinfo-ek1100-el1004)")
+    path = os.path.join(corpus, "soem-sdinfo-ek1100-el1004.pcapng")
+    first_brd, ident = oracle(pr.Capture.read(path))
+    print("bytes: first BRD answered in frame %s; identities read in frames %s" % (first_brd, ident))
+    cases = [
+        ("match", [EK1100, EL1004], {"ok": {max(ident.values())}}),
+        ("drop", [EK1100], {"count": {first_brd}}),
+        ("add", [EK1100, EL1004, EL1004], {"count": {first_brd}}),
+        ("swap", [EL1004, EK1100], {"model": {ident[0], ident[1]}}),
+    ]
+    for case, slaves, want in cases:
+        with TsharkEnv() as env:
+            env.install_plugin(dissgen, rules, ["--network", design(env, case + ".xml", slaves)])
+            local = env.add_file("soem.pcapng", open(path, "rb").read())
+            results = []
+            for two_pass in (False, True):
+                rows = decode(env, local, EXPERTS, two_pass)
+                got = {e.rsplit(".", 1)[1]: {n for n, r in rows if r[e]} for e in EXPERTS}
+                got = {k: v for k, v in got.items() if v}
+                results.append(got)
+                check(got == want, "%s design%s: experts %s, expected %s" % (
+                    case, " (-2)" if two_pass else "", got, want))
+            texts = env.tshark(["-r", local, "-2", "-z", "expert,note", "-q"]).stdout
+            for line in texts.splitlines():
+                if "design" in line or "Position" in line:
+                    print("   " + line.strip())
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--dissgen", required=True)
+    ap.add_argument("--source-dir", required=True)
+    args = ap.parse_args()
+    shared = os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus")
+    corpus = os.path.join(shared, "ethercat")
+    files = sorted(f for f in os.listdir(corpus) if f.endswith((".pcap", ".pcapng"))) \
+        if os.path.isdir(corpus) else []
+    if not files:
+        print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng)" % corpus)
+        return SKIP
+    rules = os.path.join(args.source_dir, "rules", "ethercat.xml")
+    with TsharkEnv() as env:
+        env.install_plugin(args.dissgen, rules, ["--esi", os.path.join(shared, "esi", "Beckhoff_EK11xx.xml"),
+                                                 "--esi", os.path.join(shared, "esi", "Beckhoff_EL1xxx.xml")])
+        env.assert_plugin_loaded("ecatr")
+        for f in files:
+            env.add_file(f, open(os.path.join(corpus, f), "rb").read())
+        identity_checks(env, env.home, files)
+        names_checks(env, env.home)
+        rows = decode(env, os.path.join(env.home, "soem-sdinfo-ek1100-el1004.pcapng"), EXPERTS, True)
+        check(not any(any(r.values()) for _n, r in rows), "no network experts without a design")
+    network_checks(args.dissgen, rules, corpus)
+    print("\n%d failed" % len(check.failed))
+    return 1 if check.failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
