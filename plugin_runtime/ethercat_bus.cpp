@@ -34,6 +34,16 @@ namespace {
 /* Beyond this position the model keeps nothing (real segments have far fewer slaves). */
 const guint max_positions = 1024;
 
+/* An FMMU of a slave: where its share of the logical process image is. */
+struct fmmu {
+    gboolean known, active;
+    guint32 logical;
+    guint16 length;
+    guint8 type;                   /* bit 0: read (inputs), bit 1: write (outputs) */
+};
+
+const guint max_fmmus = 16;
+
 enum ident_word { W_VENDOR = 0x08, W_PRODUCT = 0x0a, W_REVISION = 0x0c, W_SERIAL = 0x0e, SII_WORDS = 0x10 };
 
 struct slave_state {
@@ -43,9 +53,10 @@ struct slave_state {
     guint16 sii[SII_WORDS];        /* SII words 0x0000..0x000F as read */
     guint32 sii_known;             /* bit per word of sii[] */
     gboolean checked;              /* compared with the design */
+    fmmu fmmus[max_fmmus];         /* as the master configured them (0x0600 + 16n) */
 };
 
-enum event_kind { EV_COUNT, EV_MODEL, EV_OK };
+enum event_kind { EV_COUNT, EV_MODEL, EV_OK, EV_WKC };
 
 struct bus_event {
     guint8 kind;
@@ -58,6 +69,7 @@ struct addressed {
     gint32 position;     /* -1: not known on the first pass */
     guint16 station;     /* FPxx: the ADP */
     gboolean by_station;
+    gint32 expected_wkc; /* logical commands: -1 when not known */
 };
 
 } /* namespace */
@@ -65,11 +77,13 @@ struct addressed {
 struct bus_model {
     const dg_bus *design;  /* NULL: nothing embedded */
     slave_state *slaves[max_positions];
+    guint positions;       /* slaves[] below this may be set */
     wmem_map_t *stations;  /* station address -> position + 1 */
     gboolean count_known;
     guint count;
     gint64 count_reported; /* the last count that differed from the design, -1 none */
     gboolean mismatch, ok_noted;
+    gboolean fmmus_known;  /* some slave's FMMU configuration was seen */
 };
 
 struct bus_frame {
@@ -82,10 +96,10 @@ struct bus_frame {
 
 namespace {
 
-int hf_slave = -1, hf_position = -1, hf_station = -1, hf_alias = -1, hf_vendor = -1, hf_product = -1,
+int hf_wkc_expected = -1, hf_slave = -1, hf_position = -1, hf_station = -1, hf_alias = -1, hf_vendor = -1, hf_product = -1,
     hf_revision = -1, hf_serial = -1, hf_name = -1;
 gint ett_slave = -1;
-expert_field ei_count = EI_INIT, ei_model = EI_INIT, ei_ok = EI_INIT;
+expert_field ei_count = EI_INIT, ei_model = EI_INIT, ei_ok = EI_INIT, ei_wkc = EI_INIT;
 
 const char *const command_names[] = {"NOP",  "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD",
                                      "BWR",  "BRW",  "LRD",  "LWR",  "LRW",  "ARMW", "FRMW"};
@@ -95,6 +109,7 @@ enum { APRD = 1, APWR, APRW, FPRD, FPWR, FPRW, BRD, BWR, BRW, LRD, LWR, LRW, ARM
 gboolean by_position(guint8 cmd) { return cmd == APRD || cmd == APWR || cmd == APRW || cmd == ARMW; }
 gboolean by_station(guint8 cmd) { return cmd == FPRD || cmd == FPWR || cmd == FPRW || cmd == FRMW; }
 gboolean reads(guint8 cmd) { return cmd == APRD || cmd == APRW || cmd == FPRD || cmd == FPRW || cmd == BRD || cmd == BRW; }
+gboolean logical(guint8 cmd) { return cmd == LRD || cmd == LWR || cmd == LRW; }
 gboolean writes(guint8 cmd) { return cmd == APWR || cmd == APRW || cmd == FPWR || cmd == FPRW || cmd == BWR || cmd == BRW; }
 
 /* The position an auto-increment datagram as sent addresses. */
@@ -111,6 +126,7 @@ slave_state *slave_at(bus_model *m, guint32 position)
 {
     if (position >= max_positions) return NULL;
     if (!m->slaves[position]) m->slaves[position] = wmem_new0(wmem_file_scope(), slave_state);
+    if (position >= m->positions) m->positions = position + 1;
     return m->slaves[position];
 }
 
@@ -155,7 +171,7 @@ const char *model_text(const dg_bus *bus, guint32 vendor, guint32 product, gint3
 
 /* The findings of one frame, collected on the first pass. */
 struct events {
-    bus_event list[8];
+    bus_event list[max_datagrams + 4];
     guint count;
     void add(guint8 kind, const datagram *d, const char *text)
     {
@@ -257,6 +273,124 @@ void learn_sii_address(slave_state *s, const datagram *d, tvbuff_t *sent)
     s->sii_address_known = TRUE;
 }
 
+/* FMMU configuration writes: 16 bytes per FMMU at 0x0600 + 16n (logical
+ * start 4, length 2, start/stop bit, physical start 2 and bit, type at +11,
+ * activate at +12), or the activate byte alone. */
+void learn_fmmus(bus_model *m, slave_state *st, const datagram *d, tvbuff_t *sent)
+{
+    if (d->ado >= 0x0700 || (guint32)d->ado + d->length <= 0x0600) return;
+    for (guint n = 0; n < max_fmmus; n++) {
+        guint32 reg = 0x0600 + 16 * n;
+        fmmu *f = &st->fmmus[n];
+        gint at = register_at(d, reg, 16);
+        if (at >= 0) {
+            f->known = TRUE;
+            f->logical = dg_tvb_get_uint32(sent, at, ENC_LITTLE_ENDIAN);
+            f->length = dg_tvb_get_uint16(sent, at + 4, ENC_LITTLE_ENDIAN);
+            f->type = dg_tvb_get_uint8(sent, at + 11) & 3;
+            f->active = dg_tvb_get_uint8(sent, at + 12) & 1;
+            m->fmmus_known = TRUE;
+        } else if (f->known && (at = register_at(d, reg + 12, 1)) >= 0) {
+            f->active = dg_tvb_get_uint8(sent, at) & 1;
+        }
+    }
+}
+
+/* One slave's part in a logical datagram's working counter. */
+struct share {
+    guint position;
+    guint8 read, write;   /* what it adds for reading (inputs) and writing (outputs) */
+};
+
+/* The slaves whose active FMMUs overlap a logical datagram, and what each
+ * adds: LRD +1 per reading slave, LWR +1 per writing one, LRW +1 and +2. */
+guint shares_of(const bus_model *m, const datagram *d, share *out, guint max)
+{
+    guint32 start = d->adp | (guint32)d->ado << 16;
+    guint64 end = (guint64)start + d->length;
+    guint n = 0;
+    for (guint p = 0; p < m->positions && n < max; p++) {
+        const slave_state *s = m->slaves[p];
+        if (!s) continue;
+        guint8 type = 0;
+        for (guint i = 0; i < max_fmmus; i++) {
+            const fmmu *f = &s->fmmus[i];
+            if (f->known && f->active && f->length && f->logical < end && start < (guint64)f->logical + f->length)
+                type |= f->type;
+        }
+        share sh = {p, 0, 0};
+        if ((type & 1) && d->cmd != LWR) sh.read = 1;
+        if ((type & 2) && d->cmd != LRD) sh.write = d->cmd == LRW ? 2 : 1;
+        if (sh.read || sh.write) out[n++] = sh;
+    }
+    return n;
+}
+
+/* The working counter a logical datagram should come back with: the ENI's
+ * cyclic command (Cnt) when one matches, else from the FMMUs; -1 unknown. */
+gint32 expected_wkc(const bus_model *m, const datagram *d, share *shares, guint *share_count)
+{
+    *share_count = 0;
+    if (!logical(d->cmd)) return -1;
+    const dg_bus *b = m->design;
+    guint32 start = d->adp | (guint32)d->ado << 16;
+    if (b && b->cyclic)
+        for (guint i = 0; i < b->cyclic_count; i++) {
+            const dg_cyclic_cmd *c = &b->cyclic[i];
+            if (c->cmd == d->cmd && c->logical_address == start && c->length == d->length && c->expected_wkc >= 0) {
+                if (shares) *share_count = shares_of(m, d, shares, max_positions);
+                return c->expected_wkc;
+            }
+        }
+    if (!m->fmmus_known) return -1;
+    share local[64];
+    share *list = shares ? shares : local;
+    *share_count = shares_of(m, d, list, shares ? max_positions : G_N_ELEMENTS(local));
+    gint32 sum = 0;
+    for (guint i = 0; i < *share_count; i++) sum += list[i].read + list[i].write;
+    return sum;
+}
+
+/* "EL2004 at position 2", or "the slave at position 2". */
+const char *slave_text(const bus_model *m, guint position)
+{
+    const slave_state *s = position < max_positions ? m->slaves[position] : NULL;
+    gint32 device = -1;
+    if (s && words_known(s, W_VENDOR) && words_known(s, W_PRODUCT))
+        device = find_device(m->design, word32(s, W_VENDOR), word32(s, W_PRODUCT),
+                             words_known(s, W_REVISION) ? word32(s, W_REVISION) : 0);
+    if (device >= 0) return wmem_strdup_printf(wmem_file_scope(), "%s at position %u", m->design->devices[device].type, position);
+    return wmem_strdup_printf(wmem_file_scope(), "the slave at position %u", position);
+}
+
+/* A returned logical datagram whose working counter is not the expected one;
+ * when exactly one slave's part accounts for the difference, it is named. */
+void check_wkc(const bus_model *m, const datagram *s, const datagram *b, events *ev)
+{
+    share shares[max_positions];
+    guint n;
+    gint32 expected = expected_wkc(m, s, shares, &n);
+    gint32 got = (gint32)b->wkc - (gint32)s->wkc;
+    if (expected < 0 || got == expected) return;
+    wmem_strbuf_t *text = wmem_strbuf_new(wmem_file_scope(), "");
+    wmem_strbuf_append_printf(text, "%s: expected working counter %d, got %d", command_name(s->cmd), expected, got);
+    gint32 missing = expected - got;
+    const char *what = NULL;
+    guint who = 0, found = 0;
+    for (guint i = 0; i < n && missing > 0; i++) {
+        const char *parts[3] = {"did not read its inputs", "did not write its outputs", "did not process it"};
+        gint32 values[3] = {shares[i].read, shares[i].write, shares[i].read + shares[i].write};
+        for (guint k = 0; k < 3; k++) {
+            if (values[k] != missing || (k == 2 && (!shares[i].read || !shares[i].write))) continue;
+            found++;
+            who = shares[i].position;
+            what = parts[k];
+        }
+    }
+    if (found == 1) wmem_strbuf_append_printf(text, ": %s %s", slave_text(m, who), what);
+    ev->add(EV_WKC, b, wmem_strbuf_get_str(text));
+}
+
 /* What one datagram pair teaches about the slave it addressed. */
 void learn_slave(bus_model *m, guint position, const datagram *s, const datagram *b, tvbuff_t *sent, tvbuff_t *back,
                  events *ev)
@@ -274,14 +408,19 @@ void learn_slave(bus_model *m, guint position, const datagram *s, const datagram
         else st->alias = dg_tvb_get_uint16(back, b->offset + (at - s->offset), ENC_LITTLE_ENDIAN);
         st->alias_known = TRUE;
     }
-    if (writes(s->cmd) && s->cmd != APRW && s->cmd != FPRW) learn_sii_address(st, s, sent);
+    if (writes(s->cmd) && s->cmd != APRW && s->cmd != FPRW) {
+        learn_sii_address(st, s, sent);
+        learn_fmmus(m, st, s, sent);
+    }
     if (reads(s->cmd) && !writes(s->cmd)) learn_sii_data(m, position, st, b, back, ev);
 }
 
 /* The slave a datagram as sent addresses. */
 addressed address_of(const bus_model *m, const datagram *s)
 {
-    addressed a = {s->offset, 12 + s->length, -1, 0, FALSE};
+    addressed a = {s->offset, 12 + s->length, -1, 0, FALSE, -1};
+    guint shares;
+    a.expected_wkc = expected_wkc(m, s, NULL, &shares);
     if (by_position(s->cmd)) {
         guint16 p = position_of(s->adp);
         if (p < max_positions) a.position = p;
@@ -398,6 +537,9 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, packet_inf
     guint n = MIN(ns, nb);
     events ev = {};
     for (guint i = 0; i < n; i++) {
+        if (logical(s[i].cmd) && s[i].cmd == b[i].cmd && s[i].adp == b[i].adp && s[i].ado == b[i].ado &&
+            s[i].length == b[i].length)
+            check_wkc(m, &s[i], &b[i], &ev);
         if (s[i].cmd != b[i].cmd || s[i].ado != b[i].ado || s[i].length != b[i].length || b[i].wkc <= s[i].wkc)
             continue;
         guint added = (guint)(b[i].wkc - s[i].wkc);
@@ -421,10 +563,17 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, packet_inf
 void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     if (!f) return;
-    for (guint i = 0; i < f->count; i++) show_slave(f->model, &f->d[i], tvb, pinfo, tree);
+    for (guint i = 0; i < f->count; i++) {
+        const addressed *a = &f->d[i];
+        show_slave(f->model, a, tvb, pinfo, tree);
+        if (a->expected_wkc >= 0)
+            proto_item_set_generated(proto_tree_add_uint(tree, hf_wkc_expected, tvb, a->offset + a->length - 2, 2,
+                                                         (guint32)a->expected_wkc));
+    }
     for (guint i = 0; i < f->event_count; i++) {
         const bus_event *e = &f->events[i];
-        expert_field *ei = e->kind == EV_COUNT ? &ei_count : e->kind == EV_MODEL ? &ei_model : &ei_ok;
+        expert_field *ei = e->kind == EV_COUNT ? &ei_count : e->kind == EV_MODEL ? &ei_model
+                           : e->kind == EV_WKC ? &ei_wkc : &ei_ok;
         proto_tree_add_expert_format(tree, pinfo, ei, tvb, e->offset, e->length, "%s", e->text);
     }
 }
@@ -432,6 +581,8 @@ void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree 
 void bus_register(int proto, const char *filter)
 {
     static hf_register_info hf[] = {
+        {&hf_wkc_expected, {"Expected working counter", NULL, FT_UINT16, BASE_DEC, NULL, 0x0,
+                            "From the ENI's cyclic commands (Cnt), else from the slaves' FMMU configuration", HFILL}},
         {&hf_slave, {"Slave", NULL, FT_NONE, BASE_NONE, NULL, 0x0,
                      "The slave this datagram addresses, as the capture shows it", HFILL}},
         {&hf_position, {"Position", NULL, FT_UINT16, BASE_DEC, NULL, 0x0, "Position on the segment, from 0", HFILL}},
@@ -446,7 +597,7 @@ void bus_register(int proto, const char *filter)
         {&hf_name, {"Model", NULL, FT_STRING, BASE_NONE, NULL, 0x0,
                     "The device type of the ESI catalogue embedded with --esi", HFILL}},
     };
-    const char *names[] = {"slave", "slave.position", "slave.station", "slave.alias", "slave.vendor",
+    const char *names[] = {"wkc.expected", "slave", "slave.position", "slave.station", "slave.alias", "slave.vendor",
                            "slave.product", "slave.revision", "slave.serial", "slave.name"};
     for (guint i = 0; i < G_N_ELEMENTS(hf); i++) hf[i].hfinfo.abbrev = g_strdup_printf("%s.%s", filter, names[i]);
     proto_register_field_array(proto, hf, (int)G_N_ELEMENTS(hf));
@@ -457,8 +608,9 @@ void bus_register(int proto, const char *filter)
         {&ei_count, {NULL, PI_PROTOCOL, PI_ERROR, "Slave count differs from the network design", EXPFILL}},
         {&ei_model, {NULL, PI_PROTOCOL, PI_ERROR, "Slave model differs from the network design", EXPFILL}},
         {&ei_ok, {NULL, PI_PROTOCOL, PI_NOTE, "The bus matches the network design", EXPFILL}},
+        {&ei_wkc, {NULL, PI_PROTOCOL, PI_WARN, "Working counter differs from the expected one", EXPFILL}},
     };
-    const char *ei_names[] = {"network.count", "network.model", "network.ok"};
+    const char *ei_names[] = {"network.count", "network.model", "network.ok", "wkc"};
     for (guint i = 0; i < G_N_ELEMENTS(ei); i++)
         ei[i].eiinfo.name = g_strdup_printf("%s.expert.%s", filter, ei_names[i]);
     expert_register_field_array(expert_register_protocol(proto), ei, (int)G_N_ELEMENTS(ei));

@@ -13,6 +13,10 @@
    else), two models swapped (ecatr.expert.network.model on the two frames where the
    identities are read, nothing else). The frames are those a reading of the bytes here
    (not the plugin) finds; one pass and `-2` give the same experts.
+3. Expected working counters (ecatr.wkc.expected, from the FMMU configuration the master
+   wrote): no ecatr.expert.wkc on any real capture; on copies of the ethercrab captures with
+   the returned working counter of some logical datagrams lowered, ecatr.expert.wkc on
+   exactly those frames (one pass and -2).
 Skips (exit 77) when the corpus is absent.
 """
 import argparse
@@ -212,6 +216,43 @@ def network_checks(dissgen, rules, corpus):
                     print("   " + line.strip())
 
 
+def wkc_checks(env, corpus, files):
+    print("\n== expected working counters")
+    for name in files:
+        path = os.path.join(corpus, name)
+        rows = decode(env, path, ["ecatr.wkc.expected", "ecatr.expert.wkc"], True)
+        with_expected = [n for n, r in rows if r["ecatr.wkc.expected"]]
+        flagged = [n for n, r in rows if r["ecatr.expert.wkc"]]
+        print("%s: %d frames with an expected working counter, %d flagged" % (name, len(with_expected),
+                                                                             len(flagged)))
+        check(not flagged, "%s: no ecatr.expert.wkc on the real capture" % name)
+    for name in ("replay-ek1100-el2828-el2889.pcapng", "replay-dc.pcapng", "replay-issue-255.pcapng"):
+        if name not in files:
+            continue
+        cap = pr.Capture.read(os.path.join(corpus, name))
+        returned = [i for i, p in enumerate(cap.packets)
+                    if p.data[6] & 0x02 and any(d["cmd"] in (10, 11, 12) and d["wkc"] for d in pr.ecat_datagrams(p))]
+        lowered = set()
+        for k, i in enumerate(returned):
+            if k % 37 != 5:
+                continue
+            p = cap.packets[i]
+            d = next(d for d in pr.ecat_datagrams(p) if d["cmd"] in (10, 11, 12) and d["wkc"])
+            pr.set_u16(p, d["wkc_offset"], d["wkc"] - 1)
+            lowered.add(i + 1)
+        faulty = env.add_file("wkc-" + name, b"")
+        cap.write(faulty)
+        os.chmod(faulty, 0o644)
+        for two_pass in (False, True):
+            rows = decode(env, faulty, ["ecatr.expert.wkc"], two_pass)
+            flagged = {n for n, r in rows if r["ecatr.expert.wkc"]}
+            check(flagged == lowered, "%s with %d returned working counters lowered%s: ecatr.expert.wkc on exactly "
+                  "those frames (missing %s, extra %s)" % (name, len(lowered), " (-2)" if two_pass else "",
+                                                           sorted(lowered - flagged)[:5], sorted(flagged - lowered)[:5]))
+        texts = env.tshark(["-r", faulty, "-q", "-z", "expert,warn"]).stdout
+        print("\n".join("   " + l.strip() for l in texts.splitlines() if "expected working counter" in l))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--dissgen", required=True)
@@ -233,6 +274,7 @@ def main():
             env.add_file(f, open(os.path.join(corpus, f), "rb").read())
         identity_checks(env, env.home, files)
         names_checks(env, env.home)
+        wkc_checks(env, env.home, files)
         rows = decode(env, os.path.join(env.home, "soem-sdinfo-ek1100-el1004.pcapng"), EXPERTS, True)
         check(not any(any(r.values()) for _n, r in rows), "no network experts without a design")
     network_checks(args.dissgen, rules, corpus)
