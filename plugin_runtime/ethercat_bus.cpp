@@ -54,6 +54,9 @@ struct slave_state {
     guint32 sii_known;             /* bit per word of sii[] */
     gboolean checked;              /* compared with the design */
     fmmu fmmus[max_fmmus];         /* as the master configured them (0x0600 + 16n) */
+    guint16 mailbox_start[2], mailbox_length[2];  /* SM0 (out), SM1 (in) in mailbox mode */
+    gboolean al_known;
+    guint8 al_state;               /* AL status (0x0130) bits 0-3, last seen */
 };
 
 enum event_kind { EV_COUNT, EV_MODEL, EV_OK, EV_WKC };
@@ -70,7 +73,12 @@ struct addressed {
     guint16 station;     /* FPxx: the ADP */
     gboolean by_station;
     gint32 expected_wkc; /* logical commands: -1 when not known */
+    guint8 stats;        /* returned frames: stat_flags, for the statistics tree */
+    gboolean logical;    /* LRD/LWR/LRW: dgram is the datagram in this frame */
+    datagram dgram;
 };
+
+enum stat_flags { ST_WKC_ERROR = 1, ST_AL_CHANGE = 2, ST_MAILBOX = 4 };
 
 } /* namespace */
 
@@ -88,6 +96,7 @@ struct bus_model {
 
 struct bus_frame {
     const bus_model *model;
+    gboolean returned;   /* inputs are shown from returned frames, outputs from frames as sent */
     guint count;
     addressed *d;
     guint event_count;
@@ -96,9 +105,9 @@ struct bus_frame {
 
 namespace {
 
-int hf_wkc_expected = -1, hf_slave = -1, hf_position = -1, hf_station = -1, hf_alias = -1, hf_vendor = -1, hf_product = -1,
+int hf_process_data = -1, hf_wkc_expected = -1, hf_slave = -1, hf_position = -1, hf_station = -1, hf_alias = -1, hf_vendor = -1, hf_product = -1,
     hf_revision = -1, hf_serial = -1, hf_name = -1;
-gint ett_slave = -1;
+gint ett_slave = -1, ett_process_data = -1;
 expert_field ei_count = EI_INIT, ei_model = EI_INIT, ei_ok = EI_INIT, ei_wkc = EI_INIT;
 
 const char *const command_names[] = {"NOP",  "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD",
@@ -391,12 +400,47 @@ void check_wkc(const bus_model *m, const datagram *s, const datagram *b, events 
     ev->add(EV_WKC, b, wmem_strbuf_get_str(text));
 }
 
-/* What one datagram pair teaches about the slave it addressed. */
-void learn_slave(bus_model *m, guint position, const datagram *s, const datagram *b, tvbuff_t *sent, tvbuff_t *back,
-                 events *ev)
+/* SyncManager 0 and 1 configured as mailboxes (0x0800 + 8n: start 2,
+ * length 2, control 1 with mode bits 0-1 = 2). */
+void learn_mailboxes(slave_state *st, const datagram *d, tvbuff_t *sent)
+{
+    for (guint n = 0; n < 2; n++) {
+        gint at = register_at(d, 0x0800 + 8 * n, 5);
+        if (at < 0 || (dg_tvb_get_uint8(sent, at + 4) & 3) != 2) continue;
+        st->mailbox_start[n] = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
+        st->mailbox_length[n] = dg_tvb_get_uint16(sent, at + 2, ENC_LITTLE_ENDIAN);
+    }
+}
+
+gboolean is_mailbox(const slave_state *st, const datagram *d)
+{
+    for (guint n = 0; n < 2; n++)
+        if (st->mailbox_length[n] && d->ado >= st->mailbox_start[n] &&
+            d->ado < (guint32)st->mailbox_start[n] + st->mailbox_length[n])
+            return TRUE;
+    return FALSE;
+}
+
+/* An AL status read (0x0130) showing another state than the last one. */
+gboolean al_changed(slave_state *st, const datagram *b, tvbuff_t *back)
+{
+    gint at = register_at(b, 0x0130, 1);
+    if (at < 0) return FALSE;
+    guint8 state = dg_tvb_get_uint8(back, at) & 0x0f;
+    gboolean changed = st->al_known && state != st->al_state;
+    st->al_known = TRUE;
+    st->al_state = state;
+    return changed;
+}
+
+/* What one datagram pair teaches about the slave it addressed; its stat_flags. */
+guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagram *b, tvbuff_t *sent, tvbuff_t *back,
+                   events *ev)
 {
     slave_state *st = slave_at(m, position);
-    if (!st) return;
+    if (!st) return 0;
+    guint8 flags = is_mailbox(st, s) ? ST_MAILBOX : 0;
+    if (b->wkc <= s->wkc) return flags | ST_WKC_ERROR;
     gint at;
     if (writes(s->cmd) && by_position(s->cmd) && (at = register_at(s, 0x0010, 2)) >= 0) {
         st->station = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
@@ -411,14 +455,19 @@ void learn_slave(bus_model *m, guint position, const datagram *s, const datagram
     if (writes(s->cmd) && s->cmd != APRW && s->cmd != FPRW) {
         learn_sii_address(st, s, sent);
         learn_fmmus(m, st, s, sent);
+        learn_mailboxes(st, s, sent);
     }
-    if (reads(s->cmd) && !writes(s->cmd)) learn_sii_data(m, position, st, b, back, ev);
+    if (reads(s->cmd) && !writes(s->cmd)) {
+        learn_sii_data(m, position, st, b, back, ev);
+        if (al_changed(st, b, back)) flags |= ST_AL_CHANGE;
+    }
+    return flags;
 }
 
 /* The slave a datagram as sent addresses. */
 addressed address_of(const bus_model *m, const datagram *s)
 {
-    addressed a = {s->offset, 12 + s->length, -1, 0, FALSE, -1};
+    addressed a = {s->offset, 12 + s->length, -1, 0, FALSE, -1, 0, logical(s->cmd), *s};
     guint shares;
     a.expected_wkc = expected_wkc(m, s, NULL, &shares);
     if (by_position(s->cmd)) {
@@ -475,6 +524,85 @@ void show_slave(const bus_model *m, const addressed *a, tvbuff_t *tvb, packet_in
             proto_item_set_generated(proto_tree_add_uint(sub, *hfs[i], tvb, a->offset, a->length, word32(s, words[i])));
     if (device >= 0)
         proto_item_set_generated(proto_tree_add_string(sub, hf_name, tvb, a->offset, a->length, b->devices[device].type));
+}
+
+/* Up to 64 bits of the process image, least significant bit first. */
+guint64 image_bits(tvbuff_t *tvb, gint offset, guint bit, guint count)
+{
+    guint64 v = 0;
+    for (guint i = 0; i < count; i++) {
+        guint b = bit + i;
+        if (dg_tvb_get_uint8(tvb, offset + (gint)(b / 8)) >> (b % 8) & 1) v |= G_GUINT64_CONSTANT(1) << i;
+    }
+    return v;
+}
+
+/* One PDO entry at `bit` bits into the datagram's data. */
+void show_entry(proto_tree *tree, const dg_pdo_entry *e, tvbuff_t *tvb, gint data, guint32 bit)
+{
+    gint offset = data + (gint)(bit / 8), bytes = (gint)((bit % 8 + e->bit_length + 7) / 8);
+    if (bit % 8 == 0 && e->bit_length % 8 == 0 && e->bit_length > 1) {
+        proto_tree_add_item(tree, *e->hf, tvb, offset, e->bit_length / 8, ENC_LITTLE_ENDIAN);
+        return;
+    }
+    if (e->bit_length > 64) return;
+    guint64 v = image_bits(tvb, data, bit, e->bit_length);
+    header_field_info *hfi = proto_registrar_get_nth(*e->hf);
+    if (!hfi) return;
+    if (hfi->type == FT_BOOLEAN) proto_tree_add_boolean(tree, *e->hf, tvb, offset, bytes, v ? 1 : 0);
+    else if (IS_FT_UINT32(hfi->type)) proto_tree_add_uint(tree, *e->hf, tvb, offset, bytes, (guint32)v);
+    else if (IS_FT_UINT(hfi->type)) proto_tree_add_uint64(tree, *e->hf, tvb, offset, bytes, v);
+    else if (IS_FT_INT(hfi->type)) {
+        guint64 sign = G_GUINT64_CONSTANT(1) << (e->bit_length - 1);
+        gint64 value = (gint64)((v ^ sign) - sign);
+        if (IS_FT_INT32(hfi->type)) proto_tree_add_int(tree, *e->hf, tvb, offset, bytes, (gint32)value);
+        else proto_tree_add_int64(tree, *e->hf, tvb, offset, bytes, value);
+    }
+}
+
+/* The logical bit where a slave's inputs (FMMU read) or outputs (FMMU write) start, -1 unknown. */
+gint64 image_start(const dg_slave *ds, const slave_state *st, gboolean output)
+{
+    gint64 given = output ? ds->output_logical_bit : ds->input_logical_bit;
+    if (given >= 0) return given;
+    if (!st) return -1;
+    for (guint i = 0; i < max_fmmus; i++) {
+        const fmmu *f = &st->fmmus[i];
+        if (f->known && f->active && (f->type & (output ? 2 : 1))) return (gint64)f->logical * 8;
+    }
+    return -1;
+}
+
+/* A logical datagram's process data, one subtree per designed slave: outputs
+ * in the frame as sent, inputs in the returned one. */
+void show_process_data(const bus_model *m, const datagram *d, gboolean returned, tvbuff_t *tvb, proto_tree *tree)
+{
+    const dg_bus *b = m->design;
+    if (!b || !b->slaves || !logical(d->cmd)) return;
+    gboolean output = !returned;
+    if ((output && d->cmd == LRD) || (!output && d->cmd == LWR)) return;
+    gint64 first = (gint64)(d->adp | (guint32)d->ado << 16) * 8, end = first + (gint64)d->length * 8;
+    gint data = d->offset + 10;
+    for (guint p = 0; p < b->slave_count; p++) {
+        const dg_slave *ds = &b->slaves[p];
+        gint64 start = image_start(ds, p < max_positions ? m->slaves[p] : NULL, output);
+        if (start < 0) continue;
+        proto_tree *sub = NULL;
+        for (guint32 i = ds->entry_first; i < ds->entry_first + ds->entry_count; i++) {
+            const dg_pdo_entry *e = &b->entries[i];
+            if (!e->hf || *e->hf < 0 || (gboolean)e->output != output) continue;
+            gint64 at = e->logical_bit >= 0 ? e->logical_bit : start + e->bit_offset;
+            if (at < first || at + e->bit_length > end) continue;
+            if (!sub) {
+                proto_item *it = proto_tree_add_none_format(tree, hf_process_data, tvb, d->offset, 12 + d->length,
+                                                            "%s (position %u): %s", ds->name, p,
+                                                            output ? "outputs" : "inputs");
+                proto_item_set_generated(it);
+                sub = proto_item_add_subtree(it, ett_process_data);
+            }
+            show_entry(sub, e, tvb, data, (guint32)(at - first));
+        }
+    }
 }
 
 } /* namespace */
@@ -536,26 +664,30 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, packet_inf
     guint ns = read_frame(sent, &header, s, max_datagrams), nb = read_frame(back, &header, b, max_datagrams);
     guint n = MIN(ns, nb);
     events ev = {};
+    guint8 flags[max_datagrams] = {};
     for (guint i = 0; i < n; i++) {
         if (logical(s[i].cmd) && s[i].cmd == b[i].cmd && s[i].adp == b[i].adp && s[i].ado == b[i].ado &&
             s[i].length == b[i].length)
             check_wkc(m, &s[i], &b[i], &ev);
-        if (s[i].cmd != b[i].cmd || s[i].ado != b[i].ado || s[i].length != b[i].length || b[i].wkc <= s[i].wkc)
-            continue;
-        guint added = (guint)(b[i].wkc - s[i].wkc);
-        if (s[i].cmd == BRD) learn_count(m, added, &b[i], &ev);
+        if (s[i].cmd != b[i].cmd || s[i].ado != b[i].ado || s[i].length != b[i].length) continue;
         gint32 position = by_position(s[i].cmd) ? position_of(s[i].adp)
                           : by_station(s[i].cmd) ? station_position(m, s[i].adp) : -1;
-        if (position >= 0) learn_slave(m, (guint)position, &s[i], &b[i], sent, back, &ev);
+        if (position >= 0) flags[i] = learn_slave(m, (guint)position, &s[i], &b[i], sent, back, &ev);
+        if (b[i].wkc <= s[i].wkc) continue;
+        guint added = (guint)(b[i].wkc - s[i].wkc);
+        if (s[i].cmd == BRD) learn_count(m, added, &b[i], &ev);
         else if (s[i].cmd == BWR)
             for (guint p = 0; m->count_known && p < m->count && p < max_positions; p++)
                 learn_sii_address(slave_at(m, p), &s[i], sent);
     }
     bus_frame *f = new_frame(m, n, &ev);
+    f->returned = TRUE;
     for (guint i = 0; i < n; i++) {
         f->d[i] = address_of(m, &s[i]);
         f->d[i].offset = b[i].offset; /* the items go over the returned datagram */
         f->d[i].length = 12 + b[i].length;
+        f->d[i].stats = flags[i];
+        f->d[i].dgram = b[i];
     }
     return f;
 }
@@ -566,6 +698,7 @@ void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree 
     for (guint i = 0; i < f->count; i++) {
         const addressed *a = &f->d[i];
         show_slave(f->model, a, tvb, pinfo, tree);
+        if (a->logical) show_process_data(f->model, &a->dgram, f->returned, tvb, tree);
         if (a->expected_wkc >= 0)
             proto_item_set_generated(proto_tree_add_uint(tree, hf_wkc_expected, tvb, a->offset + a->length - 2, 2,
                                                          (guint32)a->expected_wkc));
@@ -578,9 +711,48 @@ void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree 
     }
 }
 
+/* --- statistics: a node per slave position ------------------------------ */
+
+namespace {
+const char *const st_slaves = "Slaves (returned datagrams)";
+const char *const st_datagrams = "Datagrams";
+const char *const st_wkc_error = "Working counter not raised";
+const char *const st_al = "AL state changes";
+const char *const st_mailbox = "Mailbox datagrams";
+const char *const st_wkc_expected = "Unexpected working counter";
+int st_slaves_id;
+} /* namespace */
+
+void bus_stats_init(stats_tree *st, int parent)
+{
+    st_slaves_id = stats_tree_create_node(st, st_slaves, parent, STAT_DT_INT, TRUE);
+    stats_tree_create_node(st, st_wkc_expected, parent, STAT_DT_INT, FALSE);
+}
+
+void bus_stats_frame(stats_tree *st, int parent, const bus_frame *f)
+{
+    if (!f) return;
+    char label[48];
+    for (guint i = 0; i < f->count; i++) {
+        const addressed *a = &f->d[i];
+        if (a->position < 0) continue;
+        g_snprintf(label, sizeof label, "Position %d", a->position);
+        tick_stat_node(st, st_slaves, parent, TRUE);
+        int id = tick_stat_node(st, label, st_slaves_id, TRUE);
+        tick_stat_node(st, st_datagrams, id, FALSE);
+        if (a->stats & ST_WKC_ERROR) tick_stat_node(st, st_wkc_error, id, FALSE);
+        if (a->stats & ST_AL_CHANGE) tick_stat_node(st, st_al, id, FALSE);
+        if (a->stats & ST_MAILBOX) tick_stat_node(st, st_mailbox, id, FALSE);
+    }
+    for (guint i = 0; i < f->event_count; i++)
+        if (f->events[i].kind == EV_WKC) tick_stat_node(st, st_wkc_expected, parent, FALSE);
+}
+
 void bus_register(int proto, const char *filter)
 {
     static hf_register_info hf[] = {
+        {&hf_process_data, {"Process data", NULL, FT_NONE, BASE_NONE, NULL, 0x0,
+                            "One designed slave's PDO entries in this logical datagram", HFILL}},
         {&hf_wkc_expected, {"Expected working counter", NULL, FT_UINT16, BASE_DEC, NULL, 0x0,
                             "From the ENI's cyclic commands (Cnt), else from the slaves' FMMU configuration", HFILL}},
         {&hf_slave, {"Slave", NULL, FT_NONE, BASE_NONE, NULL, 0x0,
@@ -597,11 +769,11 @@ void bus_register(int proto, const char *filter)
         {&hf_name, {"Model", NULL, FT_STRING, BASE_NONE, NULL, 0x0,
                     "The device type of the ESI catalogue embedded with --esi", HFILL}},
     };
-    const char *names[] = {"wkc.expected", "slave", "slave.position", "slave.station", "slave.alias", "slave.vendor",
+    const char *names[] = {"process_data", "wkc.expected", "slave", "slave.position", "slave.station", "slave.alias", "slave.vendor",
                            "slave.product", "slave.revision", "slave.serial", "slave.name"};
     for (guint i = 0; i < G_N_ELEMENTS(hf); i++) hf[i].hfinfo.abbrev = g_strdup_printf("%s.%s", filter, names[i]);
     proto_register_field_array(proto, hf, (int)G_N_ELEMENTS(hf));
-    static gint *ett[] = {&ett_slave};
+    static gint *ett[] = {&ett_slave, &ett_process_data};
     proto_register_subtree_array(ett, (int)G_N_ELEMENTS(ett));
 
     static ei_register_info ei[] = {

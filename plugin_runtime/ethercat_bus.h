@@ -42,5 +42,8 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, packet_inf
 /* Every pass: the slave items and the network-check expert infos. */
 void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
 void bus_register(int proto, const char *filter);
+/* Statistics (tshark -z ecatr,tree): per slave position, from returned frames. */
+void bus_stats_init(stats_tree *st, int parent);
+void bus_stats_frame(stats_tree *st, int parent, const bus_frame *f);
 
 } /* namespace dg_ecat */

@@ -296,6 +296,7 @@ void esc_stats_init(stats_tree *st, int parent)
 {
     st_wkc_id = stats_tree_create_node(st, st_wkc, parent, STAT_DT_INT, TRUE);
     stats_tree_create_node(st, st_wkc_down, parent, STAT_DT_INT, FALSE);
+    bus_stats_init(st, parent);
 }
 
 void esc_stats_response(stats_tree *st, int parent, const void *data)
@@ -310,6 +311,7 @@ void esc_stats_response(stats_tree *st, int parent, const void *data)
         tick_stat_node(st, label, cmd_id, FALSE);
         if (c->wkc_added < 0) tick_stat_node(st, st_wkc_down, parent, FALSE);
     }
+    bus_stats_frame(st, parent, r->bus);
 }
 
 void esc_register(int proto, const char *filter)

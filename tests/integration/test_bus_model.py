@@ -17,7 +17,15 @@
    wrote): no ecatr.expert.wkc on any real capture; on copies of the ethercrab captures with
    the returned working counter of some logical datagrams lowered, ecatr.expert.wkc on
    exactly those frames (one pass and -2).
-Skips (exit 77) when the corpus is absent.
+4. The per-slave statistics (-z ecatr,tree): the same in one pass and -2, and the datagram
+   counts those of the returned frames' slave items.
+5. The ENI of ../shared/corpus/eni: its cyclic commands' Cnt is the expected working counter
+   of a matching LRD (generated frames: the right count, then one short).
+6. Process data by name (generated frames, tests/esi_ok/small_io.xml with
+   tests/network/small_design.xml): after the stations and FMMUs are set, an LRW shows the
+   EL2004's outputs (ecatr.pdo.el2004.*) in the frame as sent and the EL1004's inputs
+   (ecatr.pdo.el1004.*) in the returned one, with the values written into the bytes here.
+Skips (exit 77) when the corpus is absent (part 6 runs all the same).
 """
 import argparse
 import os
@@ -25,6 +33,7 @@ import struct
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pcapgen as pg  # noqa: E402
 import pcaprewrite as pr  # noqa: E402
 from tshark_env import Checks, TsharkEnv  # noqa: E402
 
@@ -253,16 +262,128 @@ def wkc_checks(env, corpus, files):
         print("\n".join("   " + l.strip() for l in texts.splitlines() if "expected working counter" in l))
 
 
+def slave_stats(env, path, two_pass):
+    """{position: {item: count}} of the "Slaves" part of -z ecatr,tree."""
+    args = ["-r", path, "-q", "-z", "ecatr,tree"] + (["-2"] if two_pass else [])
+    out, pos = {}, None
+    for line in env.tshark(args).stdout.splitlines():
+        label = line[:41].strip()
+        cols = line[41:].split()
+        if line.startswith("  Position "):
+            pos = int(label.split()[1])
+            out[pos] = {}
+        elif line.startswith("   ") and pos is not None and cols:
+            out[pos][label] = int(cols[0])
+        elif not line.startswith("   "):
+            pos = None
+    return out
+
+
+def stats_checks(env, corpus):
+    print("\n== statistics per slave (-z ecatr,tree)")
+    for name in ("soem-sdinfo-ek1100-el1004.pcapng", "replay-mailbox-el6910.pcapng", "twincat-scan-boxes.pcapng"):
+        path = os.path.join(corpus, name)
+        one, two = slave_stats(env, path, False), slave_stats(env, path, True)
+        print("%s: %s" % (name, one))
+        check(one == two and one, "%s: the same per-slave statistics in one pass and -2" % name)
+        rows = decode(env, path, ["ecatr.slave.position"], False, "ecatr.request_in")
+        counts = {}
+        for _n, r in rows:
+            for p in r["ecatr.slave.position"]:
+                counts[int(p)] = counts.get(int(p), 0) + 1
+        check({p: v.get("Datagrams") for p, v in one.items()} == counts,
+              "%s: per-slave datagram counts are those of the returned frames' ecatr.slave.position (%s)"
+              % (name, counts))
+
+
+def eni_checks(dissgen, rules, shared):
+    print("\n== the ENI's expected working counters")
+    eni = os.path.join(shared, "eni", "twincat_5_slaves_eni.xml")
+    # Its cyclic frame reads 14 bytes at logical 0x01000000 with <Cnt>1</Cnt>.
+    master, back = b"\x00\x00\x00\x00\x00\x01", b"\x02\x00\x00\x00\x00\x01"
+    frames = []
+    for i, wkc in enumerate((1, 0)):
+        for src, w in ((master, 0), (back, wkc)):
+            frames.append(pg.Frame([pg.Datagram(10, idx=i, lad=0x01000000, data=bytes(14), wkc=w)], src_mac=src))
+    with TsharkEnv() as env:
+        env.install_plugin(dissgen, rules, ["--network", eni])
+        path = env.add_file("eni.pcap", pg.pcap_bytes(frames))
+        for two_pass in (False, True):
+            rows = decode(env, path, ["ecatr.wkc.expected", "ecatr.expert.wkc"], two_pass)
+            got = [(n, r["ecatr.wkc.expected"], bool(r["ecatr.expert.wkc"])) for n, r in rows]
+            check(got == [(1, ["1"], False), (2, ["1"], False), (3, ["1"], False), (4, ["1"], True)],
+                  "ENI Cnt 1 expected on every frame, ecatr.expert.wkc on frame 4 only%s: %s" % (
+                      " (-2)" if two_pass else "", got))
+
+
+def fmmu(logical, length, kind):
+    return struct.pack("<IHBBHBBBxxx", logical, length, 0, 7, 0x1000, 0, kind, 1)
+
+
+def pdo_checks(dissgen, source_dir):
+    print("\n== process data by name (generated frames)")
+    master, back = b"\x00\x00\x00\x00\x00\x01", b"\x02\x00\x00\x00\x00\x01"
+    mode, setpoint = 0x35, -1234
+    outputs = bytes([1 | mode << 1]) + struct.pack("<h", setpoint)
+    steps = [  # (sent datagram, returned data or None: as sent, returned wkc)
+        (pg.Datagram(2, adp=0xFFFF, ado=0x0010, data=struct.pack("<H", 0x1002)), None, 1),  # position 1
+        (pg.Datagram(2, adp=0xFFFE, ado=0x0010, data=struct.pack("<H", 0x1003)), None, 1),  # position 2
+        (pg.Datagram(5, adp=0x1002, ado=0x0600, data=fmmu(0x10000, 1, 1)), None, 1),  # EL1004 reads
+        (pg.Datagram(5, adp=0x1003, ado=0x0600, data=fmmu(0x10001, 3, 2)), None, 1),  # EL2004 writes
+        (pg.Datagram(12, lad=0x10000, data=bytes(1) + outputs), bytes([0b101]) + outputs, 3),
+    ]
+    frames = []
+    for i, (d, data, wkc) in enumerate(steps):
+        d.idx = i
+        frames.append(pg.Frame([d], src_mac=master))
+        r = pg.Datagram(d.cmd, idx=i, adp=d.adp, ado=d.ado, lad=d.lad, data=data if data else d.data, wkc=wkc)
+        frames.append(pg.Frame([r], src_mac=back))
+    fields = ["ecatr.pdo.el1004.channel_1.input", "ecatr.pdo.el1004.channel_2.input",
+              "ecatr.pdo.el1004.channel_3.input", "ecatr.pdo.el2004.channel_1.output",
+              "ecatr.pdo.el2004.channel_1.mode", "ecatr.pdo.el2004.channel_1.setpoint",
+              "ecatr.wkc.expected", "ecatr.expert.wkc"]
+    yes = {"1", "True"}
+    no = {"0", "False"}
+    with TsharkEnv() as env:
+        env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"),
+                           ["--esi", os.path.join(source_dir, "tests", "esi_ok", "small_io.xml"),
+                            "--network", os.path.join(source_dir, "tests", "network", "small_design.xml")])
+        path = env.add_file("pdo.pcap", pg.pcap_bytes(frames))
+        for two_pass in (False, True):
+            rows = dict(decode(env, path, fields, two_pass))
+            tag = " (-2)" if two_pass else ""
+            sent, ret = rows[9], rows[10]
+            check(sent["ecatr.pdo.el2004.channel_1.output"][0] in yes and
+                  sent["ecatr.pdo.el2004.channel_1.mode"] == [str(mode)] and
+                  sent["ecatr.pdo.el2004.channel_1.setpoint"] == [str(setpoint)],
+                  "LRW as sent: EL2004 outputs by name (1, %d, %d)%s: %s" % (mode, setpoint, tag, sent))
+            check(not any(sent[f] for f in fields[:3]), "LRW as sent: no EL1004 inputs" + tag)
+            check([ret[f][0] if ret[f] else "" for f in fields[:3]] in (["1", "0", "1"], ["True", "False", "True"]),
+                  "LRW returned: EL1004 inputs by name (1, 0, 1)%s: %s" % (tag, ret))
+            check(not any(ret[f] for f in fields[3:6]), "LRW returned: no EL2004 outputs" + tag)
+            check(sent["ecatr.wkc.expected"] == ["3"] and ret["ecatr.wkc.expected"] == ["3"] and
+                  not ret["ecatr.expert.wkc"], "expected working counter 3 (EL1004 +1, EL2004 +2), met" + tag)
+            check(not any(r[f] for n, r in rows.items() if n < 9 for f in fields[:6]),
+                  "no process data before the LRW" + tag)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--dissgen", required=True)
     ap.add_argument("--source-dir", required=True)
+    ap.add_argument("--only", help="run only this part (pdo)")
     args = ap.parse_args()
+    if args.only == "pdo":
+        pdo_checks(args.dissgen, args.source_dir)
+        return 1 if check.failed else 0
     shared = os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus")
     corpus = os.path.join(shared, "ethercat")
     files = sorted(f for f in os.listdir(corpus) if f.endswith((".pcap", ".pcapng"))) \
         if os.path.isdir(corpus) else []
     if not files:
+        pdo_checks(args.dissgen, args.source_dir)
+        if check.failed:
+            return 1
         print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng)" % corpus)
         return SKIP
     rules = os.path.join(args.source_dir, "rules", "ethercat.xml")
@@ -275,9 +396,12 @@ def main():
         identity_checks(env, env.home, files)
         names_checks(env, env.home)
         wkc_checks(env, env.home, files)
+        stats_checks(env, env.home)
         rows = decode(env, os.path.join(env.home, "soem-sdinfo-ek1100-el1004.pcapng"), EXPERTS, True)
         check(not any(any(r.values()) for _n, r in rows), "no network experts without a design")
     network_checks(args.dissgen, rules, corpus)
+    eni_checks(args.dissgen, rules, shared)
+    pdo_checks(args.dissgen, args.source_dir)
     print("\n%d failed" % len(check.failed))
     return 1 if check.failed else 0
 
