@@ -444,7 +444,8 @@ void Emitter::protocol_struct() {
        << (pdu ? p_.pdu_fixed_len - value_bytes(*pdu) : 0) << ", " << p_.pdulengthadd;
     // Members after pdu_add default to none; a protocol that uses later ones
     // spells out everything before them.
-    const bool pairing = p_.pairing != nullptr, after_10b = l_.uses_10b() || pairing;
+    const bool bus = extra_ && !extra_->bus_symbol.empty();  // issue 12
+    const bool pairing = p_.pairing != nullptr, after_10b = l_.uses_10b() || pairing || bus;
     if (uses_reassembly())  // issue 10a
         o_ << ",\n    &" << f << "_reassembly, &" << f << "_fragment_items";
     else if (after_10b)
@@ -456,6 +457,8 @@ void Emitter::protocol_struct() {
            << name("places", !l_.places.empty());
     }
     if (pairing) o_ << ",\n    &" << f << "_pairing";  // issue 11
+    else if (bus) o_ << ",\n    NULL";
+    if (bus) o_ << ",\n    &" << extra_->bus_symbol;  // issue 12
     o_ << "\n};\n\n";
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
        << "    return dg_dissect(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";

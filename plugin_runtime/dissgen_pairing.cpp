@@ -115,7 +115,7 @@ capture_state *current_capture(void)
     if (!capture) {
         capture = wmem_new0(wmem_file_scope(), capture_state);
         capture->keys = wmem_map_new(wmem_file_scope(), key_hash, key_equal);
-        if (analysis && analysis->capture_new) capture->analysis = analysis->capture_new();
+        if (analysis && analysis->capture_new) capture->analysis = analysis->capture_new(protocol);
     }
     return capture;
 }
@@ -287,6 +287,7 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
         fp->role = DG_ROLE_ORPHAN;
         return fp;
     }
+    if (analysis && analysis->sent) fp->analysis = analysis->sent(c->analysis, tvb, pinfo);
     dg_transaction *t = wmem_new0(wmem_file_scope(), dg_transaction);
     t->request_frame = pinfo->num;
     t->request_time = pinfo->abs_ts;
@@ -337,6 +338,8 @@ void show(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, proto_t
         break;
     default: break;
     }
+    if (fp->role == DG_ROLE_REQUEST && analysis && analysis->show_sent && fp->analysis)
+        analysis->show_sent(fp->analysis, tvb, pinfo, tree);
 }
 
 /* --- statistics ---------------------------------------------------------- */

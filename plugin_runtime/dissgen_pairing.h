@@ -44,7 +44,7 @@ typedef struct dg_frame_pairing {
     guint8 role;             /* dg_role */
     gboolean out_of_order;   /* response: a later request was answered first */
     guint32 duplicate_of;    /* duplicate: the frame it repeats */
-    void *analysis;          /* response: the analysis's comparison (wmem_file_scope) */
+    void *analysis;          /* response: the analysis's comparison; request: its sent() result */
 } dg_frame_pairing;
 
 /* What one protocol knows about its requests and responses. Every callback
@@ -53,9 +53,9 @@ typedef struct dg_analysis {
     const char *name;        /* the rule file's <pairing analysis="..."> */
     /* Registers the analysis's own fields and expert infos (once, at start-up). */
     void (*register_info)(int proto, const char *filter);
-    /* Capture-wide state, allocated in wmem_file_scope (the issue-12 slave
-     * model belongs here), or NULL. */
-    void *(*capture_new)(void);
+    /* Capture-wide state, allocated in wmem_file_scope (e.g. the EtherCAT
+     * slave model, which reads p->bus), or NULL. */
+    void *(*capture_new)(const dg_protocol *p);
     /* First pass, every message in capture order, before pairing. */
     void (*see)(void *capture, tvbuff_t *tvb, packet_info *pinfo);
     /* Whether a message from `src` can be the response to a pending request
@@ -73,6 +73,11 @@ typedef struct dg_analysis {
     /* Statistics (tshark -z FILTER,tree): nodes under the pairing's own. */
     void (*stats_init)(stats_tree *st, int parent);
     void (*stats_response)(stats_tree *st, int parent, const void *result);
+    /* First pass, a request: the analysis's result for it (wmem_file_scope),
+     * or NULL. */
+    void *(*sent)(void *capture, tvbuff_t *tvb, packet_info *pinfo);
+    /* Every pass: shows a sent() result. */
+    void (*show_sent)(const void *result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
 } dg_analysis;
 
 #ifdef __cplusplus

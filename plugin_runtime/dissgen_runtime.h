@@ -180,6 +180,8 @@ typedef struct dg_pairing {
     const char *analysis;    /* NULL, or a protocol analysis ("ethercat-esc") */
 } dg_pairing;
 
+struct dg_bus; /* dissgen_bus.h */
+
 typedef struct dg_protocol {
     const char *name;        /* long name, e.g. "EtherCAT" */
     const char *short_name;  /* Protocol column, e.g. "ECATR" */
@@ -231,6 +233,14 @@ typedef struct dg_protocol {
     const dg_pairing *pairing = nullptr;
 #else
     const dg_pairing *pairing;
+#endif
+    /* issue 12: the ESI catalogue and network design embedded with --esi /
+     * --network (dissgen_bus.h), NULL when none. Generated code gives it only
+     * when the tables are embedded. */
+#ifdef __cplusplus
+    const struct dg_bus *bus = nullptr;
+#else
+    const struct dg_bus *bus;
 #endif
 } dg_protocol;
 

@@ -27,6 +27,7 @@
  * the bit is a hint for the pairing, not a rule.
  */
 #include "ethercat_esc.h"
+#include "ethercat_bus.h"
 
 #include <epan/expert.h>
 
@@ -34,16 +35,9 @@
 
 namespace {
 
-enum esc_change { CHANGED_CMD = 1, CHANGED_IDX = 2, CHANGED_LEN = 4, CHANGED_ADDR = 8 };
+using namespace dg_ecat;
 
-/* One datagram as read from a frame. */
-struct datagram {
-    gint offset;        /* of the datagram in its tvb */
-    guint8 cmd, idx;
-    guint16 adp, ado;   /* the 32-bit address: ADP low half, ADO high half */
-    guint16 length;     /* of the data */
-    guint16 wkc;
-};
+enum esc_change { CHANGED_CMD = 1, CHANGED_IDX = 2, CHANGED_LEN = 4, CHANGED_ADDR = 8 };
 
 /* One returned datagram compared with the one sent. */
 struct compared {
@@ -65,22 +59,19 @@ struct result {
     guint sent_length, back_length;   /* header lengths */
     guint sent_count, back_count;     /* datagrams */
     compared *d;
+    bus_frame *bus;                   /* the slaves (ethercat_bus.cpp) */
 };
 
 struct capture_hints {
     gboolean marking_seen; /* a slave set the locally administered bit: the capture shows direction */
     guint8 master[6];      /* the (unmarked) source of the frames answered so far */
+    bus_model *bus;        /* the slaves the capture shows (ethercat_bus.cpp) */
 };
 
 int hf_esc = -1, hf_datagram = -1, hf_wkc_added = -1, hf_slaves_passed = -1, hf_data_changed = -1;
 gint ett_esc = -1, ett_datagram = -1;
 expert_field ei_changed = EI_INIT, ei_frame_length = EI_INIT, ei_write_changed = EI_INIT, ei_wkc_down = EI_INIT,
              ei_forwarding = EI_INIT;
-
-const char *const command_names[] = {"NOP",  "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD",
-                                     "BWR",  "BRW",  "LRD",  "LWR",  "LRW",  "ARMW", "FRMW"};
-
-const char *command_name(guint8 cmd) { return cmd < G_N_ELEMENTS(command_names) ? command_names[cmd] : "unknown"; }
 
 gboolean advances_adp(guint8 cmd)
 {
@@ -95,40 +86,6 @@ gboolean advances_adp(guint8 cmd)
 gboolean is_logical(guint8 cmd) { return cmd >= 10 && cmd <= 12; }
 
 gboolean is_write(guint8 cmd) { return cmd == 2 || cmd == 5 || cmd == 8 || cmd == 11; }
-
-/* The frame's header length, and its datagrams (up to `max`); every read is
- * checked against the bytes there are. */
-guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max)
-{
-    gint end = (gint)tvb_captured_length(tvb);
-    *header_length = 0;
-    if (end < 2) return 0;
-    guint16 header = dg_tvb_get_uint16(tvb, 0, ENC_LITTLE_ENDIAN);
-    *header_length = header & 0x7ff;
-    if ((header >> 12) != 1) return 0;
-    if ((gint)(2 + *header_length) < end) end = 2 + (gint)*header_length;
-    guint n = 0;
-    gint offset = 2;
-    while (n < max && offset + 12 <= end) {
-        datagram *d = &out[n];
-        d->offset = offset;
-        d->cmd = dg_tvb_get_uint8(tvb, offset);
-        d->idx = dg_tvb_get_uint8(tvb, offset + 1);
-        d->adp = dg_tvb_get_uint16(tvb, offset + 2, ENC_LITTLE_ENDIAN);
-        d->ado = dg_tvb_get_uint16(tvb, offset + 4, ENC_LITTLE_ENDIAN);
-        guint16 flags = dg_tvb_get_uint16(tvb, offset + 6, ENC_LITTLE_ENDIAN);
-        d->length = flags & 0x7ff;
-        if (offset + 12 + d->length > end) break;
-        d->wkc = dg_tvb_get_uint16(tvb, offset + 10 + d->length, ENC_LITTLE_ENDIAN);
-        n++;
-        offset += 12 + d->length;
-        if (!(flags & 0x8000)) break;
-    }
-    return n;
-}
-
-/* At most this many datagrams per frame: 1500 bytes hold at most 124. */
-const guint max_datagrams = 128;
 
 void compare_datagram(compared *c, const datagram *s, const datagram *b, tvbuff_t *request, tvbuff_t *response)
 {
@@ -180,7 +137,12 @@ void check_forwarding(result *r)
     }
 }
 
-void *esc_capture_new(void) { return wmem_new0(wmem_file_scope(), capture_hints); }
+void *esc_capture_new(const dg_protocol *p)
+{
+    capture_hints *h = wmem_new0(wmem_file_scope(), capture_hints);
+    h->bus = bus_new(p->bus);
+    return h;
+}
 
 int esc_is_response(void *capture, const address *request_src, const address *src)
 {
@@ -207,7 +169,7 @@ gboolean esc_is_returned(void *capture, const address *src)
     return b[0] == (h->master[0] | 0x02) && memcmp(b + 1, h->master + 1, 5) == 0;
 }
 
-void *esc_compare(void *, tvbuff_t *request, tvbuff_t *response, packet_info *)
+void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, packet_info *pinfo)
 {
     datagram sent[max_datagrams], back[max_datagrams];
     result *r = wmem_new0(wmem_file_scope(), result);
@@ -218,6 +180,7 @@ void *esc_compare(void *, tvbuff_t *request, tvbuff_t *response, packet_info *)
     r->d = wmem_alloc0_array(wmem_file_scope(), compared, r->count ? r->count : 1);
     for (guint i = 0; i < r->count; i++) compare_datagram(&r->d[i], &sent[i], &back[i], request, response);
     check_forwarding(r);
+    r->bus = bus_returned(((capture_hints *)capture)->bus, request, response, pinfo);
     return r;
 }
 
@@ -309,6 +272,18 @@ void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *t
         proto_tree *dg = items ? show_datagram_items(c, i, tvb, sub) : sub;
         show_datagram_experts(c, i, tvb, pinfo, dg);
     }
+    bus_show(r->bus, tvb, pinfo, tree);
+}
+
+/* A frame as sent (or returned without its request): only the slaves. */
+void *esc_sent(void *capture, tvbuff_t *tvb, packet_info *pinfo)
+{
+    return bus_sent(((capture_hints *)capture)->bus, tvb, pinfo);
+}
+
+void esc_show_sent(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    bus_show((const bus_frame *)data, tvb, pinfo, tree);
 }
 
 /* --- statistics ---------------------------------------------------------- */
@@ -321,6 +296,7 @@ void esc_stats_init(stats_tree *st, int parent)
 {
     st_wkc_id = stats_tree_create_node(st, st_wkc, parent, STAT_DT_INT, TRUE);
     stats_tree_create_node(st, st_wkc_down, parent, STAT_DT_INT, FALSE);
+    bus_stats_init(st, parent);
 }
 
 void esc_stats_response(stats_tree *st, int parent, const void *data)
@@ -335,6 +311,7 @@ void esc_stats_response(stats_tree *st, int parent, const void *data)
         tick_stat_node(st, label, cmd_id, FALSE);
         if (c->wkc_added < 0) tick_stat_node(st, st_wkc_down, parent, FALSE);
     }
+    bus_stats_frame(st, parent, r->bus);
 }
 
 void esc_register(int proto, const char *filter)
@@ -371,6 +348,7 @@ void esc_register(int proto, const char *filter)
     for (guint i = 0; i < G_N_ELEMENTS(ei); i++)
         ei[i].eiinfo.name = g_strdup_printf("%s.expert.%s", filter, ei_names[i]);
     expert_register_field_array(expert_register_protocol(proto), ei, (int)G_N_ELEMENTS(ei));
+    bus_register(proto, filter);
 }
 
 } /* namespace */
@@ -386,4 +364,6 @@ extern "C" const dg_analysis dg_ethercat_esc = {
     esc_show,
     esc_stats_init,
     esc_stats_response,
+    esc_sent,
+    esc_show_sent,
 };

@@ -1,0 +1,791 @@
+/* The EtherCAT bus as the capture shows it (issue 12): the slave model the
+ * master's own frames reveal, and the check against the designed network.
+ *
+ * What is learnt, on the first pass, from each returned frame together with
+ * the frame as sent (a datagram counts only when its working counter grew):
+ *  - the slave count: the working counter a broadcast read (BRD) adds, since
+ *    every slave increments it;
+ *  - station addresses: an auto-increment write (APWR/APRW) to register
+ *    0x0010 at ADP = -position (16-bit wrap) gives that position its station;
+ *  - aliases: register 0x0012, read or written;
+ *  - identities from the SII EEPROM: a write of the EEPROM address (0x0504,
+ *    with the control word at 0x0502 asking for a read when it is written as
+ *    well), then a read of the data at 0x0508 (4 or 8 bytes) gives the words
+ *    from that address on; TwinCAT reads 14 bytes from 0x0502 (status,
+ *    address and data in one). Words 0x0008/9 hold the vendor id, 0x000A/B the
+ *    product code, 0x000C/D the revision, 0x000E/F the serial number.
+ * Datagrams addressed to one slave (APxx: ADP = -position on the frame as
+ * sent; FPxx: ADP = station address) carry that slave's items. On the first
+ * pass they show what is known at that point of the capture; on later passes
+ * (tshark -2, the GUI) the model of the whole capture, so that frames before
+ * the scan get names too. The network-check findings are stored with the
+ * frame where the capture showed them, so every pass shows the same ones.
+ */
+#include "ethercat_bus.h"
+
+#include <epan/expert.h>
+
+#include <string.h>
+
+namespace dg_ecat {
+
+namespace {
+
+/* Beyond this position the model keeps nothing (real segments have far fewer slaves). */
+const guint max_positions = 1024;
+
+/* An FMMU of a slave: where its share of the logical process image is. */
+struct fmmu {
+    gboolean known, active;
+    guint32 logical;
+    guint16 length;
+    guint8 type;                   /* bit 0: read (inputs), bit 1: write (outputs) */
+};
+
+const guint max_fmmus = 16;
+
+enum ident_word { W_VENDOR = 0x08, W_PRODUCT = 0x0a, W_REVISION = 0x0c, W_SERIAL = 0x0e, SII_WORDS = 0x10 };
+
+struct slave_state {
+    gboolean station_known, alias_known, sii_address_known;
+    guint16 station, alias;
+    guint32 sii_address;           /* in words, the last one the master asked for */
+    guint16 sii[SII_WORDS];        /* SII words 0x0000..0x000F as read */
+    guint32 sii_known;             /* bit per word of sii[] */
+    gboolean checked;              /* compared with the design */
+    fmmu fmmus[max_fmmus];         /* as the master configured them (0x0600 + 16n) */
+    guint16 mailbox_start[2], mailbox_length[2];  /* SM0 (out), SM1 (in) in mailbox mode */
+    gboolean al_known;
+    guint8 al_state;               /* AL status (0x0130) bits 0-3, last seen */
+};
+
+enum event_kind { EV_COUNT, EV_MODEL, EV_OK, EV_WKC };
+
+struct bus_event {
+    guint8 kind;
+    gint offset, length;
+    const char *text;
+};
+
+struct addressed {
+    gint offset, length;
+    gint32 position;     /* -1: not known on the first pass */
+    guint16 station;     /* FPxx: the ADP */
+    gboolean by_station;
+    gint32 expected_wkc; /* logical commands: -1 when not known */
+    guint8 stats;        /* returned frames: stat_flags, for the statistics tree */
+    gboolean logical;    /* LRD/LWR/LRW: dgram is the datagram in this frame */
+    datagram dgram;
+};
+
+enum stat_flags { ST_WKC_ERROR = 1, ST_AL_CHANGE = 2, ST_MAILBOX = 4 };
+
+} /* namespace */
+
+struct bus_model {
+    const dg_bus *design;  /* NULL: nothing embedded */
+    slave_state *slaves[max_positions];
+    guint positions;       /* slaves[] below this may be set */
+    wmem_map_t *stations;  /* station address -> position + 1 */
+    gboolean count_known;
+    guint count;
+    gint64 count_reported; /* the last count that differed from the design, -1 none */
+    gboolean mismatch, ok_noted;
+    gboolean fmmus_known;  /* some slave's FMMU configuration was seen */
+};
+
+struct bus_frame {
+    const bus_model *model;
+    gboolean returned;   /* inputs are shown from returned frames, outputs from frames as sent */
+    guint count;
+    addressed *d;
+    guint event_count;
+    bus_event *events;
+};
+
+namespace {
+
+int hf_process_data = -1, hf_wkc_expected = -1, hf_slave = -1, hf_position = -1, hf_station = -1, hf_alias = -1, hf_vendor = -1, hf_product = -1,
+    hf_revision = -1, hf_serial = -1, hf_name = -1;
+gint ett_slave = -1, ett_process_data = -1;
+expert_field ei_count = EI_INIT, ei_model = EI_INIT, ei_ok = EI_INIT, ei_wkc = EI_INIT;
+
+const char *const command_names[] = {"NOP",  "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD",
+                                     "BWR",  "BRW",  "LRD",  "LWR",  "LRW",  "ARMW", "FRMW"};
+
+enum { APRD = 1, APWR, APRW, FPRD, FPWR, FPRW, BRD, BWR, BRW, LRD, LWR, LRW, ARMW, FRMW };
+
+gboolean by_position(guint8 cmd) { return cmd == APRD || cmd == APWR || cmd == APRW || cmd == ARMW; }
+gboolean by_station(guint8 cmd) { return cmd == FPRD || cmd == FPWR || cmd == FPRW || cmd == FRMW; }
+gboolean reads(guint8 cmd) { return cmd == APRD || cmd == APRW || cmd == FPRD || cmd == FPRW || cmd == BRD || cmd == BRW; }
+gboolean logical(guint8 cmd) { return cmd == LRD || cmd == LWR || cmd == LRW; }
+gboolean writes(guint8 cmd) { return cmd == APWR || cmd == APRW || cmd == FPWR || cmd == FPRW || cmd == BWR || cmd == BRW; }
+
+/* The position an auto-increment datagram as sent addresses. */
+guint16 position_of(guint16 adp) { return (guint16)(0x10000u - adp); }
+
+/* Where register `reg` (n bytes) sits in the datagram's data, or -1. */
+gint register_at(const datagram *d, guint32 reg, guint32 n)
+{
+    if (d->ado > reg || reg + n > (guint32)d->ado + d->length) return -1;
+    return d->offset + 10 + (gint)(reg - d->ado);
+}
+
+slave_state *slave_at(bus_model *m, guint32 position)
+{
+    if (position >= max_positions) return NULL;
+    if (!m->slaves[position]) m->slaves[position] = wmem_new0(wmem_file_scope(), slave_state);
+    if (position >= m->positions) m->positions = position + 1;
+    return m->slaves[position];
+}
+
+gint32 station_position(const bus_model *m, guint16 station)
+{
+    guint v = GPOINTER_TO_UINT(wmem_map_lookup(m->stations, GUINT_TO_POINTER((guint)station)));
+    return v ? (gint32)v - 1 : -1;
+}
+
+gboolean words_known(const slave_state *s, guint word) { return (s->sii_known >> word & 3u) == 3u; }
+guint32 word32(const slave_state *s, guint word) { return s->sii[word] | (guint32)s->sii[word + 1] << 16; }
+
+/* The catalogue's device with this identity: the same revision, else the
+ * product's latest; -1 when the product is not in the catalogue. */
+gint32 find_device(const dg_bus *bus, guint32 vendor, guint32 product, guint32 revision)
+{
+    if (!bus || !bus->device_count) return -1;
+    guint lo = 0, hi = bus->device_count;
+    while (lo < hi) {
+        guint mid = lo + (hi - lo) / 2;
+        const dg_device *d = &bus->devices[mid];
+        if (d->vendor < vendor || (d->vendor == vendor && d->product < product)) lo = mid + 1;
+        else hi = mid;
+    }
+    gint32 found = -1;
+    for (guint i = lo; i < bus->device_count && bus->devices[i].vendor == vendor && bus->devices[i].product == product;
+         i++) {
+        found = (gint32)i;
+        if (bus->devices[i].revision == revision) break;
+    }
+    return found;
+}
+
+/* "EL1004 (vendor 0x00000002, product 0x03ec3052)", or the numbers alone. */
+const char *model_text(const dg_bus *bus, guint32 vendor, guint32 product, gint32 device)
+{
+    if (device >= 0)
+        return wmem_strdup_printf(wmem_file_scope(), "%s (vendor 0x%08x, product 0x%08x)", bus->devices[device].type,
+                                  vendor, product);
+    return wmem_strdup_printf(wmem_file_scope(), "vendor 0x%08x, product 0x%08x", vendor, product);
+}
+
+/* The findings of one frame, collected on the first pass. */
+struct events {
+    bus_event list[max_datagrams + 4];
+    guint count;
+    void add(guint8 kind, const datagram *d, const char *text)
+    {
+        if (count >= G_N_ELEMENTS(list)) return;
+        list[count++] = {kind, d->offset, 12 + d->length, text};
+    }
+};
+
+/* Once the count and every designed slave's identity are known and match: the note, once. */
+void check_complete(bus_model *m, const datagram *d, events *ev)
+{
+    const dg_bus *b = m->design;
+    if (!b || !b->slaves || m->ok_noted || m->mismatch || !m->count_known || m->count != b->slave_count) return;
+    for (guint i = 0; i < b->slave_count; i++)
+        if (!m->slaves[i] || !m->slaves[i]->checked) return;
+    m->ok_noted = TRUE;
+    ev->add(EV_OK, d, wmem_strdup_printf(wmem_file_scope(), "The bus matches the design: %u slaves, every model as designed",
+                                         b->slave_count));
+}
+
+void learn_count(bus_model *m, guint count, const datagram *d, events *ev)
+{
+    m->count_known = TRUE;
+    m->count = count;
+    const dg_bus *b = m->design;
+    if (!b || !b->slaves) return;
+    if (count != b->slave_count) {
+        m->mismatch = TRUE;
+        if (m->count_reported != (gint64)count)
+            ev->add(EV_COUNT, d, wmem_strdup_printf(wmem_file_scope(), "design: %u slaves, bus: %u", b->slave_count, count));
+        m->count_reported = count;
+    }
+    check_complete(m, d, ev);
+}
+
+/* A slave's identity, once read, against the design's slave at its position. */
+void check_identity(bus_model *m, guint position, slave_state *s, const datagram *d, events *ev)
+{
+    const dg_bus *b = m->design;
+    if (!b || !b->slaves || s->checked || position >= b->slave_count) return;
+    const dg_slave *want = &b->slaves[position];
+    if (!words_known(s, W_VENDOR) || !words_known(s, W_PRODUCT)) return;
+    if (want->revision_given && !words_known(s, W_REVISION)) return;
+    s->checked = TRUE;
+    guint32 vendor = word32(s, W_VENDOR), product = word32(s, W_PRODUCT);
+    guint32 revision = words_known(s, W_REVISION) ? word32(s, W_REVISION) : 0;
+    gboolean same = vendor == want->vendor && product == want->product &&
+                    (!want->revision_given || revision == want->revision);
+    if (!same) {
+        m->mismatch = TRUE;
+        const char *expected = want->device >= 0 ? model_text(b, want->vendor, want->product, want->device)
+                                                 : model_text(b, want->vendor, want->product, -1);
+        const char *found = model_text(b, vendor, product, find_device(b, vendor, product, revision));
+        if (want->revision_given && vendor == want->vendor && product == want->product)
+            ev->add(EV_MODEL, d, wmem_strdup_printf(wmem_file_scope(),
+                                                    "Position %u: design %s revision 0x%08x, bus revision 0x%08x",
+                                                    position, expected, want->revision, revision));
+        else
+            ev->add(EV_MODEL, d, wmem_strdup_printf(wmem_file_scope(), "Position %u: design %s, bus %s", position,
+                                                    expected, found));
+    }
+    check_complete(m, d, ev);
+}
+
+/* The SII words a read of 0x0508 returned, stored from the EEPROM address on. */
+void learn_sii_data(bus_model *m, guint position, slave_state *s, const datagram *b, tvbuff_t *back, events *ev)
+{
+    gint data = register_at(b, 0x0508, 4);
+    if (data < 0) return;
+    guint32 address;
+    gint status = register_at(b, 0x0502, 2);
+    guint bytes = MIN(8u, (guint)(b->offset + 10 + b->length - data));
+    if (status >= 0) {
+        guint16 st = dg_tvb_get_uint16(back, status, ENC_LITTLE_ENDIAN);
+        if (st & 0x8000) return;        /* busy: the data is not there yet */
+        if (!(st & 0x0040)) bytes = 4;  /* the ESC reads 4 bytes at a time */
+    }
+    gint at = register_at(b, 0x0504, 2);
+    if (at >= 0) address = dg_tvb_get_uint16(back, at, ENC_LITTLE_ENDIAN);
+    else if (s->sii_address_known) address = s->sii_address;
+    else return;
+    for (guint i = 0; i < bytes / 2; i++) {
+        guint32 word = address + i;
+        if (word >= SII_WORDS) break;
+        s->sii[word] = dg_tvb_get_uint16(back, data + 2 * (gint)i, ENC_LITTLE_ENDIAN);
+        s->sii_known |= 1u << word;
+    }
+    check_identity(m, position, s, b, ev);
+}
+
+/* A write of the EEPROM address (with a read command when the control word is written too). */
+void learn_sii_address(slave_state *s, const datagram *d, tvbuff_t *sent)
+{
+    gint at = register_at(d, 0x0504, 2);
+    if (at < 0) return;
+    gint control = register_at(d, 0x0502, 2);
+    if (control >= 0 && !(dg_tvb_get_uint16(sent, control, ENC_LITTLE_ENDIAN) & 0x0100)) return;
+    s->sii_address = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
+    s->sii_address_known = TRUE;
+}
+
+/* FMMU configuration writes: 16 bytes per FMMU at 0x0600 + 16n (logical
+ * start 4, length 2, start/stop bit, physical start 2 and bit, type at +11,
+ * activate at +12), or the activate byte alone. */
+void learn_fmmus(bus_model *m, slave_state *st, const datagram *d, tvbuff_t *sent)
+{
+    if (d->ado >= 0x0700 || (guint32)d->ado + d->length <= 0x0600) return;
+    for (guint n = 0; n < max_fmmus; n++) {
+        guint32 reg = 0x0600 + 16 * n;
+        fmmu *f = &st->fmmus[n];
+        gint at = register_at(d, reg, 16);
+        if (at >= 0) {
+            f->known = TRUE;
+            f->logical = dg_tvb_get_uint32(sent, at, ENC_LITTLE_ENDIAN);
+            f->length = dg_tvb_get_uint16(sent, at + 4, ENC_LITTLE_ENDIAN);
+            f->type = dg_tvb_get_uint8(sent, at + 11) & 3;
+            f->active = dg_tvb_get_uint8(sent, at + 12) & 1;
+            m->fmmus_known = TRUE;
+        } else if (f->known && (at = register_at(d, reg + 12, 1)) >= 0) {
+            f->active = dg_tvb_get_uint8(sent, at) & 1;
+        }
+    }
+}
+
+/* One slave's part in a logical datagram's working counter. */
+struct share {
+    guint position;
+    guint8 read, write;   /* what it adds for reading (inputs) and writing (outputs) */
+};
+
+/* The slaves whose active FMMUs overlap a logical datagram, and what each
+ * adds: LRD +1 per reading slave, LWR +1 per writing one, LRW +1 and +2. */
+guint shares_of(const bus_model *m, const datagram *d, share *out, guint max)
+{
+    guint32 start = d->adp | (guint32)d->ado << 16;
+    guint64 end = (guint64)start + d->length;
+    guint n = 0;
+    for (guint p = 0; p < m->positions && n < max; p++) {
+        const slave_state *s = m->slaves[p];
+        if (!s) continue;
+        guint8 type = 0;
+        for (guint i = 0; i < max_fmmus; i++) {
+            const fmmu *f = &s->fmmus[i];
+            if (f->known && f->active && f->length && f->logical < end && start < (guint64)f->logical + f->length)
+                type |= f->type;
+        }
+        share sh = {p, 0, 0};
+        if ((type & 1) && d->cmd != LWR) sh.read = 1;
+        if ((type & 2) && d->cmd != LRD) sh.write = d->cmd == LRW ? 2 : 1;
+        if (sh.read || sh.write) out[n++] = sh;
+    }
+    return n;
+}
+
+/* The working counter a logical datagram should come back with: the ENI's
+ * cyclic command (Cnt) when one matches, else from the FMMUs; -1 unknown. */
+gint32 expected_wkc(const bus_model *m, const datagram *d, share *shares, guint *share_count)
+{
+    *share_count = 0;
+    if (!logical(d->cmd)) return -1;
+    const dg_bus *b = m->design;
+    guint32 start = d->adp | (guint32)d->ado << 16;
+    if (b && b->cyclic)
+        for (guint i = 0; i < b->cyclic_count; i++) {
+            const dg_cyclic_cmd *c = &b->cyclic[i];
+            if (c->cmd == d->cmd && c->logical_address == start && c->length == d->length && c->expected_wkc >= 0) {
+                if (shares) *share_count = shares_of(m, d, shares, max_positions);
+                return c->expected_wkc;
+            }
+        }
+    if (!m->fmmus_known) return -1;
+    share local[64];
+    share *list = shares ? shares : local;
+    *share_count = shares_of(m, d, list, shares ? max_positions : G_N_ELEMENTS(local));
+    gint32 sum = 0;
+    for (guint i = 0; i < *share_count; i++) sum += list[i].read + list[i].write;
+    return sum;
+}
+
+/* "EL2004 at position 2", or "the slave at position 2". */
+const char *slave_text(const bus_model *m, guint position)
+{
+    const slave_state *s = position < max_positions ? m->slaves[position] : NULL;
+    gint32 device = -1;
+    if (s && words_known(s, W_VENDOR) && words_known(s, W_PRODUCT))
+        device = find_device(m->design, word32(s, W_VENDOR), word32(s, W_PRODUCT),
+                             words_known(s, W_REVISION) ? word32(s, W_REVISION) : 0);
+    if (device >= 0) return wmem_strdup_printf(wmem_file_scope(), "%s at position %u", m->design->devices[device].type, position);
+    return wmem_strdup_printf(wmem_file_scope(), "the slave at position %u", position);
+}
+
+/* A returned logical datagram whose working counter is not the expected one;
+ * when exactly one slave's part accounts for the difference, it is named. */
+void check_wkc(const bus_model *m, const datagram *s, const datagram *b, events *ev)
+{
+    share shares[max_positions];
+    guint n;
+    gint32 expected = expected_wkc(m, s, shares, &n);
+    gint32 got = (gint32)b->wkc - (gint32)s->wkc;
+    if (expected < 0 || got == expected) return;
+    wmem_strbuf_t *text = wmem_strbuf_new(wmem_file_scope(), "");
+    wmem_strbuf_append_printf(text, "%s: expected working counter %d, got %d", command_name(s->cmd), expected, got);
+    gint32 missing = expected - got;
+    const char *what = NULL;
+    guint who = 0, found = 0;
+    for (guint i = 0; i < n && missing > 0; i++) {
+        const char *parts[3] = {"did not read its inputs", "did not write its outputs", "did not process it"};
+        gint32 values[3] = {shares[i].read, shares[i].write, shares[i].read + shares[i].write};
+        for (guint k = 0; k < 3; k++) {
+            if (values[k] != missing || (k == 2 && (!shares[i].read || !shares[i].write))) continue;
+            found++;
+            who = shares[i].position;
+            what = parts[k];
+        }
+    }
+    if (found == 1) wmem_strbuf_append_printf(text, ": %s %s", slave_text(m, who), what);
+    ev->add(EV_WKC, b, wmem_strbuf_get_str(text));
+}
+
+/* SyncManager 0 and 1 configured as mailboxes (0x0800 + 8n: start 2,
+ * length 2, control 1 with mode bits 0-1 = 2). */
+void learn_mailboxes(slave_state *st, const datagram *d, tvbuff_t *sent)
+{
+    for (guint n = 0; n < 2; n++) {
+        gint at = register_at(d, 0x0800 + 8 * n, 5);
+        if (at < 0 || (dg_tvb_get_uint8(sent, at + 4) & 3) != 2) continue;
+        st->mailbox_start[n] = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
+        st->mailbox_length[n] = dg_tvb_get_uint16(sent, at + 2, ENC_LITTLE_ENDIAN);
+    }
+}
+
+gboolean is_mailbox(const slave_state *st, const datagram *d)
+{
+    for (guint n = 0; n < 2; n++)
+        if (st->mailbox_length[n] && d->ado >= st->mailbox_start[n] &&
+            d->ado < (guint32)st->mailbox_start[n] + st->mailbox_length[n])
+            return TRUE;
+    return FALSE;
+}
+
+/* An AL status read (0x0130) showing another state than the last one. */
+gboolean al_changed(slave_state *st, const datagram *b, tvbuff_t *back)
+{
+    gint at = register_at(b, 0x0130, 1);
+    if (at < 0) return FALSE;
+    guint8 state = dg_tvb_get_uint8(back, at) & 0x0f;
+    gboolean changed = st->al_known && state != st->al_state;
+    st->al_known = TRUE;
+    st->al_state = state;
+    return changed;
+}
+
+/* What one datagram pair teaches about the slave it addressed; its stat_flags. */
+guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagram *b, tvbuff_t *sent, tvbuff_t *back,
+                   events *ev)
+{
+    slave_state *st = slave_at(m, position);
+    if (!st) return 0;
+    guint8 flags = is_mailbox(st, s) ? ST_MAILBOX : 0;
+    if (b->wkc <= s->wkc) return flags | ST_WKC_ERROR;
+    gint at;
+    if (writes(s->cmd) && by_position(s->cmd) && (at = register_at(s, 0x0010, 2)) >= 0) {
+        st->station = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
+        st->station_known = TRUE;
+        wmem_map_insert(m->stations, GUINT_TO_POINTER((guint)st->station), GUINT_TO_POINTER(position + 1));
+    }
+    if ((at = register_at(s, 0x0012, 2)) >= 0) {
+        if (writes(s->cmd)) st->alias = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
+        else st->alias = dg_tvb_get_uint16(back, b->offset + (at - s->offset), ENC_LITTLE_ENDIAN);
+        st->alias_known = TRUE;
+    }
+    if (writes(s->cmd) && s->cmd != APRW && s->cmd != FPRW) {
+        learn_sii_address(st, s, sent);
+        learn_fmmus(m, st, s, sent);
+        learn_mailboxes(st, s, sent);
+    }
+    if (reads(s->cmd) && !writes(s->cmd)) {
+        learn_sii_data(m, position, st, b, back, ev);
+        if (al_changed(st, b, back)) flags |= ST_AL_CHANGE;
+    }
+    return flags;
+}
+
+/* The slave a datagram as sent addresses. */
+addressed address_of(const bus_model *m, const datagram *s)
+{
+    addressed a = {s->offset, 12 + s->length, -1, 0, FALSE, -1, 0, logical(s->cmd), *s};
+    guint shares;
+    a.expected_wkc = expected_wkc(m, s, NULL, &shares);
+    if (by_position(s->cmd)) {
+        guint16 p = position_of(s->adp);
+        if (p < max_positions) a.position = p;
+    } else if (by_station(s->cmd)) {
+        a.by_station = TRUE;
+        a.station = s->adp;
+        a.position = station_position(m, s->adp);
+    }
+    return a;
+}
+
+bus_frame *new_frame(const bus_model *m, guint count, const events *ev)
+{
+    bus_frame *f = wmem_new0(wmem_file_scope(), bus_frame);
+    f->model = m;
+    f->count = count;
+    f->d = wmem_alloc0_array(wmem_file_scope(), addressed, count ? count : 1);
+    if (ev && ev->count) {
+        f->event_count = ev->count;
+        f->events = (bus_event *)wmem_memdup(wmem_file_scope(), ev->list, ev->count * sizeof(bus_event));
+    }
+    return f;
+}
+
+void show_slave(const bus_model *m, const addressed *a, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    gint32 position = a->position;
+    if (position < 0 && a->by_station && PINFO_FD_VISITED(pinfo)) position = station_position(m, a->station);
+    if (position < 0) return;
+    const slave_state *s = m->slaves[position];
+    const dg_bus *b = m->design;
+    gint32 device = -1;
+    if (s && words_known(s, W_VENDOR) && words_known(s, W_PRODUCT))
+        device = find_device(b, word32(s, W_VENDOR), word32(s, W_PRODUCT),
+                             words_known(s, W_REVISION) ? word32(s, W_REVISION) : 0);
+    proto_item *item = proto_tree_add_none_format(tree, hf_slave, tvb, a->offset, a->length, "Slave at position %d%s%s",
+                                                  position, device >= 0 ? ": " : "",
+                                                  device >= 0 ? b->devices[device].name : "");
+    proto_item_set_generated(item);
+    proto_tree *sub = proto_item_add_subtree(item, ett_slave);
+    proto_item_set_generated(proto_tree_add_uint(sub, hf_position, tvb, a->offset, a->length, (guint32)position));
+    if (a->by_station || (s && s->station_known))
+        proto_item_set_generated(
+            proto_tree_add_uint(sub, hf_station, tvb, a->offset, a->length, a->by_station ? a->station : s->station));
+    if (!s) return;
+    if (s->alias_known)
+        proto_item_set_generated(proto_tree_add_uint(sub, hf_alias, tvb, a->offset, a->length, s->alias));
+    const int *hfs[] = {&hf_vendor, &hf_product, &hf_revision, &hf_serial};
+    const guint words[] = {W_VENDOR, W_PRODUCT, W_REVISION, W_SERIAL};
+    for (guint i = 0; i < G_N_ELEMENTS(words); i++)
+        if (words_known(s, words[i]))
+            proto_item_set_generated(proto_tree_add_uint(sub, *hfs[i], tvb, a->offset, a->length, word32(s, words[i])));
+    if (device >= 0)
+        proto_item_set_generated(proto_tree_add_string(sub, hf_name, tvb, a->offset, a->length, b->devices[device].type));
+}
+
+/* Up to 64 bits of the process image, least significant bit first. */
+guint64 image_bits(tvbuff_t *tvb, gint offset, guint bit, guint count)
+{
+    guint64 v = 0;
+    for (guint i = 0; i < count; i++) {
+        guint b = bit + i;
+        if (dg_tvb_get_uint8(tvb, offset + (gint)(b / 8)) >> (b % 8) & 1) v |= G_GUINT64_CONSTANT(1) << i;
+    }
+    return v;
+}
+
+/* One PDO entry at `bit` bits into the datagram's data. */
+void show_entry(proto_tree *tree, const dg_pdo_entry *e, tvbuff_t *tvb, gint data, guint32 bit)
+{
+    gint offset = data + (gint)(bit / 8), bytes = (gint)((bit % 8 + e->bit_length + 7) / 8);
+    if (bit % 8 == 0 && e->bit_length % 8 == 0 && e->bit_length > 1) {
+        proto_tree_add_item(tree, *e->hf, tvb, offset, e->bit_length / 8, ENC_LITTLE_ENDIAN);
+        return;
+    }
+    if (e->bit_length > 64) return;
+    guint64 v = image_bits(tvb, data, bit, e->bit_length);
+    header_field_info *hfi = proto_registrar_get_nth(*e->hf);
+    if (!hfi) return;
+    if (hfi->type == FT_BOOLEAN) proto_tree_add_boolean(tree, *e->hf, tvb, offset, bytes, v ? 1 : 0);
+    else if (IS_FT_UINT32(hfi->type)) proto_tree_add_uint(tree, *e->hf, tvb, offset, bytes, (guint32)v);
+    else if (IS_FT_UINT(hfi->type)) proto_tree_add_uint64(tree, *e->hf, tvb, offset, bytes, v);
+    else if (IS_FT_INT(hfi->type)) {
+        guint64 sign = G_GUINT64_CONSTANT(1) << (e->bit_length - 1);
+        gint64 value = (gint64)((v ^ sign) - sign);
+        if (IS_FT_INT32(hfi->type)) proto_tree_add_int(tree, *e->hf, tvb, offset, bytes, (gint32)value);
+        else proto_tree_add_int64(tree, *e->hf, tvb, offset, bytes, value);
+    }
+}
+
+/* The logical bit where a slave's inputs (FMMU read) or outputs (FMMU write) start, -1 unknown. */
+gint64 image_start(const dg_slave *ds, const slave_state *st, gboolean output)
+{
+    gint64 given = output ? ds->output_logical_bit : ds->input_logical_bit;
+    if (given >= 0) return given;
+    if (!st) return -1;
+    for (guint i = 0; i < max_fmmus; i++) {
+        const fmmu *f = &st->fmmus[i];
+        if (f->known && f->active && (f->type & (output ? 2 : 1))) return (gint64)f->logical * 8;
+    }
+    return -1;
+}
+
+/* A logical datagram's process data, one subtree per designed slave: outputs
+ * in the frame as sent, inputs in the returned one. */
+void show_process_data(const bus_model *m, const datagram *d, gboolean returned, tvbuff_t *tvb, proto_tree *tree)
+{
+    const dg_bus *b = m->design;
+    if (!b || !b->slaves || !logical(d->cmd)) return;
+    gboolean output = !returned;
+    if ((output && d->cmd == LRD) || (!output && d->cmd == LWR)) return;
+    gint64 first = (gint64)(d->adp | (guint32)d->ado << 16) * 8, end = first + (gint64)d->length * 8;
+    gint data = d->offset + 10;
+    for (guint p = 0; p < b->slave_count; p++) {
+        const dg_slave *ds = &b->slaves[p];
+        gint64 start = image_start(ds, p < max_positions ? m->slaves[p] : NULL, output);
+        if (start < 0) continue;
+        proto_tree *sub = NULL;
+        for (guint32 i = ds->entry_first; i < ds->entry_first + ds->entry_count; i++) {
+            const dg_pdo_entry *e = &b->entries[i];
+            if (!e->hf || *e->hf < 0 || (gboolean)e->output != output) continue;
+            gint64 at = e->logical_bit >= 0 ? e->logical_bit : start + e->bit_offset;
+            if (at < first || at + e->bit_length > end) continue;
+            if (!sub) {
+                proto_item *it = proto_tree_add_none_format(tree, hf_process_data, tvb, d->offset, 12 + d->length,
+                                                            "%s (position %u): %s", ds->name, p,
+                                                            output ? "outputs" : "inputs");
+                proto_item_set_generated(it);
+                sub = proto_item_add_subtree(it, ett_process_data);
+            }
+            show_entry(sub, e, tvb, data, (guint32)(at - first));
+        }
+    }
+}
+
+} /* namespace */
+
+const char *command_name(guint8 cmd) { return cmd < G_N_ELEMENTS(command_names) ? command_names[cmd] : "unknown"; }
+
+guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max)
+{
+    gint end = (gint)tvb_captured_length(tvb);
+    *header_length = 0;
+    if (end < 2) return 0;
+    guint16 header = dg_tvb_get_uint16(tvb, 0, ENC_LITTLE_ENDIAN);
+    *header_length = header & 0x7ff;
+    if ((header >> 12) != 1) return 0;
+    if ((gint)(2 + *header_length) < end) end = 2 + (gint)*header_length;
+    guint n = 0;
+    gint offset = 2;
+    while (n < max && offset + 12 <= end) {
+        datagram *d = &out[n];
+        d->offset = offset;
+        d->cmd = dg_tvb_get_uint8(tvb, offset);
+        d->idx = dg_tvb_get_uint8(tvb, offset + 1);
+        d->adp = dg_tvb_get_uint16(tvb, offset + 2, ENC_LITTLE_ENDIAN);
+        d->ado = dg_tvb_get_uint16(tvb, offset + 4, ENC_LITTLE_ENDIAN);
+        guint16 flags = dg_tvb_get_uint16(tvb, offset + 6, ENC_LITTLE_ENDIAN);
+        d->length = flags & 0x7ff;
+        if (offset + 12 + d->length > end) break;
+        d->wkc = dg_tvb_get_uint16(tvb, offset + 10 + d->length, ENC_LITTLE_ENDIAN);
+        n++;
+        offset += 12 + d->length;
+        if (!(flags & 0x8000)) break;
+    }
+    return n;
+}
+
+bus_model *bus_new(const dg_bus *design)
+{
+    bus_model *m = wmem_new0(wmem_file_scope(), bus_model);
+    m->design = design;
+    m->stations = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+    m->count_reported = -1;
+    return m;
+}
+
+bus_frame *bus_sent(bus_model *m, tvbuff_t *tvb, packet_info *)
+{
+    datagram d[max_datagrams];
+    guint header;
+    guint n = read_frame(tvb, &header, d, max_datagrams);
+    bus_frame *f = new_frame(m, n, NULL);
+    for (guint i = 0; i < n; i++) f->d[i] = address_of(m, &d[i]);
+    return f;
+}
+
+bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, packet_info *)
+{
+    datagram s[max_datagrams], b[max_datagrams];
+    guint header;
+    guint ns = read_frame(sent, &header, s, max_datagrams), nb = read_frame(back, &header, b, max_datagrams);
+    guint n = MIN(ns, nb);
+    events ev = {};
+    guint8 flags[max_datagrams] = {};
+    for (guint i = 0; i < n; i++) {
+        if (logical(s[i].cmd) && s[i].cmd == b[i].cmd && s[i].adp == b[i].adp && s[i].ado == b[i].ado &&
+            s[i].length == b[i].length)
+            check_wkc(m, &s[i], &b[i], &ev);
+        if (s[i].cmd != b[i].cmd || s[i].ado != b[i].ado || s[i].length != b[i].length) continue;
+        gint32 position = by_position(s[i].cmd) ? position_of(s[i].adp)
+                          : by_station(s[i].cmd) ? station_position(m, s[i].adp) : -1;
+        if (position >= 0) flags[i] = learn_slave(m, (guint)position, &s[i], &b[i], sent, back, &ev);
+        if (b[i].wkc <= s[i].wkc) continue;
+        guint added = (guint)(b[i].wkc - s[i].wkc);
+        if (s[i].cmd == BRD) learn_count(m, added, &b[i], &ev);
+        else if (s[i].cmd == BWR)
+            for (guint p = 0; m->count_known && p < m->count && p < max_positions; p++)
+                learn_sii_address(slave_at(m, p), &s[i], sent);
+    }
+    bus_frame *f = new_frame(m, n, &ev);
+    f->returned = TRUE;
+    for (guint i = 0; i < n; i++) {
+        f->d[i] = address_of(m, &s[i]);
+        f->d[i].offset = b[i].offset; /* the items go over the returned datagram */
+        f->d[i].length = 12 + b[i].length;
+        f->d[i].stats = flags[i];
+        f->d[i].dgram = b[i];
+    }
+    return f;
+}
+
+void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    if (!f) return;
+    for (guint i = 0; i < f->count; i++) {
+        const addressed *a = &f->d[i];
+        show_slave(f->model, a, tvb, pinfo, tree);
+        if (a->logical) show_process_data(f->model, &a->dgram, f->returned, tvb, tree);
+        if (a->expected_wkc >= 0)
+            proto_item_set_generated(proto_tree_add_uint(tree, hf_wkc_expected, tvb, a->offset + a->length - 2, 2,
+                                                         (guint32)a->expected_wkc));
+    }
+    for (guint i = 0; i < f->event_count; i++) {
+        const bus_event *e = &f->events[i];
+        expert_field *ei = e->kind == EV_COUNT ? &ei_count : e->kind == EV_MODEL ? &ei_model
+                           : e->kind == EV_WKC ? &ei_wkc : &ei_ok;
+        proto_tree_add_expert_format(tree, pinfo, ei, tvb, e->offset, e->length, "%s", e->text);
+    }
+}
+
+/* --- statistics: a node per slave position ------------------------------ */
+
+namespace {
+const char *const st_slaves = "Slaves (returned datagrams)";
+const char *const st_datagrams = "Datagrams";
+const char *const st_wkc_error = "Working counter not raised";
+const char *const st_al = "AL state changes";
+const char *const st_mailbox = "Mailbox datagrams";
+const char *const st_wkc_expected = "Unexpected working counter";
+int st_slaves_id;
+} /* namespace */
+
+void bus_stats_init(stats_tree *st, int parent)
+{
+    st_slaves_id = stats_tree_create_node(st, st_slaves, parent, STAT_DT_INT, TRUE);
+    stats_tree_create_node(st, st_wkc_expected, parent, STAT_DT_INT, FALSE);
+}
+
+void bus_stats_frame(stats_tree *st, int parent, const bus_frame *f)
+{
+    if (!f) return;
+    char label[48];
+    for (guint i = 0; i < f->count; i++) {
+        const addressed *a = &f->d[i];
+        if (a->position < 0) continue;
+        g_snprintf(label, sizeof label, "Position %d", a->position);
+        tick_stat_node(st, st_slaves, parent, TRUE);
+        int id = tick_stat_node(st, label, st_slaves_id, TRUE);
+        tick_stat_node(st, st_datagrams, id, FALSE);
+        if (a->stats & ST_WKC_ERROR) tick_stat_node(st, st_wkc_error, id, FALSE);
+        if (a->stats & ST_AL_CHANGE) tick_stat_node(st, st_al, id, FALSE);
+        if (a->stats & ST_MAILBOX) tick_stat_node(st, st_mailbox, id, FALSE);
+    }
+    for (guint i = 0; i < f->event_count; i++)
+        if (f->events[i].kind == EV_WKC) tick_stat_node(st, st_wkc_expected, parent, FALSE);
+}
+
+void bus_register(int proto, const char *filter)
+{
+    static hf_register_info hf[] = {
+        {&hf_process_data, {"Process data", NULL, FT_NONE, BASE_NONE, NULL, 0x0,
+                            "One designed slave's PDO entries in this logical datagram", HFILL}},
+        {&hf_wkc_expected, {"Expected working counter", NULL, FT_UINT16, BASE_DEC, NULL, 0x0,
+                            "From the ENI's cyclic commands (Cnt), else from the slaves' FMMU configuration", HFILL}},
+        {&hf_slave, {"Slave", NULL, FT_NONE, BASE_NONE, NULL, 0x0,
+                     "The slave this datagram addresses, as the capture shows it", HFILL}},
+        {&hf_position, {"Position", NULL, FT_UINT16, BASE_DEC, NULL, 0x0, "Position on the segment, from 0", HFILL}},
+        {&hf_station, {"Station address", NULL, FT_UINT16, BASE_HEX, NULL, 0x0,
+                       "Configured station address (register 0x0010)", HFILL}},
+        {&hf_alias, {"Station alias", NULL, FT_UINT16, BASE_HEX, NULL, 0x0, "Configured station alias (register 0x0012)",
+                     HFILL}},
+        {&hf_vendor, {"Vendor id", NULL, FT_UINT32, BASE_HEX, NULL, 0x0, "From the SII EEPROM (word 0x0008)", HFILL}},
+        {&hf_product, {"Product code", NULL, FT_UINT32, BASE_HEX, NULL, 0x0, "From the SII EEPROM (word 0x000A)", HFILL}},
+        {&hf_revision, {"Revision", NULL, FT_UINT32, BASE_HEX, NULL, 0x0, "From the SII EEPROM (word 0x000C)", HFILL}},
+        {&hf_serial, {"Serial number", NULL, FT_UINT32, BASE_HEX, NULL, 0x0, "From the SII EEPROM (word 0x000E)", HFILL}},
+        {&hf_name, {"Model", NULL, FT_STRING, BASE_NONE, NULL, 0x0,
+                    "The device type of the ESI catalogue embedded with --esi", HFILL}},
+    };
+    const char *names[] = {"process_data", "wkc.expected", "slave", "slave.position", "slave.station", "slave.alias", "slave.vendor",
+                           "slave.product", "slave.revision", "slave.serial", "slave.name"};
+    for (guint i = 0; i < G_N_ELEMENTS(hf); i++) hf[i].hfinfo.abbrev = g_strdup_printf("%s.%s", filter, names[i]);
+    proto_register_field_array(proto, hf, (int)G_N_ELEMENTS(hf));
+    static gint *ett[] = {&ett_slave, &ett_process_data};
+    proto_register_subtree_array(ett, (int)G_N_ELEMENTS(ett));
+
+    static ei_register_info ei[] = {
+        {&ei_count, {NULL, PI_PROTOCOL, PI_ERROR, "Slave count differs from the network design", EXPFILL}},
+        {&ei_model, {NULL, PI_PROTOCOL, PI_ERROR, "Slave model differs from the network design", EXPFILL}},
+        {&ei_ok, {NULL, PI_PROTOCOL, PI_NOTE, "The bus matches the network design", EXPFILL}},
+        {&ei_wkc, {NULL, PI_PROTOCOL, PI_WARN, "Working counter differs from the expected one", EXPFILL}},
+    };
+    const char *ei_names[] = {"network.count", "network.model", "network.ok", "wkc"};
+    for (guint i = 0; i < G_N_ELEMENTS(ei); i++)
+        ei[i].eiinfo.name = g_strdup_printf("%s.expert.%s", filter, ei_names[i]);
+    expert_register_field_array(expert_register_protocol(proto), ei, (int)G_N_ELEMENTS(ei));
+}
+
+} /* namespace dg_ecat */

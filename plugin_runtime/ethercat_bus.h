@@ -1,0 +1,49 @@
+/* The EtherCAT bus as the capture shows it (issue 12): what ethercat_esc.cpp
+ * and ethercat_bus.cpp share. ethercat_esc.cpp compares each returned frame
+ * with the one sent; ethercat_bus.cpp learns the slaves from the same frames
+ * (count, positions, station addresses, identities from the SII EEPROM) and
+ * checks them against the network design embedded with `--network`.
+ * C++ only, inside the runtime. */
+#pragma once
+
+#include "dissgen_bus.h"
+#include "dissgen_pairing.h"
+
+namespace dg_ecat {
+
+/* One datagram as read from a frame. */
+struct datagram {
+    gint offset;        /* of the datagram in its tvb */
+    guint8 cmd, idx;
+    guint16 adp, ado;   /* the 32-bit address: ADP low half, ADO high half */
+    guint16 length;     /* of the data */
+    guint16 wkc;
+};
+
+/* At most this many datagrams per frame: 1500 bytes hold at most 124. */
+const guint max_datagrams = 128;
+
+/* The frame's header length, and its datagrams (up to `max`); every read is
+ * checked against the bytes there are. */
+guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max);
+
+const char *command_name(guint8 cmd);
+
+struct bus_model;   /* capture-wide, wmem_file_scope */
+struct bus_frame;   /* one frame's slaves and network-check findings, wmem_file_scope */
+
+bus_model *bus_new(const dg_bus *design);
+/* First pass. A frame as sent (a request, or one whose response is not paired):
+ * which slave each datagram addresses. */
+bus_frame *bus_sent(bus_model *m, tvbuff_t *tvb, packet_info *pinfo);
+/* First pass. A returned frame with the frame as sent: what it teaches about
+ * the bus, and which slave each datagram addresses. */
+bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, packet_info *pinfo);
+/* Every pass: the slave items and the network-check expert infos. */
+void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+void bus_register(int proto, const char *filter);
+/* Statistics (tshark -z ecatr,tree): per slave position, from returned frames. */
+void bus_stats_init(stats_tree *st, int parent);
+void bus_stats_frame(stats_tree *st, int parent, const bus_frame *f);
+
+} /* namespace dg_ecat */

@@ -1,0 +1,410 @@
+#!/usr/bin/env python3
+"""The bus as the capture shows it, and the network check (issue 12), with real tshark.
+
+1. Identities: on every real capture of ../shared/corpus/ethercat, the slaves the plugin
+   reports per position (ecatr.slave.position/station/vendor/product/revision) are the ones
+   the corpus README lists (read there from the SII EEPROM by other means). With
+   --esi Beckhoff_EK11xx.xml --esi Beckhoff_EL1xxx.xml the SOEM capture names both slaves
+   (ecatr.slave.name EK1100, EL1004); with `-2` every datagram addressed to a slave carries
+   its identity, also those before the scan.
+2. The network check on soem-sdinfo-ek1100-el1004 (EK1100 + EL1004) with four designs:
+   matching (one ecatr.expert.network.ok, no error), a slave dropped and one added
+   (ecatr.expert.network.count on the first broadcast read that shows the count, nothing
+   else), two models swapped (ecatr.expert.network.model on the two frames where the
+   identities are read, nothing else). The frames are those a reading of the bytes here
+   (not the plugin) finds; one pass and `-2` give the same experts.
+3. Expected working counters (ecatr.wkc.expected, from the FMMU configuration the master
+   wrote): no ecatr.expert.wkc on any real capture; on copies of the ethercrab captures with
+   the returned working counter of some logical datagrams lowered, ecatr.expert.wkc on
+   exactly those frames (one pass and -2).
+4. The per-slave statistics (-z ecatr,tree): the same in one pass and -2, and the datagram
+   counts those of the returned frames' slave items.
+5. The ENI of ../shared/corpus/eni: its cyclic commands' Cnt is the expected working counter
+   of a matching LRD (generated frames: the right count, then one short).
+6. Process data by name (generated frames, tests/esi_ok/small_io.xml with
+   tests/network/small_design.xml): after the stations and FMMUs are set, an LRW shows the
+   EL2004's outputs (ecatr.pdo.el2004.*) in the frame as sent and the EL1004's inputs
+   (ecatr.pdo.el1004.*) in the returned one, with the values written into the bytes here.
+Skips (exit 77) when the corpus is absent (part 6 runs all the same).
+"""
+import argparse
+import os
+import struct
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pcapgen as pg  # noqa: E402
+import pcaprewrite as pr  # noqa: E402
+from tshark_env import Checks, TsharkEnv  # noqa: E402
+
+SKIP = 77
+check = Checks()
+SLAVE = ["ecatr.slave.position", "ecatr.slave.station", "ecatr.slave.vendor", "ecatr.slave.product",
+         "ecatr.slave.revision", "ecatr.slave.name"]
+EXPERTS = ["ecatr.expert.network.count", "ecatr.expert.network.model", "ecatr.expert.network.ok"]
+
+# From ../shared/corpus/README.md: (vendor, product, revision) by position; None: not stated there.
+BECKHOFF = 2
+EK1100 = (BECKHOFF, 0x044c2c52, 0x00120000)
+EL1004 = (BECKHOFF, 0x03ec3052, 0x00130000)
+EXPECTED = {
+    "soem-sdinfo-ek1100-el1004.pcapng": [EK1100, EL1004],
+    "twincat-scan-boxes.pcapng": [EK1100, EL1004],
+    "replay-ek1100-el2828-el2889.pcapng": [EK1100, (BECKHOFF, 0x0b0c3052, None), (BECKHOFF, 0x0b493052, None)],
+    "replay-dc.pcapng": [EK1100, (BECKHOFF, 0x0b0c3052, None), (BECKHOFF, 0x0b493052, None)],
+    "replay-issue-255.pcapng": [EK1100, (BECKHOFF, 0x0b0c3052, None), (BECKHOFF, 0x0b493052, None)],
+    "replay-ek1914-segmented-upload.pcapng": [(BECKHOFF, 0x077a2c52, None), (BECKHOFF, 0x0bbc3052, None)],
+    "replay-sdo-error.pcapng": [(BECKHOFF, 0x077a2c52, None)],
+    "twincat-akd-nc-mode.pcapng": [(0x6a, 0x00414b44, None)],
+    "soem-sdinfo-no-slaves.pcapng": [],
+}
+
+
+def decode(env, path, fields, two_pass, display_filter=None):
+    """[(frame, {field: [values]})] from tshark -T fields (all occurrences)."""
+    args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=;", "-e", "frame.number"]
+    if two_pass:
+        args.append("-2")
+    if display_filter:
+        args += ["-Y", display_filter]
+    for f in fields:
+        args += ["-e", f]
+    rows = []
+    for line in env.tshark(args).stdout.splitlines():
+        cols = line.split("\t") + [""] * len(fields)
+        rows.append((int(cols[0]), {f: [v for v in cols[i + 1].split(";") if v] for i, f in enumerate(fields)}))
+    return rows
+
+
+def slaves_seen(rows):
+    """{position: {(station, vendor, product, revision, name)}} over every datagram."""
+    seen = {}
+    for _n, r in rows:
+        k = len(r["ecatr.slave.position"])
+        for i in range(k):
+            def col(f):
+                v = r[f]
+                return v[i] if len(v) == k else ("?" if v else "")
+            seen.setdefault(int(col("ecatr.slave.position")), set()).add(
+                tuple(col(f) for f in SLAVE[1:]))
+    return seen
+
+
+# ----------------------------------------------------------------------------- the bytes' view
+
+def returned_pairs(cap):
+    """[(frame number, sent datagrams, returned datagrams)] of returned frames, paired with the
+    latest sent frame of the same datagram commands and lengths (returned frames come from the
+    master's address with the locally administered bit set)."""
+    out, waiting = [], {}
+    for i, p in enumerate(cap.packets):
+        dgs = pr.ecat_datagrams(p)
+        if not dgs:
+            continue
+        key = tuple((d["cmd"], d["idx"], d["length"]) for d in dgs)
+        if p.data[6] & 0x02:
+            if key in waiting:
+                out.append((i + 1, waiting.pop(key), (p, dgs)))
+        else:
+            waiting[key] = (p, dgs)
+    return out
+
+
+def u16(p, off):
+    return struct.unpack("<H", bytes(p.data[off:off + 2]))[0]
+
+
+def oracle(cap):
+    """(frame of the first BRD with a working counter, {position: frame where vendor and
+    product had both been read from the SII EEPROM})."""
+    first_brd, station_pos, address, words, identity_frame = None, {}, {}, {}, {}
+    for n, (sp, sent), (bp, back) in returned_pairs(cap):
+        for s, b in zip(sent, back):
+            if b["wkc"] <= s["wkc"]:
+                continue
+            if s["cmd"] == 7 and first_brd is None:
+                first_brd = n
+            if s["cmd"] in (1, 2):  # APRD APWR
+                pos = (0x10000 - s["adp"]) & 0xFFFF
+            elif s["cmd"] in (4, 5):  # FPRD FPWR
+                pos = station_pos.get(s["adp"])
+            else:
+                continue
+            if s["cmd"] == 2 and s["ado"] == 0x0010:
+                station_pos[u16(sp, s["data_offset"])] = pos
+            if s["cmd"] in (2, 5) and s["ado"] <= 0x0504 <= s["ado"] + s["length"] - 2:
+                address[pos] = u16(sp, s["data_offset"] + 0x0504 - s["ado"])
+            if s["cmd"] in (1, 4) and s["ado"] == 0x0508 and pos in address:
+                for w in range(b["length"] // 2):
+                    words.setdefault(pos, set()).add(address[pos] + w)
+                if pos not in identity_frame and {8, 9, 10, 11} <= words.get(pos, set()):
+                    identity_frame[pos] = n
+    return first_brd, identity_frame
+
+
+# ----------------------------------------------------------------------------- checks
+
+def identity_checks(env, corpus, files):
+    print("\n== identities per capture (tshark -2)")
+    for name in files:
+        rows = decode(env, os.path.join(corpus, name), SLAVE, True, "ecatr.slave")
+        seen = slaves_seen(rows)
+        want = EXPECTED.get(name)
+        print("%s: %d datagram frames with slaves; %s" % (name, len(rows), {
+            p: sorted(v) for p, v in sorted(seen.items())}))
+        if want is None:
+            continue
+        check(sorted(seen) == list(range(len(want))), "%s: positions %s" % (name, list(range(len(want)))))
+        for pos, (vendor, product, revision) in enumerate(want):
+            ids = {(v, pr_, r) for _st, v, pr_, r, _name in seen.get(pos, set())}
+            got = ids == {("0x%08x" % vendor, "0x%08x" % product,
+                           "0x%08x" % revision if revision is not None else next(iter(ids))[2])} if ids else False
+            check(got, "%s: position %d is vendor 0x%x product 0x%08x%s on every datagram (-2): %s" % (
+                name, pos, vendor, product, "" if revision is None else " revision 0x%08x" % revision, sorted(ids)))
+            stations = {st for st, *_rest in seen.get(pos, set())}
+            check(len(stations) == 1 and "" not in stations, "%s: position %d has one station %s" % (
+                name, pos, sorted(stations)))
+
+
+def names_checks(env, corpus):
+    print("\n== names from the ESI files (soem-sdinfo-ek1100-el1004)")
+    path = os.path.join(corpus, "soem-sdinfo-ek1100-el1004.pcapng")
+    rows = decode(env, path, SLAVE, True, "ecatr.slave")
+    seen = slaves_seen(rows)
+    names = {p: {t[-1] for t in v} for p, v in seen.items()}
+    check(names == {0: {"EK1100"}, 1: {"EL1004"}}, "-2: every datagram to position 0 names EK1100, to 1 EL1004: %s"
+          % names)
+    one = decode(env, path, SLAVE, False, "ecatr.slave")
+    _brd, ident = oracle(pr.Capture.read(path))
+    for pos, want in ((0, "EK1100"), (1, "EL1004")):
+        named = [n for n, r in one if pos_name(r, pos) == want]
+        unnamed = [n for n, r in one if pos_name(r, pos) == ""]
+        check(named and min(named) == ident[pos] and (not unnamed or max(unnamed) < ident[pos]),
+              "one pass: position %d named %s from frame %s on (identity read there), not before" % (
+                  pos, want, ident.get(pos)))
+
+
+def pos_name(r, pos):
+    ps, ns = r["ecatr.slave.position"], r["ecatr.slave.name"]
+    if str(pos) not in ps:
+        return None
+    return ns[0] if ns and len(set(ps)) == 1 else ("" if not ns else None)
+
+
+def design(env, name, slaves):
+    body = "".join('  <slave vendor="0x%x" product="0x%08x"/>\n' % s[:2] for s in slaves)
+    return env.add_file(name, ("<network>\n%s</network>\n" % body).encode())
+
+
+def network_checks(dissgen, rules, corpus):
+    print("\n== the network check (soem-sdinfo-ek1100-el1004)")
+    path = os.path.join(corpus, "soem-sdinfo-ek1100-el1004.pcapng")
+    first_brd, ident = oracle(pr.Capture.read(path))
+    print("bytes: first BRD answered in frame %s; identities read in frames %s" % (first_brd, ident))
+    cases = [
+        ("match", [EK1100, EL1004], {"ok": {max(ident.values())}}),
+        ("drop", [EK1100], {"count": {first_brd}}),
+        ("add", [EK1100, EL1004, EL1004], {"count": {first_brd}}),
+        ("swap", [EL1004, EK1100], {"model": {ident[0], ident[1]}}),
+    ]
+    for case, slaves, want in cases:
+        with TsharkEnv() as env:
+            env.install_plugin(dissgen, rules, ["--network", design(env, case + ".xml", slaves)])
+            local = env.add_file("soem.pcapng", open(path, "rb").read())
+            results = []
+            for two_pass in (False, True):
+                rows = decode(env, local, EXPERTS, two_pass)
+                got = {e.rsplit(".", 1)[1]: {n for n, r in rows if r[e]} for e in EXPERTS}
+                got = {k: v for k, v in got.items() if v}
+                results.append(got)
+                check(got == want, "%s design%s: experts %s, expected %s" % (
+                    case, " (-2)" if two_pass else "", got, want))
+            texts = env.tshark(["-r", local, "-2", "-z", "expert,note", "-q"]).stdout
+            for line in texts.splitlines():
+                if "design" in line or "Position" in line:
+                    print("   " + line.strip())
+
+
+def wkc_checks(env, corpus, files):
+    print("\n== expected working counters")
+    for name in files:
+        path = os.path.join(corpus, name)
+        rows = decode(env, path, ["ecatr.wkc.expected", "ecatr.expert.wkc"], True)
+        with_expected = [n for n, r in rows if r["ecatr.wkc.expected"]]
+        flagged = [n for n, r in rows if r["ecatr.expert.wkc"]]
+        print("%s: %d frames with an expected working counter, %d flagged" % (name, len(with_expected),
+                                                                             len(flagged)))
+        check(not flagged, "%s: no ecatr.expert.wkc on the real capture" % name)
+    for name in ("replay-ek1100-el2828-el2889.pcapng", "replay-dc.pcapng", "replay-issue-255.pcapng"):
+        if name not in files:
+            continue
+        cap = pr.Capture.read(os.path.join(corpus, name))
+        returned = [i for i, p in enumerate(cap.packets)
+                    if p.data[6] & 0x02 and any(d["cmd"] in (10, 11, 12) and d["wkc"] for d in pr.ecat_datagrams(p))]
+        lowered = set()
+        for k, i in enumerate(returned):
+            if k % 37 != 5:
+                continue
+            p = cap.packets[i]
+            d = next(d for d in pr.ecat_datagrams(p) if d["cmd"] in (10, 11, 12) and d["wkc"])
+            pr.set_u16(p, d["wkc_offset"], d["wkc"] - 1)
+            lowered.add(i + 1)
+        faulty = env.add_file("wkc-" + name, b"")
+        cap.write(faulty)
+        os.chmod(faulty, 0o644)
+        for two_pass in (False, True):
+            rows = decode(env, faulty, ["ecatr.expert.wkc"], two_pass)
+            flagged = {n for n, r in rows if r["ecatr.expert.wkc"]}
+            check(flagged == lowered, "%s with %d returned working counters lowered%s: ecatr.expert.wkc on exactly "
+                  "those frames (missing %s, extra %s)" % (name, len(lowered), " (-2)" if two_pass else "",
+                                                           sorted(lowered - flagged)[:5], sorted(flagged - lowered)[:5]))
+        texts = env.tshark(["-r", faulty, "-q", "-z", "expert,warn"]).stdout
+        print("\n".join("   " + l.strip() for l in texts.splitlines() if "expected working counter" in l))
+
+
+def slave_stats(env, path, two_pass):
+    """{position: {item: count}} of the "Slaves" part of -z ecatr,tree."""
+    args = ["-r", path, "-q", "-z", "ecatr,tree"] + (["-2"] if two_pass else [])
+    out, pos = {}, None
+    for line in env.tshark(args).stdout.splitlines():
+        label = line[:41].strip()
+        cols = line[41:].split()
+        if line.startswith("  Position "):
+            pos = int(label.split()[1])
+            out[pos] = {}
+        elif line.startswith("   ") and pos is not None and cols:
+            out[pos][label] = int(cols[0])
+        elif not line.startswith("   "):
+            pos = None
+    return out
+
+
+def stats_checks(env, corpus):
+    print("\n== statistics per slave (-z ecatr,tree)")
+    for name in ("soem-sdinfo-ek1100-el1004.pcapng", "replay-mailbox-el6910.pcapng", "twincat-scan-boxes.pcapng"):
+        path = os.path.join(corpus, name)
+        one, two = slave_stats(env, path, False), slave_stats(env, path, True)
+        print("%s: %s" % (name, one))
+        check(one == two and one, "%s: the same per-slave statistics in one pass and -2" % name)
+        rows = decode(env, path, ["ecatr.slave.position"], False, "ecatr.request_in")
+        counts = {}
+        for _n, r in rows:
+            for p in r["ecatr.slave.position"]:
+                counts[int(p)] = counts.get(int(p), 0) + 1
+        check({p: v.get("Datagrams") for p, v in one.items()} == counts,
+              "%s: per-slave datagram counts are those of the returned frames' ecatr.slave.position (%s)"
+              % (name, counts))
+
+
+def eni_checks(dissgen, rules, shared):
+    print("\n== the ENI's expected working counters")
+    eni = os.path.join(shared, "eni", "twincat_5_slaves_eni.xml")
+    # Its cyclic frame reads 14 bytes at logical 0x01000000 with <Cnt>1</Cnt>.
+    master, back = b"\x00\x00\x00\x00\x00\x01", b"\x02\x00\x00\x00\x00\x01"
+    frames = []
+    for i, wkc in enumerate((1, 0)):
+        for src, w in ((master, 0), (back, wkc)):
+            frames.append(pg.Frame([pg.Datagram(10, idx=i, lad=0x01000000, data=bytes(14), wkc=w)], src_mac=src))
+    with TsharkEnv() as env:
+        env.install_plugin(dissgen, rules, ["--network", eni])
+        path = env.add_file("eni.pcap", pg.pcap_bytes(frames))
+        for two_pass in (False, True):
+            rows = decode(env, path, ["ecatr.wkc.expected", "ecatr.expert.wkc"], two_pass)
+            got = [(n, r["ecatr.wkc.expected"], bool(r["ecatr.expert.wkc"])) for n, r in rows]
+            check(got == [(1, ["1"], False), (2, ["1"], False), (3, ["1"], False), (4, ["1"], True)],
+                  "ENI Cnt 1 expected on every frame, ecatr.expert.wkc on frame 4 only%s: %s" % (
+                      " (-2)" if two_pass else "", got))
+
+
+def fmmu(logical, length, kind):
+    return struct.pack("<IHBBHBBBxxx", logical, length, 0, 7, 0x1000, 0, kind, 1)
+
+
+def pdo_checks(dissgen, source_dir):
+    print("\n== process data by name (generated frames)")
+    master, back = b"\x00\x00\x00\x00\x00\x01", b"\x02\x00\x00\x00\x00\x01"
+    mode, setpoint = 0x35, -1234
+    outputs = bytes([1 | mode << 1]) + struct.pack("<h", setpoint)
+    steps = [  # (sent datagram, returned data or None: as sent, returned wkc)
+        (pg.Datagram(2, adp=0xFFFF, ado=0x0010, data=struct.pack("<H", 0x1002)), None, 1),  # position 1
+        (pg.Datagram(2, adp=0xFFFE, ado=0x0010, data=struct.pack("<H", 0x1003)), None, 1),  # position 2
+        (pg.Datagram(5, adp=0x1002, ado=0x0600, data=fmmu(0x10000, 1, 1)), None, 1),  # EL1004 reads
+        (pg.Datagram(5, adp=0x1003, ado=0x0600, data=fmmu(0x10001, 3, 2)), None, 1),  # EL2004 writes
+        (pg.Datagram(12, lad=0x10000, data=bytes(1) + outputs), bytes([0b101]) + outputs, 3),
+    ]
+    frames = []
+    for i, (d, data, wkc) in enumerate(steps):
+        d.idx = i
+        frames.append(pg.Frame([d], src_mac=master))
+        r = pg.Datagram(d.cmd, idx=i, adp=d.adp, ado=d.ado, lad=d.lad, data=data if data else d.data, wkc=wkc)
+        frames.append(pg.Frame([r], src_mac=back))
+    fields = ["ecatr.pdo.el1004.channel_1.input", "ecatr.pdo.el1004.channel_2.input",
+              "ecatr.pdo.el1004.channel_3.input", "ecatr.pdo.el2004.channel_1.output",
+              "ecatr.pdo.el2004.channel_1.mode", "ecatr.pdo.el2004.channel_1.setpoint",
+              "ecatr.wkc.expected", "ecatr.expert.wkc"]
+    yes = {"1", "True"}
+    no = {"0", "False"}
+    with TsharkEnv() as env:
+        env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"),
+                           ["--esi", os.path.join(source_dir, "tests", "esi_ok", "small_io.xml"),
+                            "--network", os.path.join(source_dir, "tests", "network", "small_design.xml")])
+        path = env.add_file("pdo.pcap", pg.pcap_bytes(frames))
+        for two_pass in (False, True):
+            rows = dict(decode(env, path, fields, two_pass))
+            tag = " (-2)" if two_pass else ""
+            sent, ret = rows[9], rows[10]
+            check(sent["ecatr.pdo.el2004.channel_1.output"][0] in yes and
+                  sent["ecatr.pdo.el2004.channel_1.mode"] == [str(mode)] and
+                  sent["ecatr.pdo.el2004.channel_1.setpoint"] == [str(setpoint)],
+                  "LRW as sent: EL2004 outputs by name (1, %d, %d)%s: %s" % (mode, setpoint, tag, sent))
+            check(not any(sent[f] for f in fields[:3]), "LRW as sent: no EL1004 inputs" + tag)
+            check([ret[f][0] if ret[f] else "" for f in fields[:3]] in (["1", "0", "1"], ["True", "False", "True"]),
+                  "LRW returned: EL1004 inputs by name (1, 0, 1)%s: %s" % (tag, ret))
+            check(not any(ret[f] for f in fields[3:6]), "LRW returned: no EL2004 outputs" + tag)
+            check(sent["ecatr.wkc.expected"] == ["3"] and ret["ecatr.wkc.expected"] == ["3"] and
+                  not ret["ecatr.expert.wkc"], "expected working counter 3 (EL1004 +1, EL2004 +2), met" + tag)
+            check(not any(r[f] for n, r in rows.items() if n < 9 for f in fields[:6]),
+                  "no process data before the LRW" + tag)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--dissgen", required=True)
+    ap.add_argument("--source-dir", required=True)
+    ap.add_argument("--only", help="run only this part (pdo)")
+    args = ap.parse_args()
+    if args.only == "pdo":
+        pdo_checks(args.dissgen, args.source_dir)
+        return 1 if check.failed else 0
+    shared = os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus")
+    corpus = os.path.join(shared, "ethercat")
+    files = sorted(f for f in os.listdir(corpus) if f.endswith((".pcap", ".pcapng"))) \
+        if os.path.isdir(corpus) else []
+    if not files:
+        pdo_checks(args.dissgen, args.source_dir)
+        if check.failed:
+            return 1
+        print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng)" % corpus)
+        return SKIP
+    rules = os.path.join(args.source_dir, "rules", "ethercat.xml")
+    with TsharkEnv() as env:
+        env.install_plugin(args.dissgen, rules, ["--esi", os.path.join(shared, "esi", "Beckhoff_EK11xx.xml"),
+                                                 "--esi", os.path.join(shared, "esi", "Beckhoff_EL1xxx.xml")])
+        env.assert_plugin_loaded("ecatr")
+        for f in files:
+            env.add_file(f, open(os.path.join(corpus, f), "rb").read())
+        identity_checks(env, env.home, files)
+        names_checks(env, env.home)
+        wkc_checks(env, env.home, files)
+        stats_checks(env, env.home)
+        rows = decode(env, os.path.join(env.home, "soem-sdinfo-ek1100-el1004.pcapng"), EXPERTS, True)
+        check(not any(any(r.values()) for _n, r in rows), "no network experts without a design")
+    network_checks(args.dissgen, rules, corpus)
+    eni_checks(args.dissgen, rules, shared)
+    pdo_checks(args.dissgen, args.source_dir)
+    print("\n%d failed" % len(check.failed))
+    return 1 if check.failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
