@@ -30,6 +30,8 @@ std::string segment(const std::string& text) {
     return out;
 }
 
+}  // namespace
+
 // How an entry of an ESI data type is registered with Wireshark.
 FieldType pdo_field_type(const std::string& data_type, unsigned bits) {
     static const std::map<std::string, FieldType> kTypes = {
@@ -54,6 +56,8 @@ FieldType pdo_field_type(const std::string& data_type, unsigned bits) {
     }
     return {"FT_BYTES", "BASE_NONE"};  // arrays, strings, vendor types: the bytes
 }
+
+namespace {
 
 struct Field {
     std::string ident;   // C name of the hf variable

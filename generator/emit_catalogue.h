@@ -18,6 +18,10 @@ struct BusOptions {
 // `filter` is the protocol's filter name: fields are FILTER.pdo.OWNER.PDO.ENTRY.
 EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& options, const std::string& filter);
 
+// The field type of a PDO entry of ESI DataType `data_type` and `bits` bits
+// (BITn: the smallest unsigned type that holds n bits; unknown types: bytes).
+FieldType pdo_field_type(const std::string& data_type, unsigned bits);
+
 // One line per PDO field, as list_fields() prints the rule fields.
 std::string list_bus_fields(const Catalogue& cat, const BusOptions& options, const std::string& filter);
 

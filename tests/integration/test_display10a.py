@@ -160,7 +160,11 @@ class Display10a(unittest.TestCase):
             "dspt.values.cycle": seconds(v["cycle_ms"], 10 ** 3),
             "dspt.values.uptime": seconds(v["uptime_s"], 1),
             "dspt.values.status": "0x%04x" % v["status"],
-            "_ws.col.Info": "%s State error %d %s seconds" % (v["name"], v["small"], seconds(v["dc_ns"], 10 ** 9)),
+            # The Info column is the runtime's own reading of each type (sign, byte
+            # order, unit), not Wireshark's: the summary shows one of each kind.
+            "_ws.col.Info": "%s State error %d %s seconds %d %d.%d.%d.%d %s %s seconds" % (
+                v["name"], v["small"], seconds(v["dc_ns"], 10 ** 9), v["odd"], *v["address_le"], "1.5",
+                seconds(v["delay_us"], 10 ** 6)),
             "_ws.expert": "",
         }
         self.assertEqual(row, expected)
@@ -214,6 +218,10 @@ class Display10a(unittest.TestCase):
         self.assertEqual(rows[0]["arp.src.proto_ipv4"], "10.1.2.3")
         self.assertNotEqual(rows[0]["dspt.frame"], "")  # still filterable
         self.assertEqual(rows[0]["_ws.col.Protocol"], "DSPT")
+        # ... but hidden: the other dissector shows the bytes, our tree does not repeat them raw.
+        tree = ENV.tshark(["-r", cap, "-V", "-O", "dspt"]).stdout
+        self.assertIn("Kind: Frame", tree)
+        self.assertNotRegex(tree, r"(?m)^\s+Frame: [0-9a-f]{8}")
 
     def test_hand_off_of_a_truncated_frame_stays_inside_the_other_dissector(self):
         cap = capture("handoff_short.pcap", [to_port(bytes([3]) + inner_frame((10, 1, 2, 3))[:20])])
@@ -296,10 +304,13 @@ class Display10a(unittest.TestCase):
         past_end = bytes([1]) + b"Motor\0\0\0" + bytes([40]) + b"short"
         cap = capture("bad_strings.pcap", [to_port(no_nul), to_port(past_end)])
         rows = run_fields(cap, ["dspt.values.name", "dspt.values.label", "dspt.values.comment",
-                                "dspt.expert.truncated", "dspt.expert.past_end"])
+                                "dspt.expert.truncated", "dspt.expert.past_end", "_ws.expert.message"])
         self.assertEqual(rows[0]["dspt.values.label"], "ok")
         self.assertEqual(rows[0]["dspt.values.comment"], "unterminated")
         self.assertNotEqual(rows[0]["dspt.expert.truncated"], "")
+        # The stringz's own message, not the generic one of a fixed length.
+        self.assertIn("'Comment' has no NUL before the end of its data (12 bytes left)",
+                      rows[0]["_ws.expert.message"])
         self.assertEqual(rows[1]["dspt.values.name"], "Motor")
         self.assertEqual(rows[1]["dspt.values.label"], "short")
         self.assertNotEqual(rows[1]["dspt.expert.past_end"], "")

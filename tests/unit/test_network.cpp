@@ -295,6 +295,15 @@ TEST(BusTables, CatalogueAloneRegistersNoFields) {
     EXPECT_TRUE(contains(t.tables, "ecatr_devices, 4, ecatr_pdo_entries, 7,\n    NULL, 0, NULL, 0,\n    NULL, 0"));
 }
 
+TEST(BusTables, BitNTakesTheSmallestFieldThatHoldsIt) {
+    const std::vector<std::pair<unsigned, std::string>> cases = {
+        {1, "FT_BOOLEAN"}, {2, "FT_UINT8"},   {7, "FT_UINT8"},   {8, "FT_UINT8"},   {9, "FT_UINT16"},
+        {16, "FT_UINT16"}, {17, "FT_UINT32"}, {32, "FT_UINT32"}, {33, "FT_BYTES"},
+    };
+    for (const auto& [bits, type] : cases)
+        EXPECT_EQ(pdo_field_type("BIT" + std::to_string(bits), bits).type, type) << "BIT" << bits;
+}
+
 TEST(BusTables, FieldTypesFollowTheDataType) {
     Catalogue cat = small_catalogue();
     NetRead r = read_net("<network><slave type=\"EL2004\" revision=\"#x00100000\"/></network>", cat);
