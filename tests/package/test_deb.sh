@@ -226,7 +226,9 @@ check "no plugin warning for root" bash -c '! grep -v "Running as user" "$1" | g
 
 # --- 6. a user's edited copy of the packaged rules replaces them for the user --
 step "a user's copy of the EtherCAT rules overrides the packaged plugin"
-sed 's/name="Working counter"/name="Edited working counter"/' /usr/share/dissgen/rules/ethercat.xml \
+# Renames the node and every reference to it (a peek looks ahead at the working counter).
+sed -e 's/name="Working counter"/name="Edited working counter"/' \
+    -e "s/@name='Working counter'/@name='Edited working counter'/g" /usr/share/dissgen/rules/ethercat.xml \
   >"$user_home/project/ethercat.xml"
 chown 65534:65534 "$user_home/project/ethercat.xml"
 (cd "$user_home/project" && as_user "$user_home" dissgen install ethercat.xml) >"$work/out" 2>"$work/err"
