@@ -545,18 +545,28 @@ void show_entry(proto_tree *tree, const dg_pdo_entry *e, tvbuff_t *tvb, gint dat
         proto_tree_add_item(tree, *e->hf, tvb, offset, e->bit_length / 8, ENC_LITTLE_ENDIAN);
         return;
     }
-    if (e->bit_length > 64) return;
+    if (e->bit_length == 0 || e->bit_length > 64) return;
     guint64 v = image_bits(tvb, data, bit, e->bit_length);
     header_field_info *hfi = proto_registrar_get_nth(*e->hf);
     if (!hfi) return;
-    if (hfi->type == FT_BOOLEAN) proto_tree_add_boolean(tree, *e->hf, tvb, offset, bytes, v ? 1 : 0);
-    else if (IS_FT_UINT32(hfi->type)) proto_tree_add_uint(tree, *e->hf, tvb, offset, bytes, (guint32)v);
-    else if (IS_FT_UINT(hfi->type)) proto_tree_add_uint64(tree, *e->hf, tvb, offset, bytes, v);
-    else if (IS_FT_INT(hfi->type)) {
-        guint64 sign = G_GUINT64_CONSTANT(1) << (e->bit_length - 1);
-        gint64 value = (gint64)((v ^ sign) - sign);
-        if (IS_FT_INT32(hfi->type)) proto_tree_add_int(tree, *e->hf, tvb, offset, bytes, (gint32)value);
-        else proto_tree_add_int64(tree, *e->hf, tvb, offset, bytes, value);
+    /* A switch on the type, not the IS_FT_* macros: Wireshark 4.4 renamed those. */
+    guint64 sign = G_GUINT64_CONSTANT(1) << (e->bit_length - 1);
+    gint64 value = (gint64)((v ^ sign) - sign);
+    switch (hfi->type) {
+    case FT_BOOLEAN: proto_tree_add_boolean(tree, *e->hf, tvb, offset, bytes, v ? 1 : 0); break;
+    case FT_UINT8: case FT_UINT16: case FT_UINT24: case FT_UINT32:
+        proto_tree_add_uint(tree, *e->hf, tvb, offset, bytes, (guint32)v);
+        break;
+    case FT_UINT40: case FT_UINT48: case FT_UINT56: case FT_UINT64:
+        proto_tree_add_uint64(tree, *e->hf, tvb, offset, bytes, v);
+        break;
+    case FT_INT8: case FT_INT16: case FT_INT24: case FT_INT32:
+        proto_tree_add_int(tree, *e->hf, tvb, offset, bytes, (gint32)value);
+        break;
+    case FT_INT40: case FT_INT48: case FT_INT56: case FT_INT64:
+        proto_tree_add_int64(tree, *e->hf, tvb, offset, bytes, value);
+        break;
+    default: break;
     }
 }
 
