@@ -138,7 +138,7 @@ void layout_10b(Layout& l) {
             l.whens.push_back("{ -1, " + std::to_string(l.peeks.size()) + ", " + ranges + " }");
             l.peeks.push_back("{ " + std::to_string(w.ref.target->doc_index - 1) + ", " + std::to_string(w.offset) + ", " +
                               std::to_string(l.peek_lengths.size()) + ", " + std::to_string(w.lengths.size()) + ", " +
-                              std::to_string(w.up) + " }");
+                              std::to_string(w.up) + ", " + std::to_string(w.target_up) + " }");
             for (const FieldRef* r : w.lengths) l.peek_lengths.push_back(ref_of(r));
         }
     }

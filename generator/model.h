@@ -74,6 +74,7 @@ struct When {
     uint64_t offset = 0;
     std::vector<const FieldRef*> lengths;
     unsigned up = 0;  // 0: from the node's start; k: from the start of its k-th container
+    unsigned target_up = 0;  // the target is a child of the node's k-th container (0: a sibling)
 };
 
 struct Node {

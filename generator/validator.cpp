@@ -732,6 +732,7 @@ void Validator::check_peek(Node& n, When& w) {
                 w.offset = offset;
                 w.lengths = lengths;
                 w.up = anchor;
+                w.target_up = up;
                 for (const FieldRef* r : lengths) mark_slot(r->target);
                 return;
             }

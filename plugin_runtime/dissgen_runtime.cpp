@@ -72,6 +72,7 @@ struct dg_state {
     /* issue 10b: where each list of siblings being decoded started (the
      * message, then each open container), for peeks counted from a container */
     gint list_starts[DG_MAX_LISTS];
+    gint list_ends[DG_MAX_LISTS]; /* and where each ends: a peek reads nothing beyond */
     guint lists;
     /* issue 11: the values of the <pairing> key fields (DG_KEY), in decoding order */
     guint64 *keys;
@@ -727,6 +728,11 @@ gboolean peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guin
 {
     if (pk->up > st->lists || st->lists - pk->up >= DG_MAX_LISTS) return FALSE;
     gint64 at = (gint64)(pk->up ? st->list_starts[st->lists - pk->up] : node_start) + pk->offset;
+    /* The leaf must lie inside the list it belongs to: bytes after a container's
+     * end (padding, the next message) are not its value. */
+    guint list = st->lists - 1 - pk->target_up;
+    gint64 limit = (pk->target_up < st->lists && list < DG_MAX_LISTS) ? MIN(st->list_ends[list], st->packet_end)
+                                                                       : st->packet_end;
     for (guint i = 0; i < pk->length_count; i++) {
         const dg_ref *ref = &st->p->peek_lengths[pk->length_first + i];
         const dg_slot *s = &st->slots[ref->slot];
@@ -734,10 +740,10 @@ gboolean peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guin
         gint64 v = ref_arith(s, ref);
         if (v < 0) return FALSE;
         at += v;
-        if (at > st->packet_end) return FALSE;
+        if (at > limit) return FALSE;
     }
     const dg_node *t = &st->p->nodes[pk->target];
-    if (at + t->length > st->packet_end) return FALSE;
+    if (at + t->length > limit) return FALSE;
     guint64 v = read_uint(st->tvb, (gint)at, t->length, encoding_of(t));
     *out = (t->flags & DG_GROUP) ? (v >> t->shift) & bit_mask(t->bits) : v;
     return TRUE;
@@ -901,7 +907,10 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
                   gboolean in_summary)
 {
     gboolean chain_taken = FALSE; /* issue 10b */
-    if (st->lists < DG_MAX_LISTS) st->list_starts[st->lists] = *offset;
+    if (st->lists < DG_MAX_LISTS) {
+        st->list_starts[st->lists] = *offset;
+        st->list_ends[st->lists] = end;
+    }
     st->lists++;
     for (guint16 i = 0; i < count && !st->stopped; i++) {
         const dg_node *n = &st->p->nodes[st->p->children[first + i]];

@@ -89,6 +89,7 @@ typedef struct dg_peek {
     guint32 offset;
     guint16 length_first, length_count;
     guint8 up;
+    guint8 target_up; /* the target's list: the node's own (0) or its k-th container's */
 } dg_peek;
 
 /* A child of a window, at an absolute address; stride > 0: `instances`

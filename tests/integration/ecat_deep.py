@@ -591,9 +591,10 @@ def same(w, o, length, kind):
     return w == o
 
 
-def compare_packet(num, ws_items, ours_items, stats, stop_at=None, stop_why=""):
-    """Returns the list of unexplained differences (strings) of one packet.  stop_at: the frame
-    position from which ours shows nothing by design (it stopped at a malformed mailbox)."""
+def compare_packet(num, ws_items, ours_items, stats, stops=()):
+    """Returns the list of unexplained differences (strings) of one packet.  stops: (frame
+    position, why) from which ours shows nothing by design (it stopped at a malformed mailbox,
+    or Wireshark decodes past the header's Length)."""
     problems = []
     for (wname, pos), wl in ws_items.items():
         if wname in DATAGRAM_FIELDS or wname.startswith(("ecat.sub", "ecat.subframe.")):
@@ -623,8 +624,10 @@ def compare_packet(num, ws_items, ours_items, stats, stop_at=None, stop_why=""):
                 stats.agree += 1
                 pf[1] += 1
                 continue
-            if not cands and stop_at is not None and pos >= stop_at:
-                stats.explained[stop_why.split(":")[0]] += 1
+            # (an item that reaches past the stop is not shown either: ours shows only whole registers)
+            why = next((w for at, w in stops if pos + max(length, 1) > at), None) if not cands else None
+            if why:
+                stats.explained[why.split(":")[0]] += 1
                 continue
             known = KNOWN_WRONG.get(wname)
             # predicate None: Wireshark's field is at bytes that mean something else (ours has

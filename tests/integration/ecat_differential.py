@@ -629,12 +629,15 @@ DG_FIXED = [("Command", 1), ("Index", 1)]
 def ours_shows(payload):
     """What the bytes imply ecatr shows besides the field values, by rules/ethercat.xml and
     the runtime's rules (RULES-SPEC): the number of ecatr.datagram items, the Info column, and
-    the expert infos as (filter name, offset in the EtherCAT payload, message) in tree order."""
-    experts, summaries = [], []
+    the expert infos as (filter name, offset in the EtherCAT payload, message) in tree order,
+    and the regions (start, end, container, ours stops there) of datagram data where ours reports what the rules
+    inside find (registers, mailboxes: the Wireshark comparison checks those; container None:
+    a faulty mailbox, where ours stops with an expert info of its own)."""
+    experts, summaries, regions = [], [], []
     size = len(payload)
     if size < 2:
         experts.append(("truncated", 0, "Truncated: 'Length' needs 2 bytes, only %d left" % size))
-        return 0, "EtherCAT", experts
+        return 0, "EtherCAT", experts, regions
     h = struct.unpack("<H", payload[:2])[0]
     length, ftype = h & 0x7FF, h >> 12
     name = "Datagrams" if ftype == 1 else "Payload"
@@ -643,7 +646,7 @@ def ours_shows(payload):
         experts.append(("past_end", 2, "'%s' has length %d, past the end of its data (%d bytes left)"
                         % (name, length, size - 2)))
     if ftype != 1:
-        return 0, "EtherCAT", experts
+        return 0, "EtherCAT", experts, regions
     end = size if past_end else 2 + length
     off, items, stopped = 2, 0, False
 
@@ -663,7 +666,7 @@ def ours_shows(payload):
         more = False
         v = leaf("Command", 1)
         if v is not None:
-            cmd = v[0]
+            cmd, ado = v[0], None
             shown["cmd"] = pcapgen.CMD_NAMES.get(cmd, "Unknown (0x%02x)" % cmd)
             parts = [("Index", 1)] + ([("Logical address", 4)] if is_logical(cmd) else
                                       [("Slave address (ADP)", 2), ("Offset address (ADO)", 2)])
@@ -672,16 +675,26 @@ def ours_shows(payload):
                 v = leaf(what, n)
                 if v is None:
                     break
+                if what == "Offset address (ADO)":
+                    ado = struct.unpack("<H", v)[0]
                 if what == "Length":
                     w = struct.unpack("<H", v)[0]
                     dlen, more = w & 0x7FF, bool(w & 0x8000)
                     shown["len"] = "%d" % dlen
             if not stopped:
+                wkc = struct.unpack_from("<H", payload, off + dlen)[0] if dlen + 2 <= end - off else None
+                view = ours_view({"cmd": cmd, "len": dlen, "ado": ado, "wkc": wkc})
                 if dlen > end - off:
-                    experts.append(("past_end", off, "'Data' has length %d, past the end of its data (%d bytes left)"
-                                    % (dlen, end - off)))
+                    experts.append(("past_end", off, "'%s' has length %d, past the end of its data (%d bytes left)"
+                                    % (DATA_CONTAINERS[view], dlen, end - off)))
+                    regions.append((off, end, DATA_CONTAINERS[view], True))
+                    stopped = True
+                elif view == "mbx" and mailbox_fault(payload[off:off + dlen]):
+                    regions.append((off, off + dlen, None, True))
                     stopped = True
                 else:
+                    if view != "data":
+                        regions.append((off, off + dlen, DATA_CONTAINERS[view], False))
                     off += dlen
                     leaf("Working counter", 2)
         summaries.append("%s len %s" % (shown["cmd"], shown["len"]))
@@ -698,7 +711,27 @@ def ours_shows(payload):
         info = "Datagram \u00d7%d: %s" % (len(summaries), ", ".join(summaries))
     else:
         info = summaries[0]
-    return items, info, experts
+    return items, info, experts, regions
+
+
+# The container rules/ethercat.xml decodes a datagram's data as, by ours_view().
+DATA_CONTAINERS = {"unread": "Not read (working counter 0)", "reg": "Registers", "mbx": "Mailbox", "data": "Data"}
+
+
+def inside_data(experts, regions):
+    """(our expert infos outside the data regions, problems): the data container's own "has
+    length ... past the end" stays; those inside are the rules' (checked against Wireshark's
+    values), but a faulty mailbox must have at least one."""
+    kept, problems = [], []
+    for s, t, container, stops in regions:
+        # Where ours stops (a faulty mailbox, data past the end), its expert may sit at the end.
+        last = t if stops else t - 1
+        inside = [e for e in experts if s <= e[1] <= last and
+                  not (container and e[1] == s and e[2].startswith("'%s' has length" % container))]
+        if container is None and not inside:
+            problems.append("ours: no expert info inside the faulty mailbox at %d..%d" % (s, t))
+        experts = [e for e in experts if e not in inside]
+    return experts, problems
 
 
 def extras_command(cap):
@@ -740,9 +773,10 @@ def parse_extras(text, pdml_path):
 
 def compare_extras(num, payload, got):
     """Problems of one frame: ecatr.datagram items, Info, expert infos against ours_shows()."""
-    items, info, experts = ours_shows(payload)
+    items, info, experts, regions = ours_shows(payload)
     got = got or {"items": 0, "info": None, "experts": []}
-    problems = []
+    got_experts, problems = inside_data(got["experts"], regions)
+    got = dict(got, experts=got_experts)
     if got["items"] != items:
         problems.append("ours: %d ecatr.datagram items, the bytes imply %d" % (got["items"], items))
     if got["info"] != info:
@@ -967,16 +1001,28 @@ def compare_capture(packets, ours_text, ws_json, stats, label, truths=None, extr
             stats.extras_frames += 1
             stats.extras_experts += len((extras.get(num) or {"experts": []})["experts"])
         if deep_ws is not None:
-            stop_at = None
+            stops = []
+            hl_why = context["header_length_why"]
+            if hl_why:      # Wireshark decodes on after the Datagrams the header's Length allows
+                payload, pkt = payloads[num][0], payloads[num][1]
+                base = len(pkt) - len(payload)
+                cut = base + 2 + (struct.unpack("<H", payload[:2])[0] & 0x7FF)
+                off = base + 2
+                for d in expected[num]["datagrams"]:     # the datagram the cut falls in: ours shows
+                    if isinstance(d.get("len"), int):    # only whole register blocks of its data
+                        if off + 12 + d["len"] > cut:
+                            cut = min(cut, off + 10)
+                            break
+                        off += 12 + d["len"]
+                stops.append((cut, hl_why))
             i = first_mailbox_fault(expected[num])
             if i is not None:     # where ours stops: the faulty datagram's data, in the frame
                 payload, pkt = payloads[num][0], payloads[num][1]
                 off = len(pkt) - len(payload) + 2
                 for d in expected[num]["datagrams"][:i]:
                     off += 12 + d["len"]
-                stop_at = off + 10
-            for what in ecat_deep.compare_packet(num, deep_ws[num - 1], deep_ours[num - 1], stats.deep,
-                                                 stop_at, STOP_WHY):
+                stops.append((off + 10, STOP_WHY))
+            for what in ecat_deep.compare_packet(num, deep_ws[num - 1], deep_ours[num - 1], stats.deep, stops):
                 probs.append({"frame": num, "what": "registers/mailboxes: " + what})
         for e in context["explained"]:
             stats.frames_with_explanations[e] += 1

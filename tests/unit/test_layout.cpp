@@ -87,11 +87,12 @@ TEST(Layout, PeekCountsFromAContainerThatEndsWhereItsLengthSays) {
     ASSERT_TRUE(f.ok()) << f.messages();
     const When& w = find(*f.proto, "Mbx")->whens[0];
     EXPECT_EQ(w.up, 2u);      // from the start of Data, Mbx's second container
+    EXPECT_EQ(w.target_up, 2u);  // Wkc: in the list two containers up (the message)
     EXPECT_EQ(w.offset, 2u);  // Pad
     ASSERT_EQ(w.lengths.size(), 1u);
     EXPECT_EQ(w.lengths[0]->target, find(*f.proto, "Len"));
     std::string code = emit_cpp(*f.proto, "t.xml");
-    EXPECT_TRUE(contains(code, "{ 8, 2, 0, 1, 2 }")) << code;
+    EXPECT_TRUE(contains(code, "{ 8, 2, 0, 1, 2, 2 }")) << code;
 }
 
 TEST(Layout, OtherwiseChains) {
