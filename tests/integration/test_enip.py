@@ -171,6 +171,9 @@ UCS_ODD = unconnected(unconnected_send(cip_request(0x10, bytes.fromhex("20012401
 # Get Attributes All (Identity 1): 6 bytes, no pad; routed over two hops.
 UCS_EVEN = unconnected(unconnected_send(cip_request(0x01, bytes.fromhex("20012401")),
                                         route=bytes.fromhex("01000203"), tick=0x1A, timeout_ticks=10))
+# ... and to 10.1.1.5 behind the front port: an extended link address (its size, then ASCII).
+UCS_EXTENDED = unconnected(unconnected_send(cip_request(0x01, bytes.fromhex("20012401")),
+                                            route=bytes.fromhex("0100") + b"\x12\x0810.1.1.5"))
 # 0x52 to a tag (ANSI symbol segment): Logix's Read Tag Fragmented, no Unconnected Send.
 READ_TAG_FRAGMENTED = unconnected(cip_request(0x52, b"\x91\x04TAG1", struct.pack("<HI", 1, 0)))
 MSP_SERVICES = [cip_request(0x0E, bytes.fromhex("200124013001")),                      # Identity 1, attribute 1
@@ -205,7 +208,7 @@ WS_FIELDS = ("enip.command|enip.length|enip.session|enip.status|enip.context|eni
              "enip.cpf.sai.connid|enip.cpf.sai.seq|enip.sinfamily|enip.sinport|enip.sinaddr|enip.lir.name|"
              "cip.seq|cip.sc|cip.rr|cip.request_path_size|cip.path_segment|cip.class|"
              "cip.msp.num_services|cip.msp.offset|cip.cm.sc|cip.cm.priority|cip.cm.tick_time|"
-             "cip.cm.timeout_tick|cip.cm.msg_req_size|cip.cm.route_path_size")
+             "cip.cm.timeout_tick|cip.cm.msg_req_size|cip.cm.route_path_size|cip.port|cip.linkaddress.byte")
 # Wireshark shows each service of a Multiple Service Packet as a text item whose value is its bytes.
 LINE = re.compile(rb'^( *)<(?:(packet)>|proto name="([^"]+)"|field name="((?:' +
                   WS_FIELDS.replace(".", r"\.").encode() +
@@ -243,7 +246,7 @@ LISTS = ("typeid", "itemlength", "connid", "seqnum", "seqcount", "sinfamily", "s
 # the message it carries.
 CIP_SLOTS = ("service", "rr", "pathsize", "segment", "class", "msp_count", "msp_offsets", "msp_services",
              "ucs_priority", "ucs_tick_time", "ucs_timeout_ticks", "ucs_msg_size", "ucs_route_size",
-             "ucs_service", "ucs_rr", "ucs_pathsize")
+             "ucs_service", "ucs_rr", "ucs_pathsize", "ucs_ports", "ucs_links")
 # Our field (after "enipr.cpf.item.cip.") -> its slot.
 OUR_CIP = {
     "service": "service", "rr": "rr", "pathsize": "pathsize", "path.segment": "segment", "path.class": "class",
@@ -258,6 +261,9 @@ THEIR_UCS = {
     "cip.cm.timeout_tick": "ucs_timeout_ticks", "cip.cm.msg_req_size": "ucs_msg_size",
     "cip.cm.route_path_size": "ucs_route_size",
 }
+# ... and of its route path's port segments -> slot (a tuple, a value per hop)
+THEIR_HOPS = {"cip.port": "ucs_ports", "cip.linkaddress.byte": "ucs_links"}
+OUR_HOPS = {"ucs.route.hop.port": "ucs_ports", "ucs.route.hop.link": "ucs_links"}
 
 
 def new_message():
@@ -375,11 +381,18 @@ def wireshark_messages(packet):
                 cip["class"] = number(attrs["show"])
             elif name == "cip.msp.offset" and not in_services:
                 cip["msp_offsets"] = (cip["msp_offsets"] or ()) + (number(attrs["show"]),)
-        elif top == "cipcm" and cip is not None and (where == "cipcm" or ucs and name in THEIR_UCS):
+        elif top == "cipcm" and cip is not None and name == "cip.cm.route_path_size":
+            where = "cipcm"             # the embedded request has ended
+            if ucs:
+                cip["ucs_route_size"] = number(attrs["show"])
+        elif where == "cipcm" and cip is not None:
             if name == "cip.cm.sc":
                 ucs = attrs["show"] == "0x52" and cip["rr"] == 0
             elif ucs and name in THEIR_UCS:
                 cip[THEIR_UCS[name]] = number(attrs["show"])
+            elif ucs and name in THEIR_HOPS:
+                slot = THEIR_HOPS[name]
+                cip[slot] = (cip[slot] or ()) + (number(attrs["show"]),)
         elif where == "embedded" and cip is not None:
             slot = {"cip.sc": "ucs_service", "cip.rr": "ucs_rr", "cip.request_path_size": "ucs_pathsize"}.get(name)
             if slot is not None and cip[slot] is None:
@@ -408,6 +421,9 @@ def our_messages(packet):
                 cip[OUR_CIP[field]] = number(attrs["show"])
             elif field in ("msp.offset", "msp_reply.offset"):
                 cip["msp_offsets"] = (cip["msp_offsets"] or ()) + (number(attrs["show"]),)
+            elif field in OUR_HOPS:
+                slot = OUR_HOPS[field]
+                cip[slot] = (cip[slot] or ()) + (number(attrs["show"]),)
             elif field in ("msp.services", "msp_reply.services"):
                 cip["msp_services"] = attrs.get("value", "")
         elif name == "enipr.context":
@@ -672,18 +688,23 @@ class Services(unittest.TestCase):
         p = self.P + "ucs."
         names = [self.P + "service", self.P + "path.class", p + "tick_time", p + "priority", p + "timeout_ticks",
                  p + "msg_size", p + "odd", p + "message.service", p + "message.rr", p + "message.pathsize",
-                 p + "message.path", p + "message.data", p + "pad", p + "route_size", p + "reserved", p + "route",
+                 p + "message.path", p + "message.data", p + "pad", p + "route_size", p + "reserved",
+                 p + "route.hop.port", p + "route.hop.extended", p + "route.hop.type", p + "route.hop.link",
                  self.P + "data", "_ws.expert"]
         flow = TcpFlow(50030, 44818)
-        cap = capture("ucs.pcap", [flow.segment(UCS_ODD), flow.segment(UCS_EVEN)])
-        rows = fields(ENV, cap, names)
+        names_more = names + [self.P + "ucs.route.hop.more"]
+        cap = capture("ucs.pcap", [flow.segment(UCS_ODD), flow.segment(UCS_EVEN), flow.segment(UCS_EXTENDED)])
+        rows = fields(ENV, cap, names_more)
         self.assertEqual([rows[0][n] for n in names],
                          ["0x52", "0x06", "7", "0", "249", "9", "1", "0x10", "0x00", "3", "20 01 24 01 30 05",
-                          "07", "0x00", "1", "0x00", "01 00", "", ""])
+                          "07", "0x00", "1", "0x00", "0x01", "0", "0x00", "0", "", ""])
         # tick byte 0x1a: tick time 10, priority 1; no pad after 6 bytes; two hops
         self.assertEqual([rows[1][n] for n in names],
                          ["0x52", "0x06", "10", "1", "10", "6", "0", "0x01", "0x00", "2", "20 01 24 01",
-                          "", "", "2", "0x00", "01 00 02 03", "", ""])
+                          "", "", "2", "0x00", "0x01,0x02", "0,0", "0x00,0x00", "0,3", "", ""])
+        r = rows[2]
+        self.assertEqual([r[n] for n in names[-8:-2]], ["6", "0x00", "0x01,0x02", "0,1", "0x00,0x00", "0"])
+        self.assertEqual(r[self.P + "ucs.route.hop.more"], "08 " + " ".join("%02x" % c for c in b"10.1.1.5"))
         s = differential(ENV.path("ucs.pcap"))
         self.assertEqual(s["frames_differ"], [])
         self.assertEqual(s["fields"], s["agree"])
