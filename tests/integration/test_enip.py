@@ -203,12 +203,18 @@ def capture(name, frames):
 
 # --- PDML: messages as each side decodes them ---------------------------------------
 
+THEIR_FO_NAMES = ("cip.cm.ot_connid", "cip.cm.to_connid", "cip.cm.conn_serial_num", "cip.cm.vendor",
+                  "cip.cm.orig_serial_num", "cip.cm.timeout_multiplier", "cip.cm.otrpi", "cip.cm.torpi",
+                  "cip.cm.connpath_size", "cip.cm.otapi", "cip.cm.toapi", "cip.cm.app_reply_size",
+                  "cip.cm.fwo.transport", "cip.cm.fwo.trigger", "cip.cm.fwo.dir", "cip.cm.fwo.consize",
+                  "cip.cm.fwo.f_v", "cip.cm.fwo.prio", "cip.cm.fwo.type", "cip.cm.fwo.owner")
 WS_FIELDS = ("enip.command|enip.length|enip.session|enip.status|enip.context|enip.listid_delay|"
              "enip.options|enip.cpf.itemcount|enip.cpf.typeid|enip.cpf.length|enip.cpf.cai.connid|"
              "enip.cpf.sai.connid|enip.cpf.sai.seq|enip.sinfamily|enip.sinport|enip.sinaddr|enip.lir.name|"
              "cip.seq|cip.sc|cip.rr|cip.request_path_size|cip.path_segment|cip.class|"
              "cip.msp.num_services|cip.msp.offset|cip.cm.sc|cip.cm.priority|cip.cm.tick_time|"
-             "cip.cm.timeout_tick|cip.cm.msg_req_size|cip.cm.route_path_size|cip.port|cip.linkaddress.byte")
+             "cip.cm.timeout_tick|cip.cm.msg_req_size|cip.cm.route_path_size|cip.port|cip.linkaddress.byte|"
+             "cip.genstat|" + "|".join(THEIR_FO_NAMES))
 # Wireshark shows each service of a Multiple Service Packet as a text item whose value is its bytes.
 LINE = re.compile(rb'^( *)<(?:(packet)>|proto name="([^"]+)"|field name="((?:' +
                   WS_FIELDS.replace(".", r"\.").encode() +
@@ -242,28 +248,50 @@ SCALARS = ("command", "length", "session", "status", "context", "options", "item
 LISTS = ("typeid", "itemlength", "connid", "seqnum", "seqcount", "sinfamily", "sinport", "sinaddr", "name", "cip")
 
 # One CIP message: what is compared, slot by slot. msp_offsets is a tuple (one value per offset),
-# msp_services the services' bytes in hex; the ucs_* slots are an Unconnected Send request and
-# the message it carries.
+# msp_services the services' bytes in hex; cm_* are the Connection Manager's priority/tick and
+# time-out ticks (Unconnected Send and Forward Open), ucs_* the rest of an Unconnected Send request
+# and the message it carries, fo_* a Forward Open request or its successful reply (times in us;
+# the connection parameters as tuples, O->T then T->O).
+FO_SCALARS = ("ot_connid", "to_connid", "conn_serial", "vendor", "orig_serial", "timeout_multiplier", "ot_rpi",
+              "to_rpi", "path_size", "ot_api", "to_api", "app_reply_size", "class", "trigger", "direction")
+FO_PARAMS = ("size", "variable", "priority", "type", "owner")
 CIP_SLOTS = ("service", "rr", "pathsize", "segment", "class", "msp_count", "msp_offsets", "msp_services",
-             "ucs_priority", "ucs_tick_time", "ucs_timeout_ticks", "ucs_msg_size", "ucs_route_size",
-             "ucs_service", "ucs_rr", "ucs_pathsize", "ucs_ports", "ucs_links")
+             "cm_priority", "cm_tick_time", "cm_timeout_ticks", "ucs_msg_size", "ucs_route_size",
+             "ucs_service", "ucs_rr", "ucs_pathsize", "ucs_ports", "ucs_links") + \
+    tuple("fo_" + k for k in FO_SCALARS + FO_PARAMS)
 # Our field (after "enipr.cpf.item.cip.") -> its slot.
 OUR_CIP = {
     "service": "service", "rr": "rr", "pathsize": "pathsize", "path.segment": "segment", "path.class": "class",
-    "msp.count": "msp_count", "msp_reply.count": "msp_count", "ucs.priority": "ucs_priority",
-    "ucs.tick_time": "ucs_tick_time", "ucs.timeout_ticks": "ucs_timeout_ticks", "ucs.msg_size": "ucs_msg_size",
+    "msp.count": "msp_count", "msp_reply.count": "msp_count", "ucs.priority": "cm_priority",
+    "ucs.tick_time": "cm_tick_time", "ucs.timeout_ticks": "cm_timeout_ticks", "ucs.msg_size": "ucs_msg_size",
     "ucs.route_size": "ucs_route_size", "ucs.message.service": "ucs_service", "ucs.message.rr": "ucs_rr",
-    "ucs.message.pathsize": "ucs_pathsize",
+    "ucs.message.pathsize": "ucs_pathsize", "fwd_open.priority": "cm_priority",
+    "fwd_open.tick_time": "cm_tick_time", "fwd_open.timeout_ticks": "cm_timeout_ticks",
+    "fwd_open.transport.class": "fo_class", "fwd_open.transport.trigger": "fo_trigger",
+    "fwd_open.transport.direction": "fo_direction",
 }
-# Wireshark's fields of an Unconnected Send request (cipcm) -> slot.
-THEIR_UCS = {
-    "cip.cm.priority": "ucs_priority", "cip.cm.tick_time": "ucs_tick_time",
-    "cip.cm.timeout_tick": "ucs_timeout_ticks", "cip.cm.msg_req_size": "ucs_msg_size",
-    "cip.cm.route_path_size": "ucs_route_size",
+for _k in FO_SCALARS[:-3]:
+    OUR_CIP["fwd_open." + _k] = OUR_CIP["fwd_open_reply." + _k] = "fo_" + _k
+# Wireshark's fields of the Connection Manager (cipcm) -> slot.
+THEIR_CM = {"cip.cm.priority": "cm_priority", "cip.cm.tick_time": "cm_tick_time",
+            "cip.cm.timeout_tick": "cm_timeout_ticks"}
+THEIR_UCS = {"cip.cm.msg_req_size": "ucs_msg_size", "cip.cm.route_path_size": "ucs_route_size"}
+THEIR_FO = {
+    "cip.cm.ot_connid": "fo_ot_connid", "cip.cm.to_connid": "fo_to_connid", "cip.cm.conn_serial_num": "fo_conn_serial",
+    "cip.cm.vendor": "fo_vendor", "cip.cm.orig_serial_num": "fo_orig_serial",
+    "cip.cm.timeout_multiplier": "fo_timeout_multiplier", "cip.cm.otrpi": "fo_ot_rpi", "cip.cm.torpi": "fo_to_rpi",
+    "cip.cm.connpath_size": "fo_path_size", "cip.cm.otapi": "fo_ot_api", "cip.cm.toapi": "fo_to_api",
+    "cip.cm.app_reply_size": "fo_app_reply_size", "cip.cm.fwo.transport": "fo_class",
+    "cip.cm.fwo.trigger": "fo_trigger", "cip.cm.fwo.dir": "fo_direction",
 }
-# ... and of its route path's port segments -> slot (a tuple, a value per hop)
+THEIR_FO_PARAMS = {"cip.cm.fwo.consize": "fo_size", "cip.cm.fwo.f_v": "fo_variable", "cip.cm.fwo.prio": "fo_priority",
+                   "cip.cm.fwo.type": "fo_type", "cip.cm.fwo.owner": "fo_owner"}
+OUR_FO_PARAMS = {"fwd_open.%s.%s" % (d, k): "fo_" + k for d in ("ot_params", "to_params") for k in FO_PARAMS}
+# ... and of an Unconnected Send's route path's port segments -> slot (a tuple, a value per hop)
 THEIR_HOPS = {"cip.port": "ucs_ports", "cip.linkaddress.byte": "ucs_links"}
 OUR_HOPS = {"ucs.route.hop.port": "ucs_ports", "ucs.route.hop.link": "ucs_links"}
+OUR_TUPLES = dict(OUR_HOPS, **OUR_FO_PARAMS)
+OUR_TIMES = ("fo_ot_rpi", "fo_to_rpi", "fo_ot_api", "fo_to_api")    # shown in seconds, compared in us
 
 
 def new_message():
@@ -323,7 +351,9 @@ def wireshark_messages(packet):
     delay = None
     segments = 0            # path segments seen in the current top-level cip
     in_services = False     # past the offset list of a Multiple Service Packet
-    ucs = False             # in the cipcm proto of an Unconnected Send request
+    cm = None               # in cipcm: "ucs" (Unconnected Send request), "fo" (Forward Open, or its
+                            # successful reply)
+    genstat = None          # of the current top-level cip
     for indent, kind, name, attrs in packet:
         if kind == "proto":
             if indent == 2:
@@ -336,12 +366,12 @@ def wireshark_messages(packet):
                 elif name == "cip" and msg is not None:
                     cip = new_cip()
                     msg["cip"].append(cip)
-                    segments, in_services = 0, False
+                    segments, in_services, genstat = 0, False, None
                 elif name == "cipcm":
-                    ucs = False
+                    cm = None
                 else:
                     cip = None
-            elif where == "cipcm" and ucs and name == "cip":
+            elif where == "cipcm" and cm == "ucs" and name == "cip":
                 where = "embedded"      # the request an Unconnected Send carries
             elif where != "enip":
                 where = "nested"
@@ -373,6 +403,8 @@ def wireshark_messages(packet):
                     "cip.msp.num_services": "msp_count"}.get(name)
             if slot is not None and cip[slot] is None:
                 cip[slot] = number(attrs["show"])
+            elif name == "cip.genstat":
+                genstat = number(attrs["show"])
             elif name == "cip.path_segment":
                 segments += 1
                 if segments == 1:
@@ -383,15 +415,21 @@ def wireshark_messages(packet):
                 cip["msp_offsets"] = (cip["msp_offsets"] or ()) + (number(attrs["show"]),)
         elif top == "cipcm" and cip is not None and name == "cip.cm.route_path_size":
             where = "cipcm"             # the embedded request has ended
-            if ucs:
+            if cm == "ucs":
                 cip["ucs_route_size"] = number(attrs["show"])
         elif where == "cipcm" and cip is not None:
             if name == "cip.cm.sc":
-                ucs = attrs["show"] == "0x52" and cip["rr"] == 0
-            elif ucs and name in THEIR_UCS:
+                # a Forward Open reply: only a successful one is decoded
+                cm = {(0x52, 0, None): "ucs", (0x54, 0, None): "fo", (0x54, 1, 0): "fo"}.get(
+                    (number(attrs["show"]), cip["rr"], genstat))
+            elif cm in ("ucs", "fo") and name in THEIR_CM:
+                cip[THEIR_CM[name]] = number(attrs["show"])
+            elif cm == "ucs" and name in THEIR_UCS:
                 cip[THEIR_UCS[name]] = number(attrs["show"])
-            elif ucs and name in THEIR_HOPS:
-                slot = THEIR_HOPS[name]
+            elif cm == "fo" and name in THEIR_FO:
+                cip[THEIR_FO[name]] = number(attrs["show"])
+            elif (cm == "ucs" and name in THEIR_HOPS) or (cm == "fo" and name in THEIR_FO_PARAMS):
+                slot = THEIR_HOPS.get(name) or THEIR_FO_PARAMS[name]
                 cip[slot] = (cip[slot] or ()) + (number(attrs["show"]),)
         elif where == "embedded" and cip is not None:
             slot = {"cip.sc": "ucs_service", "cip.rr": "ucs_rr", "cip.request_path_size": "ucs_pathsize"}.get(name)
@@ -418,11 +456,12 @@ def our_messages(packet):
         elif name.startswith(prefix):
             field = name[len(prefix):]
             if field in OUR_CIP:
-                cip[OUR_CIP[field]] = number(attrs["show"])
+                slot = OUR_CIP[field]
+                cip[slot] = round(float(attrs["show"]) * 1e6) if slot in OUR_TIMES else number(attrs["show"])
             elif field in ("msp.offset", "msp_reply.offset"):
                 cip["msp_offsets"] = (cip["msp_offsets"] or ()) + (number(attrs["show"]),)
-            elif field in OUR_HOPS:
-                slot = OUR_HOPS[field]
+            elif field in OUR_TUPLES:
+                slot = OUR_TUPLES[field]
                 cip[slot] = (cip[slot] or ()) + (number(attrs["show"]),)
             elif field in ("msp.services", "msp_reply.services"):
                 cip["msp_services"] = attrs.get("value", "")
@@ -540,21 +579,43 @@ SEED_EXPECTED = {
     "enipr.cpf.item.cip.service": "0x54", "enipr.cpf.item.cip.rr": "0x00",
     "enipr.cpf.item.cip.pathsize": "2", "enipr.cpf.item.cip.path.segment": "0x20",
     "enipr.cpf.item.cip.path.class": "0x06", "enipr.cpf.item.cip.path.more": "24 01",
-    # header 24, interface handle + timeout 6, item count 2, two item headers 8, service + path size 2, path 4
-    "enipr.cpf.item.cip.data": " ".join("%02x" % b for b in SEED[24 + 6 + 2 + 8 + 2 + 4:]),
-    "enipr.cpf.item.cip.genstat": "", "enipr.cpf.item.connid": "", "enipr.cpf.item.data": "",
+    # The Forward Open's 40 bytes after the path (header 24, interface handle + timeout 6, item
+    # count 2, two item headers 8, service + path size 2, path 4), field by field (forward_open_fields).
+    "enipr.cpf.item.cip.data": "", "enipr.cpf.item.cip.genstat": "", "enipr.cpf.item.connid": "",
+    "enipr.cpf.item.data": "",
 }
+
+
+def forward_open_fields(data):
+    """The rules' Forward Open fields, as tshark prints them, computed from a request's bytes."""
+    (tick, ticks, ot_connid, to_connid, serial, vendor, orig_serial, multiplier, ot_rpi, ot_params, to_rpi,
+     to_params, transport, path_size) = struct.unpack("<BBIIHHIB3xIHIHBB", data[:36])
+    p = "enipr.cpf.item.cip.fwd_open."
+    out = {p + "tick_time": str(tick & 15), p + "priority": str(tick >> 4 & 1), p + "timeout_ticks": str(ticks),
+           p + "ot_connid": "0x%08x" % ot_connid, p + "to_connid": "0x%08x" % to_connid,
+           p + "conn_serial": "0x%04x" % serial, p + "vendor": "0x%04x" % vendor,
+           p + "orig_serial": "0x%08x" % orig_serial, p + "timeout_multiplier": "0x%02x" % multiplier,
+           p + "ot_rpi": "%d.%06d000" % divmod(ot_rpi, 10 ** 6), p + "to_rpi": "%d.%06d000" % divmod(to_rpi, 10 ** 6),
+           p + "transport.class": str(transport & 15), p + "transport.trigger": "0x%02x" % (transport >> 4 & 7),
+           p + "transport.direction": "0x%02x" % (transport >> 7), p + "path_size": str(path_size),
+           p + "path": " ".join("%02x" % b for b in data[36:36 + 2 * path_size])}
+    for d, v in (("ot_params.", ot_params), ("to_params.", to_params)):
+        out.update({p + d + "size": str(v & 0x1FF), p + d + "variable": "0x%04x" % (v >> 9 & 1),
+                    p + d + "priority": "0x%04x" % (v >> 10 & 3), p + d + "type": "0x%04x" % (v >> 13 & 3),
+                    p + d + "owner": str(v >> 15)})
+    return out
 
 
 class Seed(unittest.TestCase):
     def test_seed_message_in_one_tcp_segment(self):
         self.assertEqual(len(SEED), 86)
         cap = capture("seed.pcap", [TcpFlow(50000, 44818).segment(SEED)])
-        rows = fields(ENV, cap, list(SEED_EXPECTED))
+        expected = dict(SEED_EXPECTED, **forward_open_fields(SEED[24 + 6 + 2 + 8 + 2 + 4:]))
+        rows = fields(ENV, cap, list(expected))
         self.assertEqual(len(rows), 1)
-        self.assertEqual(rows[0], SEED_EXPECTED)
-        # The CIP data is the 40 bytes after the 4-byte path: 46 - 2 - 4.
-        self.assertEqual(len(rows[0]["enipr.cpf.item.cip.data"].split()), 40)
+        self.assertEqual(rows[0], expected)
+        # The connection path ends the message: 46 - 2 - 4 - 36 bytes.
+        self.assertEqual(len(rows[0]["enipr.cpf.item.cip.fwd_open.path"].split()), 4)
 
     def test_wireshark_agrees_on_the_seed(self):
         cap = capture("seed_ws.pcap", [TcpFlow(50000, 44818).segment(SEED)])
@@ -631,11 +692,17 @@ class Tcp(unittest.TestCase):
         names = ["enipr.cpf.item.typeid", "enipr.cpf.item.length", "enipr.cpf.item.cip.service",
                  "enipr.cpf.item.cip.rr", "enipr.cpf.item.cip.genstat", p + "family", p + "port", p + "addr",
                  p + "zero"]
-        rows = fields(ENV, capture("sockaddr.pcap", [TcpFlow(44818, 50004).segment(FORWARD_OPEN_REPLY)]), names)
-        self.assertEqual([rows[0][n] for n in names],
+        # The request first: Wireshark's cip knows a reply's object from its request only.
+        frames = [TcpFlow(50004, 44818).segment(SEED),
+                  TcpFlow(44818, 50004, src=(10, 1, 1, 164), dst=(10, 1, 1, 167)).segment(FORWARD_OPEN_REPLY)]
+        rows = fields(ENV, capture("sockaddr.pcap", frames), names + ["enipr.cpf.item.cip.fwd_open_reply.ot_api"])
+        self.assertEqual([rows[1][n] for n in names],
                          ["0x0000,0x00b2,0x8001", "0,30,16", "0x54", "0x01", "0x00", "2", "2222", "239.192.1.2",
                           "00 00 00 00 00 00 00 00"])
-        self.assertEqual(differential(ENV.path("sockaddr.pcap"))["frames_differ"], [])
+        self.assertEqual(rows[1]["enipr.cpf.item.cip.fwd_open_reply.ot_api"], "0.000000000")
+        s = differential(ENV.path("sockaddr.pcap"))
+        self.assertEqual(s["frames_differ"], [])
+        self.assertEqual(s["fields"], s["agree"])
 
 
 class Udp(unittest.TestCase):
@@ -719,7 +786,7 @@ class Services(unittest.TestCase):
 
     def test_multiple_service_packet_request_and_replies(self):
         flow = TcpFlow(50032, 44818)
-        back = TcpFlow(44818, 50032)
+        back = TcpFlow(44818, 50032, src=(10, 1, 1, 164), dst=(10, 1, 1, 167))
         cap = capture("msp.pcap", [flow.segment(MSP_REQUEST), back.segment(MSP_REPLY),
                                    back.segment(MSP_ERROR_REPLY)])
         names = [self.P + "service", self.P + "rr", self.P + "genstat", self.P + "msp.count", self.P + "msp.offset",
