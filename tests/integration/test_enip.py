@@ -182,6 +182,11 @@ MSP_REQUEST = unconnected(multiple_service(MSP_SERVICES))
 MSP_REPLY = unconnected(multiple_service([cip_response(0x0E, data=b"\x01\x00"),
                                           cip_response(0x03, 0x05)], reply=True, status=0x1E))
 MSP_ERROR_REPLY = unconnected(cip_response(0x0A, 0x08))     # Service not supported: no data
+# Forward Close of connection serial 0x0014 (vendor 0x4d), path: backplane slot 0, Message Router
+FORWARD_CLOSE = unconnected(cip_request(0x4E, CONNECTION_MANAGER, struct.pack("<BBHHIBB", 0x0A, 0xF0, 0x14, 0x4D,
+                                                                              0x32952BF3, 3, 0) +
+                                        bytes.fromhex("010020022401")))
+FORWARD_CLOSE_REPLY = unconnected(cip_response(0x4E, data=struct.pack("<HHIBB", 0x14, 0x4D, 0x32952BF3, 0, 0)))
 
 
 # --- running tshark ----------------------------------------------------------------
@@ -249,9 +254,9 @@ LISTS = ("typeid", "itemlength", "connid", "seqnum", "seqcount", "sinfamily", "s
 
 # One CIP message: what is compared, slot by slot. msp_offsets is a tuple (one value per offset),
 # msp_services the services' bytes in hex; cm_* are the Connection Manager's priority/tick and
-# time-out ticks (Unconnected Send and Forward Open), ucs_* the rest of an Unconnected Send request
-# and the message it carries, fo_* a Forward Open request or its successful reply (times in us;
-# the connection parameters as tuples, O->T then T->O).
+# time-out ticks (Unconnected Send, Forward Open and Close), ucs_* the rest of an Unconnected
+# Send request and the message it carries, fo_* a Forward Open or Close request or its successful
+# reply (times in us; the connection parameters as tuples, O->T then T->O).
 FO_SCALARS = ("ot_connid", "to_connid", "conn_serial", "vendor", "orig_serial", "timeout_multiplier", "ot_rpi",
               "to_rpi", "path_size", "ot_api", "to_api", "app_reply_size", "class", "trigger", "direction")
 FO_PARAMS = ("size", "variable", "priority", "type", "owner")
@@ -272,6 +277,10 @@ OUR_CIP = {
 }
 for _k in FO_SCALARS[:-3]:
     OUR_CIP["fwd_open." + _k] = OUR_CIP["fwd_open_reply." + _k] = "fo_" + _k
+for _k in ("conn_serial", "vendor", "orig_serial", "path_size", "app_reply_size"):
+    OUR_CIP["fwd_close." + _k] = OUR_CIP["fwd_close_reply." + _k] = "fo_" + _k
+for _k in ("priority", "tick_time", "timeout_ticks"):
+    OUR_CIP["fwd_close." + _k] = "cm_" + _k
 # Wireshark's fields of the Connection Manager (cipcm) -> slot.
 THEIR_CM = {"cip.cm.priority": "cm_priority", "cip.cm.tick_time": "cm_tick_time",
             "cip.cm.timeout_tick": "cm_timeout_ticks"}
@@ -420,7 +429,8 @@ def wireshark_messages(packet):
         elif where == "cipcm" and cip is not None:
             if name == "cip.cm.sc":
                 # a Forward Open reply: only a successful one is decoded
-                cm = {(0x52, 0, None): "ucs", (0x54, 0, None): "fo", (0x54, 1, 0): "fo"}.get(
+                cm = {(0x52, 0, None): "ucs", (0x54, 0, None): "fo", (0x54, 1, 0): "fo", (0x4e, 0, None): "fo",
+                      (0x4e, 1, 0): "fo"}.get(
                     (number(attrs["show"]), cip["rr"], genstat))
             elif cm in ("ucs", "fo") and name in THEIR_CM:
                 cip[THEIR_CM[name]] = number(attrs["show"])
@@ -784,6 +794,23 @@ class Services(unittest.TestCase):
                          ["0x52", "0x91", "", "04 54 41 47 31", "", "", "01 00 00 00 00 00", ""])
         self.assertEqual(differential(ENV.path("readtagfrag.pcap"))["frames_differ"], [])
 
+    def test_forward_close_and_its_reply(self):
+        p, r = self.P + "fwd_close.", self.P + "fwd_close_reply."
+        names = [p + "tick_time", p + "priority", p + "timeout_ticks", p + "conn_serial", p + "vendor",
+                 p + "orig_serial", p + "path_size", p + "reserved", p + "path", r + "conn_serial", r + "vendor",
+                 r + "orig_serial", r + "app_reply_size", self.P + "data", "_ws.expert"]
+        frames = [TcpFlow(50033, 44818).segment(FORWARD_CLOSE),
+                  TcpFlow(44818, 50033, src=(10, 1, 1, 164), dst=(10, 1, 1, 167)).segment(FORWARD_CLOSE_REPLY)]
+        rows = fields(ENV, capture("fwdclose.pcap", frames), names)
+        self.assertEqual([rows[0][n] for n in names],
+                         ["10", "0", "240", "0x0014", "0x004d", "0x32952bf3", "3", "0x00", "01 00 20 02 24 01",
+                          "", "", "", "", "", ""])
+        self.assertEqual([rows[1][n] for n in names],
+                         ["", "", "", "", "", "", "", "", "", "0x0014", "0x004d", "0x32952bf3", "0", "", ""])
+        s = differential(ENV.path("fwdclose.pcap"))
+        self.assertEqual(s["frames_differ"], [])
+        self.assertEqual(s["fields"], s["agree"])
+
     def test_multiple_service_packet_request_and_replies(self):
         flow = TcpFlow(50032, 44818)
         back = TcpFlow(44818, 50032, src=(10, 1, 1, 164), dst=(10, 1, 1, 167))
@@ -814,7 +841,7 @@ class Malformed(unittest.TestCase):
         infos, not exceptions."""
         payloads = [m[:n] for m in (SEED, LIST_IDENTITY_REPLY, GET_ATTR_ERROR) for n in range(1, len(m))]
         # Unconnected Send and Multiple Service Packet: cut inside the CIP message, and flipped
-        more = [m[:n] for m in (UCS_ODD, MSP_REQUEST, MSP_REPLY) for n in range(40, len(m))]
+        more = [m[:n] for m in (UCS_ODD, MSP_REQUEST, MSP_REPLY, FORWARD_CLOSE) for n in range(40, len(m))]
         more += [m[:i] + bytes([m[i] ^ 0xFF]) + m[i + 1:] for m in (UCS_ODD, MSP_REPLY) for i in range(40, len(m))]
         for m in (SEED, LIST_IDENTITY_REPLY, IO_FRAME):
             for i in range(len(m)):
