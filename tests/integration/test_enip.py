@@ -12,8 +12,15 @@
   (class-1 I/O: a bare Common Packet Format, chosen with `ifhook`);
 - differential against Wireshark's own enip/cip dissectors on the real captures of
   <source-dir>/../shared/corpus/enip (read in place): every encapsulation header field,
-  item count, CPF type id and length, connection ids and sequence numbers, CIP service,
-  request/response bit and request path size, message by message, frame by frame.
+  item count, CPF type id and length, connection ids and sequence numbers, socket addresses
+  and ListIdentity product names, CIP service, request/response bit, request path size and
+  class; a Multiple Service Packet's count, offsets and services' bytes; Unconnected Send
+  (cipcm: priority/tick, time-out ticks, message size, the embedded request's header, route
+  path size, ports and link addresses), Forward Open and Forward Close requests and
+  successful replies (every cipcm field of theirs), message by message, frame by frame;
+- Unconnected Send with odd (padded) and even messages and an extended link address,
+  0x52 to a tag (not Unconnected Send), Multiple Service Packet requests and replies (an
+  error reply without services), Forward Close: against the bytes and against Wireshark.
 
 When the corpus is absent, everything else still runs; the script then prints SKIPPED and
 exits 77 if all else passed.
