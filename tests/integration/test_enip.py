@@ -533,11 +533,14 @@ def compare_messages(theirs, ours):
 def differential(capture_path):
     """Per-frame comparison of one capture; returns a summary dict."""
     theirs = [wireshark_messages(p) for p in pdml_packets(BARE, capture_path)]
-    ours = [our_messages(p) for p in pdml_packets(ENV, capture_path)]
+    ours, experts = [], 0
+    for p in pdml_packets(ENV, capture_path):
+        ours.append(our_messages(p))
+        experts += sum(1 for _, kind, name, _ in p if kind == "field" and name.startswith("enipr.expert."))
     if len(theirs) != len(ours):
         raise AssertionError("%s: %d frames for Wireshark, %d with the rules" % (capture_path, len(theirs), len(ours)))
     s = {"frames": len(ours), "enip_frames": 0, "messages_ws": 0, "messages_ours": 0,
-         "fields": 0, "agree": 0, "frames_differ": []}
+         "fields": 0, "agree": 0, "frames_differ": [], "experts": experts}
     for number_, (t, o) in enumerate(zip(theirs, ours), 1):
         if not t and not o:
             continue
@@ -868,6 +871,8 @@ class Malformed(unittest.TestCase):
         self.assertNotIn("[Malformed Packet", verbose.stdout, "a Wireshark exception escaped the rules")
         # A prefix cut inside the Unconnected Data item says so where it happens.
         self.assertRegex(rows[60][1], r"past the end|Truncated|should occur")
+        # ... and the differential counts our expert infos (none on the corpus, see Corpus)
+        self.assertGreater(differential(ENV.path("malformed.pcap"))["experts"], len(payloads) // 2)
 
 
 class Corpus(unittest.TestCase):
@@ -880,7 +885,8 @@ class Corpus(unittest.TestCase):
         if not files:
             self.skipTest("no EtherNet/IP corpus at %s" % corpus)
         start = time.time()
-        total = {"enip_frames": 0, "messages_ws": 0, "messages_ours": 0, "fields": 0, "agree": 0, "differ": 0}
+        total = {"enip_frames": 0, "messages_ws": 0, "messages_ours": 0, "fields": 0, "agree": 0, "differ": 0,
+                 "experts": 0}
         problems = []
         print("\n%-40s %7s %8s %9s %9s %9s" % ("capture", "frames", "msgs ws", "msgs ours", "fields",
                                                 "agreeing"), file=sys.stderr)
@@ -900,6 +906,8 @@ class Corpus(unittest.TestCase):
                                                       time.time() - start), file=sys.stderr)
         self.assertGreater(total["messages_ws"], 0)
         self.assertEqual(problems, [], "\n".join(problems[:40]))
+        # Real traffic is well-formed: none of our expert infos fires on it.
+        self.assertEqual(total["experts"], 0)
 
 
 def corpus_dir():
