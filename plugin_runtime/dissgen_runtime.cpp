@@ -535,8 +535,10 @@ void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
     }
     gint left = end - *offset;
     if (length > left) {
-        /* Show the bytes that are there, then say what is missing. */
-        if (!(n->flags & DG_NUMERIC) && left > 0 && tree) {
+        /* Show the bytes that are there, then say what is missing. An IPv4
+         * address or a float has one size only: Wireshark throws on fewer bytes. */
+        gboolean fixed_size = n->show == DG_SHOW_IPV4 || n->show == DG_SHOW_FLOAT;
+        if (!(n->flags & DG_NUMERIC) && !fixed_size && left > 0 && tree) {
             proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, left, item_encoding(n));
             if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
         }

@@ -319,6 +319,23 @@ class Display10a(unittest.TestCase):
         cap = capture("clean.pcap", [to_port(values_message())])
         self.assertEqual(run_fields(cap, ["_ws.expert"])[0]["_ws.expert"], "")
 
+    def test_truncated_address_and_float_give_expert_infos(self):
+        """An IPv4 address or a float cut short: our expert info, no Wireshark exception
+        (FT_IPv4 and FT_FLOAT items cannot show fewer bytes than their size)."""
+        m = values_message()
+        address = m.index(bytes(VALUES["address"]))
+        real = m.index(struct.pack("<f", VALUES["real"]))
+        cap = capture("cut_fixed_size.pcap", [to_port(m[:address + 2]), to_port(m[:real + 3])])
+        rows = run_fields(cap, ["dspt.values.fixed_text", "dspt.values.address", "dspt.values.small",
+                                "dspt.values.real", "_ws.expert.message"])
+        self.assertEqual(rows[0]["dspt.values.fixed_text"], "ab")
+        self.assertEqual(rows[0]["dspt.values.address"], "")
+        self.assertIn("Truncated: 'Address' needs 4 bytes, only 2 left", rows[0]["_ws.expert.message"])
+        self.assertEqual(rows[1]["dspt.values.small"], str(VALUES["small"]))
+        self.assertEqual(rows[1]["dspt.values.real"], "")
+        self.assertIn("Truncated: 'Real' needs 4 bytes, only 3 left", rows[1]["_ws.expert.message"])
+        assert_no_exception(cap)
+
     def test_every_truncation_of_every_message_decodes_without_exception(self):
         messages = [values_message(), bytes([2]) + struct.pack("<HH", 1, 2),
                     bytes([3]) + inner_frame((1, 2, 3, 4)), fragment(11, 0, False, bytes(16)),
@@ -331,6 +348,7 @@ class Display10a(unittest.TestCase):
         p = ENV.tshark(["-r", cap, "-V", "-2"], check=False)
         self.assertEqual(p.returncode, 0, p.stderr[-2000:])
         self.assertNotIn("Dissector bug", p.stdout)
+        self.assertNotIn("[Malformed Packet: DSPT]", p.stdout)
 
 
 if __name__ == "__main__":

@@ -12,8 +12,15 @@
   (class-1 I/O: a bare Common Packet Format, chosen with `ifhook`);
 - differential against Wireshark's own enip/cip dissectors on the real captures of
   <source-dir>/../shared/corpus/enip (read in place): every encapsulation header field,
-  item count, CPF type id and length, connection ids and sequence numbers, CIP service,
-  request/response bit and request path size, message by message, frame by frame.
+  item count, CPF type id and length, connection ids and sequence numbers, socket addresses
+  and ListIdentity product names, CIP service, request/response bit, request path size and
+  class; a Multiple Service Packet's count, offsets and services' bytes; Unconnected Send
+  (cipcm: priority/tick, time-out ticks, message size, the embedded request's header, route
+  path size, ports and link addresses), Forward Open and Forward Close requests and
+  successful replies (every cipcm field of theirs), message by message, frame by frame;
+- Unconnected Send with odd (padded) and even messages and an extended link address,
+  0x52 to a tag (not Unconnected Send), Multiple Service Packet requests and replies (an
+  error reply without services), Forward Close: against the bytes and against Wireshark.
 
 When the corpus is absent, everything else still runs; the script then prints SKIPPED and
 exits 77 if all else passed.
@@ -138,6 +145,57 @@ FORWARD_OPEN_REPLY = send_data(0x6F, [(0x0000, b""),
 IO_FRAME = cpf((0x8002, struct.pack("<II", 0x004B0603, 4166875)), (0x00B1, bytes.fromhex("a587e80f0300")))
 
 
+def unconnected(cip, session=0x11020100):
+    """SendRRData: a Null Address item and an Unconnected Data item holding cip."""
+    return send_data(0x6F, [(0x0000, b""), (0x00B2, cip)], session=session, timeout=32)
+
+
+CONNECTION_MANAGER = bytes.fromhex("20062401")       # class 6, instance 1
+ROUTE_BACKPLANE_SLOT0 = bytes.fromhex("0100")        # port 1, link address 0
+
+
+def unconnected_send(message, route=ROUTE_BACKPLANE_SLOT0, tick=0x07, timeout_ticks=249):
+    """Unconnected Send (0x52) to the Connection Manager; a pad byte follows an odd message."""
+    pad = b"\0" if len(message) % 2 else b""
+    return cip_request(0x52, CONNECTION_MANAGER, bytes([tick, timeout_ticks]) + struct.pack("<H", len(message)) +
+                       message + pad + bytes([len(route) // 2, 0]) + route)
+
+
+def multiple_service(services, reply=False, status=0):
+    """Multiple Service Packet (0x0a) to the Message Router: count, offsets, services."""
+    offsets, at = [], 2 + 2 * len(services)
+    for m in services:
+        offsets.append(at)
+        at += len(m)
+    body = struct.pack("<H%dH" % len(services), len(services), *offsets) + b"".join(services)
+    if reply:
+        return cip_response(0x0A, status, data=body)
+    return cip_request(0x0A, bytes.fromhex("20022401"), body)
+
+
+# Set Attribute Single (Identity 1, attribute 5) with a 1-byte value: a 9-byte message, padded.
+UCS_ODD = unconnected(unconnected_send(cip_request(0x10, bytes.fromhex("200124013005"), b"\x07")))
+# Get Attributes All (Identity 1): 6 bytes, no pad; routed over two hops.
+UCS_EVEN = unconnected(unconnected_send(cip_request(0x01, bytes.fromhex("20012401")),
+                                        route=bytes.fromhex("01000203"), tick=0x1A, timeout_ticks=10))
+# ... and to 10.1.1.5 behind the front port: an extended link address (its size, then ASCII).
+UCS_EXTENDED = unconnected(unconnected_send(cip_request(0x01, bytes.fromhex("20012401")),
+                                            route=bytes.fromhex("0100") + b"\x12\x0810.1.1.5"))
+# 0x52 to a tag (ANSI symbol segment): Logix's Read Tag Fragmented, no Unconnected Send.
+READ_TAG_FRAGMENTED = unconnected(cip_request(0x52, b"\x91\x04TAG1", struct.pack("<HI", 1, 0)))
+MSP_SERVICES = [cip_request(0x0E, bytes.fromhex("200124013001")),                      # Identity 1, attribute 1
+                cip_request(0x03, bytes.fromhex("20f52401"), struct.pack("<HHH", 2, 3, 5))]  # TCP/IP 1: 3 and 5
+MSP_REQUEST = unconnected(multiple_service(MSP_SERVICES))
+MSP_REPLY = unconnected(multiple_service([cip_response(0x0E, data=b"\x01\x00"),
+                                          cip_response(0x03, 0x05)], reply=True, status=0x1E))
+MSP_ERROR_REPLY = unconnected(cip_response(0x0A, 0x08))     # Service not supported: no data
+# Forward Close of connection serial 0x0014 (vendor 0x4d), path: backplane slot 0, Message Router
+FORWARD_CLOSE = unconnected(cip_request(0x4E, CONNECTION_MANAGER, struct.pack("<BBHHIBB", 0x0A, 0xF0, 0x14, 0x4D,
+                                                                              0x32952BF3, 3, 0) +
+                                        bytes.fromhex("010020022401")))
+FORWARD_CLOSE_REPLY = unconnected(cip_response(0x4E, data=struct.pack("<HHIBB", 0x14, 0x4D, 0x32952BF3, 0, 0)))
+
+
 # --- running tshark ----------------------------------------------------------------
 
 def fields(env, capture, names, extra=()):
@@ -157,11 +215,22 @@ def capture(name, frames):
 
 # --- PDML: messages as each side decodes them ---------------------------------------
 
+THEIR_FO_NAMES = ("cip.cm.ot_connid", "cip.cm.to_connid", "cip.cm.conn_serial_num", "cip.cm.vendor",
+                  "cip.cm.orig_serial_num", "cip.cm.timeout_multiplier", "cip.cm.otrpi", "cip.cm.torpi",
+                  "cip.cm.connpath_size", "cip.cm.otapi", "cip.cm.toapi", "cip.cm.app_reply_size",
+                  "cip.cm.fwo.transport", "cip.cm.fwo.trigger", "cip.cm.fwo.dir", "cip.cm.fwo.consize",
+                  "cip.cm.fwo.f_v", "cip.cm.fwo.prio", "cip.cm.fwo.type", "cip.cm.fwo.owner")
 WS_FIELDS = ("enip.command|enip.length|enip.session|enip.status|enip.context|enip.listid_delay|"
              "enip.options|enip.cpf.itemcount|enip.cpf.typeid|enip.cpf.length|enip.cpf.cai.connid|"
-             "enip.cpf.sai.connid|enip.cpf.sai.seq|cip.seq|cip.sc|cip.rr|cip.request_path_size")
+             "enip.cpf.sai.connid|enip.cpf.sai.seq|enip.sinfamily|enip.sinport|enip.sinaddr|enip.lir.name|"
+             "cip.seq|cip.sc|cip.rr|cip.request_path_size|cip.path_segment|cip.class|"
+             "cip.msp.num_services|cip.msp.offset|cip.cm.sc|cip.cm.priority|cip.cm.tick_time|"
+             "cip.cm.timeout_tick|cip.cm.msg_req_size|cip.cm.route_path_size|cip.port|cip.linkaddress.byte|"
+             "cip.genstat|" + "|".join(THEIR_FO_NAMES))
+# Wireshark shows each service of a Multiple Service Packet as a text item whose value is its bytes.
 LINE = re.compile(rb'^( *)<(?:(packet)>|proto name="([^"]+)"|field name="((?:' +
-                  WS_FIELDS.replace(".", r"\.").encode() + rb')|enipr\.[a-z0-9_.]+)"([^\n]*))', re.M)
+                  WS_FIELDS.replace(".", r"\.").encode() +
+                  rb')|enipr\.[a-z0-9_.]+|(?=" show="Service Packet #))"([^\n]*))', re.M)
 ATTR = re.compile(rb'(show|value|size)="([^"]*)"')
 
 # Our field -> the record key it fills (Wireshark's names map to the same keys below).
@@ -174,21 +243,81 @@ OURS = {
     "enipr.cpf.item.connid": "connid", "enipr.io.cpf.item.connid": "connid",
     "enipr.cpf.item.seqnum": "seqnum", "enipr.io.cpf.item.seqnum": "seqnum",
     "enipr.cpf.item.seqcount": "seqcount",
+    "enipr.cpf.item.sockaddr.family": "sinfamily", "enipr.cpf.item.identity.sockaddr.family": "sinfamily",
+    "enipr.cpf.item.sockaddr.port": "sinport", "enipr.cpf.item.identity.sockaddr.port": "sinport",
+    "enipr.cpf.item.sockaddr.addr": "sinaddr", "enipr.cpf.item.identity.sockaddr.addr": "sinaddr",
+    "enipr.cpf.item.identity.name": "name",
 }
 THEIRS = {
     "enip.command": "command", "enip.length": "length", "enip.session": "session",
     "enip.status": "status", "enip.options": "options", "enip.cpf.itemcount": "itemcount",
     "enip.cpf.typeid": "typeid", "enip.cpf.length": "itemlength", "enip.cpf.cai.connid": "connid",
     "enip.cpf.sai.connid": "connid", "enip.cpf.sai.seq": "seqnum", "cip.seq": "seqcount",
+    "enip.sinfamily": "sinfamily", "enip.sinport": "sinport", "enip.sinaddr": "sinaddr", "enip.lir.name": "name",
 }
+TEXTS = ("sinaddr", "name")        # compared as shown (dotted address, product name), not as numbers
 SCALARS = ("command", "length", "session", "status", "context", "options", "itemcount")
-LISTS = ("typeid", "itemlength", "connid", "seqnum", "seqcount", "cip")
+LISTS = ("typeid", "itemlength", "connid", "seqnum", "seqcount", "sinfamily", "sinport", "sinaddr", "name", "cip")
+
+# One CIP message: what is compared, slot by slot. msp_offsets is a tuple (one value per offset),
+# msp_services the services' bytes in hex; cm_* are the Connection Manager's priority/tick and
+# time-out ticks (Unconnected Send, Forward Open and Close), ucs_* the rest of an Unconnected
+# Send request and the message it carries, fo_* a Forward Open or Close request or its successful
+# reply (times in us; the connection parameters as tuples, O->T then T->O).
+FO_SCALARS = ("ot_connid", "to_connid", "conn_serial", "vendor", "orig_serial", "timeout_multiplier", "ot_rpi",
+              "to_rpi", "path_size", "ot_api", "to_api", "app_reply_size", "class", "trigger", "direction")
+FO_PARAMS = ("size", "variable", "priority", "type", "owner")
+CIP_SLOTS = ("service", "rr", "pathsize", "segment", "class", "msp_count", "msp_offsets", "msp_services",
+             "cm_priority", "cm_tick_time", "cm_timeout_ticks", "ucs_msg_size", "ucs_route_size",
+             "ucs_service", "ucs_rr", "ucs_pathsize", "ucs_ports", "ucs_links") + \
+    tuple("fo_" + k for k in FO_SCALARS + FO_PARAMS)
+# Our field (after "enipr.cpf.item.cip.") -> its slot.
+OUR_CIP = {
+    "service": "service", "rr": "rr", "pathsize": "pathsize", "path.segment": "segment", "path.class": "class",
+    "msp.count": "msp_count", "msp_reply.count": "msp_count", "ucs.priority": "cm_priority",
+    "ucs.tick_time": "cm_tick_time", "ucs.timeout_ticks": "cm_timeout_ticks", "ucs.msg_size": "ucs_msg_size",
+    "ucs.route_size": "ucs_route_size", "ucs.message.service": "ucs_service", "ucs.message.rr": "ucs_rr",
+    "ucs.message.pathsize": "ucs_pathsize", "fwd_open.priority": "cm_priority",
+    "fwd_open.tick_time": "cm_tick_time", "fwd_open.timeout_ticks": "cm_timeout_ticks",
+    "fwd_open.transport.class": "fo_class", "fwd_open.transport.trigger": "fo_trigger",
+    "fwd_open.transport.direction": "fo_direction",
+}
+for _k in FO_SCALARS[:-3]:
+    OUR_CIP["fwd_open." + _k] = OUR_CIP["fwd_open_reply." + _k] = "fo_" + _k
+for _k in ("conn_serial", "vendor", "orig_serial", "path_size", "app_reply_size"):
+    OUR_CIP["fwd_close." + _k] = OUR_CIP["fwd_close_reply." + _k] = "fo_" + _k
+for _k in ("priority", "tick_time", "timeout_ticks"):
+    OUR_CIP["fwd_close." + _k] = "cm_" + _k
+# Wireshark's fields of the Connection Manager (cipcm) -> slot.
+THEIR_CM = {"cip.cm.priority": "cm_priority", "cip.cm.tick_time": "cm_tick_time",
+            "cip.cm.timeout_tick": "cm_timeout_ticks"}
+THEIR_UCS = {"cip.cm.msg_req_size": "ucs_msg_size", "cip.cm.route_path_size": "ucs_route_size"}
+THEIR_FO = {
+    "cip.cm.ot_connid": "fo_ot_connid", "cip.cm.to_connid": "fo_to_connid", "cip.cm.conn_serial_num": "fo_conn_serial",
+    "cip.cm.vendor": "fo_vendor", "cip.cm.orig_serial_num": "fo_orig_serial",
+    "cip.cm.timeout_multiplier": "fo_timeout_multiplier", "cip.cm.otrpi": "fo_ot_rpi", "cip.cm.torpi": "fo_to_rpi",
+    "cip.cm.connpath_size": "fo_path_size", "cip.cm.otapi": "fo_ot_api", "cip.cm.toapi": "fo_to_api",
+    "cip.cm.app_reply_size": "fo_app_reply_size", "cip.cm.fwo.transport": "fo_class",
+    "cip.cm.fwo.trigger": "fo_trigger", "cip.cm.fwo.dir": "fo_direction",
+}
+THEIR_FO_PARAMS = {"cip.cm.fwo.consize": "fo_size", "cip.cm.fwo.f_v": "fo_variable", "cip.cm.fwo.prio": "fo_priority",
+                   "cip.cm.fwo.type": "fo_type", "cip.cm.fwo.owner": "fo_owner"}
+OUR_FO_PARAMS = {"fwd_open.%s.%s" % (d, k): "fo_" + k for d in ("ot_params", "to_params") for k in FO_PARAMS}
+# ... and of an Unconnected Send's route path's port segments -> slot (a tuple, a value per hop)
+THEIR_HOPS = {"cip.port": "ucs_ports", "cip.linkaddress.byte": "ucs_links"}
+OUR_HOPS = {"ucs.route.hop.port": "ucs_ports", "ucs.route.hop.link": "ucs_links"}
+OUR_TUPLES = dict(OUR_HOPS, **OUR_FO_PARAMS)
+OUR_TIMES = ("fo_ot_rpi", "fo_to_rpi", "fo_ot_api", "fo_to_api")    # shown in seconds, compared in us
 
 
 def new_message():
     m = {k: None for k in SCALARS}
     m.update({k: [] for k in LISTS})
     return m
+
+
+def new_cip():
+    return dict.fromkeys(CIP_SLOTS)
 
 
 def number(text):
@@ -230,24 +359,44 @@ def pdml_packets(env, capture_path, extra=()):
 
 def wireshark_messages(packet):
     """Messages of Wireshark's enip (one top-level enip proto each) and, attached to the
-    message before, the outer service of each top-level cip proto (nested requests of
-    Multiple Service Packet / Unconnected Send, and cipcm's copies, are left out)."""
-    out, msg, cip, where = [], None, None, None
+    message before, each top-level cip proto: its service, request path size, first path
+    segment (and class), a Multiple Service Packet's count, offsets and services' bytes, and
+    for an Unconnected Send request the cipcm fields and the embedded request's header
+    (the services inside a Multiple Service Packet and cipcm's copies are left out)."""
+    out, msg, cip, where, top = [], None, None, None, None
     delay = None
+    segments = 0            # path segments seen in the current top-level cip
+    in_services = False     # past the offset list of a Multiple Service Packet
+    cm = None               # in cipcm: "ucs" (Unconnected Send request), "fo" (Forward Open, or its
+                            # successful reply)
+    genstat = None          # of the current top-level cip
     for indent, kind, name, attrs in packet:
         if kind == "proto":
             if indent == 2:
-                where = name
-                cip = None
+                where = top = name
                 if name == "enip":
                     msg = new_message()
                     out.append(msg)
                     delay = None
+                    cip = None
                 elif name == "cip" and msg is not None:
-                    cip = [None, None, None]
+                    cip = new_cip()
                     msg["cip"].append(cip)
-            elif where == "cip":
+                    segments, in_services, genstat = 0, False, None
+                elif name == "cipcm":
+                    cm = None
+                else:
+                    cip = None
+            elif where == "cipcm" and cm == "ucs" and name == "cip":
+                where = "embedded"      # the request an Unconnected Send carries
+            elif where != "enip":
                 where = "nested"
+            continue
+        if not name:
+            # "Service Packet #n", at the top level of a Multiple Service Packet (not inside one)
+            if top == "cip" and indent == 6 and cip is not None:
+                in_services = True
+                cip["msp_services"] = (cip["msp_services"] or "") + attrs.get("value", "")
             continue
         if attrs.get("size") == "0":
             continue            # generated, e.g. a response's request path size copied from its request
@@ -260,13 +409,47 @@ def wireshark_messages(packet):
                 msg["context"] = (delay or "") + attrs.get("value", "")
             elif name in THEIRS:
                 key = THEIRS[name]
-                value = number(attrs["show"])
+                value = attrs["show"] if key in TEXTS else number(attrs["show"])
                 if key in SCALARS:
                     msg[key] = value
                 else:
                     msg[key].append(value)
         elif where == "cip" and cip is not None:
-            slot = {"cip.sc": 0, "cip.rr": 1, "cip.request_path_size": 2}.get(name)
+            slot = {"cip.sc": "service", "cip.rr": "rr", "cip.request_path_size": "pathsize",
+                    "cip.msp.num_services": "msp_count"}.get(name)
+            if slot is not None and cip[slot] is None:
+                cip[slot] = number(attrs["show"])
+            elif name == "cip.genstat":
+                genstat = number(attrs["show"])
+            elif name == "cip.path_segment":
+                segments += 1
+                if segments == 1:
+                    cip["segment"] = number(attrs["show"])
+            elif name == "cip.class" and segments == 1 and cip["segment"] == 0x20:
+                cip["class"] = number(attrs["show"])
+            elif name == "cip.msp.offset" and not in_services:
+                cip["msp_offsets"] = (cip["msp_offsets"] or ()) + (number(attrs["show"]),)
+        elif top == "cipcm" and cip is not None and name == "cip.cm.route_path_size":
+            where = "cipcm"             # the embedded request has ended
+            if cm == "ucs":
+                cip["ucs_route_size"] = number(attrs["show"])
+        elif where == "cipcm" and cip is not None:
+            if name == "cip.cm.sc":
+                # a Forward Open reply: only a successful one is decoded
+                cm = {(0x52, 0, None): "ucs", (0x54, 0, None): "fo", (0x54, 1, 0): "fo", (0x4e, 0, None): "fo",
+                      (0x4e, 1, 0): "fo"}.get(
+                    (number(attrs["show"]), cip["rr"], genstat))
+            elif cm in ("ucs", "fo") and name in THEIR_CM:
+                cip[THEIR_CM[name]] = number(attrs["show"])
+            elif cm == "ucs" and name in THEIR_UCS:
+                cip[THEIR_UCS[name]] = number(attrs["show"])
+            elif cm == "fo" and name in THEIR_FO:
+                cip[THEIR_FO[name]] = number(attrs["show"])
+            elif (cm == "ucs" and name in THEIR_HOPS) or (cm == "fo" and name in THEIR_FO_PARAMS):
+                slot = THEIR_HOPS.get(name) or THEIR_FO_PARAMS[name]
+                cip[slot] = (cip[slot] or ()) + (number(attrs["show"]),)
+        elif where == "embedded" and cip is not None:
+            slot = {"cip.sc": "ucs_service", "cip.rr": "ucs_rr", "cip.request_path_size": "ucs_pathsize"}.get(name)
             if slot is not None and cip[slot] is None:
                 cip[slot] = number(attrs["show"])
     return out
@@ -274,6 +457,7 @@ def wireshark_messages(packet):
 
 def our_messages(packet):
     out, msg, cip = [], None, None
+    prefix = "enipr.cpf.item.cip."
     for indent, kind, name, attrs in packet:
         if kind == "proto":
             if indent == 2:
@@ -281,20 +465,28 @@ def our_messages(packet):
                 if msg is not None:
                     out.append(msg)
             continue
-        if msg is None:
+        if msg is None or not name:
             continue
         if name == "enipr.cpf.item.cip":
-            cip = [None, None, None]
+            cip = new_cip()
             msg["cip"].append(cip)
-        elif name.startswith("enipr.cpf.item.cip."):
-            slot = {"service": 0, "rr": 1, "pathsize": 2}.get(name.rsplit(".", 1)[1])
-            if slot is not None:
-                cip[slot] = number(attrs["show"])
+        elif name.startswith(prefix):
+            field = name[len(prefix):]
+            if field in OUR_CIP:
+                slot = OUR_CIP[field]
+                cip[slot] = round(float(attrs["show"]) * 1e6) if slot in OUR_TIMES else number(attrs["show"])
+            elif field in ("msp.offset", "msp_reply.offset"):
+                cip["msp_offsets"] = (cip["msp_offsets"] or ()) + (number(attrs["show"]),)
+            elif field in OUR_TUPLES:
+                slot = OUR_TUPLES[field]
+                cip[slot] = (cip[slot] or ()) + (number(attrs["show"]),)
+            elif field in ("msp.services", "msp_reply.services"):
+                cip["msp_services"] = attrs.get("value", "")
         elif name == "enipr.context":
             msg["context"] = attrs.get("value", "")
         elif name in OURS:
             key = OURS[name]
-            value = number(attrs["show"])
+            value = attrs["show"] if key in TEXTS else number(attrs["show"])
             if key in SCALARS:
                 msg[key] = value
             else:
@@ -302,10 +494,15 @@ def our_messages(packet):
     return out
 
 
+def cip_count(c):
+    """Fields in one CIP record: each offset of a Multiple Service Packet counts."""
+    return sum(len(v) if isinstance(v, tuple) else 1 for v in c.values() if v is not None)
+
+
 def field_count(msg):
     n = sum(1 for k in SCALARS if msg[k] is not None)
     n += sum(len(msg[k]) for k in LISTS if k != "cip")
-    return n + sum(sum(1 for v in c if v is not None) for c in msg["cip"])
+    return n + sum(cip_count(c) for c in msg["cip"])
 
 
 def compare_messages(theirs, ours):
@@ -316,10 +513,7 @@ def compare_messages(theirs, ours):
         for k in SCALARS + LISTS:
             a, b = t[k], o[k]
             if k == "cip":
-                a = [tuple(c) for c in a]
-                b = [tuple(c) for c in b]
-                n = max(sum(sum(1 for v in c if v is not None) for c in a),
-                        sum(sum(1 for v in c if v is not None) for c in b))
+                n = max(sum(cip_count(c) for c in a), sum(cip_count(c) for c in b))
             elif k in LISTS:
                 n = max(len(a), len(b))
             else:
@@ -339,11 +533,14 @@ def compare_messages(theirs, ours):
 def differential(capture_path):
     """Per-frame comparison of one capture; returns a summary dict."""
     theirs = [wireshark_messages(p) for p in pdml_packets(BARE, capture_path)]
-    ours = [our_messages(p) for p in pdml_packets(ENV, capture_path)]
+    ours, experts = [], 0
+    for p in pdml_packets(ENV, capture_path):
+        ours.append(our_messages(p))
+        experts += sum(1 for _, kind, name, _ in p if kind == "field" and name.startswith("enipr.expert."))
     if len(theirs) != len(ours):
         raise AssertionError("%s: %d frames for Wireshark, %d with the rules" % (capture_path, len(theirs), len(ours)))
     s = {"frames": len(ours), "enip_frames": 0, "messages_ws": 0, "messages_ours": 0,
-         "fields": 0, "agree": 0, "frames_differ": []}
+         "fields": 0, "agree": 0, "frames_differ": [], "experts": experts}
     for number_, (t, o) in enumerate(zip(theirs, ours), 1):
         if not t and not o:
             continue
@@ -400,22 +597,45 @@ SEED_EXPECTED = {
     "enipr.iface": "0x00000000", "enipr.timeout": "1024", "enipr.cpf.itemcount": "2",
     "enipr.cpf.item.typeid": "0x0000,0x00b2", "enipr.cpf.item.length": "0,46",
     "enipr.cpf.item.cip.service": "0x54", "enipr.cpf.item.cip.rr": "0x00",
-    "enipr.cpf.item.cip.pathsize": "2", "enipr.cpf.item.cip.path": "20 06 24 01",
-    # header 24, interface handle + timeout 6, item count 2, two item headers 8, service + path size 2, path 4
-    "enipr.cpf.item.cip.data": " ".join("%02x" % b for b in SEED[24 + 6 + 2 + 8 + 2 + 4:]),
-    "enipr.cpf.item.cip.genstat": "", "enipr.cpf.item.connid": "", "enipr.cpf.item.data": "",
+    "enipr.cpf.item.cip.pathsize": "2", "enipr.cpf.item.cip.path.segment": "0x20",
+    "enipr.cpf.item.cip.path.class": "0x06", "enipr.cpf.item.cip.path.more": "24 01",
+    # The Forward Open's 40 bytes after the path (header 24, interface handle + timeout 6, item
+    # count 2, two item headers 8, service + path size 2, path 4), field by field (forward_open_fields).
+    "enipr.cpf.item.cip.data": "", "enipr.cpf.item.cip.genstat": "", "enipr.cpf.item.connid": "",
+    "enipr.cpf.item.data": "",
 }
+
+
+def forward_open_fields(data):
+    """The rules' Forward Open fields, as tshark prints them, computed from a request's bytes."""
+    (tick, ticks, ot_connid, to_connid, serial, vendor, orig_serial, multiplier, ot_rpi, ot_params, to_rpi,
+     to_params, transport, path_size) = struct.unpack("<BBIIHHIB3xIHIHBB", data[:36])
+    p = "enipr.cpf.item.cip.fwd_open."
+    out = {p + "tick_time": str(tick & 15), p + "priority": str(tick >> 4 & 1), p + "timeout_ticks": str(ticks),
+           p + "ot_connid": "0x%08x" % ot_connid, p + "to_connid": "0x%08x" % to_connid,
+           p + "conn_serial": "0x%04x" % serial, p + "vendor": "0x%04x" % vendor,
+           p + "orig_serial": "0x%08x" % orig_serial, p + "timeout_multiplier": "0x%02x" % multiplier,
+           p + "ot_rpi": "%d.%06d000" % divmod(ot_rpi, 10 ** 6), p + "to_rpi": "%d.%06d000" % divmod(to_rpi, 10 ** 6),
+           p + "transport.class": str(transport & 15), p + "transport.trigger": "0x%02x" % (transport >> 4 & 7),
+           p + "transport.direction": "0x%02x" % (transport >> 7), p + "path_size": str(path_size),
+           p + "path": " ".join("%02x" % b for b in data[36:36 + 2 * path_size])}
+    for d, v in (("ot_params.", ot_params), ("to_params.", to_params)):
+        out.update({p + d + "size": str(v & 0x1FF), p + d + "variable": "0x%04x" % (v >> 9 & 1),
+                    p + d + "priority": "0x%04x" % (v >> 10 & 3), p + d + "type": "0x%04x" % (v >> 13 & 3),
+                    p + d + "owner": str(v >> 15)})
+    return out
 
 
 class Seed(unittest.TestCase):
     def test_seed_message_in_one_tcp_segment(self):
         self.assertEqual(len(SEED), 86)
         cap = capture("seed.pcap", [TcpFlow(50000, 44818).segment(SEED)])
-        rows = fields(ENV, cap, list(SEED_EXPECTED))
+        expected = dict(SEED_EXPECTED, **forward_open_fields(SEED[24 + 6 + 2 + 8 + 2 + 4:]))
+        rows = fields(ENV, cap, list(expected))
         self.assertEqual(len(rows), 1)
-        self.assertEqual(rows[0], SEED_EXPECTED)
-        # The CIP data is the 40 bytes after the 4-byte path: 46 - 2 - 4.
-        self.assertEqual(len(rows[0]["enipr.cpf.item.cip.data"].split()), 40)
+        self.assertEqual(rows[0], expected)
+        # The connection path ends the message: 46 - 2 - 4 - 36 bytes.
+        self.assertEqual(len(rows[0]["enipr.cpf.item.cip.fwd_open.path"].split()), 4)
 
     def test_wireshark_agrees_on_the_seed(self):
         cap = capture("seed_ws.pcap", [TcpFlow(50000, 44818).segment(SEED)])
@@ -492,11 +712,17 @@ class Tcp(unittest.TestCase):
         names = ["enipr.cpf.item.typeid", "enipr.cpf.item.length", "enipr.cpf.item.cip.service",
                  "enipr.cpf.item.cip.rr", "enipr.cpf.item.cip.genstat", p + "family", p + "port", p + "addr",
                  p + "zero"]
-        rows = fields(ENV, capture("sockaddr.pcap", [TcpFlow(44818, 50004).segment(FORWARD_OPEN_REPLY)]), names)
-        self.assertEqual([rows[0][n] for n in names],
-                         ["0x0000,0x00b2,0x8001", "0,30,16", "0x54", "0x01", "0x00", "2", "2222", "0xefc00102",
+        # The request first: Wireshark's cip knows a reply's object from its request only.
+        frames = [TcpFlow(50004, 44818).segment(SEED),
+                  TcpFlow(44818, 50004, src=(10, 1, 1, 164), dst=(10, 1, 1, 167)).segment(FORWARD_OPEN_REPLY)]
+        rows = fields(ENV, capture("sockaddr.pcap", frames), names + ["enipr.cpf.item.cip.fwd_open_reply.ot_api"])
+        self.assertEqual([rows[1][n] for n in names],
+                         ["0x0000,0x00b2,0x8001", "0,30,16", "0x54", "0x01", "0x00", "2", "2222", "239.192.1.2",
                           "00 00 00 00 00 00 00 00"])
-        self.assertEqual(differential(ENV.path("sockaddr.pcap"))["frames_differ"], [])
+        self.assertEqual(rows[1]["enipr.cpf.item.cip.fwd_open_reply.ot_api"], "0.000000000")
+        s = differential(ENV.path("sockaddr.pcap"))
+        self.assertEqual(s["frames_differ"], [])
+        self.assertEqual(s["fields"], s["agree"])
 
 
 class Udp(unittest.TestCase):
@@ -515,9 +741,9 @@ class Udp(unittest.TestCase):
         self.assertEqual(rows[0]["enipr.cpf.itemcount"], "")      # a request has no data
         r = rows[1]
         self.assertEqual(r["enipr.context"], "00 00 c1 de be d1 f0 0d")
-        expected = ["1", "0x000c", str(len(IDENTITY_ITEM)), "1", "2", "44818", "0x0a0101a4",
+        expected = ["1", "0x000c", str(len(IDENTITY_ITEM)), "1", "2", "44818", "10.1.1.164",
                     "00 00 00 00 00 00 00 00", "0x0001", "0x000c", "58", "4", "3", "0x0030", "0x00524d8e",
-                    "11", " ".join("%02x" % c for c in b"1756-ENBT/A"), "0x03"]
+                    "11", "1756-ENBT/A", "0x03"]
         self.assertEqual([r[n] for n in names[3:]], expected)
         self.assertEqual(differential(ENV.path("listidentity.pcap"))["frames_differ"], [])
 
@@ -527,7 +753,7 @@ class Udp(unittest.TestCase):
         rows = fields(ENV, capture("listservices.pcap", [TcpFlow(44818, 50011).segment(LIST_SERVICES_REPLY)]),
                       names)
         self.assertEqual([rows[0][n] for n in names],
-                         ["0x0004", "0x0100", "1", "1", "1", " ".join("%02x" % c for c in b"Communications\0\0")])
+                         ["0x0004", "0x0100", "1", "1", "1", "Communications"])
 
     def test_class1_io_over_udp_2222(self):
         frames = [udp(2222, 2222, IO_FRAME)]
@@ -540,15 +766,98 @@ class Udp(unittest.TestCase):
         self.assertEqual(differential(ENV.path("io.pcap"))["frames_differ"], [])
 
 
+class Services(unittest.TestCase):
+    """Unconnected Send and Multiple Service Packet, field by field against the bytes, and
+    against Wireshark's cip/cipcm (the differential compares the same fields)."""
+    P = "enipr.cpf.item.cip."
+
+    def test_unconnected_send_with_odd_and_even_message(self):
+        p = self.P + "ucs."
+        names = [self.P + "service", self.P + "path.class", p + "tick_time", p + "priority", p + "timeout_ticks",
+                 p + "msg_size", p + "odd", p + "message.service", p + "message.rr", p + "message.pathsize",
+                 p + "message.path", p + "message.data", p + "pad", p + "route_size", p + "reserved",
+                 p + "route.hop.port", p + "route.hop.extended", p + "route.hop.type", p + "route.hop.link",
+                 self.P + "data", "_ws.expert"]
+        flow = TcpFlow(50030, 44818)
+        names_more = names + [self.P + "ucs.route.hop.more"]
+        cap = capture("ucs.pcap", [flow.segment(UCS_ODD), flow.segment(UCS_EVEN), flow.segment(UCS_EXTENDED)])
+        rows = fields(ENV, cap, names_more)
+        self.assertEqual([rows[0][n] for n in names],
+                         ["0x52", "0x06", "7", "0", "249", "9", "1", "0x10", "0x00", "3", "20 01 24 01 30 05",
+                          "07", "0x00", "1", "0x00", "0x01", "0", "0x00", "0", "", ""])
+        # tick byte 0x1a: tick time 10, priority 1; no pad after 6 bytes; two hops
+        self.assertEqual([rows[1][n] for n in names],
+                         ["0x52", "0x06", "10", "1", "10", "6", "0", "0x01", "0x00", "2", "20 01 24 01",
+                          "", "", "2", "0x00", "0x01,0x02", "0,0", "0x00,0x00", "0,3", "", ""])
+        r = rows[2]
+        self.assertEqual([r[n] for n in names[-8:-2]], ["6", "0x00", "0x01,0x02", "0,1", "0x00,0x00", "0"])
+        self.assertEqual(r[self.P + "ucs.route.hop.more"], "08 " + " ".join("%02x" % c for c in b"10.1.1.5"))
+        s = differential(ENV.path("ucs.pcap"))
+        self.assertEqual(s["frames_differ"], [])
+        self.assertEqual(s["fields"], s["agree"])
+
+    def test_service_0x52_to_another_class_is_not_unconnected_send(self):
+        names = [self.P + "service", self.P + "path.segment", self.P + "path.class", self.P + "path.more",
+                 self.P + "ucs", self.P + "ucs.msg_size", self.P + "data", "_ws.expert"]
+        rows = fields(ENV, capture("readtagfrag.pcap", [TcpFlow(50031, 44818).segment(READ_TAG_FRAGMENTED)]), names)
+        self.assertEqual([rows[0][n] for n in names],
+                         ["0x52", "0x91", "", "04 54 41 47 31", "", "", "01 00 00 00 00 00", ""])
+        self.assertEqual(differential(ENV.path("readtagfrag.pcap"))["frames_differ"], [])
+
+    def test_forward_close_and_its_reply(self):
+        p, r = self.P + "fwd_close.", self.P + "fwd_close_reply."
+        names = [p + "tick_time", p + "priority", p + "timeout_ticks", p + "conn_serial", p + "vendor",
+                 p + "orig_serial", p + "path_size", p + "reserved", p + "path", r + "conn_serial", r + "vendor",
+                 r + "orig_serial", r + "app_reply_size", self.P + "data", "_ws.expert"]
+        frames = [TcpFlow(50033, 44818).segment(FORWARD_CLOSE),
+                  TcpFlow(44818, 50033, src=(10, 1, 1, 164), dst=(10, 1, 1, 167)).segment(FORWARD_CLOSE_REPLY)]
+        rows = fields(ENV, capture("fwdclose.pcap", frames), names)
+        self.assertEqual([rows[0][n] for n in names],
+                         ["10", "0", "240", "0x0014", "0x004d", "0x32952bf3", "3", "0x00", "01 00 20 02 24 01",
+                          "", "", "", "", "", ""])
+        self.assertEqual([rows[1][n] for n in names],
+                         ["", "", "", "", "", "", "", "", "", "0x0014", "0x004d", "0x32952bf3", "0", "", ""])
+        s = differential(ENV.path("fwdclose.pcap"))
+        self.assertEqual(s["frames_differ"], [])
+        self.assertEqual(s["fields"], s["agree"])
+
+    def test_multiple_service_packet_request_and_replies(self):
+        flow = TcpFlow(50032, 44818)
+        back = TcpFlow(44818, 50032, src=(10, 1, 1, 164), dst=(10, 1, 1, 167))
+        cap = capture("msp.pcap", [flow.segment(MSP_REQUEST), back.segment(MSP_REPLY),
+                                   back.segment(MSP_ERROR_REPLY)])
+        names = [self.P + "service", self.P + "rr", self.P + "genstat", self.P + "msp.count", self.P + "msp.offset",
+                 self.P + "msp.services", self.P + "msp_reply.count", self.P + "msp_reply.offset",
+                 self.P + "msp_reply.services", self.P + "data", "_ws.expert"]
+        rows = fields(ENV, cap, names)
+        hexed = lambda b: " ".join("%02x" % c for c in b)   # noqa: E731
+        self.assertEqual([rows[0][n] for n in names],
+                         ["0x0a", "0x00", "", "2", "6,14", hexed(b"".join(MSP_SERVICES)), "", "", "", "", ""])
+        reply_services = cip_response(0x0E, data=b"\x01\x00") + cip_response(0x03, 0x05)
+        self.assertEqual([rows[1][n] for n in names],
+                         ["0x0a", "0x01", "0x1e", "", "", "", "2", "6,12", hexed(reply_services), "", ""])
+        # An error reply carries no services: nothing to decode, nothing to report.
+        self.assertEqual([rows[2][n] for n in names],
+                         ["0x0a", "0x01", "0x08", "", "", "", "", "", "", "", ""])
+        s = differential(ENV.path("msp.pcap"))
+        self.assertEqual(s["frames_differ"], [])
+        self.assertEqual(s["fields"], s["agree"])
+
+
 class Malformed(unittest.TestCase):
     def test_truncated_and_corrupted_messages_never_break_tshark(self):
-        """Every prefix of the seed and of a ListIdentity reply, and byte flips, over UDP
-        44818 and 2222: tshark exits 0, and truncations give expert infos, not exceptions."""
+        """Every prefix of the seed, of a ListIdentity reply and of CIP service messages, and
+        byte flips, over UDP 44818 and 2222: tshark exits 0, and truncations give expert
+        infos, not exceptions."""
         payloads = [m[:n] for m in (SEED, LIST_IDENTITY_REPLY, GET_ATTR_ERROR) for n in range(1, len(m))]
+        # Unconnected Send and Multiple Service Packet: cut inside the CIP message, and flipped
+        more = [m[:n] for m in (UCS_ODD, MSP_REQUEST, MSP_REPLY, FORWARD_CLOSE) for n in range(40, len(m))]
+        more += [m[:i] + bytes([m[i] ^ 0xFF]) + m[i + 1:] for m in (UCS_ODD, MSP_REPLY) for i in range(40, len(m))]
         for m in (SEED, LIST_IDENTITY_REPLY, IO_FRAME):
             for i in range(len(m)):
                 payloads.append(m[:i] + bytes([m[i] ^ 0xFF]) + m[i + 1:])
         frames = [udp(50020, 44818, b) for b in payloads] + [udp(2222, 2222, b) for b in payloads[:200]]
+        frames += [udp(50020, 44818, b) for b in more]
         cap = capture("malformed.pcap", frames)
         p = ENV.tshark(["-r", cap, "-T", "fields", "-e", "_ws.col.Protocol", "-e", "_ws.expert.message"],
                        check=False)
@@ -562,6 +871,8 @@ class Malformed(unittest.TestCase):
         self.assertNotIn("[Malformed Packet", verbose.stdout, "a Wireshark exception escaped the rules")
         # A prefix cut inside the Unconnected Data item says so where it happens.
         self.assertRegex(rows[60][1], r"past the end|Truncated|should occur")
+        # ... and the differential counts our expert infos (none on the corpus, see Corpus)
+        self.assertGreater(differential(ENV.path("malformed.pcap"))["experts"], len(payloads) // 2)
 
 
 class Corpus(unittest.TestCase):
@@ -574,7 +885,8 @@ class Corpus(unittest.TestCase):
         if not files:
             self.skipTest("no EtherNet/IP corpus at %s" % corpus)
         start = time.time()
-        total = {"enip_frames": 0, "messages_ws": 0, "messages_ours": 0, "fields": 0, "agree": 0, "differ": 0}
+        total = {"enip_frames": 0, "messages_ws": 0, "messages_ours": 0, "fields": 0, "agree": 0, "differ": 0,
+                 "experts": 0}
         problems = []
         print("\n%-40s %7s %8s %9s %9s %9s" % ("capture", "frames", "msgs ws", "msgs ours", "fields",
                                                 "agreeing"), file=sys.stderr)
@@ -594,6 +906,8 @@ class Corpus(unittest.TestCase):
                                                       time.time() - start), file=sys.stderr)
         self.assertGreater(total["messages_ws"], 0)
         self.assertEqual(problems, [], "\n".join(problems[:40]))
+        # Real traffic is well-formed: none of our expert infos fires on it.
+        self.assertEqual(total["experts"], 0)
 
 
 def corpus_dir():
