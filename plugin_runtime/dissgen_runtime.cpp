@@ -343,6 +343,20 @@ void append_shown_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s
     }
 }
 
+/* Whether every value an optional part shows itself (not those of the parts
+ * inside it) was decoded: a part that is left out then costs no text. */
+gboolean part_decoded(const dg_state *st, guint first, guint count)
+{
+    for (guint i = first; i < first + count; i++) {
+        const dg_summary_piece *piece = &st->p->pieces[i];
+        if (piece->group)
+            i += piece->group;
+        else if (piece->slot >= 0 && !st->slots[piece->slot].present)
+            return FALSE;
+    }
+    return TRUE;
+}
+
 /* Appends the `count` summary pieces from pieces[first] on; FALSE when a
  * placeholder among them showed nothing (not decoded, or empty), which drops
  * the optional part {?...} around it. Outside optional parts a value that was
@@ -354,7 +368,8 @@ gboolean append_pieces(const dg_state *st, wmem_strbuf_t *out, guint first, guin
         const dg_summary_piece *piece = &st->p->pieces[i];
         if (piece->group) {
             gsize mark = wmem_strbuf_get_len(out);
-            if (!append_pieces(st, out, i + 1, piece->group)) wmem_strbuf_truncate(out, mark);
+            if (part_decoded(st, i + 1, piece->group) && !append_pieces(st, out, i + 1, piece->group))
+                wmem_strbuf_truncate(out, mark); /* a value with empty text */
             i += piece->group;
         } else if (piece->slot < 0) {
             append_str(out, piece->text);
