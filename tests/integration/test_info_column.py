@@ -84,7 +84,7 @@ def coe_text(body):
                 raise NotModelled("SDO object truncated")
             text += " 0x%04x:0x%02x" % (struct.unpack("<H", body[3:5])[0], body[5])
     elif service == 8:
-        if len(body) < 3:
+        if len(body) < 6:                            # the 4-byte header is read as one bit group
             raise NotModelled("SDO information header truncated")
         text += " " + enum(SDO_INFO, body[2] & 0x7F, 2)
     elif service == 1 and len(body) >= 4:
