@@ -675,7 +675,13 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     proto_item_set_len(item, *offset - start);
 
     /* A container that a summary refers to: decoded in this instance. */
-    if (n->slot >= 0) store(st, n, 0, start, *offset - start);
+    if (n->slot >= 0) {
+        dg_slot *s = &st->slots[n->slot];
+        s->offset = start;
+        s->length = *offset - start;
+        s->present = TRUE;
+        s->node = n;
+    }
     /* The text only when something shows it: the item, or the Info column
      * (a summarised container inside another one only has its item). */
     if (n->summary_count > 0 && st->want_text && (item || (!in_summary && st->want_info))) {
