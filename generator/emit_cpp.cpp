@@ -56,7 +56,13 @@ struct Layout {
     std::vector<ValueRange> ranges;
     std::map<const Node*, int> range_first;
     std::map<const Node*, int> hook_range_first;     // ifhook lists, after every 'in' list
-    std::vector<std::pair<std::string, int>> pieces;  // (text, slot)
+    struct Piece {
+        std::string text;
+        int slot = -1;
+        size_t group = 0;  // an optional part of the next `group` pieces
+        int node = -1;     // a container whose summary is inserted
+    };
+    std::vector<Piece> pieces;
     std::map<const Node*, int> piece_first;
     // issue 10b: table rows for <when>, peeks, windows and their places
     std::map<const Node*, int> when_first;
@@ -112,7 +118,8 @@ Layout make_layout(const Protocol& proto) {
         if (!n->summary_pieces.empty()) {
             l.piece_first[n] = static_cast<int>(l.pieces.size());
             for (const SummaryPiece& p : n->summary_pieces)
-                l.pieces.push_back({p.text, p.leaf ? p.leaf->slot : -1});
+                l.pieces.push_back({p.text, p.leaf ? p.leaf->slot : -1, p.group,
+                                    p.leaf && p.leaf->is_container() ? p.leaf->doc_index - 1 : -1});
         }
     }
     layout_10b(l);
@@ -337,11 +344,19 @@ void Emitter::tables() {
     for (size_t i = 0; i < l_.ranges.size(); ++i)
         o_ << (i ? ", " : " ") << "{ " << hex(l_.ranges[i].low) << ", " << hex(l_.ranges[i].high) << " }";
     o_ << " };\n\n";
+    bool parts = false;
+    for (const Layout::Piece& p : l_.pieces) parts = parts || p.group || p.node >= 0;
+    if (parts)
+        o_ << "/* Summary pieces: text, value slot; an optional part {?...}: -1 and how many pieces follow in\n"
+              " * it; a container's summary: the slot that says it was decoded, 0, its node index + 1. */\n";
     o_ << "static const dg_summary_piece " << p_.filter << "_summary[] = {";
     if (l_.pieces.empty()) o_ << " { NULL, -1 }";
     for (size_t i = 0; i < l_.pieces.size(); ++i) {
-        const auto& [text, slot] = l_.pieces[i];
-        o_ << (i ? ",\n    " : "\n    ") << "{ " << (slot < 0 ? c_string(text) : "NULL") << ", " << slot << " }";
+        const Layout::Piece& p = l_.pieces[i];
+        o_ << (i ? ",\n    " : "\n    ") << "{ " << (p.slot < 0 && !p.group ? c_string(p.text) : "NULL") << ", "
+           << p.slot;
+        if (p.group || p.node >= 0) o_ << ", " << p.group << ", " << p.node + 1;
+        o_ << " }";
     }
     o_ << (l_.pieces.empty() ? " };\n\n" : "\n};\n\n");
     o_ << "static const dg_hook " << p_.filter << "_hooks[] = {";

@@ -56,10 +56,13 @@ struct ValueRange {
     uint64_t low = 0, high = 0;
 };
 
-// One piece of a summary template: literal text, or the shown value of a leaf.
+// One piece of a summary template: literal text, the shown value of a leaf,
+// the summary of a container, or an optional part {?...} made of the `group`
+// pieces after it.
 struct SummaryPiece {
-    std::string text;       // literal when leaf == nullptr
-    Node* leaf = nullptr;
+    std::string text;       // literal when leaf == nullptr and group == 0
+    Node* leaf = nullptr;   // a leaf, or a container with a summary
+    size_t group = 0;       // > 0: an optional part of the next `group` pieces
 };
 
 // issue 10b: one <when> condition of a node: an earlier field (`field`) or

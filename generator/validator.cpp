@@ -357,27 +357,63 @@ void Validator::check_hook_list(const Node& n) {
                                "values: it is decoded only through Decode As on such a value");
 }
 
+// A summary template: literal text, {X} (the first node named X inside the
+// container, in document order, that is a leaf or has a summary: its shown
+// value or its summary) and {?...} (an optional part: left out when a
+// placeholder inside it has nothing to show). Parsed into pieces; an optional
+// part is a piece that owns the pieces after it.
 void Validator::parse_summary(Node& n) {
     if (!n.is_container()) return;
     const std::string& s = *n.summary;
+    std::vector<size_t> open_parts;  // pieces of the optional parts not closed yet
     size_t i = 0;
     while (i < s.size()) {
-        size_t open = s.find('{', i);
-        if (open == std::string::npos) {
+        size_t stop = s.find_first_of(open_parts.empty() ? "{" : "{}", i);
+        if (stop == std::string::npos) {
             n.summary_pieces.push_back({s.substr(i), nullptr});
             break;
         }
-        if (open > i) n.summary_pieces.push_back({s.substr(i, open - i), nullptr});
-        size_t close = s.find('}', open);
+        if (stop > i) n.summary_pieces.push_back({s.substr(i, stop - i), nullptr});
+        if (s[stop] == '}') {  // closes the innermost optional part
+            SummaryPiece& part = n.summary_pieces[open_parts.back()];
+            part.group = n.summary_pieces.size() - open_parts.back() - 1;
+            open_parts.pop_back();
+            i = stop + 1;
+            continue;
+        }
+        size_t close = s.find('}', stop);
         if (close == std::string::npos) {
             diags_.error(n.line, "summary of " + quote(n) + " has '{' without '}'");
             return;
         }
-        std::string name = s.substr(open + 1, close - open - 1);
+        std::string name = s.substr(stop + 1, close - stop - 1);
+        // {?NAME} with no '{' inside is a reference to a leaf named "?NAME" as
+        // before optional parts existed; with one it opens an optional part.
+        if (name.size() > 1 && name[0] == '?' && name.find('{') != std::string::npos) {
+            open_parts.push_back(n.summary_pieces.size());
+            n.summary_pieces.push_back({"", nullptr});
+            i = stop + 2;
+            continue;
+        }
+        // The first node named so, in document order, that shows a value or
+        // has a summary; a container without one only explains a failure.
         Node* found = nullptr;
+        Node* container = nullptr;
         for_each_node(n.children, [&](Node& d) {
-            if (!found && d.is_leaf() && d.name == name) found = &d;
+            if (d.name != name) return;
+            if (!found && (d.is_leaf() || d.summary)) found = &d;
+            if (!container && d.is_container() && !d.summary) container = &d;
         });
+        if (!found && container) {
+            diags_.error(n.line, "summary of " + quote(n) + " refers to {" + name + "}, a container without a summary: "
+                                     "give " + quote(*container) + " a summary or name a leaf");
+            return;
+        }
+        if (!found && !name.empty() && name[0] == '?') {
+            diags_.error(n.line, "summary of " + quote(n) + " has an optional part {" + name +
+                                     "} with no {X} inside: it would never show anything");
+            return;
+        }
         if (!found) {
             diags_.error(n.line, "summary of " + quote(n) + " refers to {" + name + "}, but no leaf named '" + name +
                                      "' is inside it");
@@ -386,6 +422,10 @@ void Validator::parse_summary(Node& n) {
         n.summary_pieces.push_back({"", found});
         mark_slot(found);
         i = close + 1;
+    }
+    if (!open_parts.empty()) {
+        n.summary_pieces.clear();
+        diags_.error(n.line, "summary of " + quote(n) + " has an optional part '{?' without its closing '}'");
     }
 }
 

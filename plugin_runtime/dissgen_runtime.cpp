@@ -344,23 +344,62 @@ void append_shown_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s
     }
 }
 
+/* Whether every value an optional part shows itself (not those of the parts
+ * inside it) was decoded: a part that is left out then costs no text. */
+gboolean part_decoded(const dg_state *st, guint first, guint count)
+{
+    for (guint i = first; i < first + count; i++) {
+        const dg_summary_piece *piece = &st->p->pieces[i];
+        if (piece->group)
+            i += piece->group;
+        else if (piece->slot >= 0 && !st->slots[piece->slot].present)
+            return FALSE;
+    }
+    return TRUE;
+}
+
+/* Appends the `count` summary pieces from pieces[first] on; FALSE when a
+ * placeholder among them showed nothing (not decoded, or empty), which drops
+ * the optional part {?...} around it. Outside optional parts a value that was
+ * not decoded shows as "-". */
+gboolean append_pieces(const dg_state *st, wmem_strbuf_t *out, guint first, guint count)
+{
+    gboolean complete = TRUE;
+    for (guint i = first; i < first + count; i++) {
+        const dg_summary_piece *piece = &st->p->pieces[i];
+        if (piece->group) {
+            gsize mark = wmem_strbuf_get_len(out);
+            if (part_decoded(st, i + 1, piece->group) && !append_pieces(st, out, i + 1, piece->group))
+                wmem_strbuf_truncate(out, mark); /* a value with empty text */
+            i += piece->group;
+        } else if (piece->slot < 0) {
+            append_str(out, piece->text);
+        } else {
+            const dg_slot *s = &st->slots[piece->slot];
+            gsize before = wmem_strbuf_get_len(out);
+            if (!s->present) {
+                wmem_strbuf_append_len(out, "-", 1);
+                complete = FALSE;
+                continue;
+            }
+            if (piece->node) {
+                const dg_node *c = &st->p->nodes[piece->node - 1];
+                append_pieces(st, out, c->summary_first, c->summary_count);
+            } else {
+                append_shown_value(st, out, s);
+            }
+            if (wmem_strbuf_get_len(out) == before) complete = FALSE;
+        }
+    }
+    return complete;
+}
+
 /* The summary of container n, in st->text (valid until the next summary). */
 const char *summary_text(const dg_state *st, const dg_node *n)
 {
     wmem_strbuf_t *out = st->text;
     wmem_strbuf_truncate(out, 0);
-    for (guint i = 0; i < n->summary_count; i++) {
-        const dg_summary_piece *piece = &st->p->pieces[n->summary_first + i];
-        if (piece->slot < 0) {
-            append_str(out, piece->text);
-        } else {
-            const dg_slot *s = &st->slots[piece->slot];
-            if (s->present)
-                append_shown_value(st, out, s);
-            else
-                wmem_strbuf_append_len(out, "-", 1);
-        }
-    }
+    append_pieces(st, out, n->summary_first, n->summary_count);
     return wmem_strbuf_get_str(out);
 }
 
@@ -638,7 +677,17 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     if (!st->stopped && length >= 0) *offset = inner_end;
     proto_item_set_len(item, *offset - start);
 
-    if (n->summary_count > 0 && st->want_text) {
+    /* A container that a summary refers to: decoded in this instance. */
+    if (n->slot >= 0) {
+        dg_slot *s = &st->slots[n->slot];
+        s->offset = start;
+        s->length = *offset - start;
+        s->present = TRUE;
+        s->node = n;
+    }
+    /* The text only when something shows it: the item, or the Info column
+     * (a summarised container inside another one only has its item). */
+    if (n->summary_count > 0 && st->want_text && (item || (!in_summary && st->want_info))) {
         const char *text = summary_text(st, n);
         gsize text_len = wmem_strbuf_get_len(st->text);
         if (item) proto_item_append_text(item, ": %s", text);

@@ -46,10 +46,20 @@ typedef struct dg_range {
     guint64 low, high;
 } dg_range;
 
-/* Literal text (slot < 0) or the shown value of the leaf in `slot`. */
+/* Literal text (slot < 0), the shown value of the leaf in `slot`, or (node >
+ * 0) the summary of container nodes[node - 1], decoded when `slot` is
+ * present. group > 0: an optional part {?...} made of the next `group`
+ * pieces, left out when one of their placeholders shows nothing. */
 typedef struct dg_summary_piece {
     const char *text;
     gint16 slot;
+#ifdef __cplusplus
+    guint16 group = 0;
+    guint16 node = 0;
+#else
+    guint16 group;
+    guint16 node;
+#endif
 } dg_summary_piece;
 
 /* issue 10a: what few nodes need (direction, repeat="rest", strings, times,

@@ -81,7 +81,8 @@ class PluginLoading(unittest.TestCase):
         self.assertEqual(len(rows), 3)
         first = rows[0]
         self.assertEqual(first[0], "ECATR")
-        self.assertEqual(first[1], "Datagram \u00d72: FPRD len 2, LRW len 6")
+        # the FPRD reads AL status (0x0130) = 0x0008: OP
+        self.assertEqual(first[1], "Datagram \u00d72: FPRD 0x1001:0x0130 len 2 AL status OP, LRW 0x00010000 len 6")
         self.assertEqual(first[2], str(2 * 12 + 2 + 6))
         self.assertEqual(first[3], "0x04,0x0c")
         self.assertEqual(first[4], "0x11,0x12")
@@ -92,7 +93,7 @@ class PluginLoading(unittest.TestCase):
         self.assertEqual(first[10], "1,0")           # more: set on all but the last
         self.assertEqual(first[11], "0x0000,0x0102")
         self.assertEqual(first[13], "1,3")
-        self.assertEqual(rows[1][1], "BRD len 1")
+        self.assertEqual(rows[1][1], "BRD 0x0000:0x0000 len 1")
         self.assertEqual(rows[1][9], "1")             # circulating
         self.assertEqual(rows[2][0], "ECATR", "EtherCAT over UDP 34980 must decode with the rules too")
         self.assertEqual(rows[2][3], "0x0e")
@@ -169,9 +170,10 @@ class PluginLoading(unittest.TestCase):
             dst.write(text.replace('name="LRW"', 'name="LRW (edited)"'))
         self.env.install_plugin(ARGS.dissgen, edited)
         rows, _ = fields(self.env, self.capture, ["_ws.col.Info"])
-        self.assertEqual(rows[0][0], "Datagram \u00d72: FPRD len 2, LRW (edited) len 6")
+        self.assertEqual(rows[0][0], "Datagram \u00d72: FPRD 0x1001:0x0130 len 2 AL status OP, "
+                                     "LRW (edited) 0x00010000 len 6")
         with open(edited, "w", encoding="utf-8") as dst:
-            dst.write(text.replace('summary="{Command} len {Length}"', 'summary="{Command} #{Index}"'))
+            dst.write(re.sub(r'(<node name="Datagram"[^>]*?summary=")[^"]*"', r'\1{Command} #{Index}"', text, count=1))
         self.env.install_plugin(ARGS.dissgen, edited)
         rows, _ = fields(self.env, self.capture, ["_ws.col.Info"])
         self.assertEqual(rows[0][0], "Datagram \u00d72: FPRD #0x11, LRW #0x12")

@@ -61,6 +61,7 @@ TESTS = {
     "loading": integration("test_plugin_loading.py"),
     "esi": unit("Esi*:Files/EsiErr.*:Design.*:Eni.*:Files/NetworkErr.*:BusTables.*:ManualBus.*:-*Golden*"),
     "display10a": integration("test_display10a.py"),
+    "info_column": integration("test_info_column.py"),
     "layout": integration("test_layout.py"),
     "bus_tables": integration("test_bus_tables.py"),
     "pairing": integration("test_pairing.py"),

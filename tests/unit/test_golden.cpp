@@ -36,6 +36,8 @@ TEST(Golden, PaperExample) { check_golden("tests/rules/paper_example.xml", "diss
 TEST(Golden, Display10a) { check_golden("tests/rules/display10a.xml", "dissgen_display10a.cpp.golden"); }
 // issue 10b: <when>, peek, otherwise and register windows.
 TEST(Golden, LayoutRules) { check_golden("tests/rules/layout.xml", "dissgen_layout.cpp.golden"); }
+// issue 10: summaries naming summarised containers, optional parts {?...}.
+TEST(Golden, SummaryParts) { check_golden("tests/rules_ok/summary_parts.xml", "dissgen_summary_parts.cpp.golden"); }
 
 TEST(Golden, OutputIsDeterministicAndHasNoPaths) {
     Front f = front_end(read_file(source_path("rules/ethercat.xml")));

@@ -485,9 +485,12 @@ TEST(Slots, OnlyReferencedFieldsInDocumentOrder) {
     for (const auto& c : datagram->children) slots[c->name] = c->slot;
     EXPECT_EQ(slots["Command"], 2);  // if, <when> and summary
     EXPECT_EQ(slots["Index"], -1);
-    EXPECT_EQ(find(p, "Offset address (ADO)")->slot, 3);  // <when> and the register window's base
-    EXPECT_EQ(slots["Length"], 4);   // the data's lengths, <when> and summary
-    EXPECT_EQ(slots["More"], 5);     // repeat flag
+    EXPECT_EQ(slots["Address"], 3);  // a container in the summary: whether it was decoded
+    EXPECT_EQ(find(p, "Slave address (ADP)")->slot, 4);   // the address's summary
+    EXPECT_EQ(find(p, "Offset address (ADO)")->slot, 5);  // <when>, the register window's base, summary
+    EXPECT_EQ(slots["Logical address"], 6);  // summary
+    EXPECT_EQ(slots["Length"], 7);   // the data's lengths, <when> and summary
+    EXPECT_EQ(slots["More"], 8);     // repeat flag
     EXPECT_EQ(slots["Working counter"], -1);  // read ahead by <when peek>, not from a slot
 }
 
@@ -543,12 +546,55 @@ TEST(Summary, PiecesAndSlots) {
     EXPECT_EQ(find(*f.proto, "长度")->slot, 1);
 }
 
+// {?...} owns the pieces up to its closing '}' (nested parts inside); {X}
+// names the first node X that is a leaf or has a summary, in document order.
+TEST(Summary, OptionalPartsAndContainerSummaries) {
+    Front f = front_end(rules("  <node name=\"M\" summary=\"{Kind}{? at {Where}{? ({Code})}}!\">\n"
+                              "    <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "    <node name=\"Plain\"><node name=\"Where\" length=\"1byte\"/></node>\n"
+                              "    <node name=\"Where\" summary=\"{Code}\">\n"
+                              "      <node name=\"Code\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "    </node>\n"
+                              "  </node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Node* m = find(*f.proto, "M");
+    const auto& p = m->summary_pieces;
+    ASSERT_EQ(p.size(), 9u);
+    EXPECT_EQ(p[0].leaf, find(*f.proto, "Kind"));
+    EXPECT_EQ(p[1].group, 6u);  // " at ", {Where}, {? ({Code})} (4 pieces)
+    EXPECT_EQ(p[2].text, " at ");
+    // the leaf 'Where' inside 'Plain' comes first in document order
+    const Node* plain = find(*f.proto, "Plain");
+    EXPECT_EQ(p[3].leaf, plain->children[0].get());
+    EXPECT_EQ(p[4].group, 3u);
+    EXPECT_EQ(p[5].text, " (");
+    EXPECT_EQ(p[6].leaf, find(*f.proto, "Code"));
+    EXPECT_EQ(p[7].text, ")");
+    EXPECT_EQ(p[8].text, "!");
+    EXPECT_EQ(p[8].group, 0u);
+}
+
+TEST(Summary, ContainerWithSummaryAndQuestionMarkNames) {
+    Front f = front_end(rules("  <node name=\"M\" summary=\"{T} {?x}\">\n"
+                              "    <node name=\"?x\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "    <node name=\"T\" summary=\"{A}\"><node name=\"A\" length=\"1byte\"/></node>\n"
+                              "  </node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Node* m = find(*f.proto, "M");
+    ASSERT_EQ(m->summary_pieces.size(), 3u);
+    EXPECT_EQ(m->summary_pieces[0].leaf, find(*f.proto, "T"));  // a container: its summary
+    EXPECT_GE(find(*f.proto, "T")->slot, 0);                      // its slot says it was decoded
+    EXPECT_EQ(m->summary_pieces[2].leaf, find(*f.proto, "?x"));  // no '{' inside: a name
+    EXPECT_EQ(m->summary_pieces[2].group, 0u);
+}
+
 TEST(Summary, Errors) {
     Front missing = front_end(rules("  <node name=\"DG\" summary=\"{Cmd}\"><node name=\"Command\" length=\"1byte\"/></node>\n"));
     EXPECT_TRUE(contains(missing.messages(), "rules.xml:2: error: summary of 'DG' refers to {Cmd}, but no leaf named 'Cmd' is inside it"))
         << missing.messages();
     Front container = front_end(rules("  <node name=\"DG\" summary=\"{In}\"><node name=\"In\"><node name=\"x\" length=\"1byte\"/></node></node>\n"));
-    EXPECT_TRUE(contains(container.messages(), "rules.xml:2: error: summary of 'DG' refers to {In}, but no leaf named 'In'"))
+    EXPECT_TRUE(contains(container.messages(), "rules.xml:2: error: summary of 'DG' refers to {In}, a container without "
+                                               "a summary: give 'In' a summary or name a leaf"))
         << container.messages();
     Front open = front_end(rules("  <node name=\"DG\" summary=\"{x\"><node name=\"x\" length=\"1byte\"/></node>\n"));
     EXPECT_TRUE(contains(open.messages(), "rules.xml:2: error: summary of 'DG' has '{' without '}'")) << open.messages();
