@@ -202,6 +202,7 @@ std::string flags_of(const Node& n, bool pairing_key) {
     if (n.group_first) f.push_back("DG_GROUP_FIRST");
     if (n.group_last) f.push_back("DG_GROUP_LAST");
     if (pairing_key) f.push_back("DG_KEY");  // issue 11
+    if (n.skip_malformed) f.push_back("DG_SKIP_MALFORMED");
     if (f.empty()) return "0";
     std::string out;
     for (size_t i = 0; i < f.size(); ++i) out += (i ? "|" : "") + f[i];

@@ -140,6 +140,7 @@ struct Node {
     // --- issue 10b: alternatives, multi-field conditions, look-ahead, register maps ---
     std::vector<When> whens;                // <when field|peek="XPATH" in="LIST"/> children, ANDed
     bool otherwise = false;                 // otherwise="true": member of the previous sibling's chain
+    bool skip_malformed = false;            // malformed="skip": a malformed spot inside spoils only this container
     std::optional<FieldRef> base;           // base="XPATH [+-* N]": this container is a window
     std::optional<uint64_t> at;             // at="ADDRESS": placed in the parent window
     std::optional<uint64_t> stride;         // stride="N" instances="M": repeated block at a stride

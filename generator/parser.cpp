@@ -29,7 +29,8 @@ const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displa
                                                   "reassemble-offset", "reassemble-seq", "reassemble-last",
                                                   "reassemble-more",
                                                   // issue 10b
-                                                  "otherwise", "base", "at", "stride", "instances"};
+                                                  "otherwise", "base", "at", "stride", "instances",
+                                                  "malformed"};
 const std::vector<std::string> kEnumAttributes = {"value", "name"};
 const std::vector<std::string> kHookAttributes = {"table", "value"};
 const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};  // issue 10b
@@ -551,6 +552,15 @@ void Parser::parse_layout_attributes(std::map<std::string, std::string>& attrs, 
             node.otherwise = true;
         else
             diags_.error(node.line, "bad otherwise '" + attrs["otherwise"] + "': the only value is 'true'");
+    }
+    if (attrs.count("malformed")) {
+        const std::string v = trim(attrs["malformed"]);
+        if (v == "skip")
+            node.skip_malformed = true;
+        else if (v != "stop")
+            diags_.error(node.line, "bad malformed '" + attrs["malformed"] +
+                                        "': 'stop' (the default: decoding of the message stops there) or 'skip' "
+                                        "(the rest of this container is skipped, decoding goes on after it)");
     }
     if (attrs.count("base")) node.base = make_ref(attrs["base"], node.line, "base", true);
     auto number = [&](const char* name, uint64_t max, std::optional<uint64_t>& out) {

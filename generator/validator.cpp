@@ -660,6 +660,14 @@ void Validator::check_layout(Node& n) {
             diags_.error(n.line, "otherwise=\"true\" on " + quote(n) + " needs a previous sibling with a condition "
                                  "(if, <when>, ifhook) or otherwise; " + lines_of(*prev) + " is always decoded");
     }
+    if (n.skip_malformed) {
+        if (n.is_leaf())
+            diags_.error(n.line, "malformed=\"skip\" on leaf " + quote(n) + ": only a container can be skipped, "
+                                 "with what is left of it after the malformed spot");
+        else if (n.length_kind != LengthKind::Field && !n.has_fixed_length())
+            diags_.error(n.line, "malformed=\"skip\" on " + quote(n) + " needs a fixed length or one from a field: "
+                                 "decoding goes on where that length says the container ends");
+    }
     if (n.base) {
         if (n.is_leaf())
             diags_.error(n.line, "'base' on leaf " + quote(n) + ": a window is a container whose children have 'at' addresses");

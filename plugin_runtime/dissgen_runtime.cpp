@@ -675,6 +675,13 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
                                      n->name, length, *offset - start, inner_end - *offset);
     }
     if (!st->stopped && length >= 0) *offset = inner_end;
+    if (st->stopped && !was_stopped && (n->flags & DG_SKIP_MALFORMED) && length >= 0) {
+        /* malformed="skip": the spot is marked by its expert info; the rest of
+         * this container is left undecoded and decoding goes on after it, as
+         * for a PDU in a tvb of its own. */
+        st->stopped = FALSE;
+        *offset = inner_end;
+    }
     proto_item_set_len(item, *offset - start);
 
     /* A container that a summary refers to: decoded in this instance. */

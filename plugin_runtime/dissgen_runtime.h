@@ -32,7 +32,8 @@ enum dg_flags {
     DG_GROUP = 1 << 3,       /* member of a bit group */
     DG_GROUP_FIRST = 1 << 4, /* first member: reads the group's bytes */
     DG_GROUP_LAST = 1 << 5,  /* last member: moves past the group's bytes */
-    DG_KEY = 1 << 6          /* issue 11: a <pairing> key field (dissgen_pairing.h) */
+    DG_KEY = 1 << 6,         /* issue 11: a <pairing> key field (dissgen_pairing.h) */
+    DG_SKIP_MALFORMED = 1 << 7 /* malformed="skip": a malformed spot inside spoils only this container */
 };
 
 /* A run-time value taken from an earlier field, with optional arithmetic. */

@@ -593,8 +593,8 @@ def same(w, o, length, kind):
 
 def compare_packet(num, ws_items, ours_items, stats, stops=()):
     """Returns the list of unexplained differences (strings) of one packet.  stops: (frame
-    position, why) from which ours shows nothing by design (it stopped at a malformed mailbox,
-    or Wireshark decodes past the header's Length)."""
+    position, end or None, why) where ours shows nothing by design (inside a malformed mailbox,
+    which it skips; from where Wireshark decodes past the header's Length on)."""
     problems = []
     for (wname, pos), wl in ws_items.items():
         if wname in DATAGRAM_FIELDS or wname.startswith(("ecat.sub", "ecat.subframe.")):
@@ -625,7 +625,8 @@ def compare_packet(num, ws_items, ours_items, stats, stops=()):
                 pf[1] += 1
                 continue
             # (an item that reaches past the stop is not shown either: ours shows only whole registers)
-            why = next((w for at, w in stops if pos + max(length, 1) > at), None) if not cands else None
+            why = next((w for at, until, w in stops if pos + max(length, 1) > at and (until is None or pos < until)),
+                       None) if not cands else None
             if why:
                 stats.explained[why.split(":")[0]] += 1
                 continue

@@ -115,8 +115,8 @@ def _u16(b, o):
 def mailbox_fault(data):
     """True when rules/ethercat.xml meets a fault inside this mailbox (a length past the end of
     the datagram's data, or fixed fields that do not fit the mailbox length): by the project's
-    contract ours then shows the tree so far and stops (expert info), so the datagram's WKC and
-    the later datagrams are not shown.  Mirrors the rules' alternatives, for any bytes."""
+    Mailbox is malformed="skip": ours shows the mailbox's tree so far with an expert info, then
+    the datagram's WKC and the later datagrams.  Mirrors the rules' alternatives, for any bytes."""
     n = len(data)
     mlen, typ = _u16(data, 0), data[5] & 0x0F
     if mlen > n - 6:
@@ -186,16 +186,14 @@ def mailbox_fault(data):
     return False
 
 
-STOP_WHY = ("ours-stops-in-mailbox: a length in this mailbox overruns its data; ours shows the tree so far "
-            "with an expert info (the project's contract), Wireshark decodes on in its subset buffer")
+STOP_WHY = ("ours-stops-in-mailbox: a length in this mailbox overruns its data; ours shows the mailbox's tree "
+            "so far with an expert info (and goes on after it), Wireshark decodes on in its subset buffer")
 
 
-def first_mailbox_fault(exp):
-    """Index of the first datagram whose mailbox makes ours stop, or None."""
-    for i, d in enumerate(exp["datagrams"]):
-        if isinstance(d.get("data"), bytes) and ours_view(d) == "mbx" and mailbox_fault(d["data"]):
-            return i
-    return None
+def mailbox_faults(exp):
+    """Indexes of the datagrams whose mailbox ours stops decoding inside (then skips)."""
+    return [i for i, d in enumerate(exp["datagrams"])
+            if isinstance(d.get("data"), bytes) and ours_view(d) == "mbx" and mailbox_fault(d["data"])]
 
 
 VIEW_WHY = {
@@ -630,7 +628,7 @@ def ours_shows(payload):
     """What the bytes imply ecatr shows besides the field values, by rules/ethercat.xml and
     the runtime's rules (RULES-SPEC): the number of ecatr.datagram items, the Info column, and
     the expert infos as (filter name, offset in the EtherCAT payload, message) in tree order,
-    and the regions (start, end, container, ours stops there) of datagram data where ours reports what the rules
+    and the regions (start, end, container, ours stops inside) of datagram data where ours reports what the rules
     inside find (registers, mailboxes: the Wireshark comparison checks those; container None:
     a faulty mailbox, where ours stops with an expert info of its own)."""
     experts, summaries, regions = [], [], []
@@ -696,11 +694,10 @@ def ours_shows(payload):
                                     % (DATA_CONTAINERS[view], dlen, end - off)))
                     regions.append((off, end, DATA_CONTAINERS[view], True))
                     stopped = True
-                elif view == "mbx" and mailbox_fault(payload[off:off + dlen]):
-                    regions.append((off, off + dlen, None, True))
-                    stopped = True
                 else:
-                    if view != "data":
+                    if view == "mbx" and mailbox_fault(payload[off:off + dlen]):
+                        regions.append((off, off + dlen, None, True))    # malformed="skip"
+                    elif view != "data":
                         regions.append((off, off + dlen, DATA_CONTAINERS[view], False))
                     off += dlen
                     leaf("Working counter", 2)
@@ -731,9 +728,9 @@ def inside_data(experts, regions):
     values), but a faulty mailbox must have at least one."""
     kept, problems = [], []
     for s, t, container, stops in regions:
-        # Where ours stops (a faulty mailbox, data past the end), its expert may sit at the end.
-        last = t if stops else t - 1
-        inside = [e for e in experts if s <= e[1] <= last and
+        # Where ours stops (a faulty mailbox, data past the end), its expert may sit at the end
+        # (not the working counter's, which follows a skipped mailbox).
+        inside = [e for e in experts if (s <= e[1] < t or stops and e[1] == t and "'Working counter'" not in e[2]) and
                   not (container and e[1] == s and e[2].startswith("'%s' has length" % container))]
         if container is None and not inside:
             problems.append("ours: no expert info inside the faulty mailbox at %d..%d" % (s, t))
@@ -913,7 +910,6 @@ def compare_frame(num, exp, model, ours, ws, stats, context):
     edg, mdg = exp["datagrams"], model["datagrams"]
     odg, wdg = ours["datagrams"], ws["datagrams"]
     n = max(len(edg), len(mdg), len(odg), len(wdg))
-    stop = first_mailbox_fault(exp) if DEEP else None
     for i in range(n):
         e_d = edg[i] if i < len(edg) else None
         m_d = mdg[i] if i < len(mdg) else None
@@ -932,9 +928,6 @@ def compare_frame(num, exp, model, ours, ws, stats, context):
                     why = VIEW_WHY["unread"]
                 if key == "data" and view != "data" and why is None:
                     why = VIEW_WHY[view]
-            if stop is not None and (i > stop or (i == stop and key == "wkc")):
-                e = MISSING
-                why = why or STOP_WHY
             if why is None and not _eq(e, m) and not isinstance(m, OneOf):
                 if e_d is None and m_d is not None:
                     why = ("ws-invented-datagram: M=1 on the last datagram, Wireshark reads the bytes after "
@@ -1046,14 +1039,17 @@ def compare_capture(packets, ours_text, ws_json, stats, label, truths=None, extr
                             cut = min(cut, off + 10)
                             break
                         off += 12 + d["len"]
-                stops.append((cut, hl_why))
-            i = first_mailbox_fault(expected[num])
-            if i is not None:     # where ours stops: the faulty datagram's data, in the frame
+                stops.append((cut, None, hl_why))
+            faults = mailbox_faults(expected[num])
+            if faults:     # where ours stops: inside the faulty mailboxes (then goes on after them)
                 payload, pkt = payloads[num][0], payloads[num][1]
                 off = len(pkt) - len(payload) + 2
-                for d in expected[num]["datagrams"][:i]:
+                for i, d in enumerate(expected[num]["datagrams"]):
+                    if not isinstance(d.get("len"), int):
+                        break       # a datagram cut short: nothing decoded after it
+                    if i in faults:
+                        stops.append((off + 10, off + 10 + d["len"], STOP_WHY))
                     off += 12 + d["len"]
-                stops.append((off + 10, STOP_WHY))
             for what in ecat_deep.compare_packet(num, deep_ws[num - 1], deep_ours[num - 1], stats.deep, stops):
                 probs.append({"frame": num, "what": "registers/mailboxes: " + what})
         for e in context["explained"]:

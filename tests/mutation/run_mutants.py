@@ -65,6 +65,7 @@ TESTS = {
     "layout": integration("test_layout.py"),
     "bus_tables": integration("test_bus_tables.py"),
     "pairing": integration("test_pairing.py"),
+    "malformed_skip": integration("test_malformed_skip.py"),
     "differential": integration("ecat_differential.py", "--frames", "2000", "--max-datagrams", "20",
                                 "--malformed", "200"),
 }
