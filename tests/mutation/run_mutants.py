@@ -2,7 +2,7 @@
 """Mutation check: does the test suite kill small, realistic bugs in the runtime and
 the generator?  Python 3 stdlib only.
 
-    run_mutants.py --source-dir .  [--only NAME ...] [--jobs 2] [--keep] [--list]
+    run_mutants.py --source-dir .  [--only NAME ...] [--jobs 2] [--budget SECONDS] [--keep] [--list]
 
 Every tests/mutation/mutants/*.mut file is one mutant: in one source file, replace
 one snippet that occurs there exactly once by another (format: tests/mutation/README.md).
@@ -12,8 +12,13 @@ dissgen_runtime); the checkout itself is never touched.  Then for each mutant: t
 mutated file is written, the build is brought up to date (only what the file feeds),
 and the mutant's tests run in the order given until one fails: the mutant is KILLED.
 When all pass it SURVIVED.  A mutant whose snippet is not found exactly once, or that
-does not build, is INVALID (the code moved on: refresh the mutant).  Before the
-mutants, the tests they name run once on the unmutated copy and must all pass.
+does not build, is INVALID (the code moved on: refresh the mutant).  Before a test
+first judges a mutant, it runs once on the unmutated copy and must pass.
+
+--budget SECONDS (CI: the whole check must fit its time limit) starts no mutant once
+that much time has gone; the mutants then run from a place in the list that the source
+tree's commit picks, so that successive commits cover all of them, and those not run
+are listed.  Without --budget (the default, and before a merge) every mutant runs.
 
 Exit status: 0 when every mutant is killed, 1 otherwise, 77 (skip) without tshark.
 """
@@ -64,7 +69,8 @@ TESTS = {
     "info_column": integration("test_info_column.py"),
     "layout": integration("test_layout.py"),
     "bus_tables": integration("test_bus_tables.py"),
-    "pairing": integration("test_pairing.py"),
+    "pairing": integration("test_pairing.py", "--quick"),
+    "pairing_full": integration("test_pairing.py"),
     "malformed_skip": integration("test_malformed_skip.py"),
     "differential": integration("ecat_differential.py", "--frames", "2000", "--max-datagrams", "20",
                                 "--malformed", "200"),
@@ -148,6 +154,16 @@ def build(src, build_dir, jobs, log):
     return status == 0, secs, out
 
 
+def commit_number(source_dir):
+    """The source tree's commit as a number (0 outside a git checkout)."""
+    try:
+        head = subprocess.run(["git", "-c", "safe.directory=*", "-C", source_dir, "rev-parse", "HEAD"],
+                              capture_output=True, text=True, timeout=30).stdout.strip()
+        return int(head[:8], 16) if head else 0
+    except (OSError, ValueError, subprocess.SubprocessError):
+        return 0
+
+
 def tail(text, lines=15):
     return "\n".join("    " + l for l in text.strip().splitlines()[-lines:])
 
@@ -162,6 +178,8 @@ def main(argv=None):
     ap.add_argument("--list", action="store_true", help="list the mutants and their tests, run nothing")
     ap.add_argument("--check", action="store_true", help="only check that every mutant still applies")
     ap.add_argument("--no-baseline", action="store_true", help="skip the run on the unmutated copy")
+    ap.add_argument("--budget", type=float, default=0, metavar="SECONDS",
+                    help="start no mutant after this many seconds (0: run all)")
     ap.add_argument("--without", nargs="*", default=[], metavar="TEST",
                     help="leave these tests out (to measure what the others kill)")
     args = ap.parse_args(argv)
@@ -191,6 +209,9 @@ def main(argv=None):
                 print("INVALID  %s: %s" % (m.name, e))
         print("%d of %d mutants apply" % (len(mutants) - bad, len(mutants)))
         return 1 if bad else 0
+    if args.budget and mutants:
+        start = commit_number(args.source_dir) % len(mutants)
+        mutants = mutants[start:] + mutants[:start]
     if shutil.which("tshark") is None:
         print("SKIPPED: tshark is not installed (the mutants' tests need it)")
         return SKIP_CODE
@@ -199,7 +220,7 @@ def main(argv=None):
     work = tempfile.mkdtemp(prefix="dissgen-mutation-")
     src, build_dir, log = os.path.join(work, "src"), os.path.join(work, "build"), os.path.join(work, "log.txt")
     print("mutation check: %d mutants, copy and log in %s" % (len(mutants), work), flush=True)
-    results = []
+    results, not_run = [], []
     try:
         copy_tree(os.path.abspath(args.source_dir), src)
         # Corpus tests look for ../shared/corpus beside the source tree: the copy gets the same.
@@ -213,19 +234,23 @@ def main(argv=None):
             print(tail(bout))
             return 1
 
-        if not args.no_baseline:
-            needed = []
-            for m in mutants:
-                needed += [t for t in m.tests if t not in needed]
-            for t in needed:
-                status, secs, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log)
+        baselined = set(args.no_baseline and TESTS or ())
+        originals = {}
+        for i, m in enumerate(mutants):
+            if args.budget and time.monotonic() - t0 > args.budget:
+                not_run = mutants[i:]
+                break
+            for t in m.tests:   # the tree is unmutated here: the test must pass on it first
+                if t in baselined:
+                    continue
+                ok, _, out = build(src, build_dir, args.jobs, log)
+                status, secs, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log) \
+                    if ok else (1, 0, out)
                 print("baseline %-13s %s (%.0fs)" % (t, "pass" if status == 0 else "FAIL", secs), flush=True)
                 if status != 0:
                     print("the unmutated tree fails '%s': fix that first\n%s" % (t, tail(out)))
                     return 1
-
-        originals = {}
-        for m in mutants:
+                baselined.add(t)
             start = time.monotonic()
             verdict, detail = None, ""
             if m.problem:
@@ -274,6 +299,9 @@ def main(argv=None):
     for m, v in results:
         if v != "KILLED":
             print("  %s %s (%s): %s" % (v, m.name, m.file, " ".join(m.why)))
+    if not_run:
+        print("not run within the budget of %.0fs (%d): %s" % (args.budget, len(not_run),
+                                                              " ".join(m.name for m in not_run)))
     return 0 if total and killed == total else 1
 
 
