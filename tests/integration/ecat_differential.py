@@ -28,6 +28,7 @@ unexplained difference or any difference from the truth.  Last line: "N passed, 
 
 import argparse
 import glob
+import io
 import json
 import os
 import re
@@ -755,7 +756,11 @@ def parse_extras(text, pdml_path):
     for line in text.splitlines():
         num, dgs, info = [c[1:-1] if len(c) >= 2 and c[0] == c[-1] == '"' else c for c in line.split("\t")]
         out[int(num)] = {"items": len(dgs.split(",")) if dgs else 0, "info": info, "experts": []}
-    for _, packet in ET.iterparse(pdml_path):
+    # tshark writes a string field's control characters into PDML as they are (text inside
+    # random mailbox bytes): not XML. Only our expert items are read here, so blank them.
+    with open(pdml_path, "rb") as fh:
+        pdml = re.sub(rb"[\x00-\x08\x0b\x0c\x0e-\x1f]", b"?", fh.read())
+    for _, packet in ET.iterparse(io.BytesIO(pdml)):
         if packet.tag != "packet":
             continue
         num = int(packet.find("proto[@name='geninfo']/field[@name='num']").get("show"))
