@@ -756,11 +756,12 @@ def parse_extras(text, pdml_path):
     for line in text.splitlines():
         num, dgs, info = [c[1:-1] if len(c) >= 2 and c[0] == c[-1] == '"' else c for c in line.split("\t")]
         out[int(num)] = {"items": len(dgs.split(",")) if dgs else 0, "info": info, "experts": []}
-    # tshark writes a string field's control characters into PDML as they are (text inside
-    # random mailbox bytes): not XML. Only our expert items are read here, so blank them.
+    # tshark's PDML is not always XML: it cuts long labels at a byte count, inside a UTF-8
+    # character (a long string from random mailbox bytes), and may write control characters.
+    # Only our expert items are read here, so mend both.
     with open(pdml_path, "rb") as fh:
-        pdml = re.sub(rb"[\x00-\x08\x0b\x0c\x0e-\x1f]", b"?", fh.read())
-    for _, packet in ET.iterparse(io.BytesIO(pdml)):
+        pdml = re.sub("[\x00-\x08\x0b\x0c\x0e-\x1f]", "?", fh.read().decode("utf-8", "replace"))
+    for _, packet in ET.iterparse(io.BytesIO(pdml.encode("utf-8"))):
         if packet.tag != "packet":
             continue
         num = int(packet.find("proto[@name='geninfo']/field[@name='num']").get("show"))
