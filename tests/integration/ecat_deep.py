@@ -518,8 +518,8 @@ class _Obj(list):
 def items_per_packet(path, prefixes):
     """tshark -T json -x -> [ {(name, pos): [(length, show)]} ] per packet, for fields whose name
     starts with one of prefixes."""
-    with open(path, "rb") as fh:
-        pkts = json.load(fh, object_pairs_hook=_Obj)
+    with open(path, "rb") as fh:   # tshark may cut a long label inside a UTF-8 character
+        pkts = json.loads(fh.read().decode("utf-8", "replace"), object_pairs_hook=_Obj)
     out = []
     for pk in pkts:
         found = defaultdict(list)

@@ -413,8 +413,8 @@ def parse_ws_json(path):
     """tshark -T json -> [ {"header": {..}, "datagrams": [ {k: v} ], "malformed": bool} ] (one per
     packet, in order).  Only the datagram subtree itself, its Header and the Length subtree are
     read (no mailbox/EoE contents)."""
-    with open(path, "rb") as fh:
-        pkts = json.load(fh, object_pairs_hook=_Obj)
+    with open(path, "rb") as fh:   # tshark may cut a long label inside a UTF-8 character
+        pkts = json.loads(fh.read().decode("utf-8", "replace"), object_pairs_hook=_Obj)
     out = []
     for pk in pkts:
         src = dict(pk)["_source"]
