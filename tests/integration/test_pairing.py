@@ -7,8 +7,9 @@ of ../shared/corpus/ethercat and on copies of them with faults injected.
 --quick (the mutation check's way to run it): part 1 and 2 on the captures below 1 MB only
 (all but twincat-akd-nc-mode), part 3 on soem-sdinfo-ek1100-el1004 only. That does not
 kill three mutants (a duplicate taken whatever its bytes; forwarding never raised; no
-response raised on the first pass), which name the whole test instead (pairing_full in
-tests/mutation/run_mutants.py).
+response raised on the first pass): the forwarding one names the whole test instead
+(pairing_full in tests/mutation/run_mutants.py); the other two survive the whole test
+too and wait in tests/mutation/survivors/.
 
 1. Every capture of the corpus, read with tshark -2: each returned frame that an independent
    reading of the bytes pairs with its sent frame (the slaves set the locally administered
