@@ -14,12 +14,15 @@ from the bytes written), and the label of every block instance ("Channel 2",
   - else a word window (kind 4, base = address * 2, otherwise + if),
   - else a page window (kind 6, base = address - 16, a child with its own if),
   - else a window whose base is the Echo byte (kind 7),
+  - else, for kind 8, the data as one item when the record has its Echo byte
+    (a <when field> on a field only some records have: without it, raw bytes),
   - else a mailbox when the counter AFTER the data is 1 (peek counted from the
     start of the data container, whose length is known),
   - else raw bytes (otherwise);
 and an Echo byte precedes the data when that counter is 2 (peek from the node
 itself, past the data). Malformed variants (windows past the end of the
-capture, counters cut off so a peek cannot read them, a mailbox too short for
+capture, counters cut off so a peek cannot read them or ending exactly at the
+end of the capture so it can, a mailbox too short for
 its header, a base below zero, a base from a field the record lacks) must give
 our expert infos where the fault is and the tree so far.
 
@@ -185,6 +188,9 @@ class Expected:
                 return False
             for name, pos, size, i, text in window_items(self, 0xE5, d, avail, ECHOED):
                 self.add(name, pos, size, le(self.payload[pos:pos + size]), text)
+        elif r.kind == 8 and echo:
+            if avail > 0:
+                self.add("lyt.rec.echodata", d, avail)
         elif r.kind in (1, 2, 3) and counter == 1:
             self.add("lyt.rec.mbx", d, avail if avail >= 3 else None)
             inner = d + avail
@@ -229,7 +235,7 @@ class Expected:
 
 
 def random_record(rng, more):
-    kind = rng.choice([1, 1, 2, 3, 4, 5, 6, 7])
+    kind = rng.choice([1, 1, 2, 3, 4, 5, 6, 7, 8])
     mode = rng.choice([0, 0, 0, 1])
     address = rng.choice([0, 0x0010, 0x0011, 0x0012, 0x00FC, 0x0100, 0x0104, 0x0110, 0x0118, 0x0F78,
                           0x0F80, 0x0FF0, 0x1000, 0x8000, rng.randrange(0x1000), rng.randrange(0x10000)])
@@ -253,8 +259,9 @@ def valid_packets(rng, count):
     # A read of 0x0000..0x0FFF shows every register it covers.
     whole = Record(1, 0, 0x0000, bytes(rng.randrange(256) for _ in range(0x1000)), 0, 0)
     out.append(([whole], None))
-    # Every branch once: registers, words, mailbox (peek 1), raw (peek 2, kind 5), pages, echoed.
-    for kind, counter in ((2, 0), (4, 1), (3, 1), (3, 2), (5, 1), (6, 0), (7, 2)):
+    # Every branch once: registers, words, mailbox (peek 1), raw (peek 2, kind 5), pages, echoed,
+    # echo data (kind 8 with its Echo byte) and raw bytes for kind 8 without it.
+    for kind, counter in ((2, 0), (4, 1), (3, 1), (3, 2), (5, 1), (6, 0), (7, 2), (8, 2), (8, 0)):
         out.append(([Record(kind, 0, 0x0010, bytes(range(24)), counter, 0)], None))
     return out
 
@@ -270,6 +277,10 @@ def malformed_packets():
         ([Record(3, 0, 0x2000, data[:8], 1, 0)], 6 + 8 + 1),
         # the counter Echo peeks at is cut off: no Echo, its byte is taken as data
         ([Record(5, 0, 0x2000, data[:8], 2, 0)], 6 + 1 + 8 + 1),
+        # ... and ends exactly at the end of the capture: Echo is there (More is cut off)
+        ([Record(5, 0, 0x2000, data[:8], 2, 0)], 6 + 1 + 8 + 2),
+        # the counter a mailbox peeks at ends exactly at the end of the capture: a mailbox
+        ([Record(3, 0, 0x2000, data[:8], 1, 0)], 6 + 8 + 2),
         # a window base below zero (address - 16)
         ([Record(6, 1, 0x0008, data[:8], 0, 0)], None),
         # a window base from a field this record does not have
@@ -386,13 +397,13 @@ class Layout(unittest.TestCase):
             self.assertEqual(self.expected[i].experts, [], "valid packet %d has a fault in the model" % (i + 1))
 
     def test_whole_register_space_shows_every_register(self):
-        exp = self.expected[self.valid_count - 8]
+        exp = self.expected[self.valid_count - 10]
         names = [it.name for it in exp.items]
         for name in ("lyt.rec.reg.status", "lyt.rec.reg.ctl", "lyt.rec.reg.id", "lyt.rec.reg.status_low",
                      "lyt.rec.reg.scratch"):
             self.assertEqual(names.count(name), 1, name)
         self.assertEqual(names.count("lyt.rec.reg.ch"), 4)
-        labels = [f.get("showname") for f in pdml_items(self.proto(self.valid_count - 8))
+        labels = [f.get("showname") for f in pdml_items(self.proto(self.valid_count - 10))
                   if f.get("name") == "lyt.rec.reg.ch"]
         self.assertEqual([s.split(":")[0] for s in labels], ["Channel 0", "Channel 1", "Channel 2", "Channel 3"])
 
@@ -402,7 +413,7 @@ class Layout(unittest.TestCase):
             seen.update(it.name for it in exp.items)
         for name in ("lyt.rec.reg", "lyt.rec.words", "lyt.rec.mbx", "lyt.rec.raw", "lyt.rec.reg.ch",
                      "lyt.rec.words.word", "lyt.rec.echo", "lyt.rec.pages.word", "lyt.rec.pages.wflag",
-                     "lyt.rec.echoed.reg"):
+                     "lyt.rec.echoed.reg", "lyt.rec.echodata"):
             self.assertIn(name, seen)
 
 
