@@ -16,6 +16,7 @@ import os
 import struct
 import sys
 import unittest
+import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from tshark_env import SANITIZE, TsharkEnv, run_unittests  # noqa: E402
@@ -218,10 +219,14 @@ class Display10a(unittest.TestCase):
         self.assertEqual(rows[0]["arp.src.proto_ipv4"], "10.1.2.3")
         self.assertNotEqual(rows[0]["dspt.frame"], "")  # still filterable
         self.assertEqual(rows[0]["_ws.col.Protocol"], "DSPT")
-        # ... but hidden: the other dissector shows the bytes, our tree does not repeat them raw.
+        # ... but hidden: the other dissector shows the bytes, our tree does not repeat them raw
+        # (-V shortens a long bytes label to "Frame […]: ...", so the PDML's hide says it).
         tree = ENV.tshark(["-r", cap, "-V", "-O", "dspt"]).stdout
         self.assertIn("Kind: Frame", tree)
-        self.assertNotRegex(tree, r"(?m)^\s+Frame: [0-9a-f]{8}")
+        self.assertNotRegex(tree, r"(?m)^\s+Frame( \[\S+\])?: [0-9a-f]{8}")
+        pdml = ET.fromstring(ENV.tshark(["-r", cap, "-T", "pdml"]).stdout)
+        ours = [f for f in pdml.iter("field") if f.get("name") == "dspt.frame"]
+        self.assertEqual([f.get("hide") for f in ours], ["yes"])
 
     def test_hand_off_of_a_truncated_frame_stays_inside_the_other_dissector(self):
         cap = capture("handoff_short.pcap", [to_port(bytes([3]) + inner_frame((10, 1, 2, 3))[:20])])
