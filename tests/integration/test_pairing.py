@@ -6,10 +6,8 @@ of ../shared/corpus/ethercat and on copies of them with faults injected.
 
 --quick (the mutation check's way to run it): part 1 and 2 on the captures below 1 MB only
 (all but twincat-akd-nc-mode), part 3 on soem-sdinfo-ek1100-el1004 only. That does not
-kill three mutants (a duplicate taken whatever its bytes; forwarding never raised; no
-response raised on the first pass): the forwarding one names the whole test instead
-(pairing_full in tests/mutation/run_mutants.py); the other two survive the whole test
-too and wait in tests/mutation/survivors/.
+kill the mutant "forwarding never raised" (soem has no frame with two auto-increment
+datagrams): it names the whole test instead (pairing_full in tests/mutation/run_mutants.py).
 
 1. Every capture of the corpus, read with tshark -2: each returned frame that an independent
    reading of the bytes pairs with its sent frame (the slaves set the locally administered
@@ -17,12 +15,13 @@ too and wait in tests/mutation/survivors/.
    unanswered sent frame, at most 10 ms before) carries ecatr.request_in of that frame, and
    the sent frame ecatr.response_in. Counts are printed per file. No expert info of the
    pairing or of the ESC analysis appears on any of them, except "no response" on sent frames
-   that the bytes show never came back.
+   that the bytes show never came back (and that only with -2: one pass cannot know it).
 2. One pass and two passes (-2) give the same items on returned frames, and a display filter
    gives the same items on the frames it keeps.
 3. Faults injected into copies (pcaprewrite.py): returned frames deleted, a working counter
    that came back lower than sent, an address, a length, an index changed, written data
-   altered, an auto-increment address advanced differently, frames reordered or duplicated.
+   altered, an auto-increment address advanced differently, frames reordered or duplicated,
+   a sent frame sent again at once with other bytes (not a duplicate).
    Each expert info appears on exactly the frames changed and nowhere else, with -2 and
    (for the returned-frame experts) in one pass.
 
@@ -45,6 +44,7 @@ RESPONSE_FIELDS = ["ecatr.request_in", "ecatr.time", "ecatr.esc.wkc_added", "eca
                    "ecatr.esc.data_changed"] + ["ecatr.expert." + e for e in EXPERTS if e != "no_response"]
 FIELDS = ["frame.number", "ecatr.response_in", "ecatr.expert.no_response"] + RESPONSE_FIELDS
 WRITES = {2, 5, 8, 11}            # APWR FPWR BWR LWR
+READS = {1, 4, 7, 10}             # APRD FPRD BRD LRD
 ADVANCING = {1, 2, 3, 7, 8, 9, 13}  # auto-increment and broadcast commands
 check = Checks()
 
@@ -138,6 +138,9 @@ def corpus_checks(env, corpus_dir, files):
         diff = [n for n in rows if any(rows[n][f] != one[n][f] for f in RESPONSE_FIELDS)]
         check(not diff, "%s: one pass shows the same items on returned frames as -2%s" % (
             name, ": %s" % diff[:5] if diff else ""))
+        early = sorted(with_expert(one, "no_response"))
+        check(not early, "%s: one pass raises no ecatr.expert.no_response (a return later in the capture "
+              "is not read yet)%s" % (name, ": %s" % early[:5] if early else ""))
         stats_checks(env, path, name, rows)
         filtered = decode(env, path, display_filter="ecatr.request_in || ecatr.expert.no_response")
         diff = [n for n in filtered if filtered[n] != rows[n]]
@@ -301,6 +304,24 @@ def make_faults(base_cap, pairs):
             f.expect["out_of_order"].add(a1)
             faults.append(f)
             break
+
+    # a look-alike: a sent frame of reads sent again at once with one data byte other. Not a
+    # duplicate (the bytes differ): a new frame of the same key, which gives the first one up
+    # (no response) and is answered by the return instead.
+    cands = [j for i, j in sorted(pairs.items()) if j > min(pairs.values())
+             and all(d["cmd"] in READS for d in pr.ecat_datagrams(base_cap.packets[j]))
+             and pr.ecat_datagrams(base_cap.packets[j])[0]["length"] >= 1]
+    if cands:
+        f = Fault("sent again at once with other bytes", copy())
+        j = spread(cands, 3)[1]
+        other = f.cap.packets[j].copy()
+        other.data[pr.ecat_datagrams(other)[0]["data_offset"]] ^= 0x5A
+        other.tag = len(f.cap.packets)
+        f.cap.packets.insert(j + 1, other)
+        f.expect["no_response"].add(j)
+        faults.append(f)
+    else:
+        print("note: %s has no sent frame of reads only" % base_cap.name)
 
     # duplicated: a returned frame and a sent frame captured twice
     f = Fault("frames duplicated", copy())
