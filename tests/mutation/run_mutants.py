@@ -234,7 +234,7 @@ def main(argv=None):
             print(tail(bout))
             return 1
 
-        baselined = set(args.no_baseline and TESTS or ())
+        baselined = set(TESTS) if args.no_baseline else set()
         originals = {}
         for i, m in enumerate(mutants):
             if args.budget and time.monotonic() - t0 > args.budget:
