@@ -22,6 +22,8 @@ import re
 from collections import defaultdict
 from decimal import Decimal, InvalidOperation
 
+from tshark_env import read_tshark_output
+
 # Wireshark field -> ((our fields, any of which may be at the same bytes), how to compare)
 DEEP_MAP = {
     'ecat.fmmu': (('ecatr.datagram.reg.fmmu',), 'container'),
@@ -518,8 +520,7 @@ class _Obj(list):
 def items_per_packet(path, prefixes):
     """tshark -T json -x -> [ {(name, pos): [(length, show)]} ] per packet, for fields whose name
     starts with one of prefixes."""
-    with open(path, "rb") as fh:   # tshark may cut a long label inside a UTF-8 character
-        pkts = json.loads(fh.read().decode("utf-8", "replace"), object_pairs_hook=_Obj)
+    pkts = json.loads(read_tshark_output(path), object_pairs_hook=_Obj)
     out = []
     for pk in pkts:
         found = defaultdict(list)

@@ -413,8 +413,7 @@ def parse_ws_json(path):
     """tshark -T json -> [ {"header": {..}, "datagrams": [ {k: v} ], "malformed": bool} ] (one per
     packet, in order).  Only the datagram subtree itself, its Header and the Length subtree are
     read (no mailbox/EoE contents)."""
-    with open(path, "rb") as fh:   # tshark may cut a long label inside a UTF-8 character
-        pkts = json.loads(fh.read().decode("utf-8", "replace"), object_pairs_hook=_Obj)
+    pkts = json.loads(tshark_env.read_tshark_output(path), object_pairs_hook=_Obj)
     out = []
     for pk in pkts:
         src = dict(pk)["_source"]
@@ -756,11 +755,8 @@ def parse_extras(text, pdml_path):
     for line in text.splitlines():
         num, dgs, info = [c[1:-1] if len(c) >= 2 and c[0] == c[-1] == '"' else c for c in line.split("\t")]
         out[int(num)] = {"items": len(dgs.split(",")) if dgs else 0, "info": info, "experts": []}
-    # tshark's PDML is not always XML: it cuts long labels at a byte count, inside a UTF-8
-    # character (a long string from random mailbox bytes), and may write control characters.
-    # Only our expert items are read here, so mend both.
-    with open(pdml_path, "rb") as fh:
-        pdml = re.sub("[\x00-\x08\x0b\x0c\x0e-\x1f]", "?", fh.read().decode("utf-8", "replace"))
+    # Only our expert items are read here, so mending the labels does not matter.
+    pdml = tshark_env.read_tshark_output(pdml_path, xml=True)
     for _, packet in ET.iterparse(io.BytesIO(pdml.encode("utf-8"))):
         if packet.tag != "packet":
             continue

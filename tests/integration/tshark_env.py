@@ -57,6 +57,15 @@ class Checks:
         return cond
 
 
+def read_tshark_output(path, xml=False):
+    """The text tshark wrote to path (JSON or PDML), made parseable: tshark cuts a long label
+    at a byte count, which may fall inside a UTF-8 character (a long string from random
+    bytes), and its PDML may hold control characters, which XML does not allow."""
+    with open(path, "rb") as fh:
+        text = fh.read().decode("utf-8", "replace")
+    return re.sub("[\x00-\x08\x0b\x0c\x0e-\x1f]", "?", text) if xml else text
+
+
 def wireshark_abi():
     """Major.minor of the installed Wireshark, e.g. "4.0" (the per-user plugin folder name)."""
     try:
