@@ -8,6 +8,9 @@
  *     paired. (A sender repeating a request it got no answer to repeats it
  *     later, or after other messages: that is a new request. So is the very
  *     request again from its sender, at any time: never its own answer.)
+ *     Except where the analysis cannot tell the directions apart (returns not
+ *     marked, as from a simulator): there a request's copy right after it is
+ *     a frame that came back unprocessed, its response.
  *  3. Pending requests of that key older than the timeout, or overtaken by
  *     the responses to more than max_overtaken later requests, are given up
  *     (they keep "no response"). The oldest remaining one whose source the
@@ -133,7 +136,9 @@ key_entry *entry_for(capture_state *c, const guint64 *keys, guint key_count)
     return e;
 }
 
-gboolean is_duplicate(const capture_state *c, const key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length)
+/* The same bytes from the same source as the last message of this key, within
+ * a hundredth of the timeout, and that message a response or the one just before. */
+gboolean same_again(const capture_state *c, const key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length)
 {
     if (!e->last_frame || e->last_length != length || !addresses_equal(&e->last_src, &pinfo->src)) return FALSE;
     if (e->last_role != DG_ROLE_RESPONSE && e->last_frame != c->last_frame) return FALSE;
@@ -141,6 +146,16 @@ gboolean is_duplicate(const capture_state *c, const key_entry *e, tvbuff_t *tvb,
     nstime_delta(&gap, &pinfo->abs_ts, &e->last_time);
     if (nstime_to_sec(&gap) > protocol->pairing->timeout / 100) return FALSE;
     return tvb_memeql(tvb, 0, e->last_bytes, length) == 0;
+}
+
+/* A message the same as the last one (same_again) is a frame that came back
+ * unprocessed, the request's response, when that one was a request and the
+ * analysis cannot tell the directions apart (returns not marked, as from a
+ * simulator). */
+gboolean unchanged_return(const capture_state *c, const key_entry *e, const packet_info *pinfo)
+{
+    return e->last_role == DG_ROLE_REQUEST && analysis && analysis->is_response &&
+           analysis->is_response(c->analysis, &e->last_src, &pinfo->src) < 0;
 }
 
 void remember_last(key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length, guint8 role)
@@ -205,14 +220,16 @@ void retire_all(capture_state *c, queue *qu, const packet_info *pinfo)
 
 /* The pending request of this key that this message answers, or NULL when
  * the message is a new request. */
-pending *take_answered(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length)
+pending *take_answered(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length,
+                       gboolean unchanged)
 {
     pending *q = oldest_waiting(c, &e->waiting, TRUE, pinfo);
     if (!q) return NULL;
     int verdict = analysis && analysis->is_response ? analysis->is_response(c->analysis, &q->src, &pinfo->src) : -1;
-    /* The very request again, from its sender: a repetition, not an answer. */
+    /* The very request again, from its sender: a repetition, not an answer
+     * (unless it came straight back unchanged). */
     if (e->last_frame == q->txn->request_frame && e->last_length == length &&
-        addresses_equal(&q->src, &pinfo->src) && tvb_memeql(tvb, 0, e->last_bytes, length) == 0)
+        addresses_equal(&q->src, &pinfo->src) && tvb_memeql(tvb, 0, e->last_bytes, length) == 0 && !unchanged)
         verdict = 0;
     if (verdict == 0) {
         /* The sender sent the same key again: what was pending is given up. */
@@ -254,7 +271,9 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
     if (analysis && analysis->see) analysis->see(c->analysis, tvb, pinfo);
     key_entry *e = entry_for(c, keys, key_count);
-    gboolean duplicate = is_duplicate(c, e, tvb, pinfo, length);
+    gboolean again = same_again(c, e, tvb, pinfo, length);
+    gboolean unchanged = again && unchanged_return(c, e, pinfo);
+    gboolean duplicate = again && !unchanged;
     c->last_frame = pinfo->num;
     if (duplicate) {
         fp->role = DG_ROLE_DUPLICATE;
@@ -262,7 +281,7 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
         return fp;
     }
 
-    pending *q = take_answered(c, e, tvb, pinfo, length);
+    pending *q = take_answered(c, e, tvb, pinfo, length, unchanged);
     gboolean returned = !q && analysis && analysis->is_returned && analysis->is_returned(c->analysis, &pinfo->src);
     if (returned) q = take_oldest(c, pinfo);
     remember_last(e, tvb, pinfo, length, q ? DG_ROLE_RESPONSE : DG_ROLE_REQUEST); /* an orphan: a request for step 2 */

@@ -22,6 +22,8 @@ datagrams): it names the whole test instead (pairing_full in tests/mutation/run_
    that came back lower than sent, an address, a length, an index changed, written data
    altered, an auto-increment address advanced differently, frames reordered or duplicated,
    a sent frame sent again at once with other bytes (not a duplicate).
+4. Variants of the same copies: the returned frames on a second interface of the pcapng,
+   and returned frames not marked (a simulator's): the same pairs and expert infos.
    Each expert info appears on exactly the frames changed and nowhere else, with -2 and
    (for the returned-frame experts) in one pass.
 
@@ -30,6 +32,7 @@ Exit 77 with "SKIPPED: ..." when the corpus is not there.
 
 import argparse
 import os
+import struct
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -367,6 +370,61 @@ def fault_checks(env, corpus_dir, files):
                         name, f.name, e))
 
 
+# ----------------------------------------------------------------------------- variants
+
+def ecat_bytes(pkt):
+    """The EtherCAT frame: header and datagrams, without the Ethernet header and padding."""
+    base = pr.ecat_offset(pkt)
+    return bytes(pkt.data[base:base + 2 + (pr.get_u16(pkt, base) & 0x7FF)])
+
+
+def on_second_interface(cap, returned):
+    """The returned frames moved to a second interface of the pcapng (a tap with two ports)."""
+    big = ">" if cap.endian == ">" else "<"
+    idb = next(k for k, b in enumerate(cap.blocks) if b is not None and struct.unpack(big + "I", b[:4])[0] == 1)
+    cap.blocks.insert(idb + 1, cap.blocks[idb])
+    cap.units[1] = cap.units[0]
+    for i in returned:
+        cap.packets[i].ifid = 1
+
+
+def unmarked(cap, returned):
+    """The returned frames' source address set back to the master's, as a simulator leaves it."""
+    for i in returned:
+        cap.packets[i].data[6] &= ~0x02
+
+
+def variant_checks(env, corpus_dir, files):
+    """The same pairs and expert infos when the returns come on another interface of the
+    capture, or unmarked (pairing must not rely on source addresses alone); unmarked, a frame
+    that nobody processed comes back byte for byte as it was sent, and is still its return."""
+    variants = [("returns on a second interface", on_second_interface, "pcapng"),
+                ("returns not marked (a simulator)", unmarked, None)]
+    for name in files:
+        path = os.path.join(corpus_dir, name)
+        base = pr.Capture.read(path)
+        pairs, _, _ = oracle(base)
+        clean = decode(env, path)
+        identical = sum(1 for i, j in pairs.items() if ecat_bytes(base.packets[i]) == ecat_bytes(base.packets[j]))
+        print("\n== variants of %s (%d pairs, %d of them came back unchanged)" % (
+            name, len(pairs), identical))
+        for what, change, kind in variants:
+            if kind and base.kind != kind:
+                continue
+            cap = pr.Capture.read(path)
+            change(cap, pairs)
+            out = env.path("variant." + cap.kind)
+            cap.write(out)
+            os.chmod(out, 0o644)
+            for two_pass in (True, False):
+                rows = decode(env, out, two_pass=two_pass)
+                want = clean if two_pass else decode(env, path, two_pass=False)
+                diff = [n for n in want if rows.get(n) != want[n]]
+                check(not diff, "%s: %s%s: the same pairs and expert infos as the original (%d frames)%s" % (
+                    name, what, "" if two_pass else ", one pass", len(want),
+                    ": differ on %s" % diff[:5] if diff else ""))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--dissgen", required=True)
@@ -394,6 +452,7 @@ def main():
         faulted = ("soem-sdinfo-ek1100-el1004.pcapng",) if args.quick else (
             "soem-sdinfo-ek1100-el1004.pcapng", "replay-ek1100-el2828-el2889.pcapng", "twincat-scan-boxes.pcapng")
         fault_checks(env, env.home, [f for f in faulted if f in local])
+        variant_checks(env, env.home, [f for f in faulted if f in local])
     print("\n%d failed" % len(check.failed))
     return 1 if check.failed else 0
 
