@@ -124,11 +124,14 @@ BusLayout make_bus_layout(const Catalogue& cat, const BusOptions& opt, const std
         return field_of[key] = static_cast<int>(l.fields.size()) - 1;
     };
 
-    // Models a design uses get fields; the rest of the catalogue is data only.
+    // Models a design uses get fields, the rest of the catalogue is data only;
+    // without a network every model does: the run time names the process data
+    // of the slaves the capture identifies by their model's defaults.
     std::set<int> design_models;
     if (net && !net->from_eni)
         for (const NetSlave& s : net->slaves)
             if (s.device >= 0) design_models.insert(s.device);
+    if (!net) design_models.insert(l.devices.begin(), l.devices.end());
     for (int d : l.devices) {
         const EsiDevice& dev = cat.devices[d];
         NetSlave defaults;

@@ -19,7 +19,7 @@ typedef struct dg_pdo_entry {
     gint64 logical_bit;      /* in the logical process image (ENI), -1: set by the master at run time */
     const char *name;        /* "Channel 1.Input": PDO name and entry name */
     const char *data_type;   /* ESI data type: "BOOL", "UINT", "BIT2", ... */
-    int *hf;                 /* registered field, NULL when none (padding, catalogue-only models) */
+    int *hf;                 /* registered field, NULL when none (padding; with a network, models it does not use) */
 } dg_pdo_entry;
 
 /* A SyncManager of a slave of the network (ESI <Sm> defaults, or the ENI's <SmN>). */

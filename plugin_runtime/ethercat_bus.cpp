@@ -169,6 +169,14 @@ gint32 find_device(const dg_bus *bus, guint32 vendor, guint32 product, guint32 r
     return found;
 }
 
+/* The catalogue's device of a slave whose identity was read from its SII, or -1. */
+gint32 learned_device(const dg_bus *bus, const slave_state *s)
+{
+    if (!s || !words_known(s, W_VENDOR) || !words_known(s, W_PRODUCT)) return -1;
+    return find_device(bus, word32(s, W_VENDOR), word32(s, W_PRODUCT),
+                       words_known(s, W_REVISION) ? word32(s, W_REVISION) : 0);
+}
+
 /* "EL1004 (vendor 0x00000002, product 0x03ec3052)", or the numbers alone. */
 const char *model_text(const dg_bus *bus, guint32 vendor, guint32 product, gint32 device)
 {
@@ -363,11 +371,7 @@ gint32 expected_wkc(const bus_model *m, const datagram *d, share *shares, guint 
 /* "EL2004 at position 2", or "the slave at position 2". */
 const char *slave_text(const bus_model *m, guint position)
 {
-    const slave_state *s = position < max_positions ? m->slaves[position] : NULL;
-    gint32 device = -1;
-    if (s && words_known(s, W_VENDOR) && words_known(s, W_PRODUCT))
-        device = find_device(m->design, word32(s, W_VENDOR), word32(s, W_PRODUCT),
-                             words_known(s, W_REVISION) ? word32(s, W_REVISION) : 0);
+    gint32 device = learned_device(m->design, position < max_positions ? m->slaves[position] : NULL);
     if (device >= 0) return wmem_strdup_printf(wmem_file_scope(), "%s at position %u", m->design->devices[device].type, position);
     return wmem_strdup_printf(wmem_file_scope(), "the slave at position %u", position);
 }
@@ -501,10 +505,7 @@ void show_slave(const bus_model *m, const addressed *a, tvbuff_t *tvb, packet_in
     if (position < 0) return;
     const slave_state *s = m->slaves[position];
     const dg_bus *b = m->design;
-    gint32 device = -1;
-    if (s && words_known(s, W_VENDOR) && words_known(s, W_PRODUCT))
-        device = find_device(b, word32(s, W_VENDOR), word32(s, W_PRODUCT),
-                             words_known(s, W_REVISION) ? word32(s, W_REVISION) : 0);
+    gint32 device = learned_device(b, s);
     proto_item *item = proto_tree_add_none_format(tree, hf_slave, tvb, a->offset, a->length, "Slave at position %d%s%s",
                                                   position, device >= 0 ? ": " : "",
                                                   device >= 0 ? b->devices[device].name : "");
@@ -573,7 +574,7 @@ void show_entry(proto_tree *tree, const dg_pdo_entry *e, tvbuff_t *tvb, gint dat
 /* The logical bit where a slave's inputs (FMMU read) or outputs (FMMU write) start, -1 unknown. */
 gint64 image_start(const dg_slave *ds, const slave_state *st, gboolean output)
 {
-    gint64 given = output ? ds->output_logical_bit : ds->input_logical_bit;
+    gint64 given = !ds ? -1 : output ? ds->output_logical_bit : ds->input_logical_bit;
     if (given >= 0) return given;
     if (!st) return -1;
     for (guint i = 0; i < max_fmmus; i++) {
@@ -583,35 +584,54 @@ gint64 image_start(const dg_slave *ds, const slave_state *st, gboolean output)
     return -1;
 }
 
-/* A logical datagram's process data, one subtree per designed slave: outputs
- * in the frame as sent, inputs in the returned one. */
+/* One slave's entries[first, first + count) that lie wholly inside a logical
+ * datagram, in a subtree; `start` is the logical bit where its inputs or
+ * outputs begin. */
+void show_slave_data(const dg_bus *b, const char *name, guint position, guint32 first, guint32 count, gint64 start,
+                     const datagram *d, gboolean output, tvbuff_t *tvb, proto_tree *tree)
+{
+    gint64 begin = (gint64)(d->adp | (guint32)d->ado << 16) * 8, end = begin + (gint64)d->length * 8;
+    proto_tree *sub = NULL;
+    for (guint32 i = first; i < first + count; i++) {
+        const dg_pdo_entry *e = &b->entries[i];
+        if (!e->hf || *e->hf < 0 || (gboolean)e->output != output) continue;
+        gint64 at = e->logical_bit >= 0 ? e->logical_bit : start + e->bit_offset;
+        if (at < begin || at + e->bit_length > end) continue;
+        if (!sub) {
+            proto_item *it = proto_tree_add_none_format(tree, hf_process_data, tvb, d->offset, 12 + d->length,
+                                                        "%s (position %u): %s", name, position,
+                                                        output ? "outputs" : "inputs");
+            proto_item_set_generated(it);
+            sub = proto_item_add_subtree(it, ett_process_data);
+        }
+        show_entry(sub, e, tvb, d->offset + 10, (guint32)(at - begin));
+    }
+}
+
+/* A logical datagram's process data, one subtree per slave: outputs in the
+ * frame as sent, inputs in the returned one. The slaves of the design with
+ * their process data; without one, the slaves the capture identified (SII)
+ * with their model's default process data from the catalogue. */
 void show_process_data(const bus_model *m, const datagram *d, gboolean returned, tvbuff_t *tvb, proto_tree *tree)
 {
     const dg_bus *b = m->design;
-    if (!b || !b->slaves || !logical(d->cmd)) return;
+    if (!b || !logical(d->cmd)) return;
     gboolean output = !returned;
     if ((output && d->cmd == LRD) || (!output && d->cmd == LWR)) return;
-    gint64 first = (gint64)(d->adp | (guint32)d->ado << 16) * 8, end = first + (gint64)d->length * 8;
-    gint data = d->offset + 10;
-    for (guint p = 0; p < b->slave_count; p++) {
-        const dg_slave *ds = &b->slaves[p];
-        gint64 start = image_start(ds, p < max_positions ? m->slaves[p] : NULL, output);
-        if (start < 0) continue;
-        proto_tree *sub = NULL;
-        for (guint32 i = ds->entry_first; i < ds->entry_first + ds->entry_count; i++) {
-            const dg_pdo_entry *e = &b->entries[i];
-            if (!e->hf || *e->hf < 0 || (gboolean)e->output != output) continue;
-            gint64 at = e->logical_bit >= 0 ? e->logical_bit : start + e->bit_offset;
-            if (at < first || at + e->bit_length > end) continue;
-            if (!sub) {
-                proto_item *it = proto_tree_add_none_format(tree, hf_process_data, tvb, d->offset, 12 + d->length,
-                                                            "%s (position %u): %s", ds->name, p,
-                                                            output ? "outputs" : "inputs");
-                proto_item_set_generated(it);
-                sub = proto_item_add_subtree(it, ett_process_data);
-            }
-            show_entry(sub, e, tvb, data, (guint32)(at - first));
+    if (b->slaves) {
+        for (guint p = 0; p < b->slave_count; p++) {
+            const dg_slave *ds = &b->slaves[p];
+            gint64 start = image_start(ds, p < max_positions ? m->slaves[p] : NULL, output);
+            if (start >= 0) show_slave_data(b, ds->name, p, ds->entry_first, ds->entry_count, start, d, output, tvb, tree);
         }
+        return;
+    }
+    for (guint p = 0; p < m->positions && p < max_positions; p++) {
+        gint32 device = learned_device(b, m->slaves[p]);
+        gint64 start = device >= 0 ? image_start(NULL, m->slaves[p], output) : -1;
+        if (start >= 0)
+            show_slave_data(b, b->devices[device].type, p, b->devices[device].entry_first,
+                            b->devices[device].entry_count, start, d, output, tvb, tree);
     }
 }
 

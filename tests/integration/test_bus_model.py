@@ -29,6 +29,7 @@ Skips (exit 77) when the corpus is absent (part 6 runs all the same).
 """
 import argparse
 import os
+import re
 import struct
 import sys
 
@@ -320,8 +321,21 @@ def fmmu(logical, length, kind):
     return struct.pack("<IHBBHBBBxxx", logical, length, 0, 7, 0x1000, 0, kind, 1)
 
 
-def pdo_checks(dissgen, source_dir):
-    print("\n== process data by name (generated frames)")
+def sii_reads(station, vendor, product, revision):
+    """The master reading a slave's identity from its SII EEPROM: the word address written to
+    0x0504 with the read command in 0x0502, then 8 bytes of 0x0508 (words 8-11: vendor and
+    product; words 12-15: revision and serial)."""
+    steps = []
+    for word, data in ((0x0008, struct.pack("<II", vendor, product)), (0x000C, struct.pack("<II", revision, 0))):
+        steps.append((pg.Datagram(5, adp=station, ado=0x0502, data=struct.pack("<HI", 0x0100, word)), None, 1))
+        steps.append((pg.Datagram(4, adp=station, ado=0x0508, data=bytes(8)), data, 1))
+    return steps
+
+
+def pdo_checks(dissgen, source_dir, design=True):
+    """Process data by name: with a design, of its slaves; without one, of the slaves the
+    capture identifies from their SII, with their model's default process data (ESI)."""
+    print("\n== process data by name (generated frames, %s)" % ("a design" if design else "the ESI file alone"))
     master, back = b"\x00\x00\x00\x00\x00\x01", b"\x02\x00\x00\x00\x00\x01"
     mode, setpoint = 0x35, -1234
     outputs = bytes([1 | mode << 1]) + struct.pack("<h", setpoint)
@@ -330,8 +344,10 @@ def pdo_checks(dissgen, source_dir):
         (pg.Datagram(2, adp=0xFFFE, ado=0x0010, data=struct.pack("<H", 0x1003)), None, 1),  # position 2
         (pg.Datagram(5, adp=0x1002, ado=0x0600, data=fmmu(0x10000, 1, 1)), None, 1),  # EL1004 reads
         (pg.Datagram(5, adp=0x1003, ado=0x0600, data=fmmu(0x10001, 3, 2)), None, 1),  # EL2004 writes
-        (pg.Datagram(12, lad=0x10000, data=bytes(1) + outputs), bytes([0b101]) + outputs, 3),
     ]
+    if not design:
+        steps += sii_reads(0x1002, 2, 0x03EC3052, 0x00130000) + sii_reads(0x1003, 2, 0x07D43052, 0x00100000)
+    steps.append((pg.Datagram(12, lad=0x10000, data=bytes(1) + outputs), bytes([0b101]) + outputs, 3))
     frames = []
     for i, (d, data, wkc) in enumerate(steps):
         d.idx = i
@@ -344,15 +360,19 @@ def pdo_checks(dissgen, source_dir):
               "ecatr.wkc.expected", "ecatr.expert.wkc"]
     yes = {"1", "True"}
     no = {"0", "False"}
+    lrw = len(frames) - 1   # the LRW as sent, then returned
+    if not design:
+        fields = fields[:6]
     with TsharkEnv() as env:
         env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"),
-                           ["--esi", os.path.join(source_dir, "tests", "esi_ok", "small_io.xml"),
-                            "--network", os.path.join(source_dir, "tests", "network", "small_design.xml")])
+                           ["--esi", os.path.join(source_dir, "tests", "esi_ok", "small_io.xml")] +
+                           (["--network", os.path.join(source_dir, "tests", "network", "small_design.xml")]
+                            if design else []))
         path = env.add_file("pdo.pcap", pg.pcap_bytes(frames))
         for two_pass in (False, True):
             rows = dict(decode(env, path, fields, two_pass))
             tag = " (-2)" if two_pass else ""
-            sent, ret = rows[9], rows[10]
+            sent, ret = rows[lrw], rows[lrw + 1]
             check(sent["ecatr.pdo.el2004.channel_1.output"][0] in yes and
                   sent["ecatr.pdo.el2004.channel_1.mode"] == [str(mode)] and
                   sent["ecatr.pdo.el2004.channel_1.setpoint"] == [str(setpoint)],
@@ -361,9 +381,15 @@ def pdo_checks(dissgen, source_dir):
             check([ret[f][0] if ret[f] else "" for f in fields[:3]] in (["1", "0", "1"], ["True", "False", "True"]),
                   "LRW returned: EL1004 inputs by name (1, 0, 1)%s: %s" % (tag, ret))
             check(not any(ret[f] for f in fields[3:6]), "LRW returned: no EL2004 outputs" + tag)
-            check(sent["ecatr.wkc.expected"] == ["3"] and ret["ecatr.wkc.expected"] == ["3"] and
-                  not ret["ecatr.expert.wkc"], "expected working counter 3 (EL1004 +1, EL2004 +2), met" + tag)
-            check(not any(r[f] for n, r in rows.items() if n < 9 for f in fields[:6]),
+            if design:
+                check(sent["ecatr.wkc.expected"] == ["3"] and ret["ecatr.wkc.expected"] == ["3"] and
+                      not ret["ecatr.expert.wkc"], "expected working counter 3 (EL1004 +1, EL2004 +2), met" + tag)
+            else:
+                tree = env.tshark(["-r", path, "-V"] + (["-2"] if two_pass else [])).stdout.split("\nFrame ")
+                titles = [re.findall(r"\[(EL\d+ \(position \d\): \w+)\]", tree[k - 1]) for k in (lrw, lrw + 1)]
+                check(titles == [["EL2004 (position 2): outputs"], ["EL1004 (position 1): inputs"]],
+                      "subtrees named by the model and position the SII gave%s: %s" % (tag, titles))
+            check(not any(r[f] for n, r in rows.items() if n < lrw for f in fields[:6]),
                   "no process data before the LRW" + tag)
 
 
@@ -375,6 +401,7 @@ def main():
     args = ap.parse_args()
     if args.only == "pdo":
         pdo_checks(args.dissgen, args.source_dir)
+        pdo_checks(args.dissgen, args.source_dir, design=False)
         return 1 if check.failed else 0
     shared = os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus")
     corpus = os.path.join(shared, "ethercat")
@@ -382,6 +409,7 @@ def main():
         if os.path.isdir(corpus) else []
     if not files:
         pdo_checks(args.dissgen, args.source_dir)
+        pdo_checks(args.dissgen, args.source_dir, design=False)
         if check.failed:
             return 1
         print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng)" % corpus)
@@ -402,6 +430,7 @@ def main():
     network_checks(args.dissgen, rules, corpus)
     eni_checks(args.dissgen, rules, shared)
     pdo_checks(args.dissgen, args.source_dir)
+    pdo_checks(args.dissgen, args.source_dir, design=False)
     print("\n%d failed" % len(check.failed))
     return 1 if check.failed else 0
 

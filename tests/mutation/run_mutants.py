@@ -69,6 +69,7 @@ TESTS = {
     "info_column": integration("test_info_column.py"),
     "layout": integration("test_layout.py"),
     "bus_tables": integration("test_bus_tables.py"),
+    "bus_pdo": integration("test_bus_model.py", "--only", "pdo"),
     "pairing": integration("test_pairing.py", "--quick"),
     "pairing_full": integration("test_pairing.py"),
     "malformed_skip": integration("test_malformed_skip.py"),

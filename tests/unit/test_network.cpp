@@ -288,11 +288,21 @@ TEST(BusTables, CompactKeepsOnlyTheModelsOfTheNetwork) {
     EXPECT_EQ(emit_bus(cat, {&r.net, true}, "ecatr").hf_entries.size(), 3u);
 }
 
-TEST(BusTables, CatalogueAloneRegistersNoFields) {
+// Without a network the run time names the process data of the slaves the
+// capture identifies, so every model's default entries get a field; the two
+// revisions of the EL2004 share theirs.
+TEST(BusTables, CatalogueAloneRegistersAFieldPerModelEntry) {
     Catalogue cat = small_catalogue();
     EmbeddedTables t = emit_bus(cat, {nullptr, false}, "ecatr");
-    EXPECT_TRUE(t.hf_entries.empty());
+    EXPECT_EQ(t.hf_entries.size(), 6u);
     EXPECT_TRUE(contains(t.tables, "ecatr_devices, 4, ecatr_pdo_entries, 7,\n    NULL, 0, NULL, 0,\n    NULL, 0"));
+    EXPECT_EQ(list_bus_fields(cat, {nullptr, false}, "ecatr"),
+              "ecatr.pdo.el1004.channel_1.input\tFT_BOOLEAN\tEL1004 Channel 1.Input\n"
+              "ecatr.pdo.el1004.channel_2.input\tFT_BOOLEAN\tEL1004 Channel 2.Input\n"
+              "ecatr.pdo.el1004.channel_3.input\tFT_BOOLEAN\tEL1004 Channel 3.Input\n"
+              "ecatr.pdo.el2004.channel_1.output\tFT_BOOLEAN\tEL2004 Channel 1.Output\n"
+              "ecatr.pdo.el2004.channel_1.mode\tFT_UINT8\tEL2004 Channel 1.Mode\n"
+              "ecatr.pdo.el2004.channel_1.setpoint\tFT_INT16\tEL2004 Channel 1.Setpoint\n");
 }
 
 TEST(BusTables, BitNTakesTheSmallestFieldThatHoldsIt) {
