@@ -154,8 +154,10 @@ gboolean same_again(const capture_state *c, const key_entry *e, tvbuff_t *tvb, p
  * simulator). */
 gboolean unchanged_return(const capture_state *c, const key_entry *e, const packet_info *pinfo)
 {
-    return e->last_role == DG_ROLE_REQUEST && analysis && analysis->is_response &&
-           analysis->is_response(c->analysis, &e->last_src, &pinfo->src) < 0;
+    if (e->last_role != DG_ROLE_REQUEST || !analysis || !analysis->is_response) return FALSE;
+    /* A copy of a returned frame that answered nothing (an orphan) is a duplicate. */
+    if (analysis->is_returned && analysis->is_returned(c->analysis, &pinfo->src)) return FALSE;
+    return analysis->is_response(c->analysis, &e->last_src, &pinfo->src) < 0;
 }
 
 void remember_last(key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length, guint8 role)

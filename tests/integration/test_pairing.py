@@ -21,9 +21,10 @@ datagrams): it names the whole test instead (pairing_full in tests/mutation/run_
 3. Faults injected into copies (pcaprewrite.py): returned frames deleted, a working counter
    that came back lower than sent, an address, a length, an index changed, written data
    altered, an auto-increment address advanced differently, frames reordered or duplicated,
-   a sent frame sent again at once with other bytes (not a duplicate).
-4. Variants of the same copies: the returned frames on a second interface of the pcapng,
-   and returned frames not marked (a simulator's): the same pairs and expert infos.
+   a sent frame sent again at once with other bytes (not a duplicate), a return whose frame
+   as sent is missing captured twice (its copy is a duplicate).
+4. Variants of the same captures (unfaulted): the returned frames on a second interface of the
+   pcapng, and returned frames not marked (a simulator's): the same pairs and expert infos.
    Each expert info appears on exactly the frames changed and nowhere else, with -2 and
    (for the returned-frame experts) in one pass.
 
@@ -325,6 +326,16 @@ def make_faults(base_cap, pairs):
         faults.append(f)
     else:
         print("note: %s has no sent frame of reads only" % base_cap.name)
+
+    # an orphan captured twice: a return whose frame as sent is missing, then its copy
+    f = Fault("orphan return captured twice", copy())
+    i = spread(sorted(pairs), 5)[3]
+    dup = f.cap.packets[i].copy()
+    dup.tag = len(f.cap.packets)
+    f.expect["duplicate"].add(dup.tag)
+    f.cap.packets.insert(i + 1, dup)
+    del f.cap.packets[pairs[i]]
+    faults.append(f)
 
     # duplicated: a returned frame and a sent frame captured twice
     f = Fault("frames duplicated", copy())
