@@ -98,7 +98,7 @@ BusLayout make_bus_layout(const Catalogue& cat, const BusOptions& opt, const std
         if (e.entry.is_padding()) return -1;
         std::string key = owner + "\n" + std::to_string(e.output) + "\n" + std::to_string(e.pdo_index) + "\n" +
                           std::to_string(e.entry.index) + ":" + std::to_string(e.entry.subindex) + "\n" +
-                          e.entry.name;
+                          e.entry.name + "\n" + e.entry.data_type + "\n" + std::to_string(e.entry.bit_length);
         auto it = field_of.find(key);
         if (it != field_of.end()) return it->second;
         std::string base = filter + ".pdo." + segment(owner);

@@ -39,8 +39,14 @@ struct fmmu {
     gboolean known, active;
     guint32 logical;
     guint16 length;
+    guint8 start_bit;              /* of the logical start */
+    guint16 physical;              /* ESC address it maps: 0x1000 on is process RAM */
     guint8 type;                   /* bit 0: read (inputs), bit 1: write (outputs) */
 };
+
+/* ESC addresses below this are registers (an FMMU there maps e.g. a
+ * SyncManager's status bit for mailbox polling), not process data. */
+const guint16 process_ram = 0x1000;
 
 const guint max_fmmus = 16;
 
@@ -304,6 +310,8 @@ void learn_fmmus(bus_model *m, slave_state *st, const datagram *d, tvbuff_t *sen
             f->known = TRUE;
             f->logical = dg_tvb_get_uint32(sent, at, ENC_LITTLE_ENDIAN);
             f->length = dg_tvb_get_uint16(sent, at + 4, ENC_LITTLE_ENDIAN);
+            f->start_bit = dg_tvb_get_uint8(sent, at + 6) & 7;
+            f->physical = dg_tvb_get_uint16(sent, at + 8, ENC_LITTLE_ENDIAN);
             f->type = dg_tvb_get_uint8(sent, at + 11) & 3;
             f->active = dg_tvb_get_uint8(sent, at + 12) & 1;
             m->fmmus_known = TRUE;
@@ -571,7 +579,9 @@ void show_entry(proto_tree *tree, const dg_pdo_entry *e, tvbuff_t *tvb, gint dat
     }
 }
 
-/* The logical bit where a slave's inputs (FMMU read) or outputs (FMMU write) start, -1 unknown. */
+/* The logical bit where a slave's inputs (FMMU read) or outputs (FMMU write)
+ * start: the design's, else the first active FMMU of that kind that maps
+ * process RAM, at its logical start bit; -1 unknown. */
 gint64 image_start(const dg_slave *ds, const slave_state *st, gboolean output)
 {
     gint64 given = !ds ? -1 : output ? ds->output_logical_bit : ds->input_logical_bit;
@@ -579,7 +589,8 @@ gint64 image_start(const dg_slave *ds, const slave_state *st, gboolean output)
     if (!st) return -1;
     for (guint i = 0; i < max_fmmus; i++) {
         const fmmu *f = &st->fmmus[i];
-        if (f->known && f->active && (f->type & (output ? 2 : 1))) return (gint64)f->logical * 8;
+        if (f->known && f->active && f->physical >= process_ram && (f->type & (output ? 2 : 1)))
+            return (gint64)f->logical * 8 + f->start_bit;
     }
     return -1;
 }
