@@ -79,7 +79,9 @@ void collect_xml_error(void* user, xmlErrorPtr error) {
     if (sink->seen || error == nullptr || error->level < XML_ERR_ERROR) return;
     sink->seen = true;
     sink->line = error->line;
-    sink->message = error->message ? trim(error->message) : "unknown XML error";
+    // one line: libxml2 may go on over a second ("...indicate encoding !\nBytes: 0xC3 ...")
+    const std::string m = error->message ? error->message : "unknown XML error";
+    sink->message = trim(m.substr(0, m.find('\n')));
 }
 
 void ignore_xml_error(void*, xmlErrorPtr) {}
