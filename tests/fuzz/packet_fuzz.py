@@ -271,7 +271,9 @@ def our_sections(verbose, title):
 
 def check_run(env, cap, args, proto, title):
     try:
-        p = env.tshark(["-r", cap] + args, check=False, timeout=TIMEOUT)
+        # errors="replace": Wireshark 4.0 may cut a long label inside a UTF-8 character
+        p = subprocess.run(env.command(["-r", cap] + args), env=env.env(), cwd=env.home, timeout=TIMEOUT,
+                           capture_output=True, encoding="utf-8", errors="replace")
     except subprocess.TimeoutExpired:
         return None, ["HANG (>%ds)" % TIMEOUT]
     problems = []
