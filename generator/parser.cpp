@@ -79,7 +79,9 @@ void collect_xml_error(void* user, xmlErrorPtr error) {
     if (sink->seen || error == nullptr || error->level < XML_ERR_ERROR) return;
     sink->seen = true;
     sink->line = error->line;
-    sink->message = error->message ? trim(error->message) : "unknown XML error";
+    // one line: libxml2 may go on over a second ("...indicate encoding !\nBytes: 0xC3 ...")
+    const std::string m = error->message ? error->message : "unknown XML error";
+    sink->message = trim(m.substr(0, m.find('\n')));
 }
 
 void ignore_xml_error(void*, xmlErrorPtr) {}
@@ -676,12 +678,14 @@ FieldRef Parser::make_ref(const std::string& text, int line, const std::string& 
     if (arithmetic && split_arithmetic(ref.xpath, path, op, number)) {
         ref.op = op;
         ref.xpath = path;
-        if (number.size() > 9) {
+        // Leading zeros do not make a number large ("* 0002" is 2).
+        const std::string digits = number.substr(std::min(number.find_first_not_of('0'), number.size() - 1));
+        if (digits.size() > 9) {
             diags_.error(line, "number " + number + " after '" + ref.op + "' in '" + attribute +
                                    "' is too large: at most 999999999");
             return ref;
         }
-        ref.operand = std::stoll(number);
+        ref.operand = std::stoll(digits);
     }
     if (ref.xpath.empty()) diags_.error(line, "empty XPath in '" + attribute + "'");
     return ref;
@@ -805,8 +809,10 @@ bool parse_number(const std::string& raw, uint64_t& value) {
     std::string text = trim(raw);
     if (text.empty()) return false;
     bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
-    const std::string digits = hex ? text.substr(2) : text;
-    if (digits.empty() || digits.size() > (hex ? 16u : 20u)) return false;
+    std::string digits = hex ? text.substr(2) : text;
+    if (digits.empty()) return false;
+    digits.erase(0, std::min(digits.find_first_not_of('0'), digits.size() - 1));  // leading zeros are no size
+    if (digits.size() > (hex ? 16u : 20u)) return false;
     for (char c : digits)
         if (!(hex ? std::isxdigit(static_cast<unsigned char>(c)) : std::isdigit(static_cast<unsigned char>(c))))
             return false;

@@ -61,6 +61,19 @@ TEST(ParseNumber, SixtyFourBitLimits) {
     EXPECT_FALSE(parse_number("99999999999999999999", v));
 }
 
+TEST(ParseNumber, LeadingZerosDoNotCountAsDigits) {
+    // found by tests/fuzz/xml_fuzz.py: '000000000000000000001' was "not a number from 0 to ..."
+    uint64_t v = 0;
+    EXPECT_TRUE(parse_number("0000000000000000000000000034997", v));
+    EXPECT_EQ(v, 34997u);
+    EXPECT_TRUE(parse_number("0x00000000000000000000ffffffffffffffff", v));
+    EXPECT_EQ(v, UINT64_MAX);
+    EXPECT_TRUE(parse_number("000000000000000000000", v));
+    EXPECT_EQ(v, 0u);
+    EXPECT_FALSE(parse_number("000000000000018446744073709551616", v));
+    EXPECT_FALSE(parse_number("0x000010000000000000000", v));
+}
+
 TEST(ParseNumber, Rejects) {
     uint64_t v = 0;
     for (const char* bad : {"", " ", "0x", "-1", "+1", "1e3", "0x1g", "12abc", "abc", "1 2", "1.0", "0b101", "x10"})
@@ -177,13 +190,25 @@ INSTANTIATE_TEST_SUITE_P(Forms, ArithmeticTail,
                                            Tail{"../node[@name='Len']*2", '*', 2},
                                            Tail{"../node[@name='Len']-24", '-', 24},
                                            Tail{"  ../node[@name='Len']   +   0  ", '+', 0},
-                                           Tail{"../node[@name='Len'] * 999999999", '*', 999999999}));
+                                           Tail{"../node[@name='Len'] * 999999999", '*', 999999999},
+                                           // leading zeros do not count towards the nine digits
+                                           Tail{"../node[@name='Len'] * 0000000000000000000002", '*', 2},
+                                           Tail{"../node[@name='Len'] + 0000000000", '+', 0}));
 
 TEST(ArithmeticTailErrors, OperandTooLarge) {
     Parsed p = parse(rules("  <node name=\"Len\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
                            "  <node name=\"Data\" length=\"../node[@name='Len'] * 1234567890\"/>\n"));
     EXPECT_FALSE(p.ok());
     EXPECT_NE(p.messages().find("rules.xml:3: error: number 1234567890 after '*' in 'length' is too large"),
+              std::string::npos)
+        << p.messages();
+}
+
+TEST(ArithmeticTailErrors, OperandTooLargeAfterLeadingZeros) {
+    Parsed p = parse(rules("  <node name=\"Len\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                           "  <node name=\"Data\" length=\"../node[@name='Len'] * 01234567890\"/>\n"));
+    EXPECT_FALSE(p.ok());
+    EXPECT_NE(p.messages().find("rules.xml:3: error: number 01234567890 after '*' in 'length' is too large"),
               std::string::npos)
         << p.messages();
 }

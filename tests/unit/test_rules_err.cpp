@@ -84,6 +84,11 @@ TEST_P(RulesErr, ReportsTheExpectedError) {
         EXPECT_TRUE(has_diagnostic(f.messages(), e))
             << path << ": expected rules.xml:" << e.line << ": " << e.severity << ": ..." << e.text
             << "...\ngot:\n" << f.messages();
+    // one diagnostic a line, each in the FILE:LINE: form (not_utf8.xml: libxml2's
+    // message goes on over a second line)
+    std::istringstream lines(f.messages());
+    for (std::string line; std::getline(lines, line);)
+        EXPECT_EQ(line.rfind("rules.xml:", 0), 0u) << path << ": a line that is no diagnostic: " << line;
 }
 
 TEST_P(RulesOk, IsAcceptedAndGenerates) {
