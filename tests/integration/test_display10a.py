@@ -212,6 +212,14 @@ class Display10a(unittest.TestCase):
         self.assertNotEqual(rows[0]["dspt.expert.truncated"], "")
         assert_no_exception(cap)
 
+    def test_a_chain_after_a_taken_one_still_takes_its_otherwise(self):
+        cap = capture("chains.pcap", [to_port(bytes([8, 1, 0x11, 0x22])), to_port(bytes([8, 2, 0x33])),
+                                      to_port(bytes([8, 3, 0x44]))])
+        names = ["dspt.chained.first", "dspt.chained.second", "dspt.chained.second_other", "_ws.expert"]
+        rows = both_passes(cap, names)
+        self.assertEqual([[r[n] for n in names] for r in rows],
+                         [["0x11", "", "0x22", ""], ["", "0x33", "", ""], ["", "", "0x44", ""]])
+
     def test_hand_off_to_eth_withoutfcs(self):
         cap = capture("handoff.pcap", [to_port(bytes([3]) + inner_frame((10, 1, 2, 3)))])
         rows = both_passes(cap, ["eth.type", "arp.src.proto_ipv4", "dspt.frame", "_ws.col.Protocol"])
