@@ -19,6 +19,12 @@ namespace dissgen {
 
 namespace {
 
+// The digits without their leading zeros ("0002" -> "2", "000" -> "0"): a
+// number's size is what remains.
+std::string significant_digits(const std::string& digits) {
+    return digits.substr(std::min(digits.find_first_not_of('0'), digits.size() - 1));
+}
+
 const std::vector<std::string> kRootAttributes = {"name",   "abbreviation", "ethertype", "filter",
                                                   "byteorder", "pdulength", "pdulengthadd"};
 const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displaytype", "repeat",
@@ -612,7 +618,7 @@ void Parser::parse_length(const std::string& raw, int line, Node& node, xmlNode*
     } else if (text == "rest") {
         node.length_kind = LengthKind::Rest;
     } else if (split_fixed_length(text, false, digits, unit)) {
-        digits.erase(0, std::min(digits.find_first_not_of('0'), digits.size() - 1));
+        digits = significant_digits(digits);
         uint64_t n = digits.size() > 12 ? UINT64_MAX : std::stoull(digits);
         bool bytes = unit == "byte";
         if (n == 0 || n > (1u << 20)) {
@@ -679,7 +685,7 @@ FieldRef Parser::make_ref(const std::string& text, int line, const std::string& 
         ref.op = op;
         ref.xpath = path;
         // Leading zeros do not make a number large ("* 0002" is 2).
-        const std::string digits = number.substr(std::min(number.find_first_not_of('0'), number.size() - 1));
+        const std::string digits = significant_digits(number);
         if (digits.size() > 9) {
             diags_.error(line, "number " + number + " after '" + ref.op + "' in '" + attribute +
                                    "' is too large: at most 999999999");
@@ -811,7 +817,7 @@ bool parse_number(const std::string& raw, uint64_t& value) {
     bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
     std::string digits = hex ? text.substr(2) : text;
     if (digits.empty()) return false;
-    digits.erase(0, std::min(digits.find_first_not_of('0'), digits.size() - 1));  // leading zeros are no size
+    digits = significant_digits(digits);
     if (digits.size() > (hex ? 16u : 20u)) return false;
     for (char c : digits)
         if (!(hex ? std::isxdigit(static_cast<unsigned char>(c)) : std::isdigit(static_cast<unsigned char>(c))))
