@@ -793,7 +793,7 @@ void bus_register(int proto, const char *filter)
 {
     static hf_register_info hf[] = {
         {&hf_process_data, {"Process data", NULL, FT_NONE, BASE_NONE, NULL, 0x0,
-                            "One designed slave's PDO entries in this logical datagram", HFILL}},
+                            "One slave's PDO entries in this logical datagram (designed, or identified from its SII)", HFILL}},
         {&hf_wkc_expected, {"Expected working counter", NULL, FT_UINT16, BASE_DEC, NULL, 0x0,
                             "From the ENI's cyclic commands (Cnt), else from the slaves' FMMU configuration", HFILL}},
         {&hf_slave, {"Slave", NULL, FT_NONE, BASE_NONE, NULL, 0x0,
