@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "emit_cpp.h"
 
+#include "quiet.h"
+
 #include "validator.h"
 
 #include <algorithm>
@@ -243,7 +245,8 @@ std::pair<int, int> slot_span(const Node& n) {
 class Emitter {
 public:
     Emitter(const Protocol& p, const std::string& source, const EmbeddedTables* extra)
-        : p_(p), source_(source), extra_(extra), l_(make_layout(p)) {}
+        : p_(p), source_(source), extra_(extra), l_(make_layout(p)),
+          quiet_(quiet_sizes(p, [this](const Node& n) { return is_pairing_key(n); })) {}
     std::string run();
 
 private:
@@ -278,6 +281,7 @@ private:
     std::string source_;
     const EmbeddedTables* extra_;
     Layout l_;
+    std::map<const Node*, uint64_t> quiet_;  // issue 14: nodes stepped over when unseen, and their sizes
     std::ostringstream o_;
 };
 
@@ -417,7 +421,8 @@ void Emitter::node_table() {
         if (n.has_hook) o_ << ", " << l_.hook_range_first.at(&n) << ", " << n.hook_list.size();
         // Members after the ifhook ranges default to none; a node that uses them
         // spells out everything before them.
-        const bool uses_extra = extra_index_.count(&n) > 0, uses_10b = l_.node_uses_10b(n);
+        const bool quiet = quiet_.count(&n) > 0;
+        const bool uses_extra = extra_index_.count(&n) > 0, uses_10b = l_.node_uses_10b(n) || quiet;
         if (!n.has_hook && (uses_extra || uses_10b)) o_ << ", 0, 0";
         // issue 10a: the node's dg_extra
         if (uses_extra)
@@ -429,6 +434,8 @@ void Emitter::node_table() {
             o_ << ",\n      " << (l_.when_first.count(&n) ? l_.when_first.at(&n) : 0) << ", " << n.whens.size() << ", "
                << (n.otherwise ? "DG_ALT_OTHERWISE" : "0") << ", "
                << (l_.window_index.count(&n) ? l_.window_index.at(&n) : -1);
+        // issue 14: the bytes a walk with no tree and no tap steps over
+        if (quiet) o_ << ", " << quiet_.at(&n) << "u";
         o_ << " },\n";
     }
     if (l_.nodes.empty()) o_ << "    { NULL, NULL, NULL, 0, 0, 0, 0, 0, 0, 0, -1, {-1, 0, 0}, {-1, 0, 0}, -1, -1, 0, 0, 0, 0, 0, 0, 0, 0 }\n";

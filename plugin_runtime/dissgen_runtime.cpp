@@ -20,11 +20,13 @@
 
 namespace {
 
+/* A slot's value is valid only while dg_state.present[slot] is set: the
+ * flags are cleared per message and per repeated instance, the slots not
+ * (fewer bytes to clear). */
 struct dg_slot {
     guint64 value;
     gint offset;
     gint length;
-    gboolean present;
     const dg_node *node;
 };
 
@@ -59,10 +61,12 @@ struct dg_state {
     tvbuff_t *tvb;
     packet_info *pinfo;
     dg_slot *slots;
+    guint8 *present;      /* per slot: decoded in this message (instance) */
     gint packet_end;      /* captured bytes */
     gboolean stopped;     /* a malformed spot was reported: decode nothing more */
     gboolean want_text;   /* summaries are shown: a visible tree, or columns */
     gboolean want_info;   /* the Info column is shown (pinfo->cinfo) */
+    gboolean quiet;       /* issue 14: no tree, no tap listener: step over quiet nodes (dg_node.quiet_size) */
     wmem_strbuf_t *info;  /* the Info column being built (want_info) */
     wmem_strbuf_t *text;  /* scratch for one container's summary (want_text) */
     guint64 group_value;  /* the bit group being decoded */
@@ -155,7 +159,7 @@ gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char
                    gint offset, gint64 *out)
 {
     const dg_slot *s = &st->slots[ref->slot];
-    if (!s->present) {
+    if (!st->present[ref->slot]) {
         report(st, tree, &st->p->ei->bad_length, offset, 0, "The %s of '%s' comes from a field that is not in this packet",
                what, n->name);
         return FALSE;
@@ -179,8 +183,8 @@ void store(dg_state *st, const dg_node *n, guint64 value, gint offset, gint leng
     s->value = value;
     s->offset = offset;
     s->length = length;
-    s->present = TRUE;
     s->node = n;
+    st->present[n->slot] = TRUE;
 }
 
 /* Whether store() uses a leaf's value: a later node reads it (slot) or the
@@ -203,7 +207,7 @@ gboolean in_ranges(const dg_protocol *p, guint16 first, guint16 count, guint64 v
 gboolean condition_holds(const dg_state *st, const dg_node *n)
 {
     const dg_slot *s = &st->slots[n->if_slot];
-    return s->present && in_ranges(st->p, n->in_first, n->in_count, s->value);
+    return st->present[n->if_slot] && in_ranges(st->p, n->in_first, n->in_count, s->value);
 }
 
 /* Summary text is built with memcpy appends (wmem_strbuf_append copies with
@@ -352,7 +356,7 @@ gboolean part_decoded(const dg_state *st, guint first, guint count)
         const dg_summary_piece *piece = &st->p->pieces[i];
         if (piece->group)
             i += piece->group;
-        else if (piece->slot >= 0 && !st->slots[piece->slot].present)
+        else if (piece->slot >= 0 && !st->present[piece->slot])
             return FALSE;
     }
     return TRUE;
@@ -377,7 +381,7 @@ gboolean append_pieces(const dg_state *st, wmem_strbuf_t *out, guint first, guin
         } else {
             const dg_slot *s = &st->slots[piece->slot];
             gsize before = wmem_strbuf_get_len(out);
-            if (!s->present) {
+            if (!st->present[piece->slot]) {
                 wmem_strbuf_append_len(out, "-", 1);
                 complete = FALSE;
                 continue;
@@ -483,7 +487,7 @@ void call_handoff(dg_state *st, dissector_handle_t handle, tvbuff_t *tvb, proto_
 gboolean reassembly_value(dg_state *st, const dg_node *n, gint16 slot, proto_tree *tree, gint offset, guint64 *out)
 {
     const dg_slot *s = &st->slots[slot];
-    if (!s->present) {
+    if (!st->present[slot]) {
         proto_tree_add_expert_format(tree, st->pinfo, &st->p->ei->bad_length, st->tvb, offset, 0,
                                      "'%s' cannot be reassembled: a field it needs is not in this packet", n->name);
         return FALSE;
@@ -689,8 +693,8 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
         dg_slot *s = &st->slots[n->slot];
         s->offset = start;
         s->length = *offset - start;
-        s->present = TRUE;
         s->node = n;
+        st->present[n->slot] = TRUE;
     }
     /* The text only when something shows it: the item, or the Info column
      * (a summarised container inside another one only has its item). */
@@ -711,7 +715,7 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
 
 void clear_slots(dg_state *st, const dg_node *n)
 {
-    if (n->slot_count) memset(&st->slots[n->slot_first], 0, n->slot_count * sizeof(dg_slot));
+    if (n->slot_count) memset(&st->present[n->slot_first], 0, n->slot_count);
 }
 
 void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
@@ -750,7 +754,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
         if (st->stopped || *offset == before) break;
         if (n->repeat_slot >= 0) {
             const dg_slot *flag = &st->slots[n->repeat_slot];
-            if (!flag->present || flag->value == 0) break;
+            if (!st->present[n->repeat_slot] || flag->value == 0) break;
             if (*offset >= end) {
                 report(st, tree, &st->p->ei->more_no_data, *offset, 0,
                        "'%s': the repeat flag '%s' says another follows, but no data is left", n->name,
@@ -794,7 +798,7 @@ gboolean peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guin
     for (guint i = 0; i < pk->length_count; i++) {
         const dg_ref *ref = &st->p->peek_lengths[pk->length_first + i];
         const dg_slot *s = &st->slots[ref->slot];
-        if (!s->present) return FALSE;
+        if (!st->present[ref->slot]) return FALSE;
         gint64 v = ref_arith(s, ref);
         if (v < 0) return FALSE;
         at += v;
@@ -817,7 +821,7 @@ gboolean whens_hold(const dg_state *st, const dg_node *n, gint node_start)
             if (!peek_value(st, &st->p->peeks[w->peek], node_start, &value)) return FALSE;
         } else {
             const dg_slot *s = &st->slots[w->slot];
-            if (!s->present) return FALSE;
+            if (!st->present[w->slot]) return FALSE;
             value = s->value;
         }
         if (!in_ranges(st->p, w->in_first, w->in_count, value)) return FALSE;
@@ -830,6 +834,10 @@ gboolean whens_hold(const dg_state *st, const dg_node *n, gint node_start)
  * after it) was decoded; an otherwise node is skipped when one was. */
 gboolean selected(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken)
 {
+    if (!n->alt && !n->hook_count && n->if_slot < 0 && !n->when_count && !n->extra) {
+        *chain_taken = FALSE; /* unconditional: ends any chain */
+        return TRUE;
+    }
     gboolean otherwise = (n->alt & DG_ALT_OTHERWISE) != 0;
     if (otherwise && *chain_taken) return FALSE;
     guint8 direction = n->extra ? n->extra->direction : (guint8)DG_DIR_ANY; /* issue 10a */
@@ -884,6 +892,7 @@ void dissect_place(dg_state *st, const dg_place *pl, proto_tree *tree, gint star
                    gboolean in_summary)
 {
     const dg_node *c = &st->p->nodes[pl->node];
+    if (st->quiet && c->quiet_size && c->quiet_size <= pl->size) return; /* issue 14: unseen, cannot be malformed */
     gboolean no_chain = FALSE;
     if (!selected(st, c, start, &no_chain)) return;
     guint32 i = 0;
@@ -925,7 +934,7 @@ void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offs
 {
     const dg_window *w = &st->p->windows[n->window];
     const dg_slot *s = &st->slots[w->base.slot];
-    if (!s->present) {
+    if (!st->present[w->base.slot]) {
         report(st, tree, &st->p->ei->bad_length, *offset, 0,
                "The base address of '%s' comes from a field that is not in this packet", n->name);
         return;
@@ -973,6 +982,10 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
     for (guint16 i = 0; i < count && !st->stopped; i++) {
         const dg_node *n = &st->p->nodes[st->p->children[first + i]];
         if (!selected(st, n, *offset, &chain_taken)) continue;
+        if (st->quiet && n->quiet_size && (gint64)n->quiet_size <= (gint64)(end - *offset)) {
+            *offset += (gint)n->quiet_size; /* nobody would see it, and it cannot be malformed */
+            continue;
+        }
         if (n->count.slot >= 0 || n->repeat_slot >= 0 || (n->extra && n->extra->repeat_rest))
             dissect_repeated(st, n, tree, offset, end, in_summary);
         else
@@ -1208,7 +1221,8 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     st.p = p;
     st.tvb = tvb;
     st.pinfo = pinfo;
-    st.slots = wmem_alloc0_array(pinfo->pool, dg_slot, p->slot_count ? p->slot_count : 1);
+    st.slots = wmem_alloc_array(pinfo->pool, dg_slot, p->slot_count ? p->slot_count : 1);
+    st.present = (guint8 *)wmem_alloc0(pinfo->pool, p->slot_count ? p->slot_count : 1);
     st.packet_end = (gint)tvb_captured_length(tvb);
     st.hook_value = pinfo->match_uint;
     st.direction = direction_of(pinfo);
@@ -1221,6 +1235,10 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     st.info = st.want_info ? wmem_strbuf_new(pinfo->pool, "") : NULL;
     st.text = st.want_text ? wmem_strbuf_new(pinfo->pool, "") : NULL;
     if (stats_tap >= 0 && have_tap_listener(stats_tap)) st.tap = wmem_new0(pinfo->pool, dg_tap_data);
+    /* issue 14: nobody sees items or expert infos without a tree and without
+     * a tap listener (the Expert dialog and -z expert are taps): quiet nodes
+     * are stepped over, the pairing does its first-pass work only. */
+    st.quiet = tree == NULL && !tap_listeners_require_dissection();
 
     proto_item *root = proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA);
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
@@ -1229,7 +1247,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     proto_item_set_len(root, offset);
     if (p->pairing) {
         const dg_frame_pairing *fp =
-            dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, *messages - 1);
+            dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, *messages - 1, st.quiet);
         if (st.tap) st.tap->pairing = fp;
     }
 

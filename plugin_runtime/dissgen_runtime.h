@@ -168,6 +168,15 @@ typedef struct dg_node {
     guint8 alt;
     gint16 window;
 #endif
+    /* issue 14: > 0 when nothing but the node's own items depends on it
+     * (no value others read, no summary, key or hand-off) and it cannot be
+     * malformed within these many bytes: a walk with no tree and no tap
+     * listener steps over it when they are there. */
+#ifdef __cplusplus
+    guint32 quiet_size = 0;
+#else
+    guint32 quiet_size;
+#endif
 } dg_node;
 
 /* Expert infos every generated protocol registers. */

@@ -73,6 +73,7 @@ TESTS = {
     "pairing": integration("test_pairing.py", "--quick"),
     "pairing_full": integration("test_pairing.py"),
     "malformed_skip": integration("test_malformed_skip.py"),
+    "quiet": integration("test_quiet.py"),
     "differential": integration("ecat_differential.py", "--frames", "2000", "--max-datagrams", "20",
                                 "--malformed", "200"),
 }

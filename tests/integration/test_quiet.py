@@ -1,0 +1,88 @@
+#!/usr/bin/env python3
+"""Issue 14: a walk nobody sees steps over quiet nodes, and nothing shown changes.
+
+With no tree and no tap listener (tshark's summary lines), the EtherCAT and
+EtherNet/IP plugins step over the nodes that feed nothing (generator/quiet.cpp)
+and the pairing does its first-pass work only. A tap listener (here `-z
+io,stat,0`, which shows nothing per packet) turns that off, so the packet lines
+of the two runs must be the same, byte for byte: on generated EtherCAT frames
+of every command with malformed variants (truncated frames, lengths that lie),
+on the shipped samples, and on the corpus captures when ../shared/corpus is
+there; in one pass and with -2.
+
+    test_quiet.py --dissgen build/bin/dissgen --source-dir .
+"""
+import os
+import sys
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pcapgen  # noqa: E402
+from tshark_env import TsharkEnv, run_unittests  # noqa: E402
+
+ARGS = None
+
+
+def corpus_captures(kind):
+    folder = os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus", kind)
+    if not os.path.isdir(folder):
+        return []
+    return [os.path.join(folder, f) for f in sorted(os.listdir(folder)) if f.endswith((".pcap", ".pcapng"))]
+
+
+class QuietWalk(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.env = TsharkEnv()
+        for rules in ("ethercat.xml", "enip.xml"):
+            cls.env.install_plugin(ARGS.dissgen, os.path.join(ARGS.source_dir, "rules", rules))
+        frames = pcapgen.random_frames(14, 3000, max_datagrams=12, m_on_last=40, truncated=80, other_types=20,
+                                       odd_lengths=40)
+        cls.generated = cls.env.add_file("quiet.pcap", pcapgen.pcap_bytes(frames))
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.env.cleanup()
+
+    def packet_lines(self, capture, extra):
+        """The summary lines without and with a tap listener; both runs must agree."""
+        cap = self.env.readable(capture)
+        quiet = self.env.tshark(["-r", cap] + extra).stdout.splitlines()
+        tapped = self.env.tshark(["-r", cap, "-z", "io,stat,0"] + extra).stdout.splitlines()
+        self.assertGreater(len(quiet), 0, capture)
+        self.assertGreater(len(tapped), len(quiet), "the io,stat table follows the packet lines")
+        following = tapped[len(quiet):len(quiet) + 2]
+        self.assertTrue(following[0] == "" and set(following[1]) == {"="}, following)  # the io,stat table
+        return quiet, tapped[:len(quiet)]
+
+    def check(self, capture):
+        for extra in ([], ["-2"]):
+            quiet, tapped = self.packet_lines(capture, extra)
+            for number, (a, b) in enumerate(zip(quiet, tapped), 1):
+                self.assertEqual(a, b, "%s%s: packet line %d differs when nobody sees the tree"
+                                 % (os.path.basename(capture), " -2" if extra else "", number))
+
+    def test_generated_frames_with_malformed_ones(self):
+        self.check(self.generated)
+        lines = self.env.tshark(["-r", self.env.readable(self.generated)]).stdout
+        self.assertIn("ECATR", lines)
+
+    def test_samples(self):
+        samples = os.path.join(os.path.abspath(ARGS.source_dir), "samples")
+        for name in sorted(os.listdir(samples)):
+            if name.endswith((".pcap", ".pcapng")):
+                with self.subTest(capture=name):
+                    self.check(os.path.join(samples, name))
+
+    def test_corpus(self):
+        captures = corpus_captures("ethercat") + corpus_captures("enip")
+        if not captures:
+            self.skipTest("no ../shared/corpus: generated frames and samples only")
+        for path in captures:
+            with self.subTest(capture=os.path.basename(path)):
+                self.check(path)
+
+
+if __name__ == "__main__":
+    ARGS, status = run_unittests()
+    sys.exit(status)
