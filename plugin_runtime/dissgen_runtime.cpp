@@ -834,10 +834,26 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     if (collect) summaries_end(st, n, &summaries);
 }
 
+/* issue 10: whether entry k of offset table t, placed at base, lies in
+ * [low, end]; otherwise reports it (bad_offset), which ends the node. */
+gboolean entry_ok(dg_state *st, const dg_node *n, proto_tree *tree, const dg_table *t, guint k, gint64 base,
+                  gint64 low, gint end, gint first)
+{
+    gint64 at = base + (gint64)MIN(t->values[k], (guint64)G_MAXINT32);
+    if (at >= low && at <= end) return TRUE;
+    report(st, tree, &st->p->ei->bad_offset, first, 0,
+           "'%s' %u of %u: offset %" G_GINT64_MODIFIER "u (byte %" G_GINT64_MODIFIER "d) is %s; "
+           "the instances lie in bytes %d to %d",
+           n->name, k + 1, t->count, t->values[k], at,
+           at > end ? "past the end" : k == 0 ? "before the bytes left" : "smaller than the one before it", first, end);
+    return FALSE;
+}
+
 /* issue 10: offsets="XPATH" from="XPATH". Instance i covers [base +
  * offset[i], base + offset[i+1]), the last one [base + offset[last], end).
  * An offset before the bytes not yet decoded, past the end, or smaller than
- * the one before is reported (bad_offset) and ends the node. */
+ * the one before is reported (bad_offset) and ends the node; the instances
+ * before it are decoded. */
 void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary)
 {
     const dg_extra *x = n->extra;
@@ -871,24 +887,20 @@ void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *off
     dg_summaries summaries = {NULL, 0};
     gboolean collect = summaries_begin(st, n, in_summary, &summaries);
     guint instances = 0;
+    gint first = *offset;
     for (guint i = 0; i < t->count && !st->stopped; i++) {
-        gint64 from = base + (gint64)MIN(t->values[i], (guint64)G_MAXINT32);
-        gint64 to = i + 1 < t->count ? base + (gint64)MIN(t->values[i + 1], (guint64)G_MAXINT32) : end;
-        if (from < *offset || from > end || to < from || to > end) {
-            report(st, tree, &st->p->ei->bad_offset, *offset, 0,
-                   "'%s' %u of %u: offset %" G_GINT64_MODIFIER "u (byte %" G_GINT64_MODIFIER "d) %s; "
-                   "the instances lie in bytes %d to %d",
-                   n->name, i + 1, t->count, t->values[i], from,
-                   from < *offset || from > end ? "is out of range"
-                                                : to < from ? "is after the next offset" : "is followed by one out of range",
-                   *offset, end);
-            break;
+        if (i == 0 && !entry_ok(st, n, tree, t, 0, base, first, end, first)) break;
+        gint64 from = base + (gint64)t->values[i]; /* checked: inside [first, end] */
+        gint to = end;
+        if (i + 1 < t->count) {
+            if (!entry_ok(st, n, tree, t, i + 1, base, from, end, first)) break;
+            to = (gint)(base + (gint64)t->values[i + 1]);
         }
         gint at = (gint)from;
         clear_slots(st, n);
-        dissect_instance(st, n, tree, &at, (gint)to, in_summary, collect ? &summaries : NULL);
+        dissect_instance(st, n, tree, &at, to, in_summary, collect ? &summaries : NULL);
         instances++;
-        if (!st->stopped) *offset = (gint)to;
+        if (!st->stopped) *offset = to;
     }
     if (st->tap) tap_record(st, n, instances);
     if (collect) summaries_end(st, n, &summaries);
