@@ -531,6 +531,7 @@ void Emitter::register_functions() {
         {"count_short", "PI_MALFORMED", "PI_WARN", "Fewer instances than the count field says"},
         {"bad_length", "PI_MALFORMED", "PI_ERROR", "A length or count is missing or negative"},
         {"unused", "PI_PROTOCOL", "PI_WARN", "A length says more bytes than its fields hold"},
+        {"bad_offset", "PI_MALFORMED", "PI_ERROR", "An offset table entry is out of order or out of range"},
     };
     const size_t expert_count = sizeof experts / sizeof experts[0];
     for (size_t i = 0; i < expert_count; ++i)
@@ -579,7 +580,8 @@ void Emitter::range_strings(const Node& n) {
 bool needs_extra(const Node& n) {
     return (n.is_leaf() && (n.display == Display::String || n.display == Display::StringZ ||
                             n.display == Display::Time)) ||
-           n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles();
+           n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
+           n.keeps_values;
 }
 
 void Emitter::extra_table() {
@@ -592,7 +594,11 @@ void Emitter::extra_table() {
     if (with.empty()) return;
     auto slot = [](const std::optional<FieldRef>& r) { return r && r->target ? r->target->slot : -1; };
     o_ << "/* What few nodes need beyond dg_node. Columns: encoding, units per second, repeat=\"rest\", direction,\n"
-       << " * dissector, reassembly (id slot, offset ref, number slot, last-flag slot, more-flag slot). */\n"
+       << " * dissector, reassembly (id slot, offset ref, number slot, last-flag slot, more-flag slot)"
+       << (std::any_of(with.begin(), with.end(), [](const Node* n) { return n->is_located() || n->keeps_values; })
+               ? ",\n * and where offset tables are used: offsets slot, from slot, from levels up, values kept"
+               : "")
+       << ". */\n"
        << "static const dg_extra " << p_.filter << "_extra[] = {\n";
     for (const Node* n : with) {
         const char* units = n->unit == "s" ? "1" : n->unit == "ms" ? "1000" : n->unit == "us" ? "1000000" : "1000000000";
@@ -603,7 +609,12 @@ void Emitter::extra_table() {
            << (n->repeat_rest ? 1 : 0) << ", " << dir << ", " << (n->dissector ? c_string(*n->dissector) : "NULL")
            << ", " << slot(n->reassemble_id) << ", "
            << ref_of(n->reassemble_offset ? &*n->reassemble_offset : nullptr) << ", " << slot(n->reassemble_seq)
-           << ", " << slot(n->reassemble_last) << ", " << slot(n->reassemble_more) << " },\n";
+           << ", " << slot(n->reassemble_last) << ", " << slot(n->reassemble_more);
+        // issue 10: offset tables (the struct defaults them to none)
+        if (n->is_located() || n->keeps_values)
+            o_ << ", " << slot(n->offsets) << ", " << (n->from_up ? -1 : slot(n->from)) << ", " << n->from_up << ", "
+               << (n->keeps_values ? 1 : 0);
+        o_ << " },\n";
     }
     o_ << "};\n\n";
 }

@@ -148,10 +148,19 @@ struct Node {
     // derived by the validator
     uint64_t place_bytes = 0;               // a window child's fixed size
     bool is_window() const { return base.has_value(); }
+    // --- issue 10: offset tables ---
+    // offsets="XPATH" from="XPATH": instance i starts offset[i] bytes after the
+    // start of `from` and ends where instance i+1 starts (the last one: at the
+    // end of the enclosing container). offsets selects a repeated numeric leaf.
+    std::optional<FieldRef> offsets, from;
+    // derived by the validator
+    bool keeps_values = false;              // an offsets table: every instance's value is kept
+    unsigned from_up = 0;                   // from an enclosing container: k levels up (0: an earlier field)
+    bool is_located() const { return offsets.has_value(); }
 
     bool is_container() const { return !children.empty(); }
     bool is_leaf() const { return children.empty(); }
-    bool is_repeated() const { return repeat.has_value() || count.has_value() || repeat_rest; }
+    bool is_repeated() const { return repeat.has_value() || count.has_value() || repeat_rest || offsets.has_value(); }
     // Decoded only under a condition (if/in or ifhook): may take no bytes.
     bool is_conditional() const {
         return if_field.has_value() || has_hook || direction != Direction::Any || !whens.empty() || otherwise;

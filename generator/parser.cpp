@@ -36,7 +36,9 @@ const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displa
                                                   "reassemble-more",
                                                   // issue 10b
                                                   "otherwise", "base", "at", "stride", "instances",
-                                                  "malformed"};
+                                                  "malformed",
+                                                  // issue 10: offset tables
+                                                  "offsets", "from"};
 const std::vector<std::string> kEnumAttributes = {"value", "name"};
 const std::vector<std::string> kHookAttributes = {"table", "value"};
 const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};  // issue 10b
@@ -503,6 +505,8 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
     }
     for (When& w : node->whens) defer(w.ref, el, w.line, w.peek ? "peek" : "field");
     if (node->base) defer(*node->base, el, node->line, "base");
+    if (node->offsets) defer(*node->offsets, el, node->line, "offsets");
+    if (node->from) defer(*node->from, el, node->line, "from");
     if (node->repeat) defer(*node->repeat, el, node->line, "repeat");
     if (node->count) defer(*node->count, el, node->line, "count");
     if (node->if_field) defer(*node->if_field, el, node->line, "if");
@@ -571,6 +575,8 @@ void Parser::parse_layout_attributes(std::map<std::string, std::string>& attrs, 
                                         "(the rest of this container is skipped, decoding goes on after it)");
     }
     if (attrs.count("base")) node.base = make_ref(attrs["base"], node.line, "base", true);
+    if (attrs.count("offsets")) node.offsets = make_ref(attrs["offsets"], node.line, "offsets", false);
+    if (attrs.count("from")) node.from = make_ref(attrs["from"], node.line, "from", false);
     auto number = [&](const char* name, uint64_t max, std::optional<uint64_t>& out) {
         if (!attrs.count(name)) return;
         uint64_t v = 0;

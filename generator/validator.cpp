@@ -60,6 +60,7 @@ private:
     // issue 10b
     void check_layout(Node& n);
     void check_peek(Node& n, When& w);
+    void check_offsets(Node& n);  // issue 10: offset tables
     bool known_before(const Node* t, const Node& n) const;
 
     Protocol& proto_;
@@ -82,6 +83,7 @@ void Validator::run() {
         if (n.summary) parse_summary(n);
         check_10a(n);
         check_layout(n);  // issue 10b
+        check_offsets(n);
     });
     check_pdulength();
     check_pairing();
@@ -705,6 +707,63 @@ void Validator::check_layout(Node& n) {
                              "children that all have one)");
     else
         n.place_bytes = *size;
+}
+
+// issue 10: offsets="XPATH" from="XPATH". The offsets are the values of every
+// instance of an earlier repeated numeric leaf; from is an earlier field or
+// container (its first byte) or a container around n (the start of its
+// content). Each instance runs to the next offset, the last to the end of its
+// container, so n's own length is "rest".
+void Validator::check_offsets(Node& n) {
+    if (!n.offsets && !n.from) return;
+    if (!n.offsets || !n.from) {
+        diags_.error(n.line, n.offsets ? "'offsets' on " + quote(n) + " needs 'from': the field or container the "
+                                         "offsets are counted from"
+                                       : "'from' on " + quote(n) + " needs 'offsets': the repeated field whose "
+                                         "values place the instances");
+        return;
+    }
+    if (n.repeat || n.count || n.repeat_rest)
+        diags_.error(n.line, "node " + quote(n) + " has 'offsets' and 'repeat' or 'count'; the offset table already "
+                             "says how many instances there are: use one of them");
+    if (n.length_kind != LengthKind::Rest)
+        diags_.error(n.line, "node " + quote(n) + " with 'offsets' needs length=\"rest\": each instance runs to "
+                             "where the next offset points, the last one to the end of its container");
+    if (const Node* t = n.offsets->target) {
+        const std::string field = "offsets field " + quote(*t) + at_line(*t);
+        const Node* outside = nullptr;  // a repeated container around t but not around n
+        for (const Node* r = t->parent; r && !outside; r = r->parent)
+            if (r->is_repeated() && !is_ancestor_or_self(r, &n)) outside = r;
+        if (!t->is_numeric())
+            diags_.error(n.line, field + " is not numeric: it must be a leaf of 1-64 bits shown as numberhex, "
+                                         "numberdec, bool, enum or nondisplay");
+        else if (!t->count && !t->repeat && !t->repeat_rest)
+            diags_.error(n.line, field + " is not repeated: it must have 'count' (or 'repeat'), one offset per "
+                                         "instance of " + quote(n));
+        else if (t->doc_index >= n.doc_index)
+            diags_.error(n.line, field + " is not decoded before " + quote(n) + "; it must come earlier in the file");
+        else if (outside)
+            diags_.error(n.line, field + " is inside repeated node " + lines_of(*outside) + ", which does not contain " +
+                                     quote(n) + "; use a table of the same instance or one outside every repeat");
+        else {
+            mark_slot(const_cast<Node*>(t));
+            const_cast<Node*>(t)->keeps_values = true;
+        }
+    }
+    if (const Node* f = n.from->target) {
+        const std::string field = "from " + quote(*f) + at_line(*f);
+        if (f == &n) {
+            diags_.error(n.line, field + " is the node itself; use the container around it or an earlier field");
+        } else if (is_ancestor_or_self(f, &n)) {
+            n.from_up = 0;
+            for (const Node* a = &n; a != f; a = a->parent) n.from_up++;
+        } else if (!known_before(f, n)) {
+            diags_.error(n.line, field + " is not decoded before " + quote(n) + " in the same instance; it must be an "
+                                         "earlier field or container, or a container around " + quote(n));
+        } else {
+            mark_slot(const_cast<Node*>(f));
+        }
+    }
 }
 
 // Whether the value of t is known when n starts: decoded earlier, in the same

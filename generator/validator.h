@@ -26,7 +26,7 @@ std::string name_without_index(const std::string& name);
 // Every generated protocol registers these expert infos as P.expert.NAME
 // (emit_cpp.cpp), so no field may take those filter names.
 constexpr const char* kExpertNames[] = {"truncated", "past_end", "more_no_data", "count_short", "bad_length",
-                                        "unused"};
+                                        "unused", "bad_offset"};
 // issue 10a: a protocol that reassembles registers these fields as P.NAME
 // (emit_cpp.cpp; the fragment_items of Wireshark's reassembly API).
 constexpr const char* kFragmentNames[] = {"fragments",        "fragment",

@@ -48,6 +48,14 @@ struct dg_tap_data {
 const dg_protocol *stats_protocol;
 int stats_tap = -1;
 
+/* issue 10: every value of an offset leaf (extra->keep_values) in this
+ * message, in instance order; reset when its repetition starts. */
+struct dg_table {
+    guint64 *values;
+    guint count, capacity;
+    gboolean overflow; /* more than DG_MAX_TABLE instances */
+};
+
 /* Summaries of one repeated node's instances, gathered for the Info column. */
 struct dg_summaries {
     wmem_strbuf_t *text;
@@ -62,6 +70,7 @@ struct dg_state {
     packet_info *pinfo;
     dg_slot *slots;
     guint8 *present;      /* per slot: decoded in this message (instance) */
+    dg_table *tables;     /* issue 10: per slot, allocated at the first offset leaf */
     gint packet_end;      /* captured bytes */
     gboolean stopped;     /* a malformed spot was reported: decode nothing more */
     gboolean want_text;   /* summaries are shown: a visible tree, or columns */
@@ -174,11 +183,48 @@ gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char
     return TRUE;
 }
 
+/* issue 10: the table of the offset leaf in `slot`, allocated on first use. */
+dg_table *table_of(dg_state *st, gint16 slot)
+{
+    if (!st->tables) st->tables = wmem_alloc0_array(st->pinfo->pool, dg_table, st->p->slot_count);
+    return &st->tables[slot];
+}
+
+void table_append(dg_state *st, const dg_node *n, guint64 value)
+{
+    dg_table *t = table_of(st, n->slot);
+    if (t->count == DG_MAX_TABLE) {
+        t->overflow = TRUE;
+        return;
+    }
+    if (t->count == t->capacity) {
+        t->capacity = t->capacity ? MIN(2 * t->capacity, (guint)DG_MAX_TABLE) : 16;
+        t->values = (guint64 *)wmem_realloc(st->pinfo->pool, t->values, t->capacity * sizeof(guint64));
+    }
+    t->values[t->count++] = value;
+}
+
+/* issue 10: an offset leaf's repetition starts a new, empty table; the slot
+ * says it is there, even when no instance follows (a count of 0). */
+void table_reset(dg_state *st, const dg_node *n, gint offset)
+{
+    dg_table *t = table_of(st, n->slot);
+    t->count = 0;
+    t->overflow = FALSE;
+    dg_slot *s = &st->slots[n->slot];
+    s->value = 0;
+    s->offset = offset;
+    s->length = 0;
+    s->node = n;
+    st->present[n->slot] = TRUE;
+}
+
 void store(dg_state *st, const dg_node *n, guint64 value, gint offset, gint length)
 {
     if (st->tap && n->show == DG_SHOW_ENUM) tap_record(st, n, value);
     if (n->flags & DG_KEY) key_append(st, value);
     if (n->slot < 0) return;
+    if (n->extra && n->extra->keep_values) table_append(st, n, value);
     dg_slot *s = &st->slots[n->slot];
     s->value = value;
     s->offset = offset;
@@ -727,15 +773,39 @@ void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
         dissect_container(st, n, tree, offset, end, in_summary, sink);
 }
 
+/* Info column text of a repeated node's summarised instances: gathered in
+ * *s while they are decoded (when summaries_begin says so), then added. */
+gboolean summaries_begin(const dg_state *st, const dg_node *n, gboolean in_summary, dg_summaries *s)
+{
+    if (in_summary || n->summary_count == 0 || !st->want_info) return FALSE;
+    s->text = wmem_strbuf_new(st->pinfo->pool, "");
+    return TRUE;
+}
+
+void summaries_end(dg_state *st, const dg_node *n, const dg_summaries *s)
+{
+    if (s->count > 1) {
+        /* "NAME ×COUNT: SUMMARY, SUMMARY, ..." */
+        if (wmem_strbuf_get_len(st->info) > 0) wmem_strbuf_append_len(st->info, ", ", 2);
+        append_str(st->info, n->name);
+        wmem_strbuf_append_len(st->info, " \xc3\x97", 3);
+        append_dec(st->info, s->count);
+        wmem_strbuf_append_len(st->info, ": ", 2);
+        wmem_strbuf_append_len(st->info, wmem_strbuf_get_str(s->text), wmem_strbuf_get_len(s->text));
+    } else if (s->count == 1) {
+        info_append(st, wmem_strbuf_get_str(s->text), wmem_strbuf_get_len(s->text));
+    }
+}
+
 /* repeat: another instance while the flag is set; count: exactly N. Every
  * instance must consume bytes, which bounds the loop by the packet size. */
 void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary)
 {
     gint64 wanted = -1;
     if (n->count.slot >= 0 && !ref_value(st, &n->count, n, "count", tree, *offset, &wanted)) return;
+    if (n->extra && n->extra->keep_values) table_reset(st, n, *offset); /* issue 10 */
     dg_summaries summaries = {NULL, 0};
-    gboolean collect = !in_summary && n->summary_count > 0 && st->want_info;
-    if (collect) summaries.text = wmem_strbuf_new(st->pinfo->pool, "");
+    gboolean collect = summaries_begin(st, n, in_summary, &summaries);
 
     guint instances = 0;
     for (gint64 done = 0; wanted < 0 || done < wanted; done++) {
@@ -765,17 +835,85 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
         }
     }
     if (st->tap) tap_record(st, n, instances);
-    if (collect && summaries.count > 1) {
-        /* "NAME ×COUNT: SUMMARY, SUMMARY, ..." */
-        if (wmem_strbuf_get_len(st->info) > 0) wmem_strbuf_append_len(st->info, ", ", 2);
-        append_str(st->info, n->name);
-        wmem_strbuf_append_len(st->info, " \xc3\x97", 3);
-        append_dec(st->info, summaries.count);
-        wmem_strbuf_append_len(st->info, ": ", 2);
-        wmem_strbuf_append_len(st->info, wmem_strbuf_get_str(summaries.text), wmem_strbuf_get_len(summaries.text));
-    } else if (collect && summaries.count == 1) {
-        info_append(st, wmem_strbuf_get_str(summaries.text), wmem_strbuf_get_len(summaries.text));
+    if (collect) summaries_end(st, n, &summaries);
+}
+
+/* issue 10: whether entry k of offset table t, placed at base, lies in
+ * [low, end]; otherwise reports it (bad_offset), which ends the node. */
+gboolean entry_ok(dg_state *st, const dg_node *n, proto_tree *tree, const dg_table *t, guint k, gint64 base,
+                  gint64 low, gint end, gint first)
+{
+    gint64 at = base + (gint64)MIN(t->values[k], (guint64)G_MAXINT32);
+    if (at >= low && at <= end) return TRUE;
+    report(st, tree, &st->p->ei->bad_offset, first, 0,
+           "'%s' %u of %u: offset %" G_GINT64_MODIFIER "u (byte %" G_GINT64_MODIFIER "d) is %s; "
+           "the instances lie in bytes %d to %d",
+           n->name, k + 1, t->count, t->values[k], at,
+           at > end ? "past the end" : k == 0 ? "before the bytes left" : "smaller than the one before it", first, end);
+    return FALSE;
+}
+
+/* issue 10: offsets="XPATH" from="XPATH". Instance i covers [base +
+ * offset[i], base + offset[i+1]), the last one [base + offset[last], end).
+ * An offset before the bytes not yet decoded, past the end, or smaller than
+ * the one before is reported (bad_offset) and ends the node; the instances
+ * before it are decoded. */
+void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary)
+{
+    const dg_extra *x = n->extra;
+    const dg_slot *ts = &st->slots[x->offsets_slot];
+    if (!st->present[x->offsets_slot]) {
+        report(st, tree, &st->p->ei->bad_length, *offset, 0,
+               "The offsets of '%s' come from a field that is not in this packet", n->name);
+        return;
     }
+    const dg_table *t = table_of(st, x->offsets_slot);
+    gint64 base;
+    if (x->from_slot >= 0) {
+        const dg_slot *fs = &st->slots[x->from_slot];
+        if (!st->present[x->from_slot]) {
+            report(st, tree, &st->p->ei->bad_length, *offset, 0,
+                   "The offsets of '%s' count from a field that is not in this packet", n->name);
+            return;
+        }
+        base = fs->offset;
+    } else if (x->from_up <= st->lists && st->lists - x->from_up < DG_MAX_LISTS) {
+        base = st->list_starts[st->lists - x->from_up];
+    } else {
+        base = 0; /* nested deeper than the lists kept: from the message */
+    }
+    if (t->overflow) {
+        report(st, tree, &st->p->ei->bad_offset, ts->offset, ts->length,
+               "The offset table '%s' has more than %u entries; '%s' is not decoded", ts->node->name,
+               (guint)DG_MAX_TABLE, n->name);
+        return;
+    }
+    dg_summaries summaries = {NULL, 0};
+    gboolean collect = summaries_begin(st, n, in_summary, &summaries);
+    guint instances = 0;
+    gint first = *offset;
+    for (guint i = 0; i < t->count && !st->stopped; i++) {
+        if (i == 0 && !entry_ok(st, n, tree, t, 0, base, first, end, first)) break;
+        gint64 from = base + (gint64)t->values[i]; /* checked: inside [first, end] */
+        gint to = end;
+        if (i + 1 < t->count) {
+            if (!entry_ok(st, n, tree, t, i + 1, base, from, end, first)) break;
+            to = (gint)(base + (gint64)t->values[i + 1]);
+        }
+        gint at = (gint)from;
+        clear_slots(st, n);
+        dissect_instance(st, n, tree, &at, to, in_summary, collect ? &summaries : NULL);
+        instances++;
+        if (!st->stopped) *offset = to;
+    }
+    if (st->tap) tap_record(st, n, instances);
+    if (collect) summaries_end(st, n, &summaries);
+}
+
+gboolean is_repeated(const dg_node *n)
+{
+    return n->count.slot >= 0 || n->repeat_slot >= 0 ||
+           (n->extra && (n->extra->repeat_rest || n->extra->offsets_slot >= 0));
 }
 
 gboolean hook_holds(const dg_state *st, const dg_node *n)
@@ -986,7 +1124,9 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
             *offset += (gint)n->quiet_size; /* nobody would see it, and it cannot be malformed */
             continue;
         }
-        if (n->count.slot >= 0 || n->repeat_slot >= 0 || (n->extra && n->extra->repeat_rest))
+        if (n->extra && n->extra->offsets_slot >= 0)
+            dissect_located(st, n, tree, offset, end, in_summary); /* issue 10 */
+        else if (n->count.slot >= 0 || n->repeat_slot >= 0 || (n->extra && n->extra->repeat_rest))
             dissect_repeated(st, n, tree, offset, end, in_summary);
         else
             dissect_instance(st, n, tree, offset, end, in_summary, NULL);
@@ -1050,7 +1190,7 @@ void stats_init(stats_tree *st)
     for (guint i = 0; i < n_nodes; i++) {
         const dg_node *n = &p->nodes[i];
         const char *what = NULL;
-        if (n->count.slot >= 0 || n->repeat_slot >= 0 || (n->extra && n->extra->repeat_rest)) what = " per message";
+        if (is_repeated(n)) what = " per message";
         else if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM) what = "";
         if (!what) continue;
         stats_node_names[i] = (char *)stats_node_name(n, what);
@@ -1070,8 +1210,7 @@ tap_packet_status stats_packet(stats_tree *st, packet_info *pinfo, epan_dissect_
         const dg_node *n = &p->nodes[r->node];
         if (!stats_node_ids[r->node]) continue;
         const char *label = NULL;
-        if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM && n->count.slot < 0 && n->repeat_slot < 0 &&
-            !(n->extra && n->extra->repeat_rest)) {
+        if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM && !is_repeated(n)) {
             header_field_info *hfi = proto_registrar_get_nth(*n->hf);
             label = enum_name(hfi, r->value);
             if (!label) {

@@ -79,7 +79,27 @@ typedef struct dg_extra {
     gint16 reassemble_seq;    /* slot of the fragment number, or -1 */
     gint16 reassemble_last;   /* slot of the "last fragment" flag, or -1 */
     gint16 reassemble_more;   /* slot of the "more fragments" flag, or -1 */
+    /* issue 10: offsets="XPATH" from="XPATH". Instance i of the node starts
+     * offset[i] bytes after the base and ends where instance i+1 starts (the
+     * last: at the end of its container). The base is the first byte of the
+     * field in from_slot, or (from_slot -1) the start of the from_up-th
+     * enclosing container's content. Generated code gives them only for the
+     * nodes that use them. */
+#ifdef __cplusplus
+    gint16 offsets_slot = -1; /* slot of the repeated offset leaf; -1: not placed by a table */
+    gint16 from_slot = -1;
+    guint8 from_up = 0;
+    guint8 keep_values = 0;   /* an offset leaf: the value of every instance is kept (up to DG_MAX_TABLE) */
+#else
+    gint16 offsets_slot;
+    gint16 from_slot;
+    guint8 from_up;
+    guint8 keep_values;
+#endif
 } dg_extra;
+
+/* issue 10: the most entries an offset table may have; longer ones are malformed. */
+#define DG_MAX_TABLE 1024
 /* issue 10b: <when> conditions, otherwise, windows (register maps). */
 enum dg_alt_flags {
     DG_ALT_OTHERWISE = 1 << 0  /* otherwise="true": only when no earlier member of its chain was decoded */
@@ -187,6 +207,7 @@ typedef struct dg_experts {
     expert_field count_short;  /* count says more instances than the data holds */
     expert_field bad_length;   /* negative or missing length / count */
     expert_field unused;       /* a known-length container's fields end before it does */
+    expert_field bad_offset;   /* issue 10: an offset table entry out of order or out of range */
 } dg_experts;
 
 typedef struct dg_hook {

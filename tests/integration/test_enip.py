@@ -14,9 +14,9 @@
   <source-dir>/../shared/corpus/enip (read in place): every encapsulation header field,
   item count, CPF type id and length, connection ids and sequence numbers, socket addresses
   and ListIdentity product names, CIP service, request/response bit, request path size and
-  class; a Multiple Service Packet's count, offsets and services' bytes; Unconnected Send
-  (cipcm: priority/tick, time-out ticks, message size, the embedded request's header, route
-  path size, ports and link addresses), Forward Open and Forward Close requests and
+  class; a Multiple Service Packet's count, offsets, where each embedded service lies, its
+  service code and class; Unconnected Send (cipcm: priority/tick, time-out ticks, message
+  size, the embedded request's header, route path size, ports and link addresses), Forward Open and Forward Close requests and
   successful replies (every cipcm field of theirs), message by message, frame by frame;
 - Unconnected Send with odd (padded) and even messages and an extended link address,
   0x52 to a tag (not Unconnected Send), Multiple Service Packet requests and replies (an
@@ -231,7 +231,7 @@ WS_FIELDS = ("enip.command|enip.length|enip.session|enip.status|enip.context|eni
 LINE = re.compile(rb'^( *)<(?:(packet)>|proto name="([^"]+)"|field name="((?:' +
                   WS_FIELDS.replace(".", r"\.").encode() +
                   rb')|enipr\.[a-z0-9_.]+|(?=" show="Service Packet #))"([^\n]*))', re.M)
-ATTR = re.compile(rb'(show|value|size)="([^"]*)"')
+ATTR = re.compile(rb'(show|value|size|pos)="([^"]*)"')
 
 # Our field -> the record key it fills (Wireshark's names map to the same keys below).
 OURS = {
@@ -260,7 +260,8 @@ SCALARS = ("command", "length", "session", "status", "context", "options", "item
 LISTS = ("typeid", "itemlength", "connid", "seqnum", "seqcount", "sinfamily", "sinport", "sinaddr", "name", "cip")
 
 # One CIP message: what is compared, slot by slot. msp_offsets is a tuple (one value per offset),
-# msp_services the services' bytes in hex; cm_* are the Connection Manager's priority/tick and
+# msp_services where each service lies in the frame ((first byte, length) each), msp_sc the embedded services' codes and msp_class
+# their classes (a tuple each, the class where the first path segment is an 8-bit class); cm_* are the Connection Manager's priority/tick and
 # time-out ticks (Unconnected Send, Forward Open and Close), ucs_* the rest of an Unconnected
 # Send request and the message it carries, fo_* a Forward Open or Close request or its successful
 # reply (times in us; the connection parameters as tuples, O->T then T->O).
@@ -268,6 +269,7 @@ FO_SCALARS = ("ot_connid", "to_connid", "conn_serial", "vendor", "orig_serial", 
               "to_rpi", "path_size", "ot_api", "to_api", "app_reply_size", "class", "trigger", "direction")
 FO_PARAMS = ("size", "variable", "priority", "type", "owner")
 CIP_SLOTS = ("service", "rr", "pathsize", "segment", "class", "msp_count", "msp_offsets", "msp_services",
+             "msp_sc", "msp_class",
              "cm_priority", "cm_tick_time", "cm_timeout_ticks", "ucs_msg_size", "ucs_route_size",
              "ucs_service", "ucs_rr", "ucs_pathsize", "ucs_ports", "ucs_links") + \
     tuple("fo_" + k for k in FO_SCALARS + FO_PARAMS)
@@ -320,6 +322,11 @@ def new_cip():
     return dict.fromkeys(CIP_SLOTS)
 
 
+def span(attrs):
+    """Where an item lies in the frame: (first byte, length)."""
+    return number(attrs["pos"]), number(attrs["size"])
+
+
 def number(text):
     return int(text, 0)
 
@@ -360,13 +367,15 @@ def pdml_packets(env, capture_path, extra=()):
 def wireshark_messages(packet):
     """Messages of Wireshark's enip (one top-level enip proto each) and, attached to the
     message before, each top-level cip proto: its service, request path size, first path
-    segment (and class), a Multiple Service Packet's count, offsets and services' bytes, and
-    for an Unconnected Send request the cipcm fields and the embedded request's header
+    segment (and class), a Multiple Service Packet's count, offsets, where each embedded
+    service lies, its code and class, and for an Unconnected Send request the cipcm fields and the embedded request's header
     (the services inside a Multiple Service Packet and cipcm's copies are left out)."""
     out, msg, cip, where, top = [], None, None, None, None
     delay = None
     segments = 0            # path segments seen in the current top-level cip
     in_services = False     # past the offset list of a Multiple Service Packet
+    msp_segments = 0        # path segments seen in the current embedded service
+    msp_first_segment = None
     cm = None               # in cipcm: "ucs" (Unconnected Send request), "fo" (Forward Open, or its
                             # successful reply)
     genstat = None          # of the current top-level cip
@@ -389,6 +398,8 @@ def wireshark_messages(packet):
                     cip = None
             elif where == "cipcm" and cm == "ucs" and name == "cip":
                 where = "embedded"      # the request an Unconnected Send carries
+            elif top == "cip" and in_services and indent == 8 and name == "cip":
+                where, msp_segments = "msp", 0      # a service of a Multiple Service Packet
             elif where != "enip":
                 where = "nested"
             continue
@@ -396,7 +407,7 @@ def wireshark_messages(packet):
             # "Service Packet #n", at the top level of a Multiple Service Packet (not inside one)
             if top == "cip" and indent == 6 and cip is not None:
                 in_services = True
-                cip["msp_services"] = (cip["msp_services"] or "") + attrs.get("value", "")
+                cip["msp_services"] = (cip["msp_services"] or ()) + (span(attrs),)
             continue
         if attrs.get("size") == "0":
             continue            # generated, e.g. a response's request path size copied from its request
@@ -448,6 +459,15 @@ def wireshark_messages(packet):
             elif (cm == "ucs" and name in THEIR_HOPS) or (cm == "fo" and name in THEIR_FO_PARAMS):
                 slot = THEIR_HOPS.get(name) or THEIR_FO_PARAMS[name]
                 cip[slot] = (cip[slot] or ()) + (number(attrs["show"]),)
+        elif where == "msp" and cip is not None:
+            if name == "cip.sc":
+                cip["msp_sc"] = (cip["msp_sc"] or ()) + (number(attrs["show"]),)
+            elif name == "cip.path_segment":
+                msp_segments += 1
+                if msp_segments == 1:
+                    msp_first_segment = number(attrs["show"])
+            elif name == "cip.class" and msp_segments == 1 and msp_first_segment == 0x20:
+                cip["msp_class"] = (cip["msp_class"] or ()) + (number(attrs["show"]),)
         elif where == "embedded" and cip is not None:
             slot = {"cip.sc": "ucs_service", "cip.rr": "ucs_rr", "cip.request_path_size": "ucs_pathsize"}.get(name)
             if slot is not None and cip[slot] is None:
@@ -480,8 +500,12 @@ def our_messages(packet):
             elif field in OUR_TUPLES:
                 slot = OUR_TUPLES[field]
                 cip[slot] = (cip[slot] or ()) + (number(attrs["show"]),)
-            elif field in ("msp.services", "msp_reply.services"):
-                cip["msp_services"] = attrs.get("value", "")
+            elif field in ("msp.request", "msp_reply.reply"):
+                cip["msp_services"] = (cip["msp_services"] or ()) + (span(attrs),)
+            elif field in ("msp.request.service", "msp_reply.reply.service"):
+                cip["msp_sc"] = (cip["msp_sc"] or ()) + (number(attrs["show"]),)
+            elif field == "msp.request.path.class":
+                cip["msp_class"] = (cip["msp_class"] or ()) + (number(attrs["show"]),)
         elif name == "enipr.context":
             msg["context"] = attrs.get("value", "")
         elif name in OURS:
@@ -530,6 +554,17 @@ def compare_messages(theirs, ours):
     return compared, agreeing, diffs
 
 
+def count_embedded(s, theirs, ours):
+    """Adds to s the embedded services' codes and classes Wireshark shows (msp_sc, msp_class)
+    and how many of ours agree, position by position."""
+    for t, o in zip(theirs, ours):
+        for tc, oc in zip(t["cip"], o["cip"]):
+            for slot in ("msp_sc", "msp_class"):
+                a, b = tc[slot] or (), oc[slot] or ()
+                s[slot] += len(a)
+                s[slot + "_agree"] += sum(1 for x, y in zip(a, b) if x == y)
+
+
 def differential(capture_path):
     """Per-frame comparison of one capture; returns a summary dict."""
     theirs = [wireshark_messages(p) for p in pdml_packets(BARE, capture_path)]
@@ -540,7 +575,8 @@ def differential(capture_path):
     if len(theirs) != len(ours):
         raise AssertionError("%s: %d frames for Wireshark, %d with the rules" % (capture_path, len(theirs), len(ours)))
     s = {"frames": len(ours), "enip_frames": 0, "messages_ws": 0, "messages_ours": 0,
-         "fields": 0, "agree": 0, "frames_differ": [], "experts": experts}
+         "fields": 0, "agree": 0, "frames_differ": [], "experts": experts,
+         "msp_sc": 0, "msp_sc_agree": 0, "msp_class": 0, "msp_class_agree": 0}
     for number_, (t, o) in enumerate(zip(theirs, ours), 1):
         if not t and not o:
             continue
@@ -548,6 +584,7 @@ def differential(capture_path):
         s["messages_ws"] += len(t)
         s["messages_ours"] += len(o)
         compared, agreeing, diffs = compare_messages(t, o)
+        count_embedded(s, t, o)
         s["fields"] += compared
         s["agree"] += agreeing
         if diffs:
@@ -827,18 +864,20 @@ class Services(unittest.TestCase):
         cap = capture("msp.pcap", [flow.segment(MSP_REQUEST), back.segment(MSP_REPLY),
                                    back.segment(MSP_ERROR_REPLY)])
         names = [self.P + "service", self.P + "rr", self.P + "genstat", self.P + "msp.count", self.P + "msp.offset",
-                 self.P + "msp.services", self.P + "msp_reply.count", self.P + "msp_reply.offset",
-                 self.P + "msp_reply.services", self.P + "data", "_ws.expert"]
+                 self.P + "msp.request.service", self.P + "msp.request.path.class", self.P + "msp.request.data",
+                 self.P + "msp_reply.count", self.P + "msp_reply.offset", self.P + "msp_reply.reply.service",
+                 self.P + "msp_reply.reply.genstat", self.P + "msp_reply.reply.data", self.P + "data", "_ws.expert"]
         rows = fields(ENV, cap, names)
-        hexed = lambda b: " ".join("%02x" % c for c in b)   # noqa: E731
+        # each embedded request: its service, class and data (the second one's three words)
         self.assertEqual([rows[0][n] for n in names],
-                         ["0x0a", "0x00", "", "2", "6,14", hexed(b"".join(MSP_SERVICES)), "", "", "", "", ""])
-        reply_services = cip_response(0x0E, data=b"\x01\x00") + cip_response(0x03, 0x05)
+                         ["0x0a", "0x00", "", "2", "6,14", "0x0e,0x03", "0x01,0xf5", "02 00 03 00 05 00",
+                          "", "", "", "", "", "", ""])
+        # each embedded reply: its service and status; the first one's data
         self.assertEqual([rows[1][n] for n in names],
-                         ["0x0a", "0x01", "0x1e", "", "", "", "2", "6,12", hexed(reply_services), "", ""])
+                         ["0x0a", "0x01", "0x1e", "", "", "", "", "", "2", "6,12", "0x0e,0x03", "0x00,0x05",
+                          "01 00", "", ""])
         # An error reply carries no services: nothing to decode, nothing to report.
-        self.assertEqual([rows[2][n] for n in names],
-                         ["0x0a", "0x01", "0x08", "", "", "", "", "", "", "", ""])
+        self.assertEqual([rows[2][n] for n in names], ["0x0a", "0x01", "0x08"] + [""] * 12)
         s = differential(ENV.path("msp.pcap"))
         self.assertEqual(s["frames_differ"], [])
         self.assertEqual(s["fields"], s["agree"])
@@ -875,6 +914,48 @@ class Malformed(unittest.TestCase):
         self.assertGreater(differential(ENV.path("malformed.pcap"))["experts"], len(payloads) // 2)
 
 
+class MspFaults(unittest.TestCase):
+    """A corrupted offset in a real Multiple Service Packet gives our bad_offset expert on
+    that frame alone; the clean copies give none, and nothing escapes as an exception."""
+
+    def test_corrupted_offset_gives_bad_offset_on_that_frame_only(self):
+        import pcaprewrite as pr
+        path = os.path.join(corpus_dir(), "cip-multiple-2.pcap")
+        if not os.path.isfile(path):
+            self.skipTest("no %s" % path)
+        cap = pr.Capture.read(path)
+        clean = cap.packets[0]
+        # the reply's count (11) and its first offsets (24, 36, 48), as the corpus has them
+        at = bytes(clean.data).find(struct.pack("<HHHH", 11, 24, 36, 48))
+        self.assertGreater(at, 0)
+        past_end, decreasing = clean.copy(), clean.copy()
+        pr.set_u16(past_end, at + 2 + 2 * 4, 0x7fff)          # service 5 starts past the end
+        pr.set_u16(decreasing, at + 2 + 2 * 2, 30)           # service 3 before service 2 ends
+        cap.packets = [clean, past_end, clean.copy(), decreasing, clean.copy()]
+        out = os.path.join(ENV.home, "msp-faults.pcap")
+        cap.write(out)
+        os.chmod(out, 0o644)
+        # the copies repeat one TCP segment: not retransmissions here, each is decoded
+        no_seq = ["-o", "tcp.analyze_sequence_numbers:FALSE"]
+        rows = fields(ENV, out, ["frame.number", "enipr.cpf.item.cip.msp_reply.reply.service", "_ws.expert.message"],
+                      extra=no_seq)
+        self.assertEqual(len(rows), 5)
+        expert = [n + 1 for n, r in enumerate(rows) if r["_ws.expert.message"]]
+        self.assertEqual(expert, [2, 4], rows)
+        flagged = ENV.tshark(["-r", out, "-Y", "enipr.expert.bad_offset", "-T", "fields", "-e", "frame.number"] +
+                             no_seq)
+        self.assertEqual(flagged.stdout.split(), ["2", "4"])
+        self.assertRegex(rows[1]["_ws.expert.message"], r"'Embedded Reply' 5 of 11: offset 32767 \(byte \d+\) is past the end")
+        self.assertRegex(rows[3]["_ws.expert.message"], r"'Embedded Reply' 3 of 11: offset 30 \(byte \d+\) is smaller than the one before")
+        # the tree so far: the services before the bad offset
+        self.assertEqual(rows[0]["enipr.cpf.item.cip.msp_reply.reply.service"], ",".join(["0x03"] * 11))
+        self.assertEqual(rows[1]["enipr.cpf.item.cip.msp_reply.reply.service"], ",".join(["0x03"] * 3))
+        self.assertEqual(rows[3]["enipr.cpf.item.cip.msp_reply.reply.service"], "0x03")
+        verbose = ENV.tshark(["-r", out, "-V"] + no_seq, check=False)
+        self.assertEqual(verbose.returncode, 0, verbose.stderr)
+        self.assertNotIn("[Malformed Packet", verbose.stdout)
+
+
 class Corpus(unittest.TestCase):
     """Wireshark's enip/cip (no dissgen plugin) against the rules (default), on real captures."""
 
@@ -886,7 +967,7 @@ class Corpus(unittest.TestCase):
             self.skipTest("no EtherNet/IP corpus at %s" % corpus)
         start = time.time()
         total = {"enip_frames": 0, "messages_ws": 0, "messages_ours": 0, "fields": 0, "agree": 0, "differ": 0,
-                 "experts": 0}
+                 "experts": 0, "msp_sc": 0, "msp_sc_agree": 0, "msp_class": 0, "msp_class_agree": 0}
         problems = []
         print("\n%-40s %7s %8s %9s %9s %9s" % ("capture", "frames", "msgs ws", "msgs ours", "fields",
                                                 "agreeing"), file=sys.stderr)
@@ -904,8 +985,14 @@ class Corpus(unittest.TestCase):
         print("%-40s %7d %8d %9d %9d %9d  (%.1f s)" % ("total", total["enip_frames"], total["messages_ws"],
                                                       total["messages_ours"], total["fields"], total["agree"],
                                                       time.time() - start), file=sys.stderr)
+        print("embedded services of Multiple Service Packets: %d of %d service codes and %d of %d classes "
+              "agree with Wireshark's cip" % (total["msp_sc_agree"], total["msp_sc"], total["msp_class_agree"],
+                                              total["msp_class"]), file=sys.stderr)
         self.assertGreater(total["messages_ws"], 0)
         self.assertEqual(problems, [], "\n".join(problems[:40]))
+        if "cip-multiple-2.pcap" in files:  # 11 replies in one Multiple Service Packet
+            self.assertGreaterEqual(total["msp_sc"], 11)
+        self.assertEqual((total["msp_sc_agree"], total["msp_class_agree"]), (total["msp_sc"], total["msp_class"]))
         # Real traffic is well-formed: none of our expert infos fires on it.
         self.assertEqual(total["experts"], 0)
 
