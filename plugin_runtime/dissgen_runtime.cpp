@@ -463,6 +463,22 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
                   gboolean in_summary);
 void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary);
 
+/* issue 14: a numeric leaf's item from its bytes already read (a bit group's
+ * whole value: Wireshark masks and shifts it by the field's bitmask), which
+ * costs Wireshark about a third less than proto_tree_add_item() reading them
+ * again. Unsigned displays only; the others are added from the bytes. */
+proto_item *add_numeric_item(const dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint length,
+                             guint64 raw)
+{
+    switch (n->show) {
+    case DG_SHOW_HEX: case DG_SHOW_DEC: case DG_SHOW_ENUM:
+        return length <= 4 ? proto_tree_add_uint(tree, *n->hf, st->tvb, offset, length, (guint32)raw)
+                           : proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, length, raw);
+    default:
+        return proto_tree_add_item(tree, *n->hf, st->tvb, offset, length, encoding_of(n));
+    }
+}
+
 void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end)
 {
     if (n->flags & DG_GROUP_FIRST) {
@@ -476,7 +492,7 @@ void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     /* No tree (e.g. tshark's summary lines): only values later nodes read are
      * wanted. proto_tree_add_item() would check the length and return NULL. */
     if (tree) {
-        proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, n->length, encoding_of(n));
+        proto_item *item = add_numeric_item(st, n, tree, *offset, (gint)n->length, st->group_value);
         if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
     }
     if (value_wanted(st, n)) store(st, n, (st->group_value >> n->shift) & bit_mask(n->bits), *offset, n->length);
@@ -665,8 +681,8 @@ void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
         if (value_wanted(st, n)) value = read_uint(st->tvb, *offset, 4, encoding_of(n));
         if (tree) item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, encoding_of(n));
     } else if (n->flags & DG_NUMERIC) {
-        if (value_wanted(st, n)) value = read_uint(st->tvb, *offset, (guint)len, encoding_of(n));
-        if (tree) item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, encoding_of(n));
+        if (tree || value_wanted(st, n)) value = read_uint(st->tvb, *offset, (guint)len, encoding_of(n));
+        if (tree) item = add_numeric_item(st, n, tree, *offset, len, value);
     } else if (len > 0 && tree) {
         item = proto_tree_add_item(tree, *n->hf, st->tvb, *offset, len, item_encoding(n));
     }

@@ -22,6 +22,7 @@
  * frame where the capture showed them, so every pass shows the same ones.
  */
 #include "ethercat_bus.h"
+#include "dissgen_label.h"
 
 #include <epan/expert.h>
 
@@ -514,9 +515,14 @@ void show_slave(const bus_model *m, const addressed *a, tvbuff_t *tvb, packet_in
     const slave_state *s = m->slaves[position];
     const dg_bus *b = m->design;
     gint32 device = learned_device(b, s);
-    proto_item *item = proto_tree_add_none_format(tree, hf_slave, tvb, a->offset, a->length, "Slave at position %d%s%s",
-                                                  position, device >= 0 ? ": " : "",
-                                                  device >= 0 ? b->devices[device].name : "");
+    dg_label label = {"", 0}; /* "Slave at position 1: EL1004" */
+    dg_label_str(&label, "Slave at position ");
+    dg_label_int(&label, position, FALSE);
+    if (device >= 0) {
+        dg_label_str(&label, ": ");
+        dg_label_str(&label, b->devices[device].name);
+    }
+    proto_item *item = proto_tree_add_none_format(tree, hf_slave, tvb, a->offset, a->length, "%s", label.text);
     proto_item_set_generated(item);
     proto_tree *sub = proto_item_add_subtree(item, ett_slave);
     proto_item_set_generated(proto_tree_add_uint(sub, hf_position, tvb, a->offset, a->length, (guint32)position));

@@ -28,6 +28,7 @@
  */
 #include "ethercat_esc.h"
 #include "ethercat_bus.h"
+#include "dissgen_label.h"
 
 #include <epan/expert.h>
 
@@ -187,15 +188,21 @@ void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, packet_i
 /* The datagram's items, when someone looks at them; `tree` is the analysis's subtree. */
 proto_tree *show_datagram_items(const compared *c, guint i, tvbuff_t *tvb, proto_tree *tree)
 {
-    const char *data = c->data_changed ? "data changed" : "data unchanged";
-    proto_item *item =
-        c->has_advance
-            ? proto_tree_add_none_format(tree, hf_datagram, tvb, c->offset, c->length,
-                                         "Datagram %u (%s): working counter %+d, %u slaves passed, %s", i + 1,
-                                         command_name(c->cmd), c->wkc_added, c->advance, data)
-            : proto_tree_add_none_format(tree, hf_datagram, tvb, c->offset, c->length,
-                                         "Datagram %u (%s): working counter %+d, %s", i + 1, command_name(c->cmd),
-                                         c->wkc_added, data);
+    /* "Datagram 1 (FPRD): working counter +1, 2 slaves passed, data changed" */
+    dg_label label = {"", 0};
+    dg_label_str(&label, "Datagram ");
+    dg_label_uint(&label, i + 1);
+    dg_label_str(&label, " (");
+    dg_label_str(&label, command_name(c->cmd));
+    dg_label_str(&label, "): working counter ");
+    dg_label_int(&label, c->wkc_added, TRUE);
+    if (c->has_advance) {
+        dg_label_str(&label, ", ");
+        dg_label_uint(&label, c->advance);
+        dg_label_str(&label, " slaves passed");
+    }
+    dg_label_str(&label, c->data_changed ? ", data changed" : ", data unchanged");
+    proto_item *item = proto_tree_add_none_format(tree, hf_datagram, tvb, c->offset, c->length, "%s", label.text);
     proto_item_set_generated(item);
     proto_tree *sub = proto_item_add_subtree(item, ett_datagram);
     proto_item *it = proto_tree_add_int(sub, hf_wkc_added, tvb, c->offset + c->length - 2, 2, c->wkc_added);
