@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cstdio>
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -90,7 +91,7 @@ struct BusLayout {
     std::vector<Field> fields;
 };
 
-// Every PDO of a device, in file order, with its mapping; and the objects
+// Every PDO of a device with its mapping (the default ones first, in packing order); and the objects
 // only its PDOs outside the default assignment map, as entries without a
 // field (their names and types). Both shared between the revisions (and
 // models) that have the same, so that a catalogue of thousands of PDOs stays
@@ -123,7 +124,15 @@ void add_device_pdos(BusLayout& l, const EsiDevice& dev, uint32_t first, uint32_
         in_defaults.insert({l.entries[i].entry.index, l.entries[i].entry.subindex});
     std::set<std::string> objects;
     r.object_first = static_cast<uint32_t>(l.entries.size());
-    for (const EsiPdo& p : dev.pdos) {
+    // The default assignment first, in the order its process data is packed
+    // (SyncManager order, then file order), then the other PDOs in file order.
+    std::vector<const EsiPdo*> order;
+    for (const EsiPdo& p : dev.pdos) order.push_back(&p);
+    std::stable_sort(order.begin(), order.end(), [](const EsiPdo* a, const EsiPdo* b) {
+        return (a->sm < 0 ? 1000 : a->sm) < (b->sm < 0 ? 1000 : b->sm);
+    });
+    for (const EsiPdo* pp : order) {
+        const EsiPdo& p = *pp;
         std::string map_key;
         for (const EsiEntry& en : p.entries) map_key += entry_key(en);
         auto m = t.maps.find(map_key);

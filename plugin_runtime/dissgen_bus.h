@@ -53,7 +53,9 @@ typedef struct dg_pdo {
 /* One device revision of the catalogue; its default process data (the PDOs
  * its ESI file assigns to a SyncManager) is entries[entry_first ..]. For a
  * master that assigns or maps other PDOs over CoE (0x1C12/0x1C13,
- * 0x16xx/0x1Axx): all its PDOs, in file order, are pdos[pdo_first ..], and
+ * 0x16xx/0x1Axx): all its PDOs are pdos[pdo_first ..] (the default ones
+ * first, in the order their process data is packed, then the others in
+ * file order), and
  * entries[object_first ..] the objects only PDOs outside the default
  * assignment map (no field). Revisions that map alike share these ranges. */
 typedef struct dg_device {
