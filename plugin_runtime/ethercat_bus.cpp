@@ -66,12 +66,30 @@ struct pdo_object {
     guint32 value[max_object_entries];   /* subindex k at [k - 1]: a PDO index, or index << 16 | sub << 8 | bits */
 };
 
+/* An entry of a configured slave's inputs or outputs. */
+struct placed {
+    guint32 bit;                /* from the start of the slave's inputs or outputs */
+    guint16 bits;
+    guint16 index;
+    guint8 subindex;
+    const dg_pdo_entry *known;  /* the ESI's, NULL when it does not have it */
+};
+
+/* A configuration's inputs or outputs, worked out for one model when first shown. */
+struct placed_list {
+    gboolean known;
+    gint32 device;              /* the catalogue's device it was worked out for */
+    guint count;
+    const placed *list;
+};
+
 /* A slave's learned objects from one frame on (the returned frame that
- * completed one of them); immutable. */
+ * completed one of them); immutable but for the lists worked out from it. */
 struct pdo_config {
     guint32 from_frame;
     guint count;
     const pdo_object *objects[max_pdo_objects];
+    mutable placed_list layout[2];  /* inputs, outputs */
 };
 
 enum ident_word { W_VENDOR = 0x08, W_PRODUCT = 0x0a, W_REVISION = 0x0c, W_SERIAL = 0x0e, SII_WORDS = 0x10 };
@@ -527,6 +545,7 @@ void add_config(slave_state *st, const pdo_object *o, guint32 frame)
     pdo_config *c = wmem_new0(wmem_file_scope(), pdo_config);
     if (st->config_count) *c = *st->configs[st->config_count - 1];
     c->from_frame = frame;
+    c->layout[0].known = c->layout[1].known = FALSE;
     const pdo_object *copy = (const pdo_object *)wmem_memdup(wmem_file_scope(), o, sizeof *o);
     guint i = 0;
     while (i < c->count && c->objects[i]->index != o->index) i++;
@@ -842,15 +861,6 @@ const dg_pdo_entry *catalogue_entry(const dg_bus *b, gint32 device, gboolean out
     return NULL;
 }
 
-/* An entry of a configured slave's inputs or outputs. */
-struct placed {
-    guint32 bit;                /* from the start of the slave's inputs or outputs */
-    guint16 bits;
-    guint16 index;
-    guint8 subindex;
-    const dg_pdo_entry *known;  /* the ESI's, NULL when it does not have it */
-};
-
 /* The PDOs a device assigns by default in one direction, in the order they
  * are packed (the catalogue lists them first, in that order), empty ones too. */
 guint default_pdos(const dg_bus *b, gint32 device, gboolean output, guint16 *out, guint max)
@@ -917,8 +927,9 @@ void show_generic(proto_tree *tree, const placed *e, tvbuff_t *tvb, gint data, g
     g_snprintf(object, sizeof object, "0x%04x:%02x", e->index, e->subindex);
     proto_item *it;
     if (e->known)
-        it = proto_tree_add_string_format_value(tree, hf_pdo_entry, tvb, offset, bytes, object, "%s %s (%s, %u bit)",
-                                                object, e->known->name, e->known->data_type, e->bits);
+        it = proto_tree_add_string_format_value(tree, hf_pdo_entry, tvb, offset, bytes, object, "%s %s (%s%s%u bit)",
+                                                object, e->known->name, e->known->data_type,
+                                                *e->known->data_type ? ", " : "", e->bits);
     else
         it = proto_tree_add_string_format_value(tree, hf_pdo_entry, tvb, offset, bytes, object,
                                                 "%s (not in the ESI file, %u bit)", object, e->bits);
@@ -935,8 +946,14 @@ void show_generic(proto_tree *tree, const placed *e, tvbuff_t *tvb, gint data, g
 void show_configured_data(const dg_bus *b, gint32 device, const pdo_config *c, const char *name, guint position,
                           gint64 start, const datagram *d, gboolean output, tvbuff_t *tvb, proto_tree *tree)
 {
-    placed list[max_placed];
-    guint n = configured_entries(b, device, c, output, list, max_placed);
+    placed_list *l = &c->layout[output ? 1 : 0];
+    if (!l->known || l->device != device) {  /* once per configuration and model (which may become known later) */
+        placed found[max_placed];
+        guint count = configured_entries(b, device, c, output, found, max_placed);
+        *l = {TRUE, device, count, (const placed *)wmem_memdup(wmem_file_scope(), found, (count ? count : 1) * sizeof *found)};
+    }
+    const placed *list = l->list;
+    guint n = l->count;
     gint64 begin = (gint64)(d->adp | (guint32)d->ado << 16) * 8, end = begin + (gint64)d->length * 8;
     proto_tree *sub = NULL;
     for (guint i = 0; i < n; i++) {
