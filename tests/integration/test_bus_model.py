@@ -34,8 +34,10 @@
    the ESI defaults; the one after it the entries at the bits the test computes from the
    assignment and mappings, with their fields, or ecatr.pdo.entry/value where the model has no
    field for them (0x1D09:10, only in a PDO not assigned by default) or its ESI file does not
-   know them (0x7777:01); one pass and -2 alike. `--only coe` runs this part alone; it is
-   SKIPPED without the ESI file.
+   know them (0x7777:01); one pass and -2 alike. The same with a design
+   (tests/network/small_design.xml: its EL1004 assigned 0x1A10, which small_io.xml does not
+   assign by default), without the corpus too. `--only coe` runs this part alone; the EL1252
+   part is SKIPPED without the ESI file.
 Skips (exit 77) when the corpus is absent (part 6 runs all the same).
 """
 import argparse
@@ -455,8 +457,9 @@ def bits_of(data, bit, n):
     return (v >> bit) & ((1 << n) - 1)
 
 
-def coe_frames(config_steps, inputs_before, inputs_after, inputs_middle=None, station=0x1002, same_frame=False):
-    """The EL1252 at position 1 (station `station`): station, identity (SII), mailboxes, an FMMU
+def coe_frames(config_steps, inputs_before, inputs_after, inputs_middle=None, station=0x1002, same_frame=False,
+               identity=EL1252):
+    """The EL1252 (or `identity`) at position 1 (station `station`): station, identity (SII), mailboxes, an FMMU
     reading 24 bytes of inputs at logical 0x10000; an LRD of them; the configuration steps
     ((mailbox, returned working counter): a write to SyncManager 0, or for a response a read of
     SyncManager 1; "lrd": an LRD returning `inputs_middle`); the LRD again (with `same_frame`, in
@@ -467,7 +470,7 @@ def coe_frames(config_steps, inputs_before, inputs_after, inputs_middle=None, st
         return [(pg.Datagram(10, lad=0x10000, data=bytes(24)), data, 1)]
 
     steps = [[(pg.Datagram(2, adp=0xFFFF, ado=0x0010, data=struct.pack("<H", station)), None, 1)]]
-    steps += [[step] for step in sii_reads(station, *EL1252)]
+    steps += [[step] for step in sii_reads(station, *identity)]
     steps += [[(pg.Datagram(5, adp=station, ado=0x0800, data=mailbox_config()), None, 1)],
               [(pg.Datagram(5, adp=station, ado=0x0600, data=fmmu(0x10000, 24, 1, 0, 0x1100)), None, 1)],
               lrd(inputs_before)]
@@ -639,6 +642,39 @@ def coe_checks(dissgen, source_dir, shared):
     return ok
 
 
+def coe_design_checks(dissgen, source_dir):
+    """With a design (tests/network/small_design.xml, tests/esi_ok/small_io.xml): its EL1004 at
+    position 1 ("Inputs left") assigned 0x1A10 (Counter, 0x6100:11, not assigned by default: no
+    field) and 0x1A00 by complete access."""
+    print("\n== process data as configured over CoE, with a design (generated frames)")
+    ch = ["ecatr.pdo.el1004.channel_%d.input" % k for k in (1, 2, 3)]
+    fields = ch + ["ecatr.pdo.entry", "ecatr.pdo.value"]
+    before, after = bytes([0b101]) + bytes(23), bytes([0x34, 0x12, 0b1]) + bytes(21)
+    steps = [(sdo_complete_access(0x1C13, [0x1A10, 0x1A00], 2), 1)]
+    frames, lrds = coe_frames(steps, before, after, identity=(BECKHOFF, 0x03EC3052, 0x00130000))
+    with TsharkEnv() as env:
+        env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"),
+                           ["--esi", os.path.join(source_dir, "tests", "esi_ok", "small_io.xml"),
+                            "--network", os.path.join(source_dir, "tests", "network", "small_design.xml")])
+        path = env.add_file("coe-design.pcap", pg.pcap_bytes(frames))
+        for two_pass in (False, True):
+            tag = " (-2)" if two_pass else ""
+            rows = dict(decode(env, path, fields, two_pass))
+            got = [{f: rows[n][f] for f in fields if rows[n][f]} for n in lrds]
+            yes = lambda v: v in ("1", "True")  # noqa: E731
+            check([yes(v) for f in ch for v in got[0].get(f, [])] == [True, False, True] and
+                  not got[0].get("ecatr.pdo.entry"), "design: the LRD before it shows the defaults%s: %s" % (
+                      tag, got[0]))
+            check(got[1].get("ecatr.pdo.entry") == ["0x6100:11"] and got[1].get("ecatr.pdo.value") == [str(0x1234)]
+                  and [yes(v) for v in got[1].get(ch[0], [])] == [True] and not got[1].get(ch[1]),
+                  "design: the LRD after it shows 0x6100:11 = 0x1234 (generic) and channel 1 at bit 16%s: %s" % (
+                      tag, got[1]))
+            tree = env.tshark(["-r", path, "-V"] + (["-2"] if two_pass else [])).stdout
+            check("0x6100:11 Counter (not assigned by default).Count (UINT, 16 bit)" in tree and
+                  "Inputs left (position 1): inputs" in tree,
+                  "design: the entry named from the ESI file, under the design's slave name%s" % tag)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--dissgen", required=True)
@@ -646,6 +682,7 @@ def main():
     ap.add_argument("--only", help="run only this part (pdo)")
     args = ap.parse_args()
     if args.only == "coe":
+        coe_design_checks(args.dissgen, args.source_dir)
         coe_checks(args.dissgen, args.source_dir,
                    os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus"))
         return 1 if check.failed else 0
@@ -660,6 +697,7 @@ def main():
     if not files:
         pdo_checks(args.dissgen, args.source_dir)
         pdo_checks(args.dissgen, args.source_dir, design=False)
+        coe_design_checks(args.dissgen, args.source_dir)
         if check.failed:
             return 1
         print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng)" % corpus)
@@ -681,6 +719,7 @@ def main():
     eni_checks(args.dissgen, rules, shared)
     pdo_checks(args.dissgen, args.source_dir)
     pdo_checks(args.dissgen, args.source_dir, design=False)
+    coe_design_checks(args.dissgen, args.source_dir)
     coe_checks(args.dissgen, args.source_dir, shared)
     print("\n%d failed" % len(check.failed))
     return 1 if check.failed else 0
