@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cstdio>
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -76,8 +77,89 @@ struct BusLayout {
     std::vector<int> entry_field;                // into fields, -1 none
     std::vector<std::pair<uint32_t, uint32_t>> device_entries;  // per row: first, count
     std::vector<std::pair<uint32_t, uint32_t>> slave_entries;   // per slave
+    struct Pdo {
+        uint16_t index;
+        bool output, assigned;
+        uint32_t first, count;  // into maps
+    };
+    struct Ranges {
+        uint32_t pdo_first = 0, pdo_count = 0, object_first = 0, object_count = 0;
+    };
+    std::vector<Pdo> pdos;                       // the devices' PDOs (revisions that map alike share them)
+    std::vector<EsiEntry> maps;                  // the PDOs' mappings: index, subindex, bit length
+    std::vector<Ranges> device_pdos;             // per row
     std::vector<Field> fields;
 };
+
+// Every PDO of a device with its mapping (the default ones first, in packing order); and the objects
+// only its PDOs outside the default assignment map, as entries without a
+// field (their names and types). Both shared between the revisions (and
+// models) that have the same, so that a catalogue of thousands of PDOs stays
+// small: no pointers in the mappings.
+struct PdoTables {
+    std::map<std::string, BusLayout::Ranges> devices;  // a device's PDOs and objects, by content
+    std::map<std::string, std::pair<uint32_t, uint32_t>> maps;  // a mapping, by content
+};
+
+std::string entry_key(const EsiEntry& en) {
+    return std::to_string(en.index) + ":" + std::to_string(en.subindex) + ":" + std::to_string(en.bit_length) + ":" +
+           en.name + ":" + en.data_type + "\n";
+}
+
+void add_device_pdos(BusLayout& l, const EsiDevice& dev, uint32_t first, uint32_t count, PdoTables& t) {
+    std::string key = dev.type + "\n";
+    for (const EsiPdo& p : dev.pdos) {
+        key += std::to_string(p.index) + (p.tx ? "t" : "r") + (p.sm >= 0 ? "a" : "") + p.name + "\n";
+        for (const EsiEntry& en : p.entries) key += entry_key(en);
+    }
+    auto known = t.devices.find(key);
+    if (known != t.devices.end()) {
+        l.device_pdos.push_back(known->second);
+        return;
+    }
+    BusLayout::Ranges r;
+    r.pdo_first = static_cast<uint32_t>(l.pdos.size());
+    std::set<std::pair<uint16_t, uint8_t>> in_defaults;
+    for (uint32_t i = first; i < first + count; ++i)
+        in_defaults.insert({l.entries[i].entry.index, l.entries[i].entry.subindex});
+    std::set<std::string> objects;
+    r.object_first = static_cast<uint32_t>(l.entries.size());
+    // The default assignment first, in the order its process data is packed
+    // (SyncManager order, then file order), then the other PDOs in file order.
+    std::vector<const EsiPdo*> order;
+    for (const EsiPdo& p : dev.pdos) order.push_back(&p);
+    std::stable_sort(order.begin(), order.end(), [](const EsiPdo* a, const EsiPdo* b) {
+        return (a->sm < 0 ? 1000 : a->sm) < (b->sm < 0 ? 1000 : b->sm);
+    });
+    for (const EsiPdo* pp : order) {
+        const EsiPdo& p = *pp;
+        std::string map_key;
+        for (const EsiEntry& en : p.entries) map_key += entry_key(en);
+        auto m = t.maps.find(map_key);
+        if (m == t.maps.end()) {
+            m = t.maps.emplace(map_key, std::make_pair(static_cast<uint32_t>(l.maps.size()),
+                                                       static_cast<uint32_t>(p.entries.size()))).first;
+            l.maps.insert(l.maps.end(), p.entries.begin(), p.entries.end());
+        }
+        l.pdos.push_back({p.index, !p.tx, p.sm >= 0, m->second.first, m->second.second});
+        for (const EsiEntry& en : p.entries) {
+            if (en.is_padding() || in_defaults.count({en.index, en.subindex}) || !objects.insert(entry_key(en)).second)
+                continue;
+            NetEntry e;
+            e.output = !p.tx;
+            e.pdo_index = p.index;
+            e.pdo_name = p.name;
+            e.entry = en;
+            l.entries.push_back(e);
+            l.entry_owner.push_back(dev.type + " (objects of PDOs not assigned by default)");
+            l.entry_field.push_back(-1);
+        }
+    }
+    r.pdo_count = static_cast<uint32_t>(l.pdos.size()) - r.pdo_first;
+    r.object_count = static_cast<uint32_t>(l.entries.size()) - r.object_first;
+    t.devices.emplace(key, r);
+    l.device_pdos.push_back(r);
+}
 
 BusLayout make_bus_layout(const Catalogue& cat, const BusOptions& opt, const std::string& filter) {
     BusLayout l;
@@ -132,6 +214,7 @@ BusLayout make_bus_layout(const Catalogue& cat, const BusOptions& opt, const std
         for (const NetSlave& s : net->slaves)
             if (s.device >= 0) design_models.insert(s.device);
     if (!net) design_models.insert(l.devices.begin(), l.devices.end());
+    PdoTables pdo_tables;
     for (int d : l.devices) {
         const EsiDevice& dev = cat.devices[d];
         NetSlave defaults;
@@ -143,6 +226,7 @@ BusLayout make_bus_layout(const Catalogue& cat, const BusOptions& opt, const std
             l.entry_field.push_back(design_models.count(d) ? field_for(dev.type, e) : -1);
         }
         l.device_entries.push_back({first, static_cast<uint32_t>(defaults.entries.size())});
+        add_device_pdos(l, dev, first, static_cast<uint32_t>(defaults.entries.size()), pdo_tables);
     }
     if (net) {
         for (const NetSlave& s : net->slaves) {
@@ -202,18 +286,39 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
     if (l.entries.empty()) o << "    { 0, 0, 0, 0, 0, 0, -1, NULL, NULL, NULL }\n";
     o << "};\n\n";
 
+    o << "/* The devices' PDOs: index, output, assigned by default, mapping (first, count). */\n"
+      << "static const dg_pdo " << filter << "_pdos[] = {\n";
+    for (const BusLayout::Pdo& p : l.pdos)
+        o << "    { " << hexn(p.index, 4) << ", " << (p.output ? 1 : 0) << ", " << (p.assigned ? 1 : 0) << ", " << p.first
+          << ", " << p.count << " },\n";
+    if (l.pdos.empty()) o << "    { 0, 0, 0, 0, 0 }\n";
+    o << "};\n\n";
+    o << "/* The PDOs' mappings: object index, bit length, subindex. */\n"
+      << "static const dg_map_entry " << filter << "_maps[] = {\n";
+    for (size_t i = 0; i < l.maps.size(); i += 4) {
+        o << "   ";
+        for (size_t k = i; k < l.maps.size() && k < i + 4; ++k)
+            o << " { " << hexn(l.maps[k].index, 4) << ", " << l.maps[k].bit_length << ", "
+              << static_cast<unsigned>(l.maps[k].subindex) << " },";
+        o << "\n";
+    }
+    if (l.maps.empty()) o << "    { 0, 0, 0 }\n";
+    o << "};\n\n";
+
     o << "/* Device catalogue" << (opt.compact ? " (compact: the models of the network only)" : "")
       << ": vendor, product code, revision, type, name,\n"
-      << " * default process data (first entry, count). */\n"
+      << " * default process data (first entry, count), PDOs (first, count), objects of other PDOs (first, count). */\n"
       << "static const dg_device " << filter << "_devices[] = {\n";
     for (size_t row = 0; row < l.devices.size(); ++row) {
         const EsiDevice& dev = cat.devices[l.devices[row]];
         o << "    /* " << std::filesystem::path(dev.file).filename().string() << ":" << dev.line << " */\n"
           << "    { " << hexn(dev.vendor, 8) << ", " << hexn(dev.product, 8) << ", " << hexn(dev.revision, 8) << ", "
           << c_string(dev.type) << ", " << c_string(dev.name) << ", " << l.device_entries[row].first << ", "
-          << l.device_entries[row].second << " },\n";
+          << l.device_entries[row].second << ", " << l.device_pdos[row].pdo_first << ", "
+          << l.device_pdos[row].pdo_count << ", " << l.device_pdos[row].object_first << ", "
+          << l.device_pdos[row].object_count << " },\n";
     }
-    if (l.devices.empty()) o << "    { 0, 0, 0, NULL, NULL, 0, 0 }\n";
+    if (l.devices.empty()) o << "    { 0, 0, 0, NULL, NULL, 0, 0, 0, 0, 0, 0 }\n";
     o << "};\n\n";
 
     size_t slave_count = net ? net->slaves.size() : 0, cyclic_count = net ? net->cyclic.size() : 0;
@@ -266,6 +371,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
       << "extern G_GNUC_INTERNAL const dg_bus " << t.bus_symbol << ";\n"
       << "const dg_bus " << t.bus_symbol << " = {\n"
       << "    " << filter << "_devices, " << l.devices.size() << ", " << filter << "_pdo_entries, " << l.entries.size()
+      << ", " << filter << "_pdos, " << l.pdos.size() << ", " << filter << "_maps, " << l.maps.size()
       << ",\n    " << (net ? filter + "_slaves" : "NULL") << ", " << slave_count << ", "
       << (net ? filter + "_sync_managers" : "NULL") << ", " << sm_count << ",\n    "
       << (cyclic_count ? filter + "_cyclic" : "NULL") << ", " << cyclic_count << "\n};\n\n";

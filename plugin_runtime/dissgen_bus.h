@@ -32,13 +32,39 @@ typedef struct dg_sync_manager {
     const char *type;        /* "Outputs", "Inputs", "MBoxOut", "MBoxIn" */
 } dg_sync_manager;
 
+/* One entry of a PDO's mapping as the ESI file gives it: no name, no
+ * pointer (the catalogue holds thousands); the name and type are those of
+ * the device's entry of that object (dg_device: default entries, then
+ * objects). */
+typedef struct dg_map_entry {
+    guint16 index;           /* object index; 0 for padding */
+    guint16 bit_length;
+    guint8 subindex;
+} dg_map_entry;
+
+/* One PDO of a device, default or not: its mapping is maps[map_first ..]. */
+typedef struct dg_pdo {
+    guint16 index;           /* 0x1600.. (RxPdo), 0x1A00.. (TxPdo) */
+    guint8 output;           /* 1: RxPdo */
+    guint8 assigned;         /* 1: in the default assignment (the ESI gives it a SyncManager) */
+    guint32 map_first, map_count;
+} dg_pdo;
+
 /* One device revision of the catalogue; its default process data (the PDOs
- * its ESI file assigns to a SyncManager) is entries[entry_first ..]. */
+ * its ESI file assigns to a SyncManager) is entries[entry_first ..]. For a
+ * master that assigns or maps other PDOs over CoE (0x1C12/0x1C13,
+ * 0x16xx/0x1Axx): all its PDOs are pdos[pdo_first ..] (the default ones
+ * first, in the order their process data is packed, then the others in
+ * file order), and
+ * entries[object_first ..] the objects only PDOs outside the default
+ * assignment map (no field). Revisions that map alike share these ranges. */
 typedef struct dg_device {
     guint32 vendor, product, revision;
     const char *type;        /* "EL1004" */
     const char *name;        /* English name */
     guint32 entry_first, entry_count;
+    guint32 pdo_first, pdo_count;
+    guint32 object_first, object_count;
 } dg_device;
 
 /* One slave of the designed network, by bus position. */
@@ -70,6 +96,10 @@ typedef struct dg_bus {
     guint32 device_count;
     const dg_pdo_entry *entries;
     guint32 entry_count;
+    const dg_pdo *pdos;              /* the devices' PDOs, see dg_device */
+    guint32 pdo_count;
+    const dg_map_entry *maps;        /* their mappings */
+    guint32 map_count;
     const dg_slave *slaves;          /* NULL when no network was given */
     guint32 slave_count;
     const dg_sync_manager *sync_managers;

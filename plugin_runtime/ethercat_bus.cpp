@@ -51,6 +51,48 @@ const guint16 process_ram = 0x1000;
 
 const guint max_fmmus = 16;
 
+/* PDO assignment and mapping the master writes over CoE (0x1C12/0x1C13,
+ * 0x1600..0x17FF, 0x1A00..0x1BFF): what the model keeps at most. */
+const guint max_pdo_objects = 64;     /* objects per slave */
+const guint max_object_entries = 64;  /* subindexes 1..64 of one object */
+const guint max_configs = 256;        /* configurations per slave over the capture */
+const guint max_placed = 1024;        /* entries of one slave's inputs or outputs */
+
+/* One assignment or mapping object as the master wrote it (or a slave's
+ * upload response showed it); a complete one is copied and never changed. */
+struct pdo_object {
+    guint16 index;
+    guint8 count;                        /* subindex 0 */
+    gboolean complete;                   /* subindex 0 written non-zero, or a complete-access transfer */
+    guint32 value[max_object_entries];   /* subindex k at [k - 1]: a PDO index, or index << 16 | sub << 8 | bits */
+};
+
+/* An entry of a configured slave's inputs or outputs. */
+struct placed {
+    guint32 bit;                /* from the start of the slave's inputs or outputs */
+    guint16 bits;
+    guint16 index;
+    guint8 subindex;
+    const dg_pdo_entry *known;  /* the ESI's, NULL when it does not have it */
+};
+
+/* A configuration's inputs or outputs, worked out for one model when first shown. */
+struct placed_list {
+    gboolean known;
+    gint32 device;              /* the catalogue's device it was worked out for */
+    guint count;
+    const placed *list;
+};
+
+/* A slave's learned objects from one frame on (the returned frame that
+ * completed one of them); immutable but for the lists worked out from it. */
+struct pdo_config {
+    guint32 from_frame;
+    guint count;
+    const pdo_object *objects[max_pdo_objects];
+    mutable placed_list layout[2];  /* inputs, outputs */
+};
+
 enum ident_word { W_VENDOR = 0x08, W_PRODUCT = 0x0a, W_REVISION = 0x0c, W_SERIAL = 0x0e, SII_WORDS = 0x10 };
 
 struct slave_state {
@@ -64,6 +106,10 @@ struct slave_state {
     guint16 mailbox_start[2], mailbox_length[2];  /* SM0 (out), SM1 (in) in mailbox mode */
     gboolean al_known;
     guint8 al_state;               /* AL status (0x0130) bits 0-3, last seen */
+    pdo_object *writing[max_pdo_objects];  /* the objects as written so far */
+    guint writing_count;
+    const pdo_config **configs;    /* learned configurations, in frame order */
+    guint config_count;
 };
 
 enum event_kind { EV_COUNT, EV_MODEL, EV_OK, EV_WKC };
@@ -113,8 +159,8 @@ struct bus_frame {
 namespace {
 
 int hf_process_data = -1, hf_wkc_expected = -1, hf_slave = -1, hf_position = -1, hf_station = -1, hf_alias = -1, hf_vendor = -1, hf_product = -1,
-    hf_revision = -1, hf_serial = -1, hf_name = -1;
-gint ett_slave = -1, ett_process_data = -1;
+    hf_revision = -1, hf_serial = -1, hf_name = -1, hf_pdo_entry = -1, hf_pdo_value = -1;
+gint ett_slave = -1, ett_process_data = -1, ett_pdo_entry = -1;
 expert_field ei_count = EI_INIT, ei_model = EI_INIT, ei_ok = EI_INIT, ei_wkc = EI_INIT;
 
 const char *const command_names[] = {"NOP",  "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD",
@@ -434,6 +480,134 @@ gboolean is_mailbox(const slave_state *st, const datagram *d)
     return FALSE;
 }
 
+/* --- PDO assignment and mapping over CoE ---------------------------------- */
+
+/* The data of an SDO transfer in a CoE mailbox (`length` bytes at `at`): a
+ * download request (service 2, command specifier 1) as the master writes it
+ * to SyncManager 0, or an upload response (service 3, specifier 2) the
+ * master reads from SyncManager 1. Expedited transfers carry up to 4 bytes
+ * in the header, normal ones a size and the data after it; one whose size
+ * is more than the mailbox holds continues in segments, which are not
+ * followed (nothing is learnt from it). */
+struct sdo_data {
+    guint16 index;
+    guint8 subindex;
+    gboolean complete_access;
+    gint offset;
+    guint32 length;
+};
+
+gboolean sdo_transfer(tvbuff_t *tvb, gint at, guint length, guint service, guint specifier, sdo_data *out)
+{
+    if (length < 16) return FALSE;  /* mailbox header 6, CoE header 2, SDO header 8 */
+    guint32 mailbox = dg_tvb_get_uint16(tvb, at, ENC_LITTLE_ENDIAN);
+    if (mailbox < 10 || (dg_tvb_get_uint8(tvb, at + 5) & 0x0f) != 3) return FALSE;  /* 3: CoE */
+    if ((guint)(dg_tvb_get_uint16(tvb, at + 6, ENC_LITTLE_ENDIAN) >> 12) != service) return FALSE;
+    guint8 cmd = dg_tvb_get_uint8(tvb, at + 8);
+    if ((guint)(cmd >> 5) != specifier) return FALSE;
+    out->index = dg_tvb_get_uint16(tvb, at + 9, ENC_LITTLE_ENDIAN);
+    out->subindex = dg_tvb_get_uint8(tvb, at + 11);
+    out->complete_access = (cmd & 0x10) != 0;
+    if (cmd & 0x02) {  /* expedited: 4 - n bytes when the size is indicated */
+        out->offset = at + 12;
+        out->length = (cmd & 0x01) ? 4u - (cmd >> 2 & 3u) : 4u;
+        return TRUE;
+    }
+    if (!(cmd & 0x01)) return FALSE;
+    guint32 present = MIN(mailbox + 6, length) - 16, size = dg_tvb_get_uint32(tvb, at + 12, ENC_LITTLE_ENDIAN);
+    if (size > present) return FALSE;  /* segmented */
+    out->offset = at + 16;
+    out->length = size;
+    return TRUE;
+}
+
+gboolean is_pdo_object(guint16 index)
+{
+    return index == 0x1c12 || index == 0x1c13 || (index >= 0x1600 && index <= 0x17ff) ||
+           (index >= 0x1a00 && index <= 0x1bff);
+}
+
+pdo_object *writing_object(slave_state *st, guint16 index)
+{
+    for (guint i = 0; i < st->writing_count; i++)
+        if (st->writing[i]->index == index) return st->writing[i];
+    if (st->writing_count >= max_pdo_objects) return NULL;
+    pdo_object *o = wmem_new0(wmem_file_scope(), pdo_object);
+    o->index = index;
+    return st->writing[st->writing_count++] = o;
+}
+
+/* A new configuration from `frame` on: the last one with a copy of `o` in
+ * place of its earlier version. */
+void add_config(slave_state *st, const pdo_object *o, guint32 frame)
+{
+    if (st->config_count >= max_configs) return;
+    if (!st->configs) st->configs = wmem_alloc0_array(wmem_file_scope(), const pdo_config *, max_configs);
+    pdo_config *c = wmem_new0(wmem_file_scope(), pdo_config);
+    if (st->config_count) *c = *st->configs[st->config_count - 1];
+    c->from_frame = frame;
+    c->layout[0].known = c->layout[1].known = FALSE;
+    const pdo_object *copy = (const pdo_object *)wmem_memdup(wmem_file_scope(), o, sizeof *o);
+    guint i = 0;
+    while (i < c->count && c->objects[i]->index != o->index) i++;
+    if (i == c->count) c->count++;
+    c->objects[i] = copy;
+    st->configs[st->config_count++] = c;
+}
+
+/* One SDO transfer of an assignment (entries of 16 bits) or mapping object
+ * (32 bits). One subindex at a time, the object is complete when subindex 0
+ * is written non-zero; a complete-access transfer from subindex 0 holds
+ * subindex 0 padded to 16 bits, then the entries (from subindex 1: the
+ * entries alone), and completes it. */
+void learn_object(slave_state *st, tvbuff_t *tvb, const sdo_data *sd, guint32 frame)
+{
+    if (!is_pdo_object(sd->index)) return;
+    pdo_object *o = writing_object(st, sd->index);
+    if (!o) return;
+    guint32 size = sd->index >= 0x1c00 ? 2 : 4;
+    if (sd->complete_access) {
+        if (sd->subindex > 1 || (sd->subindex == 0 && sd->length < 1)) return;
+        guint32 at = 0, count = sd->length / size;
+        if (sd->subindex == 0) {
+            count = dg_tvb_get_uint8(tvb, sd->offset);
+            at = 2;
+        }
+        guint n = 0;
+        for (; n < count && n < max_object_entries && at + size <= sd->length; n++, at += size)
+            o->value[n] = size == 2 ? dg_tvb_get_uint16(tvb, sd->offset + (gint)at, ENC_LITTLE_ENDIAN)
+                                    : dg_tvb_get_uint32(tvb, sd->offset + (gint)at, ENC_LITTLE_ENDIAN);
+        o->count = (guint8)n;
+        o->complete = TRUE;
+        add_config(st, o, frame);
+        return;
+    }
+    if (sd->subindex == 0) {
+        if (sd->length < 1) return;
+        o->count = (guint8)MIN(dg_tvb_get_uint8(tvb, sd->offset), max_object_entries);
+        o->complete = o->count != 0;
+        if (o->complete) add_config(st, o, frame);
+        return;
+    }
+    if (sd->subindex > max_object_entries || sd->length < size) return;
+    o->value[sd->subindex - 1] = size == 2 ? dg_tvb_get_uint16(tvb, sd->offset, ENC_LITTLE_ENDIAN)
+                                           : dg_tvb_get_uint32(tvb, sd->offset, ENC_LITTLE_ENDIAN);
+    o->complete = FALSE;
+}
+
+/* A mailbox datagram to a slave: a download to its SyncManager 0 (the frame
+ * as sent), or an upload response read from SyncManager 1 (returned). */
+void learn_coe(slave_state *st, const datagram *s, const datagram *b, tvbuff_t *sent, tvbuff_t *back, guint32 frame)
+{
+    sdo_data sd;
+    if (writes(s->cmd) && !reads(s->cmd) && st->mailbox_length[0] && s->ado == st->mailbox_start[0] &&
+        sdo_transfer(sent, s->offset + 10, s->length, 2, 1, &sd))
+        learn_object(st, sent, &sd, frame);
+    if (reads(s->cmd) && !writes(s->cmd) && st->mailbox_length[1] && s->ado == st->mailbox_start[1] &&
+        sdo_transfer(back, b->offset + 10, b->length, 3, 2, &sd))
+        learn_object(st, back, &sd, frame);
+}
+
 /* An AL status read (0x0130) showing another state than the last one. */
 gboolean al_changed(slave_state *st, const datagram *b, tvbuff_t *back)
 {
@@ -448,7 +622,7 @@ gboolean al_changed(slave_state *st, const datagram *b, tvbuff_t *back)
 
 /* What one datagram pair teaches about the slave it addressed; its stat_flags. */
 guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagram *b, tvbuff_t *sent, tvbuff_t *back,
-                   events *ev)
+                   guint32 frame, events *ev)
 {
     slave_state *st = slave_at(m, position);
     if (!st) return 0;
@@ -470,6 +644,7 @@ guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagr
         learn_fmmus(m, st, s, sent);
         learn_mailboxes(st, s, sent);
     }
+    learn_coe(st, s, b, sent, back, frame);
     if (reads(s->cmd) && !writes(s->cmd)) {
         learn_sii_data(m, position, st, b, back, ev);
         if (al_changed(st, b, back)) flags |= ST_AL_CHANGE;
@@ -601,6 +776,20 @@ gint64 image_start(const dg_slave *ds, const slave_state *st, gboolean output)
     return -1;
 }
 
+/* The subtree of one slave's inputs or outputs in a logical datagram, made
+ * when its first entry is shown. */
+proto_tree *data_subtree(proto_tree **sub, proto_tree *tree, const char *name, guint position, gboolean output,
+                         const datagram *d, tvbuff_t *tvb)
+{
+    if (!*sub) {
+        proto_item *it = proto_tree_add_none_format(tree, hf_process_data, tvb, d->offset, 12 + d->length,
+                                                    "%s (position %u): %s", name, position, output ? "outputs" : "inputs");
+        proto_item_set_generated(it);
+        *sub = proto_item_add_subtree(it, ett_process_data);
+    }
+    return *sub;
+}
+
 /* One slave's entries[first, first + count) that lie wholly inside a logical
  * datagram, in a subtree; `start` is the logical bit where its inputs or
  * outputs begin. */
@@ -614,41 +803,215 @@ void show_slave_data(const dg_bus *b, const char *name, guint position, guint32 
         if (!e->hf || *e->hf < 0 || (gboolean)e->output != output) continue;
         gint64 at = e->logical_bit >= 0 ? e->logical_bit : start + e->bit_offset;
         if (at < begin || at + e->bit_length > end) continue;
-        if (!sub) {
-            proto_item *it = proto_tree_add_none_format(tree, hf_process_data, tvb, d->offset, 12 + d->length,
-                                                        "%s (position %u): %s", name, position,
-                                                        output ? "outputs" : "inputs");
-            proto_item_set_generated(it);
-            sub = proto_item_add_subtree(it, ett_process_data);
+        show_entry(data_subtree(&sub, tree, name, position, output, d, tvb), e, tvb, d->offset + 10,
+                   (guint32)(at - begin));
+    }
+}
+
+/* --- process data as the master configured it over CoE ------------------- */
+
+/* The configuration a slave had in frame `frame`: the last one learnt in it
+ * or before; NULL: none (the ESI defaults). The same in every pass. */
+const pdo_config *config_at(const slave_state *st, guint32 frame)
+{
+    if (!st) return NULL;
+    for (guint i = st->config_count; i > 0; i--)
+        if (st->configs[i - 1]->from_frame <= frame) return st->configs[i - 1];
+    return NULL;
+}
+
+const pdo_object *config_object(const pdo_config *c, guint16 index)
+{
+    for (guint i = 0; c && i < c->count; i++)
+        if (c->objects[i]->index == index) return c->objects[i];
+    return NULL;
+}
+
+gboolean is_output_pdo(guint16 index) { return index >= 0x1600 && index <= 0x17ff; }
+
+/* Does the configuration change a slave's inputs or outputs: their assignment,
+ * or the mapping of a PDO of that direction? */
+gboolean config_changes(const pdo_config *c, gboolean output)
+{
+    for (guint i = 0; c && i < c->count; i++) {
+        guint16 index = c->objects[i]->index;
+        if (index == (output ? 0x1c12 : 0x1c13) || (index != 0x1c12 && index != 0x1c13 && is_output_pdo(index) == output))
+            return TRUE;
+    }
+    return FALSE;
+}
+
+/* The catalogue's PDO `index` of a device, or NULL. */
+const dg_pdo *catalogue_pdo(const dg_bus *b, gint32 device, guint16 index)
+{
+    if (!b || device < 0) return NULL;
+    const dg_device *dev = &b->devices[device];
+    for (guint32 p = dev->pdo_first; p < dev->pdo_first + dev->pdo_count && p < b->pdo_count; p++)
+        if (b->pdos[p].index == index && b->pdos[p].output == is_output_pdo(index)) return &b->pdos[p];
+    return NULL;
+}
+
+/* Object index:subindex among all the PDOs of a device: its default
+ * entries (with their fields), then the objects only other PDOs map; NULL
+ * when the ESI file does not map it. */
+const dg_pdo_entry *catalogue_entry(const dg_bus *b, gint32 device, gboolean output, guint16 index, guint8 subindex)
+{
+    if (!b || device < 0) return NULL;
+    const dg_device *dev = &b->devices[device];
+    const guint32 first[] = {dev->entry_first, dev->object_first}, count[] = {dev->entry_count, dev->object_count};
+    for (guint r = 0; r < G_N_ELEMENTS(first); r++)
+        for (guint32 i = first[r]; i < first[r] + count[r] && i < b->entry_count; i++) {
+            const dg_pdo_entry *e = &b->entries[i];
+            if (e->index == index && e->subindex == subindex && (gboolean)e->output == output) return e;
         }
-        show_entry(sub, e, tvb, d->offset + 10, (guint32)(at - begin));
+    return NULL;
+}
+
+/* The PDOs a device assigns by default in one direction, in the order they
+ * are packed (the catalogue lists them first, in that order), empty ones too. */
+guint default_pdos(const dg_bus *b, gint32 device, gboolean output, guint16 *out, guint max)
+{
+    guint n = 0;
+    if (!b || device < 0) return 0;
+    const dg_device *dev = &b->devices[device];
+    for (guint32 p = dev->pdo_first; p < dev->pdo_first + dev->pdo_count && p < b->pdo_count && n < max; p++)
+        if (b->pdos[p].assigned && (gboolean)b->pdos[p].output == output) out[n++] = b->pdos[p].index;
+    return n;
+}
+
+/* A slave's inputs or outputs under a learnt configuration: the assigned
+ * PDOs (learnt, else the ESI's defaults), each with its learnt mapping, else
+ * the ESI's; a PDO that neither gives ends the list (what follows it has no
+ * known place). Padding (index 0) takes its bits. */
+guint configured_entries(const dg_bus *b, gint32 device, const pdo_config *c, gboolean output, placed *out, guint max)
+{
+    guint16 pdos[max_object_entries];
+    guint pdo_count;
+    const pdo_object *assign = config_object(c, output ? 0x1c12 : 0x1c13);
+    if (assign) {
+        pdo_count = assign->count;
+        for (guint i = 0; i < pdo_count; i++) pdos[i] = (guint16)assign->value[i];
+    } else {
+        pdo_count = default_pdos(b, device, output, pdos, max_object_entries);
+    }
+    guint n = 0;
+    guint32 bit = 0;
+    for (guint p = 0; p < pdo_count; p++) {
+        const pdo_object *map = config_object(c, pdos[p]);
+        gboolean out_pdo = is_output_pdo(pdos[p]);
+        if (map) {
+            for (guint k = 0; k < map->count; k++) {
+                guint32 v = map->value[k];
+                placed e = {bit, (guint16)(v & 0xff), (guint16)(v >> 16), (guint8)(v >> 8), NULL};
+                bit += e.bits;
+                if (!e.index || n == max) continue;
+                e.known = catalogue_entry(b, device, out_pdo, e.index, e.subindex);
+                out[n++] = e;
+            }
+            continue;
+        }
+        const dg_pdo *pdo = catalogue_pdo(b, device, pdos[p]);
+        if (!pdo) break;
+        for (guint32 i = pdo->map_first; i < pdo->map_first + pdo->map_count && i < b->map_count; i++) {
+            const dg_map_entry *en = &b->maps[i];
+            placed e = {bit, en->bit_length, en->index, en->subindex, NULL};
+            bit += en->bit_length;
+            if (!e.index || n == max) continue;
+            e.known = catalogue_entry(b, device, out_pdo, e.index, e.subindex);
+            out[n++] = e;
+        }
+    }
+    return n;
+}
+
+/* An entry without a registered field: its object as text, its value in its
+ * bit length (up to 64 bits). */
+void show_generic(proto_tree *tree, const placed *e, tvbuff_t *tvb, gint data, guint32 bit)
+{
+    gint offset = data + (gint)(bit / 8), bytes = (gint)((bit % 8 + e->bits + 7) / 8);
+    char object[16];
+    g_snprintf(object, sizeof object, "0x%04x:%02x", e->index, e->subindex);
+    proto_item *it;
+    if (e->known)
+        it = proto_tree_add_string_format_value(tree, hf_pdo_entry, tvb, offset, bytes, object, "%s %s (%s%s%u bit)",
+                                                object, e->known->name, e->known->data_type,
+                                                *e->known->data_type ? ", " : "", e->bits);
+    else
+        it = proto_tree_add_string_format_value(tree, hf_pdo_entry, tvb, offset, bytes, object,
+                                                "%s (not in the ESI file, %u bit)", object, e->bits);
+    proto_item_set_generated(it);
+    if (e->bits == 0 || e->bits > 64) return;
+    guint64 v = image_bits(tvb, data, bit, e->bits);
+    proto_tree *sub = proto_item_add_subtree(it, ett_pdo_entry);
+    proto_item_set_generated(proto_tree_add_uint64_format_value(sub, hf_pdo_value, tvb, offset, bytes, v,
+                                                                "%" G_GUINT64_FORMAT " (0x%0*" G_GINT64_MODIFIER "x)",
+                                                                v, (int)(e->bits + 3) / 4, v));
+}
+
+/* A configured slave's entries that lie wholly inside a logical datagram. */
+void show_configured_data(const dg_bus *b, gint32 device, const pdo_config *c, const char *name, guint position,
+                          gint64 start, const datagram *d, gboolean output, tvbuff_t *tvb, proto_tree *tree)
+{
+    placed_list *l = &c->layout[output ? 1 : 0];
+    if (!l->known || l->device != device) {  /* once per configuration and model (which may become known later) */
+        placed found[max_placed];
+        guint count = configured_entries(b, device, c, output, found, max_placed);
+        *l = {TRUE, device, count, (const placed *)wmem_memdup(wmem_file_scope(), found, (count ? count : 1) * sizeof *found)};
+    }
+    const placed *list = l->list;
+    guint n = l->count;
+    gint64 begin = (gint64)(d->adp | (guint32)d->ado << 16) * 8, end = begin + (gint64)d->length * 8;
+    proto_tree *sub = NULL;
+    for (guint i = 0; i < n; i++) {
+        const placed *e = &list[i];
+        gint64 at = start + e->bit;
+        if (at < begin || at + e->bits > end) continue;
+        proto_tree *into = data_subtree(&sub, tree, name, position, output, d, tvb);
+        if (e->known && e->known->hf && *e->known->hf >= 0 && e->known->bit_length == e->bits)
+            show_entry(into, e->known, tvb, d->offset + 10, (guint32)(at - begin));
+        else
+            show_generic(into, e, tvb, d->offset + 10, (guint32)(at - begin));
     }
 }
 
 /* A logical datagram's process data, one subtree per slave: outputs in the
  * frame as sent, inputs in the returned one. The slaves of the design with
  * their process data; without one, the slaves the capture identified (SII)
- * with their model's default process data from the catalogue. */
-void show_process_data(const bus_model *m, const datagram *d, gboolean returned, tvbuff_t *tvb, proto_tree *tree)
+ * with their model's default process data from the catalogue. A slave whose
+ * assignment or mapping the master configured over CoE by this frame gets
+ * that instead (not with an ENI, whose process image is the configuration). */
+void show_process_data(const bus_model *m, const datagram *d, gboolean returned, guint32 frame, tvbuff_t *tvb,
+                       proto_tree *tree)
 {
     const dg_bus *b = m->design;
-    if (!b || !logical(d->cmd)) return;
+    if (!logical(d->cmd)) return;
     gboolean output = !returned;
     if ((output && d->cmd == LRD) || (!output && d->cmd == LWR)) return;
-    if (b->slaves) {
+    if (b && b->slaves) {
         for (guint p = 0; p < b->slave_count; p++) {
             const dg_slave *ds = &b->slaves[p];
-            gint64 start = image_start(ds, p < max_positions ? m->slaves[p] : NULL, output);
-            if (start >= 0) show_slave_data(b, ds->name, p, ds->entry_first, ds->entry_count, start, d, output, tvb, tree);
+            const slave_state *st = p < max_positions ? m->slaves[p] : NULL;
+            gint64 start = image_start(ds, st, output);
+            const pdo_config *c = config_at(st, frame);
+            if (start < 0) continue;
+            if (config_changes(c, output) && ds->input_logical_bit < 0 && ds->output_logical_bit < 0)
+                show_configured_data(b, ds->device, c, ds->name, p, start, d, output, tvb, tree);
+            else
+                show_slave_data(b, ds->name, p, ds->entry_first, ds->entry_count, start, d, output, tvb, tree);
         }
         return;
     }
     for (guint p = 0; p < m->positions && p < max_positions; p++) {
-        gint32 device = learned_device(b, m->slaves[p]);
-        gint64 start = device >= 0 ? image_start(NULL, m->slaves[p], output) : -1;
-        if (start >= 0)
-            show_slave_data(b, b->devices[device].type, p, b->devices[device].entry_first,
-                            b->devices[device].entry_count, start, d, output, tvb, tree);
+        const slave_state *st = m->slaves[p];
+        gint32 device = learned_device(b, st);
+        const pdo_config *c = config_at(st, frame);
+        gboolean configured = config_changes(c, output);
+        gint64 start = device >= 0 || configured ? image_start(NULL, st, output) : -1;
+        if (start < 0) continue;
+        const char *name = device >= 0 ? b->devices[device].type : "Slave";
+        if (configured) show_configured_data(b, device, c, name, p, start, d, output, tvb, tree);
+        else show_slave_data(b, name, p, b->devices[device].entry_first, b->devices[device].entry_count, start, d, output,
+                             tvb, tree);
     }
 }
 
@@ -704,7 +1067,7 @@ bus_frame *bus_sent(bus_model *m, tvbuff_t *tvb, packet_info *)
     return f;
 }
 
-bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, packet_info *)
+bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, packet_info *pinfo)
 {
     datagram s[max_datagrams], b[max_datagrams];
     guint header;
@@ -719,7 +1082,7 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, packet_inf
         if (s[i].cmd != b[i].cmd || s[i].ado != b[i].ado || s[i].length != b[i].length) continue;
         gint32 position = by_position(s[i].cmd) ? position_of(s[i].adp)
                           : by_station(s[i].cmd) ? station_position(m, s[i].adp) : -1;
-        if (position >= 0) flags[i] = learn_slave(m, (guint)position, &s[i], &b[i], sent, back, &ev);
+        if (position >= 0) flags[i] = learn_slave(m, (guint)position, &s[i], &b[i], sent, back, pinfo->num, &ev);
         if (b[i].wkc <= s[i].wkc) continue;
         guint added = (guint)(b[i].wkc - s[i].wkc);
         if (s[i].cmd == BRD) learn_count(m, added, &b[i], &ev);
@@ -745,7 +1108,7 @@ void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree 
     for (guint i = 0; i < f->count; i++) {
         const addressed *a = &f->d[i];
         show_slave(f->model, a, tvb, pinfo, tree);
-        if (a->logical) show_process_data(f->model, &a->dgram, f->returned, tvb, tree);
+        if (a->logical) show_process_data(f->model, &a->dgram, f->returned, pinfo->num, tvb, tree);
         if (a->expected_wkc >= 0)
             proto_item_set_generated(proto_tree_add_uint(tree, hf_wkc_expected, tvb, a->offset + a->length - 2, 2,
                                                          (guint32)a->expected_wkc));
@@ -815,12 +1178,17 @@ void bus_register(int proto, const char *filter)
         {&hf_serial, {"Serial number", NULL, FT_UINT32, BASE_HEX, NULL, 0x0, "From the SII EEPROM (word 0x000E)", HFILL}},
         {&hf_name, {"Model", NULL, FT_STRING, BASE_NONE, NULL, 0x0,
                     "The device type of the ESI catalogue embedded with --esi", HFILL}},
+        {&hf_pdo_entry, {"PDO entry", NULL, FT_STRING, BASE_NONE, NULL, 0x0,
+                         "A PDO entry the master mapped over CoE that has no registered field: its object "
+                         "(index:subindex), with the ESI name and type when the model's ESI file has it", HFILL}},
+        {&hf_pdo_value, {"Value", NULL, FT_UINT64, BASE_DEC, NULL, 0x0,
+                         "The PDO entry's bits (up to 64), least significant first, as an unsigned number", HFILL}},
     };
     const char *names[] = {"process_data", "wkc.expected", "slave", "slave.position", "slave.station", "slave.alias", "slave.vendor",
-                           "slave.product", "slave.revision", "slave.serial", "slave.name"};
+                           "slave.product", "slave.revision", "slave.serial", "slave.name", "pdo.entry", "pdo.value"};
     for (guint i = 0; i < G_N_ELEMENTS(hf); i++) hf[i].hfinfo.abbrev = g_strdup_printf("%s.%s", filter, names[i]);
     proto_register_field_array(proto, hf, (int)G_N_ELEMENTS(hf));
-    static gint *ett[] = {&ett_slave, &ett_process_data};
+    static gint *ett[] = {&ett_slave, &ett_process_data, &ett_pdo_entry};
     proto_register_subtree_array(ett, (int)G_N_ELEMENTS(ett));
 
     static ei_register_info ei[] = {

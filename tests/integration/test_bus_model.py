@@ -25,10 +25,24 @@
    tests/network/small_design.xml): after the stations and FMMUs are set, an LRW shows the
    EL2004's outputs (ecatr.pdo.el2004.*) in the frame as sent and the EL1004's inputs
    (ecatr.pdo.el1004.*) in the returned one, with the values written into the bytes here.
+7. Process data as the master configures it over CoE (generated frames, an EL1252 of
+   ../shared/corpus/esi/Beckhoff_EL1xxx.xml identified from its SII): 0x1C13 and a mapping
+   written one subindex at a time (with a write the slave did not take and a segmented
+   download, neither followed), by complete access (completed in the frame of the LRD), and
+   read back by an upload; odd traffic (short mailboxes, an empty mapping, counts past the
+   data, entries past the slave's share). Every LRD before the configuration is complete shows
+   the ESI defaults; the one after it the entries at the bits the test computes from the
+   assignment and mappings, with their fields, or ecatr.pdo.entry/value where the model has no
+   field for them (0x1D09:10, only in a PDO not assigned by default) or its ESI file does not
+   know them (0x7777:01); one pass and -2 alike. The same with a design
+   (tests/network/small_design.xml: its EL1004 assigned 0x1A10, which small_io.xml does not
+   assign by default), without the corpus too. `--only coe` runs this part alone; the EL1252
+   part is SKIPPED without the ESI file.
 Skips (exit 77) when the corpus is absent (part 6 runs all the same).
 """
 import argparse
 import os
+import random
 import re
 import struct
 import sys
@@ -397,12 +411,281 @@ def pdo_checks(dissgen, source_dir, design=True):
                       "subtrees named by the model and position the SII gave%s: %s" % (tag, titles))
 
 
+# ----------------------------------------------------------------------------- CoE PDO configuration
+
+EL1252 = (BECKHOFF, 0x04E43052, 0x00160000)
+MBX_OUT, MBX_IN = 0x1000, 0x1080   # SyncManager 0 (master to slave) and 1 mailboxes
+
+
+def mailbox_config():
+    """SyncManagers 0 and 1 as mailboxes (0x0800: start, length, control with mode 2)."""
+    return struct.pack("<HHBBBB", MBX_OUT, 128, 0x26, 0, 1, 0) + struct.pack("<HHBBBB", MBX_IN, 128, 0x22, 0, 1, 0)
+
+
+def coe_mailbox(service, sdo, counter=1):
+    """A CoE mailbox of 128 bytes: mailbox header, CoE header, the SDO bytes, zero padding."""
+    body = struct.pack("<H", service << 12) + sdo
+    return (struct.pack("<HHBB", len(body), 0, 0, 3 | (counter & 7) << 4) + body).ljust(128, b"\0")
+
+
+def sdo_expedited(index, sub, value, size):
+    """An expedited SDO download request of `size` bytes (1, 2 or 4)."""
+    cmd = 0x20 | 0x02 | 0x01 | (4 - size) << 2
+    return coe_mailbox(2, struct.pack("<BHB", cmd, index, sub) + value.to_bytes(size, "little").ljust(4, b"\0"))
+
+
+def sdo_complete_access(index, values, size):
+    """A complete-access SDO download from subindex 0: subindex 0 padded to 16 bits, then the
+    entries of `size` bytes (normal transfer: a size, then the data)."""
+    data = struct.pack("<BB", len(values), 0) + b"".join(v.to_bytes(size, "little") for v in values)
+    return coe_mailbox(2, struct.pack("<BHBI", 0x21 | 0x10, index, 0, len(data)) + data)
+
+
+def sdo_upload_response(index, values, size):
+    """The slave's answer to a complete-access upload of `index` (normal transfer)."""
+    data = struct.pack("<BB", len(values), 0) + b"".join(v.to_bytes(size, "little") for v in values)
+    return coe_mailbox(3, struct.pack("<BHBI", 0x41 | 0x10, index, 0, len(data)) + data)
+
+
+def sdo_segmented_start(index, sub, data):
+    """A normal SDO download whose size is more than the mailbox holds (segments would follow)."""
+    return coe_mailbox(2, struct.pack("<BHBI", 0x21, index, sub, 4096) + data[:100])
+
+
+def bits_of(data, bit, n):
+    v = int.from_bytes(data, "little")
+    return (v >> bit) & ((1 << n) - 1)
+
+
+def coe_frames(config_steps, inputs_before, inputs_after, inputs_middle=None, station=0x1002, same_frame=False,
+               identity=EL1252):
+    """The EL1252 (or `identity`) at position 1 (station `station`): station, identity (SII), mailboxes, an FMMU
+    reading 24 bytes of inputs at logical 0x10000; an LRD of them; the configuration steps
+    ((mailbox, returned working counter): a write to SyncManager 0, or for a response a read of
+    SyncManager 1; "lrd": an LRD returning `inputs_middle`); the LRD again (with `same_frame`, in
+    the frame of the last step). Returns (frames, frame numbers of the returned LRDs)."""
+    master, back = b"\x00\x00\x00\x00\x00\x01", b"\x02\x00\x00\x00\x00\x01"
+
+    def lrd(data):
+        return [(pg.Datagram(10, lad=0x10000, data=bytes(24)), data, 1)]
+
+    steps = [[(pg.Datagram(2, adp=0xFFFF, ado=0x0010, data=struct.pack("<H", station)), None, 1)]]
+    steps += [[step] for step in sii_reads(station, *identity)]
+    steps += [[(pg.Datagram(5, adp=station, ado=0x0800, data=mailbox_config()), None, 1)],
+              [(pg.Datagram(5, adp=station, ado=0x0600, data=fmmu(0x10000, 24, 1, 0, 0x1100)), None, 1)],
+              lrd(inputs_before)]
+    for step in config_steps:
+        if step == "lrd":
+            steps.append(lrd(inputs_middle))
+            continue
+        m, wkc = step
+        if m[5] & 0x0F == 3 and struct.unpack("<H", m[6:8])[0] >> 12 == 3:   # a response: read from SM1
+            steps.append([(pg.Datagram(4, adp=station, ado=MBX_IN, data=bytes(len(m))), m, wkc)])
+        else:
+            steps.append([(pg.Datagram(5, adp=station, ado=MBX_OUT, data=m), None, wkc)])
+    if same_frame:
+        steps[-1] += lrd(inputs_after)
+    else:
+        steps.append(lrd(inputs_after))
+    frames, lrds = [], []
+    for i, frame in enumerate(steps):
+        sent, returned = [], []
+        for d, data, wkc in frame:
+            d.idx = i & 0xFF
+            sent.append(d)
+            returned.append(pg.Datagram(d.cmd, idx=d.idx, adp=d.adp, ado=d.ado, lad=d.lad,
+                                        data=data if data else d.data, wkc=wkc))
+        frames += [pg.Frame(sent, src_mac=master), pg.Frame(returned, src_mac=back)]
+        if any(d.cmd == 10 for d in sent):
+            lrds.append(len(frames))
+    return frames, lrds
+
+
+def coe_checks(dissgen, source_dir, shared):
+    """Process data as the master assigns and maps it over CoE (0x1C13, 0x1Axx), on an EL1252
+    of Beckhoff_EL1xxx.xml: its default inputs are 0x1A00, 0x1A01, 0x1A02 (empty) and 0x1A13;
+    0x1A14 (SysTime, 0x1D09:10) is one it does not assign by default."""
+    print("\n== process data as configured over CoE (generated frames, EL1252)")
+    esi = os.path.join(shared, "esi", "Beckhoff_EL1xxx.xml")
+    if not os.path.isfile(esi):
+        print("SKIPPED: the CoE PDO part: no %s" % esi)
+        return False
+    ch1, ch2 = "ecatr.pdo.el1252.channel_0.input", "ecatr.pdo.el1252.channel_1.input"
+    # The fields of revision 0x00160000's 0x1A13 (0x1D09:AE, AF, B0, B8): older revisions name
+    # other objects of 0x1A13 Status1 and LatchPos1 (see `dissgen fields`), hence the _2.
+    latch = ["ecatr.pdo.el1252.latch.status1_2", "ecatr.pdo.el1252.latch.status2",
+             "ecatr.pdo.el1252.latch.latchpos1_2", "ecatr.pdo.el1252.latch.latchneg1_2"]
+    fields = [ch1, ch2] + latch + ["ecatr.pdo.entry", "ecatr.pdo.value", "ecatr.process_data"]
+    before = bytes(range(0xA1, 0xB9))   # 24 bytes of inputs, each byte other
+    after = bytes((i * 37 + 11) & 0xFF for i in range(24))
+
+    def defaults(data):  # 0x1A00 0x6000:01 bit 0, 0x1A01 0x6000:02 bit 1 + 6 padding, 0x1A13 from bit 8
+        return {ch1: [bits_of(data, 0, 1)], ch2: [bits_of(data, 1, 1)],
+                latch[0]: [data[1]], latch[1]: [data[2]], latch[2]: [bits_of(data, 24, 64)],
+                latch[3]: [bits_of(data, 88, 64)]}
+
+    # (a) one subindex at a time: 0x1A02 mapped to an object the ESI file does not have
+    # (0x7777:01, 16 bits); 0x1C13 = 0x1A01, 0x1A00, 0x1A14 (SysTime, 32 bits: no field), 0x1A02.
+    expedited = [(sdo_expedited(0x1A02, 0, 0, 1), 1), (sdo_expedited(0x1A02, 1, 0x77770110, 4), 1),
+                 (sdo_expedited(0x1A02, 0, 1, 1), 1),
+                 (sdo_expedited(0x1C13, 0, 0, 1), 1), (sdo_expedited(0x1C13, 1, 0x1A01, 2), 1),
+                 (sdo_expedited(0x1C13, 2, 0x1A00, 2), 1), (sdo_expedited(0x1C13, 3, 0x1A14, 2), 1),
+                 (sdo_expedited(0x1C13, 4, 0x1A02, 2), 1),
+                 (sdo_expedited(0x1C13, 4, 0x1A13, 2), 0),     # not taken by the slave (wkc 0)
+                 (sdo_segmented_start(0x1C13, 1, struct.pack("<H", 0x1A13)), 1),  # segmented: not followed
+                 "lrd",                                         # 0x1C13 not complete yet
+                 (sdo_expedited(0x1C13, 0, 4, 1), 1)]
+
+    def middle_expedited(data):  # the defaults, 0x1A02 (in them, empty in the ESI) mapped anew
+        return {ch1: [bits_of(data, 0, 1)], ch2: [bits_of(data, 1, 1)],
+                "ecatr.pdo.entry": ["0x7777:01"], "ecatr.pdo.value": [bits_of(data, 8, 16)],
+                latch[0]: [data[3]], latch[1]: [data[4]], latch[2]: [bits_of(data, 40, 64)],
+                latch[3]: [bits_of(data, 104, 64)]}
+
+    def after_expedited(data):
+        return {ch2: [bits_of(data, 0, 1)], ch1: [bits_of(data, 7, 1)],
+                "ecatr.pdo.entry": ["0x1d09:10", "0x7777:01"],
+                "ecatr.pdo.value": [bits_of(data, 8, 32), bits_of(data, 40, 16)]}
+
+    # (b) complete access: 0x1A02 = 0x6000:01 (1 bit) + 7 bits of padding, then 0x1C13 =
+    # 0x1A02, 0x1A13.
+    complete = [(sdo_complete_access(0x1A02, [0x60000101, 0x00000007], 4), 1),
+                (sdo_complete_access(0x1C13, [0x1A02, 0x1A13], 2), 1)]
+
+    def after_complete(data):
+        return {ch1: [bits_of(data, 0, 1)], latch[0]: [data[1]], latch[1]: [data[2]],
+                latch[2]: [bits_of(data, 24, 64)], latch[3]: [bits_of(data, 88, 64)]}
+
+    # (c) the slave's answer to an upload: 0x1C13 = 0x1A13 alone.
+    upload = [(sdo_upload_response(0x1C13, [0x1A13], 2), 1)]
+
+    def after_upload(data):
+        return {latch[0]: [data[0]], latch[1]: [data[1]], latch[2]: [bits_of(data, 16, 64)],
+                latch[3]: [bits_of(data, 80, 64)]}
+
+    # (d) odd traffic: a mailbox too short for an SDO, one whose length field is too small, an
+    # empty mapping (0x1A02), a mapping that claims 200 entries (0x1A13, entries never written:
+    # 0 bits each), a complete access that claims 60 entries and holds 4 (0x1A03: four of
+    # 64 bits, past the 24 bytes of the slave's share), then 0x1C13 = 0x1A02, 0x1A00, 0x1A13,
+    # 0x1A03: the entries that fit are shown, the rest not.
+    short = coe_mailbox(2, struct.pack("<BHB", 0x2F, 0x1C13, 0) + b"\x01")
+    odd = [(short[:12], 1), (bytes([4]) + short[1:], 1),
+           (sdo_complete_access(0x1A02, [], 4), 1),
+           (sdo_expedited(0x1A13, 0, 0, 1), 1), (sdo_expedited(0x1A13, 0, 200, 1), 1),
+           (coe_mailbox(2, struct.pack("<BHBI", 0x31, 0x1A03, 0, 2 + 4 * 4) + struct.pack("<BB", 60, 0) +
+                        struct.pack("<4I", *[0x70000140] * 4)), 1),
+           (sdo_complete_access(0x1C13, [0x1A02, 0x1A00, 0x1A13, 0x1A03], 2), 1)]
+
+    def after_odd(data):
+        return {ch1: [bits_of(data, 0, 1)], "ecatr.pdo.entry": ["0x7000:01", "0x7000:01"],
+                "ecatr.pdo.value": [bits_of(data, 1, 64), bits_of(data, 65, 64)]}
+
+    def norm(row):
+        out = {}
+        for f in fields[:-1]:
+            vals = []
+            for v in row[f]:
+                vals.append(v if f == "ecatr.pdo.entry" else int(v == "True") if v in ("True", "False")
+                            else int(v, 0))
+            if vals:
+                out[f] = vals
+        return out
+
+    middle = bytes((i * 53 + 5) & 0xFF for i in range(24))
+    ok = True
+    with TsharkEnv() as env:
+        env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"), ["--esi", esi])
+        # (case, steps, expected after, expected in the middle, the last step in the LRD's frame)
+        for case, steps, want, want_middle, same_frame in (
+                ("one subindex at a time", expedited, after_expedited, middle_expedited, False),
+                ("complete access", complete, after_complete, None, True),
+                ("an upload answered", upload, after_upload, None, False),
+                ("odd traffic", odd, after_odd, None, False),
+                ("no configuration", [], defaults, None, False)):
+            frames, lrds = coe_frames(steps, before, after, middle, same_frame=same_frame)
+            path = env.add_file("coe-%s.pcap" % case.replace(" ", "-"), pg.pcap_bytes(frames))
+            results = []
+            for two_pass in (False, True):
+                rows = dict(decode(env, path, fields, two_pass))
+                tag = " (-2)" if two_pass else ""
+                got = [norm(rows[n]) for n in lrds]
+                results.append(got)
+                ok &= check(got[0] == defaults(before), "%s: the LRD before it shows the ESI defaults%s: %s" % (
+                    case, tag, got[0]))
+                if want_middle:
+                    ok &= check(got[1] == want_middle(middle), "%s: an LRD before it is complete: %s, expected "
+                                "%s%s" % (case, got[1], want_middle(middle), tag))
+                ok &= check(got[-1] == want(after), "%s: the LRD after it%s: %s, expected %s%s" % (
+                    case, " (in the frame that completes it)" if same_frame else "", got[-1], want(after), tag))
+            check(results[0] == results[1], "%s: one pass and -2 agree" % case)
+        # Random SDO transfers of the PDO objects (mostly download or upload command bytes, any
+        # subindex, data and mailbox length), each followed by an LRD: tshark decodes every frame,
+        # no dissector bug, and some of them show configured entries.
+        rng = random.Random(12)
+        steps = []
+        for _ in range(300):
+            index = rng.choice([0x1C12, 0x1C13, 0x1600, 0x1A00, 0x1A02, 0x1A13, 0x1BFF])
+            cmd = rng.choice([0x2F, 0x2B, 0x23, 0x21, 0x31, 0x4F, 0x43, 0x41, 0x51, rng.randrange(256)])
+            sdo = struct.pack("<BHB", cmd, index, rng.choice([0, 0, 1, 2, 64, 65, 255])) + \
+                bytes(rng.randrange(256) for _ in range(rng.randrange(0, 40)))
+            m = bytearray(coe_mailbox(rng.choice([2, 2, 3]), sdo))
+            if rng.random() < 0.2:
+                m[0:2] = struct.pack("<H", rng.randrange(0, 200))
+            steps += [(bytes(m[:rng.choice([128, 128, 20, 15])]), 1), "lrd"]
+        frames, lrds = coe_frames(steps, before, after, middle)
+        path = env.add_file("coe-random.pcap", pg.pcap_bytes(frames))
+        for args in (["-V"], ["-V", "-2"]):
+            p = env.tshark(["-r", path] + args, check=False)
+            check(p.returncode == 0 and "Dissector bug" not in p.stdout and "PDO entry: 0x" in p.stdout,
+                  "300 random SDO transfers of PDO objects %s: decoded, no dissector bug, some entries "
+                  "configured (exit %d)" % (" ".join(args), p.returncode))
+    return ok
+
+
+def coe_design_checks(dissgen, source_dir):
+    """With a design (tests/network/small_design.xml, tests/esi_ok/small_io.xml): its EL1004 at
+    position 1 ("Inputs left") assigned 0x1A10 (Counter, 0x6100:11, not assigned by default: no
+    field) and 0x1A00 by complete access."""
+    print("\n== process data as configured over CoE, with a design (generated frames)")
+    ch = ["ecatr.pdo.el1004.channel_%d.input" % k for k in (1, 2, 3)]
+    fields = ch + ["ecatr.pdo.entry", "ecatr.pdo.value"]
+    before, after = bytes([0b101]) + bytes(23), bytes([0x34, 0x12, 0b1]) + bytes(21)
+    steps = [(sdo_complete_access(0x1C13, [0x1A10, 0x1A00], 2), 1)]
+    frames, lrds = coe_frames(steps, before, after, identity=(BECKHOFF, 0x03EC3052, 0x00130000))
+    with TsharkEnv() as env:
+        env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"),
+                           ["--esi", os.path.join(source_dir, "tests", "esi_ok", "small_io.xml"),
+                            "--network", os.path.join(source_dir, "tests", "network", "small_design.xml")])
+        path = env.add_file("coe-design.pcap", pg.pcap_bytes(frames))
+        for two_pass in (False, True):
+            tag = " (-2)" if two_pass else ""
+            rows = dict(decode(env, path, fields, two_pass))
+            got = [{f: rows[n][f] for f in fields if rows[n][f]} for n in lrds]
+            yes = lambda v: v in ("1", "True")  # noqa: E731
+            check([yes(v) for f in ch for v in got[0].get(f, [])] == [True, False, True] and
+                  not got[0].get("ecatr.pdo.entry"), "design: the LRD before it shows the defaults%s: %s" % (
+                      tag, got[0]))
+            check(got[1].get("ecatr.pdo.entry") == ["0x6100:11"] and got[1].get("ecatr.pdo.value") == [str(0x1234)]
+                  and [yes(v) for v in got[1].get(ch[0], [])] == [True] and not got[1].get(ch[1]),
+                  "design: the LRD after it shows 0x6100:11 = 0x1234 (generic) and channel 1 at bit 16%s: %s" % (
+                      tag, got[1]))
+            tree = env.tshark(["-r", path, "-V"] + (["-2"] if two_pass else [])).stdout
+            check("0x6100:11 Counter (not assigned by default).Count (UINT, 16 bit)" in tree and
+                  "Inputs left (position 1): inputs" in tree,
+                  "design: the entry named from the ESI file, under the design's slave name%s" % tag)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--dissgen", required=True)
     ap.add_argument("--source-dir", required=True)
     ap.add_argument("--only", help="run only this part (pdo)")
     args = ap.parse_args()
+    if args.only == "coe":
+        coe_design_checks(args.dissgen, args.source_dir)
+        coe_checks(args.dissgen, args.source_dir,
+                   os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus"))
+        return 1 if check.failed else 0
     if args.only == "pdo":
         pdo_checks(args.dissgen, args.source_dir)
         pdo_checks(args.dissgen, args.source_dir, design=False)
@@ -414,6 +697,7 @@ def main():
     if not files:
         pdo_checks(args.dissgen, args.source_dir)
         pdo_checks(args.dissgen, args.source_dir, design=False)
+        coe_design_checks(args.dissgen, args.source_dir)
         if check.failed:
             return 1
         print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng)" % corpus)
@@ -435,6 +719,8 @@ def main():
     eni_checks(args.dissgen, rules, shared)
     pdo_checks(args.dissgen, args.source_dir)
     pdo_checks(args.dissgen, args.source_dir, design=False)
+    coe_design_checks(args.dissgen, args.source_dir)
+    coe_checks(args.dissgen, args.source_dir, shared)
     print("\n%d failed" % len(check.failed))
     return 1 if check.failed else 0
 

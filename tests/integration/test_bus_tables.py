@@ -55,6 +55,9 @@ class BusTables(unittest.TestCase):
             "ecatr.pdo.el2004.channel_1.output": ("FT_BOOLEAN", "EL2004 Channel 1.Output"),
             "ecatr.pdo.el2004.channel_1.mode": ("FT_UINT8", "EL2004 Channel 1.Mode"),
             "ecatr.pdo.el2004.channel_1.setpoint": ("FT_INT16", "EL2004 Channel 1.Setpoint"),
+            # entries a master maps over CoE that have no field of their own
+            "ecatr.pdo.entry": ("FT_STRING", "PDO entry"),
+            "ecatr.pdo.value": ("FT_UINT64", "Value"),
         })
         # The fields are usable in display filters.
         p = self.env.tshark(["-Y", "ecatr.pdo.el1004.channel_1.input", "-r",
@@ -69,10 +72,11 @@ class BusTables(unittest.TestCase):
         self.env.install_plugin(ARGS.dissgen, self.rules, ["--network", eni])
         self.env.assert_plugin_loaded("ecatr")
         fields = registered_fields(self.env, "ecatr.pdo.")
-        # ProcessImage variables "Imu.Transmit PDO Mapping.Acceleration X" (INT), ...; 7 + 4 x 6 entries.
+        # ProcessImage variables "Imu.Transmit PDO Mapping.Acceleration X" (INT), ...; 7 + 4 x 6 entries,
+        # and ecatr.pdo.entry and ecatr.pdo.value (entries mapped over CoE without a field).
         self.assertEqual(fields["ecatr.pdo.imu.transmit_pdo_mapping.acceleration_x"][0], "FT_INT16")
         self.assertEqual(fields["ecatr.pdo.wheelfrontright.outputs.control_word"][0], "FT_UINT16")
-        self.assertEqual(len(fields), 31)
+        self.assertEqual(len(fields), 33)
 
     def test_broken_inputs_stop_install(self):
         for extra, message in (

@@ -70,6 +70,7 @@ TESTS = {
     "layout": integration("test_layout.py"),
     "bus_tables": integration("test_bus_tables.py"),
     "bus_pdo": integration("test_bus_model.py", "--only", "pdo"),
+    "bus_coe": integration("test_bus_model.py", "--only", "coe"),
     "pairing": integration("test_pairing.py", "--quick"),
     "pairing_full": integration("test_pairing.py"),
     "malformed_skip": integration("test_malformed_skip.py"),

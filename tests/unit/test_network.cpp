@@ -295,7 +295,11 @@ TEST(BusTables, CatalogueAloneRegistersAFieldPerModelEntry) {
     Catalogue cat = small_catalogue();
     EmbeddedTables t = emit_bus(cat, {nullptr, false}, "ecatr");
     EXPECT_EQ(t.hf_entries.size(), 6u);
-    EXPECT_TRUE(contains(t.tables, "ecatr_devices, 4, ecatr_pdo_entries, 7,\n    NULL, 0, NULL, 0,\n    NULL, 0"));
+    // 7 default entries and 0x6100:11, which only EL1004's 0x1A10 (not assigned by default) maps;
+    // its 5 PDOs and their mappings, 0x1A10 last and not assigned.
+    EXPECT_TRUE(contains(t.tables, "ecatr_devices, 4, ecatr_pdo_entries, 8, ecatr_pdos, 5, ecatr_maps, 8,\n"
+                                   "    NULL, 0, NULL, 0,\n    NULL, 0"));
+    EXPECT_TRUE(contains(t.tables, "    { 0x1a10, 0, 0, 4, 1 },\n"));
     EXPECT_EQ(list_bus_fields(cat, {nullptr, false}, "ecatr"),
               "ecatr.pdo.el1004.channel_1.input\tFT_BOOLEAN\tEL1004 Channel 1.Input\n"
               "ecatr.pdo.el1004.channel_2.input\tFT_BOOLEAN\tEL1004 Channel 2.Input\n"
