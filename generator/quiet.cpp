@@ -19,7 +19,8 @@ bool feeds_others(const Node& n, const std::function<bool(const Node&)>& is_key)
 // bytes can raise no expert info (no truncation, no length past its
 // container, no unused bytes); nullopt otherwise.
 std::optional<uint64_t> infallible_size(const Node& n) {
-    if (n.is_repeated() || n.is_window() || n.dissector || n.reassembles()) return std::nullopt;
+    // (Hand-offs never get here: they feed another dissector, see feeds_others.)
+    if (n.is_repeated() || n.is_window()) return std::nullopt;
     if (n.is_leaf()) {
         if (n.in_bit_group || !n.has_fixed_length() || n.fixed_bits % 8) return std::nullopt;
         return n.fixed_bits / 8;

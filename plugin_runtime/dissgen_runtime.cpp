@@ -1142,7 +1142,7 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
         }
         if (n->extra && n->extra->offsets_slot >= 0)
             dissect_located(st, n, tree, offset, end, in_summary); /* issue 10 */
-        else if (n->count.slot >= 0 || n->repeat_slot >= 0 || (n->extra && n->extra->repeat_rest))
+        else if (is_repeated(n))
             dissect_repeated(st, n, tree, offset, end, in_summary);
         else
             dissect_instance(st, n, tree, offset, end, in_summary, NULL);
