@@ -56,9 +56,53 @@ struct dg_table {
     gboolean overflow; /* more than DG_MAX_TABLE instances */
 };
 
+/* Text being built (summaries, the Info column): a buffer in the packet pool
+ * with inline appends. wmem_strbuf_new() and its appends cost several times
+ * more, and summary lines run this on every frame (issue 14). */
+struct dg_text {
+    wmem_allocator_t *pool;
+    char *data;   /* NUL-terminated */
+    gsize len, cap;
+};
+
+/* One allocation: the struct and a first buffer that most texts never outgrow. */
+dg_text *text_new(wmem_allocator_t *pool)
+{
+    const gsize first = 120;
+    dg_text *t = (dg_text *)wmem_alloc(pool, sizeof(dg_text) + first);
+    t->pool = pool;
+    t->data = (char *)(t + 1);
+    t->data[0] = '\0';
+    t->len = 0;
+    t->cap = first;
+    return t;
+}
+
+void text_append(dg_text *t, const char *s, gsize n)
+{
+    if (t->len + n >= t->cap) {
+        gsize cap = MAX(2 * t->cap, t->len + n + 1);
+        char *bigger = (char *)wmem_alloc(t->pool, cap);
+        memcpy(bigger, t->data, t->len + 1);
+        t->data = bigger; /* the old buffer goes with the pool */
+        t->cap = cap;
+    }
+    memcpy(t->data + t->len, s, n);
+    t->len += n;
+    t->data[t->len] = '\0';
+}
+
+void text_truncate(dg_text *t, gsize len)
+{
+    if (len < t->len) {
+        t->len = len;
+        t->data[len] = '\0';
+    }
+}
+
 /* Summaries of one repeated node's instances, gathered for the Info column. */
 struct dg_summaries {
-    wmem_strbuf_t *text;
+    dg_text *text;
     guint count;
 };
 
@@ -76,8 +120,8 @@ struct dg_state {
     gboolean want_text;   /* summaries are shown: a visible tree, or columns */
     gboolean want_info;   /* the Info column is shown (pinfo->cinfo) */
     gboolean quiet;       /* issue 14: no tree, no tap listener: step over quiet nodes (dg_node.quiet_size) */
-    wmem_strbuf_t *info;  /* the Info column being built (want_info) */
-    wmem_strbuf_t *text;  /* scratch for one container's summary (want_text) */
+    dg_text *info;  /* the Info column being built (want_info) */
+    dg_text *text;  /* scratch for one container's summary (want_text) */
     guint64 group_value;  /* the bit group being decoded */
     guint32 hook_value;   /* pinfo->match_uint on entry: the hook (or Decode As) value, for ifhook */
     dg_tap_data *tap;     /* what the stats tree counts; NULL when nobody listens */
@@ -256,13 +300,12 @@ gboolean condition_holds(const dg_state *st, const dg_node *n)
     return st->present[n->if_slot] && in_ranges(st->p, n->in_first, n->in_count, s->value);
 }
 
-/* Summary text is built with memcpy appends (wmem_strbuf_append copies with
- * g_strlcpy, byte by byte) and hand-made numbers instead of printf: it runs
- * for every instance of a summarised container. */
-void append_str(wmem_strbuf_t *out, const char *text) { wmem_strbuf_append_len(out, text, strlen(text)); }
+/* Summary text is built with memcpy appends and hand-made numbers instead of
+ * printf: it runs for every instance of a summarised container. */
+void append_str(dg_text *out, const char *text) { text_append(out, text, strlen(text)); }
 
 /* Same text as "%" G_GINT64_MODIFIER "u". */
-void append_dec(wmem_strbuf_t *out, guint64 v)
+void append_dec(dg_text *out, guint64 v)
 {
     char buf[24];
     gsize i = sizeof buf;
@@ -270,11 +313,11 @@ void append_dec(wmem_strbuf_t *out, guint64 v)
         buf[--i] = (char)('0' + v % 10);
         v /= 10;
     } while (v);
-    wmem_strbuf_append_len(out, buf + i, sizeof buf - i);
+    text_append(out, buf + i, sizeof buf - i);
 }
 
 /* Same text as "0x%0*" G_GINT64_MODIFIER "x" with width `digits` (at most 16 used). */
-void append_hex(wmem_strbuf_t *out, guint64 v, guint digits)
+void append_hex(dg_text *out, guint64 v, guint digits)
 {
     static const char hex[] = "0123456789abcdef";
     char buf[2 + 16];
@@ -288,7 +331,7 @@ void append_hex(wmem_strbuf_t *out, guint64 v, guint digits)
     for (; n < digits && n < 16; n++) buf[--i] = '0';
     buf[--i] = 'x';
     buf[--i] = '0';
-    wmem_strbuf_append_len(out, buf + i, sizeof buf - i);
+    text_append(out, buf + i, sizeof buf - i);
 }
 
 /* The name an enum's value_string, val64_string or range_string gives the value, or NULL. */
@@ -311,7 +354,7 @@ nstime_t time_of(const dg_node *n, guint64 value)
 
 /* issue 10a: the values of string, stringz, ipv4, int, float and time leaves,
  * for summaries and the Info column (as the tree item shows them). */
-void append_typed_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s)
+void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
 {
     const dg_node *n = s->node;
     char buf[64];
@@ -350,7 +393,7 @@ void append_typed_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s
 }
 
 /* Appends a leaf's value as its tree item shows it, for summaries. */
-void append_shown_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s)
+void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s)
 {
     wmem_allocator_t *pool = st->pinfo->pool;
     const dg_node *n = s->node;
@@ -367,9 +410,9 @@ void append_shown_value(const dg_state *st, wmem_strbuf_t *out, const dg_slot *s
             append_str(out, name);
         } else {
             /* As the tree shows it: as many hex digits as the field's bits need. */
-            wmem_strbuf_append_len(out, "Unknown (", 9);
+            text_append(out, "Unknown (", 9);
             append_hex(out, s->value, (n->bits + 3) / 4);
-            wmem_strbuf_append_len(out, ")", 1);
+            text_append(out, ")", 1);
         }
         return;
     }
@@ -412,23 +455,23 @@ gboolean part_decoded(const dg_state *st, guint first, guint count)
  * placeholder among them showed nothing (not decoded, or empty), which drops
  * the optional part {?...} around it. Outside optional parts a value that was
  * not decoded shows as "-". */
-gboolean append_pieces(const dg_state *st, wmem_strbuf_t *out, guint first, guint count)
+gboolean append_pieces(const dg_state *st, dg_text *out, guint first, guint count)
 {
     gboolean complete = TRUE;
     for (guint i = first; i < first + count; i++) {
         const dg_summary_piece *piece = &st->p->pieces[i];
         if (piece->group) {
-            gsize mark = wmem_strbuf_get_len(out);
+            gsize mark = out->len;
             if (part_decoded(st, i + 1, piece->group) && !append_pieces(st, out, i + 1, piece->group))
-                wmem_strbuf_truncate(out, mark); /* a value with empty text */
+                text_truncate(out, mark); /* a value with empty text */
             i += piece->group;
         } else if (piece->slot < 0) {
             append_str(out, piece->text);
         } else {
             const dg_slot *s = &st->slots[piece->slot];
-            gsize before = wmem_strbuf_get_len(out);
+            gsize before = out->len;
             if (!st->present[piece->slot]) {
-                wmem_strbuf_append_len(out, "-", 1);
+                text_append(out, "-", 1);
                 complete = FALSE;
                 continue;
             }
@@ -438,7 +481,7 @@ gboolean append_pieces(const dg_state *st, wmem_strbuf_t *out, guint first, guin
             } else {
                 append_shown_value(st, out, s);
             }
-            if (wmem_strbuf_get_len(out) == before) complete = FALSE;
+            if (out->len == before) complete = FALSE;
         }
     }
     return complete;
@@ -447,16 +490,16 @@ gboolean append_pieces(const dg_state *st, wmem_strbuf_t *out, guint first, guin
 /* The summary of container n, in st->text (valid until the next summary). */
 const char *summary_text(const dg_state *st, const dg_node *n)
 {
-    wmem_strbuf_t *out = st->text;
-    wmem_strbuf_truncate(out, 0);
+    dg_text *out = st->text;
+    text_truncate(out, 0);
     append_pieces(st, out, n->summary_first, n->summary_count);
-    return wmem_strbuf_get_str(out);
+    return out->data;
 }
 
 void info_append(dg_state *st, const char *text, gsize len)
 {
-    if (wmem_strbuf_get_len(st->info) > 0) wmem_strbuf_append_len(st->info, ", ", 2);
-    wmem_strbuf_append_len(st->info, text, len);
+    if (st->info->len > 0) text_append(st->info, ", ", 2);
+    text_append(st->info, text, len);
 }
 
 void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
@@ -762,12 +805,12 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
      * (a summarised container inside another one only has its item). */
     if (n->summary_count > 0 && st->want_text && (item || (!in_summary && st->want_info))) {
         const char *text = summary_text(st, n);
-        gsize text_len = wmem_strbuf_get_len(st->text);
+        gsize text_len = st->text->len;
         if (item) proto_item_append_text(item, ": %s", text);
         if (!in_summary && st->want_info) {
             if (sink) {
-                if (sink->count++) wmem_strbuf_append_len(sink->text, ", ", 2);
-                wmem_strbuf_append_len(sink->text, text, text_len);
+                if (sink->count++) text_append(sink->text, ", ", 2);
+                text_append(sink->text, text, text_len);
             } else {
                 info_append(st, text, text_len);
             }
@@ -794,7 +837,7 @@ void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
 gboolean summaries_begin(const dg_state *st, const dg_node *n, gboolean in_summary, dg_summaries *s)
 {
     if (in_summary || n->summary_count == 0 || !st->want_info) return FALSE;
-    s->text = wmem_strbuf_new(st->pinfo->pool, "");
+    s->text = text_new(st->pinfo->pool);
     return TRUE;
 }
 
@@ -802,14 +845,14 @@ void summaries_end(dg_state *st, const dg_node *n, const dg_summaries *s)
 {
     if (s->count > 1) {
         /* "NAME ×COUNT: SUMMARY, SUMMARY, ..." */
-        if (wmem_strbuf_get_len(st->info) > 0) wmem_strbuf_append_len(st->info, ", ", 2);
+        if (st->info->len > 0) text_append(st->info, ", ", 2);
         append_str(st->info, n->name);
-        wmem_strbuf_append_len(st->info, " \xc3\x97", 3);
+        text_append(st->info, " \xc3\x97", 3);
         append_dec(st->info, s->count);
-        wmem_strbuf_append_len(st->info, ": ", 2);
-        wmem_strbuf_append_len(st->info, wmem_strbuf_get_str(s->text), wmem_strbuf_get_len(s->text));
+        text_append(st->info, ": ", 2);
+        text_append(st->info, s->text->data, s->text->len);
     } else if (s->count == 1) {
-        info_append(st, wmem_strbuf_get_str(s->text), wmem_strbuf_get_len(s->text));
+        info_append(st, s->text->data, s->text->len);
     }
 }
 
@@ -1005,21 +1048,21 @@ gboolean selected(const dg_state *st, const dg_node *n, gint offset, gboolean *c
 /* The name of instance i of a block at a stride: "{i}" replaced by i, or " i" appended. */
 const char *instance_name(const dg_state *st, const dg_node *n, guint i)
 {
-    wmem_strbuf_t *out = wmem_strbuf_new(st->pinfo->pool, "");
+    dg_text *out = text_new(st->pinfo->pool);
     const char *name = n->name, *mark;
     gboolean marked = FALSE;
     while ((mark = strstr(name, "{i}")) != NULL) {
-        wmem_strbuf_append_len(out, name, (gsize)(mark - name));
+        text_append(out, name, (gsize)(mark - name));
         append_dec(out, i);
         name = mark + 3;
         marked = TRUE;
     }
     append_str(out, name);
     if (!marked) {
-        wmem_strbuf_append_len(out, " ", 1);
+        text_append(out, " ", 1);
         append_dec(out, i);
     }
-    return wmem_strbuf_get_str(out);
+    return out->data;
 }
 
 /* Renames the item a block instance added after `before` in tree: its label
@@ -1387,8 +1430,8 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
      * filter-only pass (-Y with -w) has neither. */
     st.want_info = pinfo->cinfo != NULL;
     st.want_text = st.want_info || (tree != NULL && PTREE_DATA(tree)->visible);
-    st.info = st.want_info ? wmem_strbuf_new(pinfo->pool, "") : NULL;
-    st.text = st.want_text ? wmem_strbuf_new(pinfo->pool, "") : NULL;
+    st.info = st.want_info ? text_new(pinfo->pool) : NULL;
+    st.text = st.want_text ? text_new(pinfo->pool) : NULL;
     if (stats_tap >= 0 && have_tap_listener(stats_tap)) st.tap = wmem_new0(pinfo->pool, dg_tap_data);
     /* issue 14: nobody sees items or expert infos without a tree and without
      * a tap listener (the Expert dialog and -z expert are taps): quiet nodes
@@ -1407,7 +1450,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     }
 
     if (st.tap) tap_queue_packet(stats_tap, pinfo, st.tap);
-    const char *info = st.info && wmem_strbuf_get_len(st.info) > 0 ? wmem_strbuf_get_str(st.info) : p->name;
+    const char *info = st.info && st.info->len > 0 ? st.info->data : p->name;
     if (first_message)
         col_add_str(pinfo->cinfo, COL_INFO, info);
     else

@@ -37,8 +37,10 @@ bus_model *bus_new(const dg_bus *design);
  * which slave each datagram addresses. */
 bus_frame *bus_sent(bus_model *m, tvbuff_t *tvb, packet_info *pinfo);
 /* First pass. A returned frame with the frame as sent: what it teaches about
- * the bus, and which slave each datagram addresses. */
-bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, packet_info *pinfo);
+ * the bus, and which slave each datagram addresses. s and b are their first n
+ * datagrams as read_frame() read them. */
+bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
+                        packet_info *pinfo);
 /* Every pass: the slave items and the network-check expert infos. */
 void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
 void bus_register(int proto, const char *filter);

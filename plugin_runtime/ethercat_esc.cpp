@@ -181,7 +181,7 @@ void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, packet_i
     r->d = wmem_alloc0_array(wmem_file_scope(), compared, r->count ? r->count : 1);
     for (guint i = 0; i < r->count; i++) compare_datagram(&r->d[i], &sent[i], &back[i], request, response);
     check_forwarding(r);
-    r->bus = bus_returned(((capture_hints *)capture)->bus, request, response, pinfo);
+    r->bus = bus_returned(((capture_hints *)capture)->bus, request, response, sent, back, r->count, pinfo);
     return r;
 }
 
