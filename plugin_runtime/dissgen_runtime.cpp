@@ -1029,12 +1029,21 @@ gboolean whens_hold(const dg_state *st, const dg_node *n, gint node_start)
 /* Whether n is decoded at `offset`. *chain_taken says whether a member of the
  * current chain of alternatives (a conditional node and the otherwise nodes
  * after it) was decoded; an otherwise node is skipped when one was. */
-gboolean selected(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken)
+gboolean selected_conditional(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken);
+
+inline gboolean selected(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken)
 {
     if (!n->alt && !n->hook_count && n->if_slot < 0 && !n->when_count && !n->extra) {
         *chain_taken = FALSE; /* unconditional: ends any chain */
         return TRUE;
     }
+    return selected_conditional(st, n, offset, chain_taken);
+}
+
+/* selected() for a node with a condition, an otherwise or a direction: out of
+ * line, so that the unconditional test above is inlined into the walk. */
+gboolean selected_conditional(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken)
+{
     gboolean otherwise = (n->alt & DG_ALT_OTHERWISE) != 0;
     if (otherwise && *chain_taken) return FALSE;
     guint8 direction = n->extra ? n->extra->direction : (guint8)DG_DIR_ANY; /* issue 10a */
