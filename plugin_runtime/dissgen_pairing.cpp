@@ -65,6 +65,8 @@ struct queue {
 };
 
 struct key_entry {
+    pair_key *key;               /* its key in capture_state.keys */
+    guint records;               /* its touch records in capture_state.touched */
     queue waiting;               /* this key's requests */
     guint32 last_frame;          /* the last message with this key (duplicates) */
     nstime_t last_time;
@@ -74,8 +76,15 @@ struct key_entry {
     guint last_length;
 };
 
+/* A key entry was the last message of its key in this frame; oldest first. */
+struct touch {
+    touch *next;
+    key_entry *e;
+};
+
 struct capture_state {
     wmem_map_t *keys;            /* pair_key -> key_entry */
+    touch *touched, *touched_tail; /* key entries in the order they were last used */
     queue sent;                  /* every key's requests, in capture order */
     guint waiting;               /* requests not yet answered nor given up */
     guint64 requests;            /* the last request's seq */
@@ -132,6 +141,7 @@ key_entry *entry_for(capture_state *c, const guint64 *keys, guint key_count)
     k->count = key_count;
     k->values = (guint64 *)wmem_memdup(wmem_file_scope(), keys, key_count * sizeof(guint64));
     e = wmem_new0(wmem_file_scope(), key_entry);
+    e->key = k;
     wmem_map_insert(c->keys, k, e);
     return e;
 }
@@ -160,8 +170,17 @@ gboolean unchanged_return(const capture_state *c, const key_entry *e, const pack
     return analysis->is_response(c->analysis, &e->last_src, &pinfo->src) < 0;
 }
 
-void remember_last(key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length, guint8 role)
+void remember_last(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length, guint8 role)
 {
+    touch *t = wmem_new(wmem_file_scope(), touch);
+    t->next = NULL;
+    t->e = e;
+    e->records++;
+    if (c->touched_tail)
+        c->touched_tail->next = t;
+    else
+        c->touched = t;
+    c->touched_tail = t;
     e->last_time = pinfo->abs_ts;
     e->last_role = role;
     wmem_free(wmem_file_scope(), e->last_bytes);
@@ -267,9 +286,77 @@ void enqueue(queue *qu, pending *q, gboolean in_key)
     q->queues++;
 }
 
+/* --- what the first pass forgets --------------------------------------------
+ * Keys that are never used again (an ENIP sender context, a generated
+ * capture's random EtherCAT indexes) would otherwise keep their entry, their
+ * last message's bytes and their unanswered requests' bytes for the whole
+ * capture. Nothing decides anything about them after `stale_after` timeouts
+ * (duplicates need a hundredth of one, answers one), so a request that old is
+ * given up now and a key entry that old is removed: a message with that key
+ * later finds a fresh entry, which behaves exactly as the stale one would.
+ * The margin keeps captures whose clocks step back a little (two interfaces)
+ * paired as before. */
+const double stale_after = 10;
+
+gboolean long_ago(const nstime_t *then, const packet_info *pinfo)
+{
+    nstime_t age;
+    nstime_delta(&age, &pinfo->abs_ts, then);
+    return nstime_to_sec(&age) > stale_after * protocol->pairing->timeout;
+}
+
+/* Requests at the head of the capture's queue that nothing can answer any more. */
+void forget_requests(capture_state *c, const packet_info *pinfo)
+{
+    while (c->sent.head) {
+        pending *q = c->sent.head;
+        if (!q->done) {
+            if (c->answered_max <= q->txn->seq + max_overtaken && !long_ago(&q->txn->request_time, pinfo)) return;
+            retire(c, q);
+        }
+        c->sent.head = q->next_sent;
+        if (!c->sent.head) c->sent.tail = NULL;
+        release(q);
+    }
+}
+
+/* Removes e when every request of its key is done; FALSE keeps it. */
+gboolean forget_key(capture_state *c, key_entry *e)
+{
+    for (pending *q = e->waiting.head; q; q = q->next)
+        if (!q->done) return FALSE;
+    for (pending *q = e->waiting.head, *next; q; q = next) {
+        next = q->next;
+        release(q);
+    }
+    wmem_map_remove(c->keys, e->key);
+    wmem_free(wmem_file_scope(), e->key->values);
+    wmem_free(wmem_file_scope(), e->key);
+    wmem_free(wmem_file_scope(), e->last_bytes);
+    free_address_wmem(wmem_file_scope(), &e->last_src);
+    wmem_free(wmem_file_scope(), e);
+    return TRUE;
+}
+
+/* Key entries last used long ago, oldest first; an entry goes with its last record. */
+void forget_keys(capture_state *c, const packet_info *pinfo)
+{
+    while (c->touched) {
+        touch *t = c->touched;
+        key_entry *e = t->e;
+        if (e->records == 1 && !long_ago(&e->last_time, pinfo)) return;
+        c->touched = t->next;
+        if (!c->touched) c->touched_tail = NULL;
+        wmem_free(wmem_file_scope(), t);
+        if (--e->records == 0) forget_key(c, e);
+    }
+}
+
 dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count, guint length)
 {
     capture_state *c = current_capture();
+    forget_requests(c, pinfo);
+    forget_keys(c, pinfo);
     dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
     if (analysis && analysis->see) analysis->see(c->analysis, tvb, pinfo);
     key_entry *e = entry_for(c, keys, key_count);
@@ -286,7 +373,7 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     pending *q = take_answered(c, e, tvb, pinfo, length, unchanged);
     gboolean returned = !q && analysis && analysis->is_returned && analysis->is_returned(c->analysis, &pinfo->src);
     if (returned) q = take_oldest(c, pinfo);
-    remember_last(e, tvb, pinfo, length, q ? DG_ROLE_RESPONSE : DG_ROLE_REQUEST); /* an orphan: a request for step 2 */
+    remember_last(c, e, tvb, pinfo, length, q ? DG_ROLE_RESPONSE : DG_ROLE_REQUEST); /* an orphan: a request for step 2 */
     if (q) {
         dg_transaction *t = q->txn;
         t->response_frame = pinfo->num;

@@ -121,15 +121,16 @@ struct bus_event {
     const char *text;
 };
 
+/* Kept for every datagram of the capture (wmem_file_scope): small. Its items
+ * go over dgram, the datagram in this frame. */
 struct addressed {
-    gint offset, length;
-    gint32 position;     /* -1: not known on the first pass */
-    guint16 station;     /* FPxx: the ADP */
-    gboolean by_station;
-    gint32 expected_wkc; /* logical commands: -1 when not known */
-    guint8 stats;        /* returned frames: stat_flags, for the statistics tree */
-    gboolean logical;    /* LRD/LWR/LRW: dgram is the datagram in this frame */
     datagram dgram;
+    gint32 expected_wkc; /* logical commands: -1 when not known */
+    gint16 position;     /* -1: not known on the first pass */
+    guint16 station;     /* FPxx: the ADP */
+    guint8 stats;        /* returned frames: stat_flags, for the statistics tree */
+    guint8 by_station : 1;
+    guint8 logical : 1;  /* LRD/LWR/LRW */
 };
 
 enum stat_flags { ST_WKC_ERROR = 1, ST_AL_CHANGE = 2, ST_MAILBOX = 4 };
@@ -656,26 +657,30 @@ guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagr
 /* The slave a datagram as sent addresses. */
 addressed address_of(const bus_model *m, const datagram *s)
 {
-    addressed a = {s->offset, 12 + s->length, -1, 0, FALSE, -1, 0, logical(s->cmd), *s};
+    addressed a = {};
+    a.dgram = *s;
+    a.position = -1;
+    a.logical = logical(s->cmd);
     guint shares;
     a.expected_wkc = expected_wkc(m, s, NULL, &shares);
     if (by_position(s->cmd)) {
         guint16 p = position_of(s->adp);
-        if (p < max_positions) a.position = p;
+        if (p < max_positions) a.position = (gint16)p;
     } else if (by_station(s->cmd)) {
         a.by_station = TRUE;
         a.station = s->adp;
-        a.position = station_position(m, s->adp);
+        a.position = (gint16)station_position(m, s->adp);
     }
     return a;
 }
 
 bus_frame *new_frame(const bus_model *m, guint count, const events *ev)
 {
-    bus_frame *f = wmem_new0(wmem_file_scope(), bus_frame);
+    /* One allocation for the frame and its datagrams. */
+    bus_frame *f = (bus_frame *)wmem_alloc0(wmem_file_scope(), sizeof(bus_frame) + count * sizeof(addressed));
     f->model = m;
     f->count = count;
-    f->d = wmem_alloc0_array(wmem_file_scope(), addressed, count ? count : 1);
+    f->d = (addressed *)(f + 1);
     if (ev && ev->count) {
         f->event_count = ev->count;
         f->events = (bus_event *)wmem_memdup(wmem_file_scope(), ev->list, ev->count * sizeof(bus_event));
@@ -688,6 +693,7 @@ void show_slave(const bus_model *m, const addressed *a, tvbuff_t *tvb, packet_in
     gint32 position = a->position;
     if (position < 0 && a->by_station && PINFO_FD_VISITED(pinfo)) position = station_position(m, a->station);
     if (position < 0) return;
+    gint offset = a->dgram.offset, length = 12 + a->dgram.length;
     const slave_state *s = m->slaves[position];
     const dg_bus *b = m->design;
     gint32 device = learned_device(b, s);
@@ -698,23 +704,23 @@ void show_slave(const bus_model *m, const addressed *a, tvbuff_t *tvb, packet_in
         dg_label_str(&label, ": ");
         dg_label_str(&label, b->devices[device].name);
     }
-    proto_item *item = proto_tree_add_none_format(tree, hf_slave, tvb, a->offset, a->length, "%s", label.text);
+    proto_item *item = proto_tree_add_none_format(tree, hf_slave, tvb, offset, length, "%s", label.text);
     proto_item_set_generated(item);
     proto_tree *sub = proto_item_add_subtree(item, ett_slave);
-    proto_item_set_generated(proto_tree_add_uint(sub, hf_position, tvb, a->offset, a->length, (guint32)position));
+    proto_item_set_generated(proto_tree_add_uint(sub, hf_position, tvb, offset, length, (guint32)position));
     if (a->by_station || (s && s->station_known))
         proto_item_set_generated(
-            proto_tree_add_uint(sub, hf_station, tvb, a->offset, a->length, a->by_station ? a->station : s->station));
+            proto_tree_add_uint(sub, hf_station, tvb, offset, length, a->by_station ? a->station : s->station));
     if (!s) return;
     if (s->alias_known)
-        proto_item_set_generated(proto_tree_add_uint(sub, hf_alias, tvb, a->offset, a->length, s->alias));
+        proto_item_set_generated(proto_tree_add_uint(sub, hf_alias, tvb, offset, length, s->alias));
     const int *hfs[] = {&hf_vendor, &hf_product, &hf_revision, &hf_serial};
     const guint words[] = {W_VENDOR, W_PRODUCT, W_REVISION, W_SERIAL};
     for (guint i = 0; i < G_N_ELEMENTS(words); i++)
         if (words_known(s, words[i]))
-            proto_item_set_generated(proto_tree_add_uint(sub, *hfs[i], tvb, a->offset, a->length, word32(s, words[i])));
+            proto_item_set_generated(proto_tree_add_uint(sub, *hfs[i], tvb, offset, length, word32(s, words[i])));
     if (device >= 0)
-        proto_item_set_generated(proto_tree_add_string(sub, hf_name, tvb, a->offset, a->length, b->devices[device].type));
+        proto_item_set_generated(proto_tree_add_string(sub, hf_name, tvb, offset, length, b->devices[device].type));
 }
 
 /* Up to 64 bits of the process image, least significant bit first. */
@@ -1096,10 +1102,8 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const data
     f->returned = TRUE;
     for (guint i = 0; i < n; i++) {
         f->d[i] = address_of(m, &s[i]);
-        f->d[i].offset = b[i].offset; /* the items go over the returned datagram */
-        f->d[i].length = 12 + b[i].length;
         f->d[i].stats = flags[i];
-        f->d[i].dgram = b[i];
+        f->d[i].dgram = b[i]; /* the items go over the returned datagram */
     }
     return f;
 }
@@ -1112,7 +1116,7 @@ void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree 
         show_slave(f->model, a, tvb, pinfo, tree);
         if (a->logical) show_process_data(f->model, &a->dgram, f->returned, pinfo->num, tvb, tree);
         if (a->expected_wkc >= 0)
-            proto_item_set_generated(proto_tree_add_uint(tree, hf_wkc_expected, tvb, a->offset + a->length - 2, 2,
+            proto_item_set_generated(proto_tree_add_uint(tree, hf_wkc_expected, tvb, a->dgram.offset + 10 + a->dgram.length, 2,
                                                          (guint32)a->expected_wkc));
     }
     for (guint i = 0; i < f->event_count; i++) {

@@ -40,19 +40,23 @@ using namespace dg_ecat;
 
 enum esc_change { CHANGED_CMD = 1, CHANGED_IDX = 2, CHANGED_LEN = 4, CHANGED_ADDR = 8 };
 
-/* One returned datagram compared with the one sent. */
+/* One returned datagram compared with the one sent; kept for every returned
+ * datagram of the capture (wmem_file_scope), so what the two datagrams say
+ * is not stored twice. Its items go over `back`, the returned datagram. */
 struct compared {
-    gint offset, length;    /* the returned datagram in the response */
-    guint8 cmd;
-    guint8 changed;         /* esc_change bits */
-    gboolean has_advance;   /* auto-increment/broadcast: advance is meaningful */
-    gboolean data_changed;
-    gboolean forwarding;    /* advanced differently from the frame's others */
+    datagram sent, back;
     guint16 advance;        /* ADP advance: slaves passed */
     guint16 majority;       /* the frame's usual advance */
-    gint32 wkc_added;
-    datagram sent, back;
+    guint8 changed;         /* esc_change bits */
+    guint8 has_advance : 1; /* auto-increment/broadcast: advance is meaningful */
+    guint8 data_changed : 1;
+    guint8 forwarding : 1;  /* advanced differently from the frame's others */
 };
+
+/* The returned datagram's bytes, header to working counter. */
+gint span(const compared *c) { return 12 + c->back.length; }
+
+gint32 wkc_added(const compared *c) { return (gint32)c->back.wkc - (gint32)c->sent.wkc; }
 
 struct result {
     guint count;
@@ -92,9 +96,6 @@ void compare_datagram(compared *c, const datagram *s, const datagram *b, tvbuff_
 {
     c->sent = *s;
     c->back = *b;
-    c->offset = b->offset;
-    c->length = 12 + b->length;
-    c->cmd = b->cmd;
     if (s->cmd != b->cmd) c->changed |= CHANGED_CMD;
     if (s->idx != b->idx) c->changed |= CHANGED_IDX;
     if (s->length != b->length) c->changed |= CHANGED_LEN;
@@ -111,7 +112,6 @@ void compare_datagram(compared *c, const datagram *s, const datagram *b, tvbuff_
     c->data_changed = s->length != b->length ||
                       (common > 0 && tvb_memeql(response, b->offset + 10,
                                                 (const guint8 *)tvb_get_ptr(request, s->offset + 10, common), common) != 0);
-    c->wkc_added = (gint32)b->wkc - (gint32)s->wkc;
 }
 
 /* The frame's usual advance is the most common one among its auto-increment
@@ -173,12 +173,19 @@ gboolean esc_is_returned(void *capture, const address *src)
 void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, packet_info *pinfo)
 {
     datagram sent[max_datagrams], back[max_datagrams];
-    result *r = wmem_new0(wmem_file_scope(), result);
-    r->sent_count = read_frame(request, &r->sent_length, sent, max_datagrams);
-    r->back_count = read_frame(response, &r->back_length, back, max_datagrams);
-    r->length_changed = r->sent_length != r->back_length || r->sent_count != r->back_count;
-    r->count = MIN(r->sent_count, r->back_count);
-    r->d = wmem_alloc0_array(wmem_file_scope(), compared, r->count ? r->count : 1);
+    guint sent_length, back_length;
+    guint sent_count = read_frame(request, &sent_length, sent, max_datagrams);
+    guint back_count = read_frame(response, &back_length, back, max_datagrams);
+    guint count = MIN(sent_count, back_count);
+    /* One allocation for the frame and its datagrams. */
+    result *r = (result *)wmem_alloc0(wmem_file_scope(), sizeof(result) + count * sizeof(compared));
+    r->d = (compared *)(r + 1);
+    r->count = count;
+    r->sent_length = sent_length;
+    r->back_length = back_length;
+    r->sent_count = sent_count;
+    r->back_count = back_count;
+    r->length_changed = sent_length != back_length || sent_count != back_count;
     for (guint i = 0; i < r->count; i++) compare_datagram(&r->d[i], &sent[i], &back[i], request, response);
     check_forwarding(r);
     r->bus = bus_returned(((capture_hints *)capture)->bus, request, response, sent, back, r->count, pinfo);
@@ -193,25 +200,25 @@ proto_tree *show_datagram_items(const compared *c, guint i, tvbuff_t *tvb, proto
     dg_label_str(&label, "Datagram ");
     dg_label_uint(&label, i + 1);
     dg_label_str(&label, " (");
-    dg_label_str(&label, command_name(c->cmd));
+    dg_label_str(&label, command_name(c->back.cmd));
     dg_label_str(&label, "): working counter ");
-    dg_label_int(&label, c->wkc_added, TRUE);
+    dg_label_int(&label, wkc_added(c), TRUE);
     if (c->has_advance) {
         dg_label_str(&label, ", ");
         dg_label_uint(&label, c->advance);
         dg_label_str(&label, " slaves passed");
     }
     dg_label_str(&label, c->data_changed ? ", data changed" : ", data unchanged");
-    proto_item *item = proto_tree_add_none_format(tree, hf_datagram, tvb, c->offset, c->length, "%s", label.text);
+    proto_item *item = proto_tree_add_none_format(tree, hf_datagram, tvb, c->back.offset, span(c), "%s", label.text);
     proto_item_set_generated(item);
     proto_tree *sub = proto_item_add_subtree(item, ett_datagram);
-    proto_item *it = proto_tree_add_int(sub, hf_wkc_added, tvb, c->offset + c->length - 2, 2, c->wkc_added);
+    proto_item *it = proto_tree_add_int(sub, hf_wkc_added, tvb, c->back.offset + span(c) - 2, 2, wkc_added(c));
     proto_item_set_generated(it);
     if (c->has_advance) {
-        it = proto_tree_add_uint(sub, hf_slaves_passed, tvb, c->offset + 2, 2, c->advance);
+        it = proto_tree_add_uint(sub, hf_slaves_passed, tvb, c->back.offset + 2, 2, c->advance);
         proto_item_set_generated(it);
     }
-    it = proto_tree_add_boolean(sub, hf_data_changed, tvb, c->offset + 10, c->length - 12, c->data_changed);
+    it = proto_tree_add_boolean(sub, hf_data_changed, tvb, c->back.offset + 10, span(c) - 12, c->data_changed);
     proto_item_set_generated(it);
     return sub;
 }
@@ -231,18 +238,18 @@ void show_datagram_experts(const compared *c, guint i, tvbuff_t *tvb, packet_inf
         if (c->changed & CHANGED_ADDR)
             wmem_strbuf_append_printf(what, ", address 0x%04x%04x came back as 0x%04x%04x", c->sent.ado, c->sent.adp,
                                       c->back.ado, c->back.adp);
-        proto_tree_add_expert_format(tree, pinfo, &ei_changed, tvb, c->offset, c->length, "Datagram %u (%s)%s", i + 1,
+        proto_tree_add_expert_format(tree, pinfo, &ei_changed, tvb, c->back.offset, span(c), "Datagram %u (%s)%s", i + 1,
                                      cmd, wmem_strbuf_get_str(what));
     }
     if (is_write(c->sent.cmd) && c->data_changed && !(c->changed & CHANGED_LEN))
-        proto_tree_add_expert_format(tree, pinfo, &ei_write_changed, tvb, c->offset + 10, c->length - 12,
+        proto_tree_add_expert_format(tree, pinfo, &ei_write_changed, tvb, c->back.offset + 10, span(c) - 12,
                                      "Datagram %u (%s): the written data came back changed", i + 1, cmd);
-    if (c->wkc_added < 0)
-        proto_tree_add_expert_format(tree, pinfo, &ei_wkc_down, tvb, c->offset + c->length - 2, 2,
+    if (wkc_added(c) < 0)
+        proto_tree_add_expert_format(tree, pinfo, &ei_wkc_down, tvb, c->back.offset + span(c) - 2, 2,
                                      "Datagram %u (%s): working counter went down from %u to %u", i + 1, cmd,
                                      c->sent.wkc, c->back.wkc);
     if (c->forwarding)
-        proto_tree_add_expert_format(tree, pinfo, &ei_forwarding, tvb, c->offset + 2, 2,
+        proto_tree_add_expert_format(tree, pinfo, &ei_forwarding, tvb, c->back.offset + 2, 2,
                                      "Datagram %u (%s): auto-increment address advanced by %u, the frame's other "
                                      "datagrams by %u",
                                      i + 1, cmd, c->advance, c->majority);
@@ -313,10 +320,10 @@ void esc_stats_response(stats_tree *st, int parent, const void *data)
     for (guint i = 0; i < r->count; i++) {
         const compared *c = &r->d[i];
         tick_stat_node(st, st_wkc, parent, TRUE);
-        int cmd_id = tick_stat_node(st, command_name(c->cmd), st_wkc_id, TRUE);
+        int cmd_id = tick_stat_node(st, command_name(c->back.cmd), st_wkc_id, TRUE);
         g_snprintf(label, sizeof label, "working counter %u", c->back.wkc);
         tick_stat_node(st, label, cmd_id, FALSE);
-        if (c->wkc_added < 0) tick_stat_node(st, st_wkc_down, parent, FALSE);
+        if (wkc_added(c) < 0) tick_stat_node(st, st_wkc_down, parent, FALSE);
     }
     bus_stats_frame(st, parent, r->bus);
 }
