@@ -56,6 +56,7 @@ struct pending {
     gboolean done;
     dg_transaction *txn;
     address src;
+    guint8 src_bytes[16];  /* src's data when it fits (kept_address) */
     guint8 *bytes;  /* the request's bytes, kept for the analysis until answered */
     guint length;
 };
@@ -66,25 +67,20 @@ struct queue {
 
 struct key_entry {
     pair_key *key;               /* its key in capture_state.keys */
-    guint records;               /* its touch records in capture_state.touched */
+    key_entry *older, *newer;    /* capture_state's list, least recently used first */
     queue waiting;               /* this key's requests */
     guint32 last_frame;          /* the last message with this key (duplicates) */
     nstime_t last_time;
     guint8 last_role;
     address last_src;
+    guint8 last_src_bytes[16];
     guint8 *last_bytes;
     guint last_length;
 };
 
-/* A key entry was the last message of its key in this frame; oldest first. */
-struct touch {
-    touch *next;
-    key_entry *e;
-};
-
 struct capture_state {
     wmem_map_t *keys;            /* pair_key -> key_entry */
-    touch *touched, *touched_tail; /* key entries in the order they were last used */
+    key_entry *oldest, *newest;  /* key entries by their last message, least recent first */
     queue sent;                  /* every key's requests, in capture order */
     guint waiting;               /* requests not yet answered nor given up */
     guint64 requests;            /* the last request's seq */
@@ -117,6 +113,24 @@ gboolean key_equal(gconstpointer a, gconstpointer b)
 {
     const pair_key *x = (const pair_key *)a, *y = (const pair_key *)b;
     return x->count == y->count && (x->count == 0 || memcmp(x->values, y->values, x->count * sizeof(guint64)) == 0);
+}
+
+/* An address kept in `bytes` (a buffer of its holder) when it fits, which
+ * spares an allocation and a free per message; larger ones are copied. */
+template <gsize N> void keep_address(address *to, guint8 (&bytes)[N], const address *from)
+{
+    if (from->len >= 0 && (gsize)from->len <= N) {
+        if (from->len > 0) memcpy(bytes, from->data, (gsize)from->len);
+        set_address(to, from->type, from->len, from->len > 0 ? bytes : NULL);
+    } else {
+        copy_address_wmem(wmem_file_scope(), to, from);
+    }
+}
+
+template <gsize N> void drop_address(address *a, const guint8 (&bytes)[N])
+{
+    if (a->data && a->data != bytes) free_address_wmem(wmem_file_scope(), a);
+    clear_address(a);
 }
 
 void capture_init(void) { capture = NULL; }
@@ -170,23 +184,35 @@ gboolean unchanged_return(const capture_state *c, const key_entry *e, const pack
     return analysis->is_response(c->analysis, &e->last_src, &pinfo->src) < 0;
 }
 
+/* Takes e out of the capture's least-recently-used list (if it is there). */
+void unlink_entry(capture_state *c, key_entry *e)
+{
+    if (e->older)
+        e->older->newer = e->newer;
+    else if (c->oldest == e)
+        c->oldest = e->newer;
+    if (e->newer)
+        e->newer->older = e->older;
+    else if (c->newest == e)
+        c->newest = e->older;
+    e->older = e->newer = NULL;
+}
+
 void remember_last(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length, guint8 role)
 {
-    touch *t = wmem_new(wmem_file_scope(), touch);
-    t->next = NULL;
-    t->e = e;
-    e->records++;
-    if (c->touched_tail)
-        c->touched_tail->next = t;
+    unlink_entry(c, e);
+    e->older = c->newest;
+    if (c->newest)
+        c->newest->newer = e;
     else
-        c->touched = t;
-    c->touched_tail = t;
+        c->oldest = e;
+    c->newest = e;
     e->last_time = pinfo->abs_ts;
     e->last_role = role;
     wmem_free(wmem_file_scope(), e->last_bytes);
-    free_address_wmem(wmem_file_scope(), &e->last_src);
+    drop_address(&e->last_src, e->last_src_bytes);
     e->last_frame = pinfo->num;
-    copy_address_wmem(wmem_file_scope(), &e->last_src, &pinfo->src);
+    keep_address(&e->last_src, e->last_src_bytes, &pinfo->src);
     e->last_bytes = (guint8 *)tvb_memdup(wmem_file_scope(), tvb, 0, length);
     e->last_length = length;
 }
@@ -199,7 +225,7 @@ void retire(capture_state *c, pending *q)
     c->waiting--;
     wmem_free(wmem_file_scope(), q->bytes);
     q->bytes = NULL;
-    free_address_wmem(wmem_file_scope(), &q->src);
+    drop_address(&q->src, q->src_bytes);
 }
 
 void release(pending *q)
@@ -320,36 +346,28 @@ void forget_requests(capture_state *c, const packet_info *pinfo)
     }
 }
 
-/* Removes e when every request of its key is done; FALSE keeps it. */
-gboolean forget_key(capture_state *c, key_entry *e)
+/* Removes e and what it keeps. Its requests are given up: its last message,
+ * and so each of them, is long ago. */
+void forget_key(capture_state *c, key_entry *e)
 {
-    for (pending *q = e->waiting.head; q; q = q->next)
-        if (!q->done) return FALSE;
     for (pending *q = e->waiting.head, *next; q; q = next) {
         next = q->next;
+        retire(c, q);
         release(q);
     }
+    unlink_entry(c, e);
     wmem_map_remove(c->keys, e->key);
     wmem_free(wmem_file_scope(), e->key->values);
     wmem_free(wmem_file_scope(), e->key);
     wmem_free(wmem_file_scope(), e->last_bytes);
-    free_address_wmem(wmem_file_scope(), &e->last_src);
+    drop_address(&e->last_src, e->last_src_bytes);
     wmem_free(wmem_file_scope(), e);
-    return TRUE;
 }
 
-/* Key entries last used long ago, oldest first; an entry goes with its last record. */
+/* Key entries whose last message is long ago, least recently used first. */
 void forget_keys(capture_state *c, const packet_info *pinfo)
 {
-    while (c->touched) {
-        touch *t = c->touched;
-        key_entry *e = t->e;
-        if (e->records == 1 && !long_ago(&e->last_time, pinfo)) return;
-        c->touched = t->next;
-        if (!c->touched) c->touched_tail = NULL;
-        wmem_free(wmem_file_scope(), t);
-        if (--e->records == 0) forget_key(c, e);
-    }
+    while (c->oldest && long_ago(&c->oldest->last_time, pinfo)) forget_key(c, c->oldest);
 }
 
 dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count, guint length)
@@ -404,7 +422,7 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     fp->txn = t;
     pending *n = wmem_new0(wmem_file_scope(), pending);
     n->txn = t;
-    copy_address_wmem(wmem_file_scope(), &n->src, &pinfo->src);
+    keep_address(&n->src, n->src_bytes, &pinfo->src);
     if (analysis && analysis->compare) {
         n->bytes = (guint8 *)tvb_memdup(wmem_file_scope(), tvb, 0, length);
         n->length = length;

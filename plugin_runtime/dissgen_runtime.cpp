@@ -1447,7 +1447,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
      * are stepped over, the pairing does its first-pass work only. */
     st.quiet = tree == NULL && !tap_listeners_require_dissection();
 
-    proto_item *root = proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA);
+    proto_item *root = tree ? proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA) : NULL;
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
     gint offset = 0;
     dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
