@@ -375,7 +375,6 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     capture_state *c = current_capture();
     forget_requests(c, pinfo);
     forget_keys(c, pinfo);
-    dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
     if (analysis && analysis->see) analysis->see(c->analysis, tvb, pinfo);
     key_entry *e = entry_for(c, keys, key_count);
     gboolean again = same_again(c, e, tvb, pinfo, length);
@@ -383,6 +382,7 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     gboolean duplicate = again && !unchanged;
     c->last_frame = pinfo->num;
     if (duplicate) {
+        dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
         fp->role = DG_ROLE_DUPLICATE;
         fp->duplicate_of = e->last_frame;
         return fp;
@@ -393,6 +393,7 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     if (returned) q = take_oldest(c, pinfo);
     remember_last(c, e, tvb, pinfo, length, q ? DG_ROLE_RESPONSE : DG_ROLE_REQUEST); /* an orphan: a request for step 2 */
     if (q) {
+        dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
         dg_transaction *t = q->txn;
         t->response_frame = pinfo->num;
         nstime_delta(&t->round_trip, &pinfo->abs_ts, &t->request_time);
@@ -410,11 +411,19 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     }
 
     if (returned) {
+        dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
         fp->role = DG_ROLE_ORPHAN;
         return fp;
     }
+    /* A request: its frame's record and the transaction in one allocation. */
+    struct request_record {
+        dg_frame_pairing fp;
+        dg_transaction txn;
+    };
+    request_record *rec = wmem_new0(wmem_file_scope(), request_record);
+    dg_frame_pairing *fp = &rec->fp;
     if (analysis && analysis->sent) fp->analysis = analysis->sent(c->analysis, tvb, pinfo);
-    dg_transaction *t = wmem_new0(wmem_file_scope(), dg_transaction);
+    dg_transaction *t = &rec->txn;
     t->request_frame = pinfo->num;
     t->request_time = pinfo->abs_ts;
     t->seq = ++c->requests;

@@ -1428,8 +1428,19 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     st.p = p;
     st.tvb = tvb;
     st.pinfo = pinfo;
-    st.slots = wmem_alloc_array(pinfo->pool, dg_slot, p->slot_count ? p->slot_count : 1);
-    st.present = (guint8 *)wmem_alloc0(pinfo->pool, p->slot_count ? p->slot_count : 1);
+    /* The values of one message live on the stack when they fit (most rule
+     * files): two allocations fewer per message. Nothing keeps them after it. */
+    enum { stack_slots = 128 };
+    dg_slot slot_buf[stack_slots];
+    guint8 present_buf[stack_slots];
+    if (p->slot_count <= stack_slots) {
+        st.slots = slot_buf;
+        st.present = present_buf;
+        memset(present_buf, 0, p->slot_count);
+    } else {
+        st.slots = wmem_alloc_array(pinfo->pool, dg_slot, p->slot_count);
+        st.present = (guint8 *)wmem_alloc0(pinfo->pool, p->slot_count);
+    }
     st.packet_end = (gint)tvb_captured_length(tvb);
     st.hook_value = pinfo->match_uint;
     st.direction = direction_of(pinfo);
