@@ -531,8 +531,7 @@ void dg_pairing_register(const dg_protocol *p)
 }
 
 const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
-                                           const guint64 *keys, guint key_count, gint length, guint message,
-                                           gboolean unseen)
+                                           const guint64 *keys, guint key_count, gint length, guint message)
 {
     /* A message cut short before its first key field answers and asks nothing. */
     if (key_count == 0) return NULL;
@@ -544,7 +543,7 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, 
         fp = first_pass(tvb, pinfo, keys, key_count, len);
         p_add_proto_data(wmem_file_scope(), pinfo, *p->proto, frame_key + message, fp);
     }
-    if (!unseen) show(fp, tvb, pinfo, tree);
+    show(fp, tvb, pinfo, tree);
     return fp;
 }
 

@@ -91,12 +91,11 @@ void dg_pairing_register(const dg_protocol *p);
 /* After a message was decoded: pairs it on the first pass, then shows the
  * pairing in `tree`. `keys` are the values of the DG_KEY fields in decoding
  * order; `length` the bytes the message took; `message` its number within the
- * frame (0 for the first); `unseen`: no tree and no tap listener, so only
- * the first pass's work is done (issue 14). Returns what was found, for the
- * statistics. */
+ * frame (0 for the first). Without a tree only the expert infos are raised
+ * (their severity reaches the Expert column). Returns what was found, for
+ * the statistics. */
 const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
-                                           const guint64 *keys, guint key_count, gint length, guint message,
-                                           gboolean unseen);
+                                           const guint64 *keys, guint key_count, gint length, guint message);
 
 void dg_pairing_stats_init(const dg_protocol *p, stats_tree *st);
 void dg_pairing_stats_packet(const dg_protocol *p, stats_tree *st, packet_info *pinfo, const dg_frame_pairing *fp);

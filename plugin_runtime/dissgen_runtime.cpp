@@ -181,14 +181,21 @@ void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint 
 
 void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format, ...)
 {
+    if (offset > st->packet_end) offset = st->packet_end;
+    if (length < 0 || offset + length > st->packet_end) length = st->packet_end - offset;
+    st->stopped = TRUE;
+    if (st->quiet) {
+        /* No tree and no tap listener: nobody reads the text, but the
+         * severity still goes to the Expert column and the capture's highest
+         * severity, as Wireshark does for every expert info. */
+        proto_tree_add_expert(tree, st->pinfo, ei, st->tvb, offset, length);
+        return;
+    }
     va_list ap;
     va_start(ap, format);
     char *text = wmem_strdup_vprintf(st->pinfo->pool, format, ap);
     va_end(ap);
-    if (offset > st->packet_end) offset = st->packet_end;
-    if (length < 0 || offset + length > st->packet_end) length = st->packet_end - offset;
     proto_tree_add_expert_format(tree, st->pinfo, ei, st->tvb, offset, length, "%s", text);
-    st->stopped = TRUE;
 }
 
 /* A reference's value with its arithmetic applied. Values beyond 2^31 are
@@ -1453,9 +1460,10 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     st.info = st.want_info ? text_new(pinfo->pool) : NULL;
     st.text = st.want_text ? text_new(pinfo->pool) : NULL;
     if (stats_tap >= 0 && have_tap_listener(stats_tap)) st.tap = wmem_new0(pinfo->pool, dg_tap_data);
-    /* issue 14: nobody sees items or expert infos without a tree and without
-     * a tap listener (the Expert dialog and -z expert are taps): quiet nodes
-     * are stepped over, the pairing does its first-pass work only. */
+    /* issue 14: nobody sees items or the text of expert infos without a tree
+     * and without a tap listener (the Expert dialog and -z expert are taps):
+     * quiet nodes are stepped over, expert infos are raised without text
+     * (their severity still reaches the Expert column). */
     st.quiet = tree == NULL && !tap_listeners_require_dissection();
 
     proto_item *root = tree ? proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA) : NULL;
@@ -1465,7 +1473,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     proto_item_set_len(root, offset);
     if (p->pairing) {
         const dg_frame_pairing *fp =
-            dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, *messages - 1, st.quiet);
+            dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, *messages - 1);
         if (st.tap) st.tap->pairing = fp;
     }
 

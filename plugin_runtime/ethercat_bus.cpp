@@ -1111,7 +1111,9 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const data
 void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     if (!f) return;
-    for (guint i = 0; i < f->count; i++) {
+    /* Items only into a tree (without one, e.g. summary lines, the labels
+     * would be built for nobody); the expert infos below always. */
+    for (guint i = 0; tree && i < f->count; i++) {
         const addressed *a = &f->d[i];
         show_slave(f->model, a, tvb, pinfo, tree);
         if (a->logical) show_process_data(f->model, &a->dgram, f->returned, pinfo->num, tvb, tree);

@@ -8,7 +8,11 @@ io,stat,0`, which shows nothing per packet) turns that off, so the packet lines
 of the two runs must be the same, byte for byte: on generated EtherCAT frames
 of every command with malformed variants (truncated frames, lengths that lie),
 on the shipped samples, and on the corpus captures when ../shared/corpus is
-there; in one pass and with -2.
+there; in one pass and with -2. The generated frames are also shown with an
+Expert column: a quiet walk raises its expert infos without their text (the
+pairing's too), so the same frames must show a severity there. (Which one, when
+a frame has several, is Wireshark's business: without a tree the last one
+raised, with a tree the highest.)
 
     test_quiet.py --dissgen build/bin/dissgen --source-dir .
 """
@@ -66,6 +70,16 @@ class QuietWalk(unittest.TestCase):
         self.check(self.generated)
         lines = self.env.tshark(["-r", self.env.readable(self.generated)]).stdout
         self.assertIn("ECATR", lines)
+
+    def test_expert_column(self):
+        columns = ["-o", 'gui.column.format:"No.","%m","Expert","%a","Info","%i"']
+        for extra in ([], ["-2"]):
+            quiet, tapped = self.packet_lines(self.generated, columns + extra)
+            with_experts = [{line.split()[0] for line in lines if line.split()[1] in ("Error", "Warning", "Note", "Chat")}
+                            for lines in (quiet, tapped)]
+            self.assertGreater(len(with_experts[1]), 100, "the malformed frames raise expert infos")
+            self.assertEqual(with_experts[0], with_experts[1], "frames with a severity in the Expert column%s"
+                             % (" (-2)" if extra else ""))
 
     def test_samples(self):
         samples = os.path.join(os.path.abspath(ARGS.source_dir), "samples")
