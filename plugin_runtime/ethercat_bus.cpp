@@ -25,7 +25,6 @@
 #include "dissgen_label.h"
 
 #include <epan/expert.h>
-#include <wsutil/pint.h>
 
 #include <string.h>
 
@@ -1026,6 +1025,10 @@ void show_process_data(const bus_model *m, const datagram *d, gboolean returned,
 
 const char *command_name(guint8 cmd) { return cmd < G_N_ELEMENTS(command_names) ? command_names[cmd] : "unknown"; }
 
+/* A little-endian 16-bit value of a header copied out of the tvb (pint.h's
+ * names changed in Wireshark 4.6). */
+static guint16 little16(const guint8 *p) { return (guint16)(p[0] | p[1] << 8); }
+
 guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max)
 {
     gint end = (gint)tvb_captured_length(tvb);
@@ -1046,9 +1049,9 @@ guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max)
         d->offset = offset;
         d->cmd = h[0];
         d->idx = h[1];
-        d->adp = pletoh16(h + 2);
-        d->ado = pletoh16(h + 4);
-        guint16 flags = pletoh16(h + 6);
+        d->adp = little16(h + 2);
+        d->ado = little16(h + 4);
+        guint16 flags = little16(h + 6);
         d->length = flags & 0x7ff;
         if (offset + 12 + d->length > end) break;
         d->wkc = dg_tvb_get_uint16(tvb, offset + 10 + d->length, ENC_LITTLE_ENDIAN);
