@@ -5,6 +5,8 @@
     python3 bench/bench.py [--runs 3] [--frames 200000] [--json results.json]
     python3 bench/bench.py --corpus ../shared/corpus/ethercat [--corpus-copies 3]   (real traffic:
         register, mailbox and process-data datagrams, as Wireshark's plugin decodes them too)
+    python3 bench/bench.py --corpus ../shared/corpus/ethercat --same-depth   (the rules without
+        their <pairing> block: what Wireshark's plugin decodes, and nothing more)
 
 Expects build/bin/dissgen (build it first: bash scripts/build.sh); builds nothing
 itself. In one run it
@@ -148,6 +150,23 @@ def generate_capture(path, seed, n, max_datagrams, max_data):
     if p.returncode != 0:
         raise BenchError("generating the capture failed:\n" + p.stderr[-2000:])
     return json.loads(p.stdout)
+
+
+def without_pairing(rules, work):
+    """A copy of rules (same file name, so the same plugin) without its <pairing> block."""
+    with open(rules, encoding="utf-8") as fh:
+        text = fh.read()
+    stripped = re.sub(r"<pairing\b[^>]*/>|<pairing\b.*?</pairing>", "", text, flags=re.S)
+    if stripped == text:
+        raise BenchError("--same-depth: %s has no <pairing> block" % rules)
+    folder = os.path.join(work, "same-depth")
+    os.makedirs(folder, exist_ok=True)
+    out = os.path.join(folder, os.path.basename(rules))
+    with open(out, "w", encoding="utf-8") as fh:
+        fh.write(stripped)
+    os.chmod(folder, 0o755)
+    os.chmod(out, 0o644)
+    return out
 
 
 def merge_corpus(folder, copies, out):
@@ -340,6 +359,7 @@ def report(info, decode, startup, install, runs, instr=None):
                                      ", ".join("%s %d" % kv for kv in sorted(cap["encap"].items()))))
     out.append("tshark %s, %d runs per cell, medians. CPU = user+sys of the tshark process; net = minus the floor."
                % (info["tshark"], runs))
+    out.append("Rules: %s" % info.get("rules", "?"))
     if decode:
         configs = list(next(iter(decode.values())).keys())
         rows = []
@@ -431,6 +451,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--dissgen", default=os.path.join(ROOT, "build", "bin", "dissgen"))
     ap.add_argument("--rules", default=os.path.join(ROOT, "rules", "ethercat.xml"))
+    ap.add_argument("--same-depth", action="store_true",
+                    help="the rules without their <pairing> block: no pairing, ESC analysis or bus model, which "
+                         "Wireshark's plugin does not do; the two then decode the same (issue 10's comparison)")
     ap.add_argument("--runs", type=int, default=3, help="tshark runs per configuration and mode (default 3)")
     ap.add_argument("--frames", type=int, default=200000, help="frames in the capture (default 200000)")
     ap.add_argument("--seed", type=int, default=1)
@@ -498,6 +521,10 @@ def main(argv=None):
             capture = os.path.join(work, "bench.pcap")
             info["capture"] = generate_capture(capture, a.seed, a.frames, a.max_datagrams, a.max_data)
         info["capture_bytes"] = os.path.getsize(capture)
+        info["rules"] = os.path.abspath(a.rules)
+        if a.same_depth:
+            a.rules = without_pairing(a.rules, work)
+            info["rules"] += " without <pairing>"
         check_cap = os.path.join(work, "check.pcap")
         pcapgen.write_pcap(check_cap, bench_frames(a.seed + 1, 400, a.max_datagrams, a.max_data))
         empty = os.path.join(work, "empty.pcap")

@@ -65,6 +65,16 @@ struct dg_text {
     gsize len, cap;
 };
 
+/* A text in `buf` (the caller's, usually on its stack) until it outgrows it. */
+void text_init(dg_text *t, wmem_allocator_t *pool, char *buf, gsize cap)
+{
+    t->pool = pool;
+    t->data = buf;
+    t->data[0] = '\0';
+    t->len = 0;
+    t->cap = cap;
+}
+
 /* One allocation: the struct and a first buffer that most texts never outgrow. */
 dg_text *text_new(wmem_allocator_t *pool)
 {
@@ -78,15 +88,19 @@ dg_text *text_new(wmem_allocator_t *pool)
     return t;
 }
 
-void text_append(dg_text *t, const char *s, gsize n)
+void text_grow(dg_text *t, gsize n)
 {
-    if (t->len + n >= t->cap) {
-        gsize cap = MAX(2 * t->cap, t->len + n + 1);
-        char *bigger = (char *)wmem_alloc(t->pool, cap);
-        memcpy(bigger, t->data, t->len + 1);
-        t->data = bigger; /* the old buffer goes with the pool */
-        t->cap = cap;
-    }
+    gsize cap = MAX(2 * t->cap, t->len + n + 1);
+    char *bigger = (char *)wmem_alloc(t->pool, cap);
+    memcpy(bigger, t->data, t->len + 1);
+    t->data = bigger; /* the old buffer goes with the pool */
+    t->cap = cap;
+}
+
+/* Inlined: it runs for every piece of every summary. */
+inline __attribute__((always_inline)) void text_append(dg_text *t, const char *s, gsize n)
+{
+    if (G_UNLIKELY(t->len + n >= t->cap)) text_grow(t, n);
     memcpy(t->data + t->len, s, n);
     t->len += n;
     t->data[t->len] = '\0';
@@ -270,7 +284,8 @@ void table_reset(dg_state *st, const dg_node *n, gint offset)
     st->present[n->slot] = TRUE;
 }
 
-void store(dg_state *st, const dg_node *n, guint64 value, gint offset, gint length)
+inline __attribute__((always_inline)) void store(dg_state *st, const dg_node *n, guint64 value, gint offset,
+                                                 gint length)
 {
     if (st->tap && n->show == DG_SHOW_ENUM) tap_record(st, n, value);
     if (n->flags & DG_KEY) key_append(st, value);
@@ -841,10 +856,12 @@ void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
 
 /* Info column text of a repeated node's summarised instances: gathered in
  * *s while they are decoded (when summaries_begin says so), then added. */
-gboolean summaries_begin(const dg_state *st, const dg_node *n, gboolean in_summary, dg_summaries *s)
+gboolean summaries_begin(const dg_state *st, const dg_node *n, gboolean in_summary, dg_summaries *s, dg_text *text,
+                         char *buf, gsize cap)
 {
     if (in_summary || n->summary_count == 0 || !st->want_info) return FALSE;
-    s->text = text_new(st->pinfo->pool);
+    text_init(text, st->pinfo->pool, buf, cap);
+    s->text = text;
     return TRUE;
 }
 
@@ -871,7 +888,10 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     if (n->count.slot >= 0 && !ref_value(st, &n->count, n, "count", tree, *offset, &wanted)) return;
     if (n->extra && n->extra->keep_values) table_reset(st, n, *offset); /* issue 10 */
     dg_summaries summaries = {NULL, 0};
-    gboolean collect = summaries_begin(st, n, in_summary, &summaries);
+    dg_text summaries_text;
+    char summaries_buf[256];
+    gboolean collect = summaries_begin(st, n, in_summary, &summaries, &summaries_text, summaries_buf,
+                                       sizeof summaries_buf);
 
     guint instances = 0;
     for (gint64 done = 0; wanted < 0 || done < wanted; done++) {
@@ -955,7 +975,10 @@ void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *off
         return;
     }
     dg_summaries summaries = {NULL, 0};
-    gboolean collect = summaries_begin(st, n, in_summary, &summaries);
+    dg_text summaries_text;
+    char summaries_buf[256];
+    gboolean collect = summaries_begin(st, n, in_summary, &summaries, &summaries_text, summaries_buf,
+                                       sizeof summaries_buf);
     guint instances = 0;
     gint first = *offset;
     for (guint i = 0; i < t->count && !st->stopped; i++) {
@@ -1457,8 +1480,17 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
      * filter-only pass (-Y with -w) has neither. */
     st.want_info = pinfo->cinfo != NULL;
     st.want_text = st.want_info || (tree != NULL && PTREE_DATA(tree)->visible);
-    st.info = st.want_info ? text_new(pinfo->pool) : NULL;
-    st.text = st.want_text ? text_new(pinfo->pool) : NULL;
+    /* The Info column and the summary scratch start on the stack. */
+    dg_text info_text, scratch_text;
+    char info_buf[256], scratch_buf[256];
+    if (st.want_info) {
+        text_init(&info_text, pinfo->pool, info_buf, sizeof info_buf);
+        st.info = &info_text;
+    }
+    if (st.want_text) {
+        text_init(&scratch_text, pinfo->pool, scratch_buf, sizeof scratch_buf);
+        st.text = &scratch_text;
+    }
     if (stats_tap >= 0 && have_tap_listener(stats_tap)) st.tap = wmem_new0(pinfo->pool, dg_tap_data);
     /* issue 14: nobody sees items or the text of expert infos without a tree
      * and without a tap listener (the Expert dialog and -z expert are taps):
