@@ -31,6 +31,7 @@
 #include <epan/proto_data.h>
 #include <epan/expert.h>
 
+#include <math.h>
 #include <string.h>
 
 namespace {
@@ -87,6 +88,9 @@ struct capture_state {
     guint64 answered_max;        /* the highest seq answered so far */
     guint32 last_frame;          /* the last message paired (its frame) */
     void *analysis;              /* the analysis's capture-wide state */
+    nstime_t clock;              /* what forgetting goes by (forget_clock) */
+    nstime_t previous_time;      /* the last message's time */
+    gboolean clock_set;
 };
 
 /* One protocol per plugin, and each plugin links its own runtime. */
@@ -321,23 +325,40 @@ void enqueue(queue *qu, pending *q, gboolean in_key)
  * given up now and a key entry that old is removed: a message with that key
  * later finds a fresh entry, which behaves exactly as the stale one would.
  * The margin keeps captures whose clocks step back a little (two interfaces)
- * paired as before. */
+ * paired as before. Forgetting goes by a clock of its own: the earlier of
+ * the last two messages' times. One message stamped an hour ahead (a merge, a
+ * broken timestamp) then moves nothing, while a real gap in the capture is
+ * followed from its second message on. */
 const double stale_after = 10;
 
-gboolean long_ago(const nstime_t *then, const packet_info *pinfo)
+void forget_clock(capture_state *c, const packet_info *pinfo)
+{
+    if (!c->clock_set) {
+        c->clock = c->previous_time = pinfo->abs_ts;
+        c->clock_set = TRUE;
+        return;
+    }
+    c->clock = nstime_cmp(&pinfo->abs_ts, &c->previous_time) < 0 ? pinfo->abs_ts : c->previous_time;
+    c->previous_time = pinfo->abs_ts;
+}
+
+/* Whether `then` is more than stale_after timeouts away from the clock, either
+ * way: an entry stamped far ahead of it goes too, so that it does not hold up
+ * the entries behind it in the list. */
+gboolean long_ago(const capture_state *c, const nstime_t *then)
 {
     nstime_t age;
-    nstime_delta(&age, &pinfo->abs_ts, then);
-    return nstime_to_sec(&age) > stale_after * protocol->pairing->timeout;
+    nstime_delta(&age, &c->clock, then);
+    return fabs(nstime_to_sec(&age)) > stale_after * protocol->pairing->timeout;
 }
 
 /* Requests at the head of the capture's queue that nothing can answer any more. */
-void forget_requests(capture_state *c, const packet_info *pinfo)
+void forget_requests(capture_state *c)
 {
     while (c->sent.head) {
         pending *q = c->sent.head;
         if (!q->done) {
-            if (c->answered_max <= q->txn->seq + max_overtaken && !long_ago(&q->txn->request_time, pinfo)) return;
+            if (c->answered_max <= q->txn->seq + max_overtaken && !long_ago(c, &q->txn->request_time)) return;
             retire(c, q);
         }
         c->sent.head = q->next_sent;
@@ -365,16 +386,17 @@ void forget_key(capture_state *c, key_entry *e)
 }
 
 /* Key entries whose last message is long ago, least recently used first. */
-void forget_keys(capture_state *c, const packet_info *pinfo)
+void forget_keys(capture_state *c)
 {
-    while (c->oldest && long_ago(&c->oldest->last_time, pinfo)) forget_key(c, c->oldest);
+    while (c->oldest && long_ago(c, &c->oldest->last_time)) forget_key(c, c->oldest);
 }
 
 dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count, guint length)
 {
     capture_state *c = current_capture();
-    forget_requests(c, pinfo);
-    forget_keys(c, pinfo);
+    forget_clock(c, pinfo);
+    forget_requests(c);
+    forget_keys(c);
     if (analysis && analysis->see) analysis->see(c->analysis, tvb, pinfo);
     key_entry *e = entry_for(c, keys, key_count);
     gboolean again = same_again(c, e, tvb, pinfo, length);

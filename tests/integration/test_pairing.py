@@ -31,6 +31,9 @@ datagrams): it names the whole test instead (pairing_full in tests/mutation/run_
    40 ms later after 40 other requests): the answered ones are paired, and tshark's peak memory
    grows by less than 25 MB from 8 000 to 32 000 frames of 700 bytes (the first pass forgets
    keys and unanswered requests ten timeouts old: 16 MB measured; when it kept them, 49 MB).
+   The same with one sent frame stamped an hour ahead, between a request and its answer, and
+   with a real gap of an hour in the middle: every answer is still paired (forgetting goes by
+   a clock that one odd timestamp does not move).
 
 Exit 77 with "SKIPPED: ..." when the corpus is not there.
 """
@@ -444,21 +447,25 @@ def variant_checks(env, corpus_dir, files):
 
 # ----------------------------------------------------------------------------- forgetting
 
-def unique_key_frames(n, answer_every=1000, answer_after=40):
+def unique_key_frames(n, answer_every=1000, answer_after=40, outlier=None, gap_at=None):
     """n sent frames 1 ms apart, each with three LRW datagrams whose indexes no other frame
     has; after every answer_every-th one (from frame 500 on) the return of the frame sent
-    answer_after frames earlier. Returns (frames, {return's frame number: request's})."""
+    answer_after frames earlier. Sent frame `outlier` is stamped an hour ahead; from sent
+    frame `gap_at` on, every frame is an hour later. Returns (frames, {return's frame
+    number: request's})."""
     def datagrams(i, wkc):
         return [pcapgen.Datagram(cmd=12, idx=(i >> (8 * k)) & 0xFF, lad=0x10000 * k, data=bytes(200), wkc=wkc)
                 for k in range(3)]
     frames, pairs, number = [], {}, {}
     base = 1704067200.0
     for i in range(n):
-        frames.append(pcapgen.Frame(datagrams(i, 0), src_mac=b"\x00\x00\x00\x00\x00\x01", ts=base + i * 0.001))
+        t = base + i * 0.001 + (3600 if gap_at is not None and i >= gap_at else 0)
+        frames.append(pcapgen.Frame(datagrams(i, 0), src_mac=b"\x00\x00\x00\x00\x00\x01",
+                                    ts=t + (3600 if i == outlier else 0)))
         number[i] = len(frames)  # frame numbers are 1-based
         if i % answer_every == 500:
             frames.append(pcapgen.Frame(datagrams(i - answer_after, 1), src_mac=b"\x02\x00\x00\x00\x00\x01",
-                                        ts=base + i * 0.001 + 0.0005))
+                                        ts=t + 0.0005))
             pairs[len(frames)] = number[i - answer_after]
     return frames, pairs
 
@@ -487,6 +494,18 @@ def forgetting_checks(env):
         print("   %s: peak RSS %.1f MB" % (name, rss[n]))
     growth = rss[32000] - rss[8000]
     check(growth < 25, "peak memory grows by %.1f MB from 8 000 to 32 000 frames (less than 25)" % growth)
+    # 2480: after request 2460, before its answer at 2500; the gap: between 5501 (after the
+    # answer at 5500) and the next answered request, 6460.
+    for what, kwargs in (("one frame stamped an hour ahead", {"outlier": 2480}),
+                         ("an hour's gap", {"gap_at": 5501})):
+        frames, pairs = unique_key_frames(8000, **kwargs)
+        name = "unique-keys-%s.pcap" % what.split()[1]
+        path = env.add_file(name, pcapgen.pcap_bytes(frames))
+        for two_pass in (False, True):
+            rows = decode(env, path, two_pass=two_pass)
+            got = {f: int(r["ecatr.request_in"]) for f, r in rows.items() if r["ecatr.request_in"]}
+            check(got == pairs, "%s%s: %d returns paired as expected (differences %s)"
+                  % (what, " (-2)" if two_pass else "", len(pairs), sorted(set(got.items()) ^ set(pairs.items()))[:4]))
 
 
 def main():
