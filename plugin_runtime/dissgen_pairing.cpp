@@ -251,15 +251,22 @@ gboolean given_up(const capture_state *c, const pending *q, const packet_info *p
 
 /* The oldest request of a queue still waiting (given-up ones retired on the
  * way), or NULL. `in_key` says which link the queue uses. */
+/* Takes a done request off the head of a queue. */
+void drop_head(queue *qu, gboolean in_key)
+{
+    pending *q = qu->head;
+    qu->head = in_key ? q->next : q->next_sent;
+    if (!qu->head) qu->tail = NULL;
+    release(q);
+}
+
 pending *oldest_waiting(capture_state *c, queue *qu, gboolean in_key, const packet_info *pinfo)
 {
     while (qu->head) {
         pending *q = qu->head;
         if (!q->done && given_up(c, q, pinfo, protocol->pairing->timeout)) retire(c, q);
         if (!q->done) return q;
-        qu->head = in_key ? q->next : q->next_sent;
-        if (!qu->head) qu->tail = NULL;
-        release(q);
+        drop_head(qu, in_key);
     }
     return NULL;
 }
@@ -361,9 +368,7 @@ void forget_requests(capture_state *c)
             if (c->answered_max <= q->txn->seq + max_overtaken && !long_ago(c, &q->txn->request_time)) return;
             retire(c, q);
         }
-        c->sent.head = q->next_sent;
-        if (!c->sent.head) c->sent.tail = NULL;
-        release(q);
+        drop_head(&c->sent, FALSE);
     }
 }
 
@@ -391,6 +396,15 @@ void forget_keys(capture_state *c)
     while (c->oldest && long_ago(c, &c->oldest->last_time)) forget_key(c, c->oldest);
 }
 
+/* A frame's record for a duplicate, a response or an orphan (a request's
+ * comes with its transaction). */
+dg_frame_pairing *new_record(guint8 role)
+{
+    dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
+    fp->role = role;
+    return fp;
+}
+
 dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count, guint length)
 {
     capture_state *c = current_capture();
@@ -404,8 +418,7 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     gboolean duplicate = again && !unchanged;
     c->last_frame = pinfo->num;
     if (duplicate) {
-        dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
-        fp->role = DG_ROLE_DUPLICATE;
+        dg_frame_pairing *fp = new_record(DG_ROLE_DUPLICATE);
         fp->duplicate_of = e->last_frame;
         return fp;
     }
@@ -415,11 +428,10 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     if (returned) q = take_oldest(c, pinfo);
     remember_last(c, e, tvb, pinfo, length, q ? DG_ROLE_RESPONSE : DG_ROLE_REQUEST); /* an orphan: a request for step 2 */
     if (q) {
-        dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
+        dg_frame_pairing *fp = new_record(DG_ROLE_RESPONSE);
         dg_transaction *t = q->txn;
         t->response_frame = pinfo->num;
         nstime_delta(&t->round_trip, &pinfo->abs_ts, &t->request_time);
-        fp->role = DG_ROLE_RESPONSE;
         fp->txn = t;
         fp->out_of_order = t->seq < c->answered_max;
         if (t->seq > c->answered_max) c->answered_max = t->seq;
@@ -432,11 +444,7 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
         return fp;
     }
 
-    if (returned) {
-        dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
-        fp->role = DG_ROLE_ORPHAN;
-        return fp;
-    }
+    if (returned) return new_record(DG_ROLE_ORPHAN);
     /* A request: its frame's record and the transaction in one allocation. */
     struct request_record {
         dg_frame_pairing fp;

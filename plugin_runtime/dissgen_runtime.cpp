@@ -56,9 +56,10 @@ struct dg_table {
     gboolean overflow; /* more than DG_MAX_TABLE instances */
 };
 
-/* Text being built (summaries, the Info column): a buffer in the packet pool
- * with inline appends. wmem_strbuf_new() and its appends cost several times
- * more, and summary lines run this on every frame (issue 14). */
+/* Text being built (summaries, the Info column): a buffer of the caller's
+ * (on its stack) or in the packet pool, moved to the pool when it outgrows
+ * it, with inline appends. wmem_strbuf_new() and its appends cost several
+ * times more, and summary lines run this on every frame (issue 14). */
 struct dg_text {
     wmem_allocator_t *pool;
     char *data;   /* NUL-terminated */
@@ -80,11 +81,7 @@ dg_text *text_new(wmem_allocator_t *pool)
 {
     const gsize first = 120;
     dg_text *t = (dg_text *)wmem_alloc(pool, sizeof(dg_text) + first);
-    t->pool = pool;
-    t->data = (char *)(t + 1);
-    t->data[0] = '\0';
-    t->len = 0;
-    t->cap = first;
+    text_init(t, pool, (char *)(t + 1), first);
     return t;
 }
 
@@ -114,9 +111,11 @@ void text_truncate(dg_text *t, gsize len)
     }
 }
 
-/* Summaries of one repeated node's instances, gathered for the Info column. */
+/* Summaries of one repeated node's instances, gathered for the Info column
+ * (in `buf` on the caller's stack until they outgrow it). */
 struct dg_summaries {
-    dg_text *text;
+    dg_text text;
+    char buf[256];
     guint count;
 };
 
@@ -831,8 +830,8 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
         if (item) proto_item_append_text(item, ": %s", text);
         if (!in_summary && st->want_info) {
             if (sink) {
-                if (sink->count++) text_append(sink->text, ", ", 2);
-                text_append(sink->text, text, text_len);
+                if (sink->count++) text_append(&sink->text, ", ", 2);
+                text_append(&sink->text, text, text_len);
             } else {
                 info_append(st, text, text_len);
             }
@@ -856,12 +855,11 @@ void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
 
 /* Info column text of a repeated node's summarised instances: gathered in
  * *s while they are decoded (when summaries_begin says so), then added. */
-gboolean summaries_begin(const dg_state *st, const dg_node *n, gboolean in_summary, dg_summaries *s, dg_text *text,
-                         char *buf, gsize cap)
+gboolean summaries_begin(const dg_state *st, const dg_node *n, gboolean in_summary, dg_summaries *s)
 {
+    s->count = 0;
     if (in_summary || n->summary_count == 0 || !st->want_info) return FALSE;
-    text_init(text, st->pinfo->pool, buf, cap);
-    s->text = text;
+    text_init(&s->text, st->pinfo->pool, s->buf, sizeof s->buf);
     return TRUE;
 }
 
@@ -874,9 +872,9 @@ void summaries_end(dg_state *st, const dg_node *n, const dg_summaries *s)
         text_append(st->info, " \xc3\x97", 3);
         append_dec(st->info, s->count);
         text_append(st->info, ": ", 2);
-        text_append(st->info, s->text->data, s->text->len);
+        text_append(st->info, s->text.data, s->text.len);
     } else if (s->count == 1) {
-        info_append(st, s->text->data, s->text->len);
+        info_append(st, s->text.data, s->text.len);
     }
 }
 
@@ -887,11 +885,8 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     gint64 wanted = -1;
     if (n->count.slot >= 0 && !ref_value(st, &n->count, n, "count", tree, *offset, &wanted)) return;
     if (n->extra && n->extra->keep_values) table_reset(st, n, *offset); /* issue 10 */
-    dg_summaries summaries = {NULL, 0};
-    dg_text summaries_text;
-    char summaries_buf[256];
-    gboolean collect = summaries_begin(st, n, in_summary, &summaries, &summaries_text, summaries_buf,
-                                       sizeof summaries_buf);
+    dg_summaries summaries;
+    gboolean collect = summaries_begin(st, n, in_summary, &summaries);
 
     guint instances = 0;
     for (gint64 done = 0; wanted < 0 || done < wanted; done++) {
@@ -974,11 +969,8 @@ void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *off
                (guint)DG_MAX_TABLE, n->name);
         return;
     }
-    dg_summaries summaries = {NULL, 0};
-    dg_text summaries_text;
-    char summaries_buf[256];
-    gboolean collect = summaries_begin(st, n, in_summary, &summaries, &summaries_text, summaries_buf,
-                                       sizeof summaries_buf);
+    dg_summaries summaries;
+    gboolean collect = summaries_begin(st, n, in_summary, &summaries);
     guint instances = 0;
     gint first = *offset;
     for (guint i = 0; i < t->count && !st->stopped; i++) {

@@ -1121,7 +1121,8 @@ void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree 
         show_slave(f->model, a, tvb, pinfo, tree);
         if (a->logical) show_process_data(f->model, &a->dgram, f->returned, pinfo->num, tvb, tree);
         if (a->expected_wkc >= 0)
-            proto_item_set_generated(proto_tree_add_uint(tree, hf_wkc_expected, tvb, a->dgram.offset + 10 + a->dgram.length, 2,
+            proto_item_set_generated(proto_tree_add_uint(tree, hf_wkc_expected, tvb,
+                                                         a->dgram.offset + 10 + a->dgram.length, 2,
                                                          (guint32)a->expected_wkc));
     }
     for (guint i = 0; i < f->event_count; i++) {
