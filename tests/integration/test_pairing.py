@@ -478,34 +478,34 @@ def peak_rss_mb(env, args):
     return usage.ru_maxrss / 1024.0
 
 
+def check_paired(env, path, pairs, what, two_pass):
+    """Every return of `pairs` ({return: request}) and no other frame carries ecatr.request_in."""
+    rows = decode(env, path, two_pass=two_pass)
+    got = {f: int(r["ecatr.request_in"]) for f, r in rows.items() if r["ecatr.request_in"]}
+    check(got == pairs, "%s%s: %d returns paired as expected (got %d, first differences %s)"
+          % (what, " (-2)" if two_pass else "", len(pairs), len(got), sorted(set(got.items()) ^ set(pairs.items()))[:4]))
+
+
 def forgetting_checks(env):
     print("== keys never used again")
     rss = {}
     for n in (8000, 32000):
         frames, pairs = unique_key_frames(n)
         name = "unique-keys-%d.pcap" % n
-        env.add_file(name, pcapgen.pcap_bytes(frames))
-        path = env.path(name)
-        rows = decode(env, path, two_pass=False)
-        got = {f: int(r["ecatr.request_in"]) for f, r in rows.items() if r["ecatr.request_in"]}
-        check(got == pairs, "%s: %d returns paired as expected (got %d, first differences %s)"
-              % (name, len(pairs), len(got), sorted(set(got.items()) ^ set(pairs.items()))[:4]))
+        path = env.add_file(name, pcapgen.pcap_bytes(frames))
+        check_paired(env, path, pairs, name, two_pass=False)
         rss[n] = min(peak_rss_mb(env, ["-r", path]) for _ in range(2))
         print("   %s: peak RSS %.1f MB" % (name, rss[n]))
     growth = rss[32000] - rss[8000]
     check(growth < 25, "peak memory grows by %.1f MB from 8 000 to 32 000 frames (less than 25)" % growth)
     # 2480: after request 2460, before its answer at 2500; the gap: between 5501 (after the
     # answer at 5500) and the next answered request, 6460.
-    for what, kwargs in (("one frame stamped an hour ahead", {"outlier": 2480}),
-                         ("an hour's gap", {"gap_at": 5501})):
+    for name, what, kwargs in (("unique-keys-outlier.pcap", "one frame stamped an hour ahead", {"outlier": 2480}),
+                               ("unique-keys-gap.pcap", "an hour's gap", {"gap_at": 5501})):
         frames, pairs = unique_key_frames(8000, **kwargs)
-        name = "unique-keys-%s.pcap" % what.split()[1]
         path = env.add_file(name, pcapgen.pcap_bytes(frames))
         for two_pass in (False, True):
-            rows = decode(env, path, two_pass=two_pass)
-            got = {f: int(r["ecatr.request_in"]) for f, r in rows.items() if r["ecatr.request_in"]}
-            check(got == pairs, "%s%s: %d returns paired as expected (differences %s)"
-                  % (what, " (-2)" if two_pass else "", len(pairs), sorted(set(got.items()) ^ set(pairs.items()))[:4]))
+            check_paired(env, path, pairs, what, two_pass)
 
 
 def main():
