@@ -182,7 +182,7 @@ guint16 position_of(guint16 adp) { return (guint16)(0x10000u - adp); }
 gint register_at(const datagram *d, guint32 reg, guint32 n)
 {
     if (d->ado > reg || reg + n > (guint32)d->ado + d->length) return -1;
-    return d->offset + 10 + (gint)(reg - d->ado);
+    return data_offset(d) + (gint)(reg - d->ado);
 }
 
 slave_state *slave_at(bus_model *m, guint32 position)
@@ -247,7 +247,7 @@ struct events {
     void add(guint8 kind, const datagram *d, const char *text)
     {
         if (count >= G_N_ELEMENTS(list)) return;
-        list[count++] = {kind, d->offset, 12 + d->length, text};
+        list[count++] = {kind, d->offset, datagram_span(d), text};
     }
 };
 
@@ -314,7 +314,7 @@ void learn_sii_data(bus_model *m, guint position, slave_state *s, const datagram
     if (data < 0) return;
     guint32 address;
     gint status = register_at(b, 0x0502, 2);
-    guint bytes = MIN(8u, (guint)(b->offset + 10 + b->length - data));
+    guint bytes = MIN(8u, (guint)(wkc_offset(b) - data));
     if (status >= 0) {
         guint16 st = dg_tvb_get_uint16(back, status, ENC_LITTLE_ENDIAN);
         if (st & 0x8000) return;        /* busy: the data is not there yet */
@@ -602,10 +602,10 @@ void learn_coe(slave_state *st, const datagram *s, const datagram *b, tvbuff_t *
 {
     sdo_data sd;
     if (writes(s->cmd) && !reads(s->cmd) && st->mailbox_length[0] && s->ado == st->mailbox_start[0] &&
-        sdo_transfer(sent, s->offset + 10, s->length, 2, 1, &sd))
+        sdo_transfer(sent, data_offset(s), s->length, 2, 1, &sd))
         learn_object(st, sent, &sd, frame);
     if (reads(s->cmd) && !writes(s->cmd) && st->mailbox_length[1] && s->ado == st->mailbox_start[1] &&
-        sdo_transfer(back, b->offset + 10, b->length, 3, 2, &sd))
+        sdo_transfer(back, data_offset(b), b->length, 3, 2, &sd))
         learn_object(st, back, &sd, frame);
 }
 
@@ -692,7 +692,7 @@ void show_slave(const bus_model *m, const addressed *a, tvbuff_t *tvb, packet_in
     gint32 position = a->position;
     if (position < 0 && a->by_station && PINFO_FD_VISITED(pinfo)) position = station_position(m, a->station);
     if (position < 0) return;
-    gint offset = a->dgram.offset, length = 12 + a->dgram.length;
+    gint offset = a->dgram.offset, length = datagram_span(&a->dgram);
     const slave_state *s = m->slaves[position];
     const dg_bus *b = m->design;
     gint32 device = learned_device(b, s);
@@ -788,7 +788,7 @@ proto_tree *data_subtree(proto_tree **sub, proto_tree *tree, const char *name, g
                          const datagram *d, tvbuff_t *tvb)
 {
     if (!*sub) {
-        proto_item *it = proto_tree_add_none_format(tree, hf_process_data, tvb, d->offset, 12 + d->length,
+        proto_item *it = proto_tree_add_none_format(tree, hf_process_data, tvb, d->offset, datagram_span(d),
                                                     "%s (position %u): %s", name, position, output ? "outputs" : "inputs");
         proto_item_set_generated(it);
         *sub = proto_item_add_subtree(it, ett_process_data);
@@ -809,7 +809,7 @@ void show_slave_data(const dg_bus *b, const char *name, guint position, guint32 
         if (!e->hf || *e->hf < 0 || (gboolean)e->output != output) continue;
         gint64 at = e->logical_bit >= 0 ? e->logical_bit : start + e->bit_offset;
         if (at < begin || at + e->bit_length > end) continue;
-        show_entry(data_subtree(&sub, tree, name, position, output, d, tvb), e, tvb, d->offset + 10,
+        show_entry(data_subtree(&sub, tree, name, position, output, d, tvb), e, tvb, data_offset(d),
                    (guint32)(at - begin));
     }
 }
@@ -974,9 +974,9 @@ void show_configured_data(const dg_bus *b, gint32 device, const pdo_config *c, c
         if (at < begin || at + e->bits > end) continue;
         proto_tree *into = data_subtree(&sub, tree, name, position, output, d, tvb);
         if (e->known && e->known->hf && *e->known->hf >= 0 && e->known->bit_length == e->bits)
-            show_entry(into, e->known, tvb, d->offset + 10, (guint32)(at - begin));
+            show_entry(into, e->known, tvb, data_offset(d), (guint32)(at - begin));
         else
-            show_generic(into, e, tvb, d->offset + 10, (guint32)(at - begin));
+            show_generic(into, e, tvb, data_offset(d), (guint32)(at - begin));
     }
 }
 
@@ -1040,10 +1040,10 @@ guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max)
     if ((gint)(2 + *header_length) < end) end = 2 + (gint)*header_length;
     guint n = 0;
     gint offset = 2;
-    while (n < max && offset + 12 <= end) {
-        /* One bounds-checked copy of the 10-byte datagram header instead of
-         * five tvb reads: this runs on every frame of the first pass. */
-        guint8 h[10];
+    while (n < max && offset + datagram_header + datagram_wkc <= end) {
+        /* One bounds-checked copy of the datagram header instead of five tvb
+         * reads: this runs on every frame of the first pass. */
+        guint8 h[datagram_header];
         tvb_memcpy(tvb, h, offset, sizeof h);
         datagram *d = &out[n];
         d->offset = offset;
@@ -1053,10 +1053,10 @@ guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max)
         d->ado = little16(h + 4);
         guint16 flags = little16(h + 6);
         d->length = flags & 0x7ff;
-        if (offset + 12 + d->length > end) break;
-        d->wkc = dg_tvb_get_uint16(tvb, offset + 10 + d->length, ENC_LITTLE_ENDIAN);
+        if (offset + datagram_span(d) > end) break;
+        d->wkc = dg_tvb_get_uint16(tvb, wkc_offset(d), ENC_LITTLE_ENDIAN);
         n++;
-        offset += 12 + d->length;
+        offset += datagram_span(d);
         if (!(flags & 0x8000)) break;
     }
     return n;
@@ -1121,9 +1121,8 @@ void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree 
         show_slave(f->model, a, tvb, pinfo, tree);
         if (a->logical) show_process_data(f->model, &a->dgram, f->returned, pinfo->num, tvb, tree);
         if (a->expected_wkc >= 0)
-            proto_item_set_generated(proto_tree_add_uint(tree, hf_wkc_expected, tvb,
-                                                         a->dgram.offset + 10 + a->dgram.length, 2,
-                                                         (guint32)a->expected_wkc));
+            proto_item_set_generated(proto_tree_add_uint(tree, hf_wkc_expected, tvb, wkc_offset(&a->dgram),
+                                                         datagram_wkc, (guint32)a->expected_wkc));
     }
     for (guint i = 0; i < f->event_count; i++) {
         const bus_event *e = &f->events[i];

@@ -20,6 +20,12 @@ struct datagram {
     guint16 wkc;
 };
 
+/* A datagram on the wire: a 10-byte header, its data, a 2-byte working counter. */
+const gint datagram_header = 10, datagram_wkc = 2;
+inline gint data_offset(const datagram *d) { return d->offset + datagram_header; }
+inline gint wkc_offset(const datagram *d) { return data_offset(d) + d->length; }
+inline gint datagram_span(const datagram *d) { return datagram_header + d->length + datagram_wkc; }
+
 /* At most this many datagrams per frame: 1500 bytes hold at most 124. */
 const guint max_datagrams = 128;
 

@@ -53,9 +53,6 @@ struct compared {
     guint8 forwarding : 1;  /* advanced differently from the frame's others */
 };
 
-/* The returned datagram's bytes, header to working counter. */
-gint span(const compared *c) { return 12 + c->back.length; }
-
 gint32 wkc_added(const compared *c) { return (gint32)c->back.wkc - (gint32)c->sent.wkc; }
 
 struct result {
@@ -110,8 +107,8 @@ void compare_datagram(compared *c, const datagram *s, const datagram *b, tvbuff_
     }
     guint16 common = MIN(s->length, b->length);
     c->data_changed = s->length != b->length ||
-                      (common > 0 && tvb_memeql(response, b->offset + 10,
-                                                (const guint8 *)tvb_get_ptr(request, s->offset + 10, common), common) != 0);
+                      (common > 0 && tvb_memeql(response, data_offset(b),
+                                                (const guint8 *)tvb_get_ptr(request, data_offset(s), common), common) != 0);
 }
 
 /* The frame's usual advance is the most common one among its auto-increment
@@ -209,16 +206,16 @@ proto_tree *show_datagram_items(const compared *c, guint i, tvbuff_t *tvb, proto
         dg_label_str(&label, " slaves passed");
     }
     dg_label_str(&label, c->data_changed ? ", data changed" : ", data unchanged");
-    proto_item *item = proto_tree_add_none_format(tree, hf_datagram, tvb, c->back.offset, span(c), "%s", label.text);
+    proto_item *item = proto_tree_add_none_format(tree, hf_datagram, tvb, c->back.offset, datagram_span(&c->back), "%s", label.text);
     proto_item_set_generated(item);
     proto_tree *sub = proto_item_add_subtree(item, ett_datagram);
-    proto_item *it = proto_tree_add_int(sub, hf_wkc_added, tvb, c->back.offset + span(c) - 2, 2, wkc_added(c));
+    proto_item *it = proto_tree_add_int(sub, hf_wkc_added, tvb, wkc_offset(&c->back), datagram_wkc, wkc_added(c));
     proto_item_set_generated(it);
     if (c->has_advance) {
         it = proto_tree_add_uint(sub, hf_slaves_passed, tvb, c->back.offset + 2, 2, c->advance);
         proto_item_set_generated(it);
     }
-    it = proto_tree_add_boolean(sub, hf_data_changed, tvb, c->back.offset + 10, span(c) - 12, c->data_changed);
+    it = proto_tree_add_boolean(sub, hf_data_changed, tvb, data_offset(&c->back), c->back.length, c->data_changed);
     proto_item_set_generated(it);
     return sub;
 }
@@ -238,14 +235,14 @@ void show_datagram_experts(const compared *c, guint i, tvbuff_t *tvb, packet_inf
         if (c->changed & CHANGED_ADDR)
             wmem_strbuf_append_printf(what, ", address 0x%04x%04x came back as 0x%04x%04x", c->sent.ado, c->sent.adp,
                                       c->back.ado, c->back.adp);
-        proto_tree_add_expert_format(tree, pinfo, &ei_changed, tvb, c->back.offset, span(c), "Datagram %u (%s)%s", i + 1,
+        proto_tree_add_expert_format(tree, pinfo, &ei_changed, tvb, c->back.offset, datagram_span(&c->back), "Datagram %u (%s)%s", i + 1,
                                      cmd, wmem_strbuf_get_str(what));
     }
     if (is_write(c->sent.cmd) && c->data_changed && !(c->changed & CHANGED_LEN))
-        proto_tree_add_expert_format(tree, pinfo, &ei_write_changed, tvb, c->back.offset + 10, span(c) - 12,
+        proto_tree_add_expert_format(tree, pinfo, &ei_write_changed, tvb, data_offset(&c->back), c->back.length,
                                      "Datagram %u (%s): the written data came back changed", i + 1, cmd);
     if (wkc_added(c) < 0)
-        proto_tree_add_expert_format(tree, pinfo, &ei_wkc_down, tvb, c->back.offset + span(c) - 2, 2,
+        proto_tree_add_expert_format(tree, pinfo, &ei_wkc_down, tvb, wkc_offset(&c->back), datagram_wkc,
                                      "Datagram %u (%s): working counter went down from %u to %u", i + 1, cmd,
                                      c->sent.wkc, c->back.wkc);
     if (c->forwarding)
