@@ -249,9 +249,8 @@ gboolean given_up(const capture_state *c, const pending *q, const packet_info *p
     return nstime_to_sec(&age) > timeout;
 }
 
-/* The oldest request of a queue still waiting (given-up ones retired on the
- * way), or NULL. `in_key` says which link the queue uses. */
-/* Takes a done request off the head of a queue. */
+/* Takes a done request off the head of a queue. `in_key` says which link the
+ * queue uses. */
 void drop_head(queue *qu, gboolean in_key)
 {
     pending *q = qu->head;
@@ -260,6 +259,8 @@ void drop_head(queue *qu, gboolean in_key)
     release(q);
 }
 
+/* The oldest request of a queue still waiting (given-up ones retired on the
+ * way), or NULL. */
 pending *oldest_waiting(capture_state *c, queue *qu, gboolean in_key, const packet_info *pinfo)
 {
     while (qu->head) {

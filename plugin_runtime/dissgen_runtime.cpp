@@ -517,9 +517,15 @@ const char *summary_text(const dg_state *st, const dg_node *n)
     return out->data;
 }
 
-void info_append(dg_state *st, const char *text, gsize len)
+/* The separator before the next item of the Info column, when there is one before it. */
+void info_separate(dg_state *st)
 {
     if (st->info->len > 0) text_append(st->info, ", ", 2);
+}
+
+void info_append(dg_state *st, const char *text, gsize len)
+{
+    info_separate(st);
     text_append(st->info, text, len);
 }
 
@@ -867,7 +873,7 @@ void summaries_end(dg_state *st, const dg_node *n, const dg_summaries *s)
 {
     if (s->count > 1) {
         /* "NAME ×COUNT: SUMMARY, SUMMARY, ..." */
-        if (st->info->len > 0) text_append(st->info, ", ", 2);
+        info_separate(st);
         append_str(st->info, n->name);
         text_append(st->info, " \xc3\x97", 3);
         append_dec(st->info, s->count);
