@@ -527,8 +527,8 @@ void Emitter::register_functions() {
     const char* experts[][4] = {
         {"truncated", "PI_MALFORMED", "PI_ERROR", "The packet ends inside a field"},
         {"past_end", "PI_MALFORMED", "PI_ERROR", "A length field points past the end of its data"},
-        {"more_no_data", "PI_MALFORMED", "PI_WARN", "The repeat flag says more follow, but no data is left"},
-        {"count_short", "PI_MALFORMED", "PI_WARN", "Fewer instances than the count field says"},
+        {"more_no_data", "PI_MALFORMED", "PI_ERROR", "The repeat flag says more follow, but no data is left"},
+        {"count_short", "PI_MALFORMED", "PI_ERROR", "Fewer instances than the count field says"},
         {"bad_length", "PI_MALFORMED", "PI_ERROR", "A length or count is missing or negative"},
         {"unused", "PI_PROTOCOL", "PI_WARN", "A length says more bytes than its fields hold"},
         {"bad_offset", "PI_MALFORMED", "PI_ERROR", "An offset table entry is out of order or out of range"},

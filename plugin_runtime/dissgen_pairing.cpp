@@ -60,6 +60,9 @@ struct pending {
     guint8 src_bytes[16];  /* src's data when it fits (kept_address) */
     guint8 *bytes;  /* the request's bytes, kept for the analysis until answered */
     guint length;
+    guint64 key;    /* its first key value (dg_lost) */
+    dg_frame_pairing *record;  /* the request's record */
+    gboolean guessed;          /* taken for a request for want of a better idea */
 };
 
 struct queue {
@@ -72,11 +75,14 @@ struct key_entry {
     queue waiting;               /* this key's requests */
     guint32 last_frame;          /* the last message with this key (duplicates) */
     nstime_t last_time;
-    guint8 last_role;
+    guint8 last_role;            /* dg_role */
+    dg_frame_pairing *last_record; /* its record (adopt_orphan) */
     address last_src;
     guint8 last_src_bytes[16];
     guint8 *last_bytes;
     guint last_length;
+    nstime_t last_request_time;  /* this key's last request */
+    nstime_t request_period;     /* between its last two requests; 0 until there are two */
 };
 
 struct capture_state {
@@ -84,6 +90,7 @@ struct capture_state {
     key_entry *oldest, *newest;  /* key entries by their last message, least recent first */
     queue sent;                  /* every key's requests, in capture order */
     guint waiting;               /* requests not yet answered nor given up */
+    guint guessed;               /* of them, taken for requests for want of a better idea */
     guint64 requests;            /* the last request's seq */
     guint64 answered_max;        /* the highest seq answered so far */
     guint32 last_frame;          /* the last message paired (its frame) */
@@ -91,14 +98,19 @@ struct capture_state {
     nstime_t clock;              /* what forgetting goes by (forget_clock) */
     nstime_t previous_time;      /* the last message's time */
     gboolean clock_set;
+    /* The requests the message being paired proves lost (give_up). */
+    guint32 frame;               /* that message's frame */
+    dg_lost *lost;
+    guint lost_count, lost_capacity;
 };
 
 /* One protocol per plugin, and each plugin links its own runtime. */
 const dg_protocol *protocol;
 const dg_analysis *analysis;
+const char *key_name = "key"; /* the first key field's name, for texts */
 capture_state *capture; /* NULL between captures */
 
-int hf_response_in = -1, hf_request_in = -1, hf_time = -1;
+int hf_response_in = -1, hf_request_in = -1, hf_time = -1, hf_no_response_to = -1;
 expert_field ei_no_response = EI_INIT, ei_duplicate = EI_INIT, ei_out_of_order = EI_INIT;
 
 guint key_hash(gconstpointer v)
@@ -164,15 +176,30 @@ key_entry *entry_for(capture_state *c, const guint64 *keys, guint key_count)
     return e;
 }
 
-/* The same bytes from the same source as the last message of this key, within
- * a hundredth of the timeout, and that message a response or the one just before. */
+/* How soon a copy of a key's last message must follow it to be that message
+ * again (a frame captured twice, or one that came back unprocessed) rather
+ * than the sender's next message: within a hundredth of the timeout, and
+ * within half the key's request period once that is known (a cyclic request
+ * sent unchanged every cycle is a new request each time, even when the
+ * response in between was lost). */
+gboolean within_copy_window(const key_entry *e, const nstime_t *then, const packet_info *pinfo)
+{
+    nstime_t gap;
+    nstime_delta(&gap, &pinfo->abs_ts, then);
+    double window = protocol->pairing->timeout / 100;
+    double period = nstime_to_sec(&e->request_period);
+    if (period > 0 && period / 2 < window) window = period / 2;
+    return nstime_to_sec(&gap) <= window;
+}
+
+/* The same bytes from the same source as the last message of this key, soon
+ * after it (within_copy_window), and that message a response or the one just
+ * before. */
 gboolean same_again(const capture_state *c, const key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length)
 {
     if (!e->last_frame || e->last_length != length || !addresses_equal(&e->last_src, &pinfo->src)) return FALSE;
     if (e->last_role != DG_ROLE_RESPONSE && e->last_frame != c->last_frame) return FALSE;
-    nstime_t gap;
-    nstime_delta(&gap, &pinfo->abs_ts, &e->last_time);
-    if (nstime_to_sec(&gap) > protocol->pairing->timeout / 100) return FALSE;
+    if (!within_copy_window(e, &e->last_time, pinfo)) return FALSE;
     return tvb_memeql(tvb, 0, e->last_bytes, length) == 0;
 }
 
@@ -227,9 +254,26 @@ void retire(capture_state *c, pending *q)
     if (q->done) return;
     q->done = TRUE;
     c->waiting--;
+    if (q->guessed) c->guessed--;
     wmem_free(wmem_file_scope(), q->bytes);
     q->bytes = NULL;
     drop_address(&q->src, q->src_bytes);
+}
+
+/* Given up unanswered while the current message was paired: that message
+ * proves it lost (its expert info goes there in one pass). */
+void give_up(capture_state *c, pending *q)
+{
+    if (q->done) return;
+    q->txn->given_up_in = c->frame;
+    if (c->lost_count == c->lost_capacity) {
+        c->lost_capacity = c->lost_capacity ? 2 * c->lost_capacity : 4;
+        c->lost = (dg_lost *)wmem_realloc(wmem_file_scope(), c->lost, c->lost_capacity * sizeof(dg_lost));
+    }
+    c->lost[c->lost_count].txn = q->txn;
+    c->lost[c->lost_count].key = q->key;
+    c->lost_count++;
+    retire(c, q);
 }
 
 void release(pending *q)
@@ -265,16 +309,16 @@ pending *oldest_waiting(capture_state *c, queue *qu, gboolean in_key, const pack
 {
     while (qu->head) {
         pending *q = qu->head;
-        if (!q->done && given_up(c, q, pinfo, protocol->pairing->timeout)) retire(c, q);
+        if (!q->done && given_up(c, q, pinfo, protocol->pairing->timeout)) give_up(c, q);
         if (!q->done) return q;
         drop_head(qu, in_key);
     }
     return NULL;
 }
 
-void retire_all(capture_state *c, queue *qu, const packet_info *pinfo)
+void give_up_all(capture_state *c, queue *qu, const packet_info *pinfo)
 {
-    for (pending *q; (q = oldest_waiting(c, qu, TRUE, pinfo));) retire(c, q);
+    for (pending *q; (q = oldest_waiting(c, qu, TRUE, pinfo));) give_up(c, q);
 }
 
 /* The pending request of this key that this message answers, or NULL when
@@ -292,21 +336,32 @@ pending *take_answered(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_inf
         verdict = 0;
     if (verdict == 0) {
         /* The sender sent the same key again: what was pending is given up. */
-        retire_all(c, &e->waiting, pinfo);
+        give_up_all(c, &e->waiting, pinfo);
         return NULL;
     }
     return q;
 }
 
 /* A response that answers nothing pending of its key (its key came back
- * changed): when exactly one request is waiting, and its sender fits, it is
- * that one's. (With several waiting, a capture that missed frames could not
- * be told from one whose keys changed.) */
-pending *take_oldest(capture_state *c, packet_info *pinfo)
+ * changed): once the capture has shown a pair, when exactly one request is
+ * waiting, its sender fits and the analysis sees the same request in it but
+ * for the key, it is that one's. (With several waiting, a capture that missed
+ * frames could not be told from one whose keys changed; a response to another
+ * request, whose own request was not captured, is an orphan.) */
+pending *take_oldest(capture_state *c, tvbuff_t *tvb, packet_info *pinfo)
 {
+    /* Before the first pair, a response is far likelier one whose request
+     * was sent before the capture started. */
+    if (!c->answered_max) return NULL;
     pending *q = oldest_waiting(c, &c->sent, FALSE, pinfo);
     if (!q || c->waiting != 1 || !analysis || !analysis->is_response || analysis->is_response(c->analysis, &q->src, &pinfo->src) != 1)
         return NULL;
+    if (analysis->key_changed && q->bytes) {
+        tvbuff_t *request = tvb_new_real_data(q->bytes, q->length, (gint)q->length);
+        gboolean same = analysis->key_changed(request, tvb);
+        tvb_free(request);
+        if (!same) return NULL;
+    }
     return q;
 }
 
@@ -360,14 +415,24 @@ gboolean long_ago(const capture_state *c, const nstime_t *then)
     return fabs(nstime_to_sec(&age)) > stale_after * protocol->pairing->timeout;
 }
 
-/* Requests at the head of the capture's queue that nothing can answer any more. */
+/* Whether a request sent `then` has waited longer than the timeout, by the
+ * forgetting clock (one message stamped far ahead proves nothing lost). */
+gboolean timed_out(const capture_state *c, const nstime_t *then)
+{
+    nstime_t age;
+    nstime_delta(&age, &c->clock, then);
+    return nstime_to_sec(&age) > protocol->pairing->timeout;
+}
+
+/* Requests at the head of the capture's queue that nothing can answer any
+ * more (overtaken, or older than the timeout): lost, as this message proves. */
 void forget_requests(capture_state *c)
 {
     while (c->sent.head) {
         pending *q = c->sent.head;
         if (!q->done) {
-            if (c->answered_max <= q->txn->seq + max_overtaken && !long_ago(c, &q->txn->request_time)) return;
-            retire(c, q);
+            if (c->answered_max <= q->txn->seq + max_overtaken && !timed_out(c, &q->txn->request_time)) return;
+            give_up(c, q);
         }
         drop_head(&c->sent, FALSE);
     }
@@ -379,7 +444,7 @@ void forget_key(capture_state *c, key_entry *e)
 {
     for (pending *q = e->waiting.head, *next; q; q = next) {
         next = q->next;
-        retire(c, q);
+        give_up(c, q);
         release(q);
     }
     unlink_entry(c, e);
@@ -406,47 +471,138 @@ dg_frame_pairing *new_record(guint8 role)
     return fp;
 }
 
-dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count, guint length)
+/* The key's waiting requests from this message's source are given up: the
+ * sender used the key again, so it no longer waits for them. */
+void give_up_sent_again(capture_state *c, key_entry *e, const packet_info *pinfo)
 {
-    capture_state *c = current_capture();
-    forget_clock(c, pinfo);
-    forget_requests(c);
-    forget_keys(c);
-    if (analysis && analysis->see) analysis->see(c->analysis, tvb, pinfo);
-    key_entry *e = entry_for(c, keys, key_count);
-    gboolean again = same_again(c, e, tvb, pinfo, length);
-    gboolean unchanged = again && unchanged_return(c, e, pinfo);
-    gboolean duplicate = again && !unchanged;
-    c->last_frame = pinfo->num;
-    if (duplicate) {
-        dg_frame_pairing *fp = new_record(DG_ROLE_DUPLICATE);
-        fp->duplicate_of = e->last_frame;
-        return fp;
-    }
+    for (pending *q = e->waiting.head; q; q = q->next)
+        if (!q->done && addresses_equal(&q->src, &pinfo->src)) give_up(c, q);
+}
 
-    pending *q = take_answered(c, e, tvb, pinfo, length, unchanged);
-    gboolean returned = !q && analysis && analysis->is_returned && analysis->is_returned(c->analysis, &pinfo->src);
-    if (returned) q = take_oldest(c, pinfo);
-    remember_last(c, e, tvb, pinfo, length, q ? DG_ROLE_RESPONSE : DG_ROLE_REQUEST); /* an orphan: a request for step 2 */
-    if (q) {
-        dg_frame_pairing *fp = new_record(DG_ROLE_RESPONSE);
-        dg_transaction *t = q->txn;
-        t->response_frame = pinfo->num;
-        nstime_delta(&t->round_trip, &pinfo->abs_ts, &t->request_time);
-        fp->txn = t;
-        fp->out_of_order = t->seq < c->answered_max;
-        if (t->seq > c->answered_max) c->answered_max = t->seq;
-        if (analysis && analysis->compare) {
-            tvbuff_t *request = tvb_new_real_data(q->bytes, q->length, (gint)q->length);
-            fp->analysis = analysis->compare(c->analysis, request, tvb, pinfo);
-            tvb_free(request);
-        }
+/* A message known to be a response: the oldest waiting request of its key
+ * whose source does not rule it out, else the one request waiting if its key
+ * came back changed (take_oldest); NULL: an orphan. */
+/* Messages taken for requests only for want of a better idea, from a source
+ * now known to send responses only (a slave's marked return), were
+ * responses whose requests were not captured: orphans, not lost. */
+void orphan_guessed_from(capture_state *c, const packet_info *pinfo)
+{
+    for (pending *q = c->sent.head; q && c->guessed; q = q->next_sent) {
+        if (q->done || !q->guessed || !addresses_equal(&q->src, &pinfo->src)) continue;
+        q->record->role = DG_ROLE_ORPHAN;
+        q->record->txn = NULL;
         retire(c, q);
-        return fp;
     }
+}
 
-    if (returned) return new_record(DG_ROLE_ORPHAN);
-    /* A request: its frame's record and the transaction in one allocation. */
+/* A message known to be a response: of its key's waiting requests the
+ * oldest whose source says it is answered (the analysis' is_response), else
+ * the oldest it does not rule out; else the one request waiting if its key
+ * came back changed (take_oldest); NULL: an orphan. */
+pending *take_response(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo)
+{
+    oldest_waiting(c, &e->waiting, TRUE, pinfo); /* gives up the expired ones */
+    pending *maybe = NULL;
+    for (pending *q = e->waiting.head; q; q = q->next) {
+        if (q->done) continue;
+        int verdict = analysis && analysis->is_response ? analysis->is_response(c->analysis, &q->src, &pinfo->src) : -1;
+        if (verdict == 1) {
+            if (c->guessed) orphan_guessed_from(c, pinfo);
+            return q;
+        }
+        if (verdict < 0 && !maybe) maybe = q;
+    }
+    return maybe ? maybe : take_oldest(c, tvb, pinfo);
+}
+
+/* A message its own bytes cannot place (the analysis has a direction()):
+ * the key's waiting request come back untouched, soon after it was sent, or
+ * NULL (a new request). */
+pending *take_unchanged(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length)
+{
+    pending *q = oldest_waiting(c, &e->waiting, TRUE, pinfo);
+    if (!q || !q->bytes || !within_copy_window(e, &q->txn->request_time, pinfo)) return NULL;
+    tvbuff_t *request = tvb_new_real_data(q->bytes, q->length, (gint)q->length);
+    gboolean same = analysis->unchanged ? analysis->unchanged(request, tvb, length)
+                                        : q->length == length && tvb_memeql(tvb, 0, q->bytes, length) == 0;
+    tvb_free(request);
+    /* Lets the analysis learn from the two sources (a marked return). */
+    if (same && analysis->is_response && analysis->is_response(c->analysis, &q->src, &pinfo->src) == 0) return NULL;
+    return same ? q : NULL;
+}
+
+/* What the message is: the transport's direction, else what the analysis
+ * reads from the message itself. */
+guint8 direction_of(capture_state *c, tvbuff_t *tvb, packet_info *pinfo, guint8 transport)
+{
+    if (transport != DG_DIR_ANY || !analysis || !analysis->direction) return transport;
+    return analysis->direction(c->analysis, tvb, pinfo);
+}
+
+/* The requests this message proved lost go with its record. */
+dg_frame_pairing *with_lost(capture_state *c, dg_frame_pairing *fp)
+{
+    if (c->lost_count) {
+        fp->lost = (const dg_lost *)wmem_memdup(wmem_file_scope(), c->lost, c->lost_count * sizeof(dg_lost));
+        fp->lost_count = (guint16)MIN(c->lost_count, G_MAXUINT16);
+    }
+    return fp;
+}
+
+/* The response record for transaction t, whose request's bytes are given. */
+dg_frame_pairing *response_to(capture_state *c, dg_transaction *t, const guint8 *request_bytes, guint request_length,
+                              tvbuff_t *tvb, packet_info *pinfo)
+{
+    dg_frame_pairing *fp = new_record(DG_ROLE_RESPONSE);
+    t->response_frame = pinfo->num;
+    nstime_delta(&t->round_trip, &pinfo->abs_ts, &t->request_time);
+    fp->txn = t;
+    fp->out_of_order = t->seq < c->answered_max;
+    if (t->seq > c->answered_max) c->answered_max = t->seq;
+    if (analysis && analysis->compare && request_bytes) {
+        tvbuff_t *request = tvb_new_real_data(request_bytes, request_length, (gint)request_length);
+        fp->analysis = analysis->compare(c->analysis, request, tvb, pinfo);
+        tvb_free(request);
+    }
+    return fp;
+}
+
+dg_frame_pairing *answer(capture_state *c, pending *q, tvbuff_t *tvb, packet_info *pinfo)
+{
+    dg_frame_pairing *fp = response_to(c, q->txn, q->bytes, q->length, tvb, pinfo);
+    retire(c, q);
+    return fp;
+}
+
+/* A response with nothing to answer, right after an orphan of its key from
+ * the same sender (or the same one with the returned-frame mark): that
+ * "orphan" was its request after all, one sent with a working counter above
+ * 0 (which only a faulty master does) or the first frame of a capture whose
+ * marking was not known yet. It becomes the request, answered by this one.
+ * (In one pass it was shown as an orphan already.) Only where the analysis
+ * guessed the direction: a transport's direction is never wrong. */
+dg_frame_pairing *adopt_orphan(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo)
+{
+    if (e->last_role != DG_ROLE_ORPHAN || !e->last_record) return NULL;
+    nstime_t gap;
+    nstime_delta(&gap, &pinfo->abs_ts, &e->last_time);
+    if (nstime_to_sec(&gap) > protocol->pairing->timeout) return NULL;
+    int verdict = analysis && analysis->is_response ? analysis->is_response(c->analysis, &e->last_src, &pinfo->src) : -1;
+    if (verdict == 0 || (verdict < 0 && !addresses_equal(&e->last_src, &pinfo->src))) return NULL;
+    dg_transaction *t = wmem_new0(wmem_file_scope(), dg_transaction);
+    t->request_frame = e->last_frame;
+    t->request_time = e->last_time;
+    t->seq = ++c->requests;
+    dg_frame_pairing *request = e->last_record;
+    request->role = DG_ROLE_REQUEST;
+    request->txn = t;
+    return response_to(c, t, e->last_bytes, e->last_length, tvb, pinfo);
+}
+
+dg_frame_pairing *new_request(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length,
+                              guint64 key, gboolean guessed)
+{
+    /* Its frame's record and the transaction in one allocation. */
     struct request_record {
         dg_frame_pairing fp;
         dg_transaction txn;
@@ -460,8 +616,15 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     t->seq = ++c->requests;
     fp->role = DG_ROLE_REQUEST;
     fp->txn = t;
+    if (!nstime_is_zero(&e->last_request_time) && nstime_cmp(&pinfo->abs_ts, &e->last_request_time) > 0)
+        nstime_delta(&e->request_period, &pinfo->abs_ts, &e->last_request_time);
+    e->last_request_time = pinfo->abs_ts;
     pending *n = wmem_new0(wmem_file_scope(), pending);
     n->txn = t;
+    n->key = key;
+    n->record = fp;
+    n->guessed = guessed;
+    if (guessed) c->guessed++;
     keep_address(&n->src, n->src_bytes, &pinfo->src);
     if (analysis && analysis->compare) {
         n->bytes = (guint8 *)tvb_memdup(wmem_file_scope(), tvb, 0, length);
@@ -473,6 +636,106 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     return fp;
 }
 
+/* The pending request this message answers, or NULL for a new request
+ * (`orphan` set: a response whose request was not captured). */
+pending *classify(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length, guint8 direction,
+                  gboolean unchanged, gboolean *orphan)
+{
+    *orphan = FALSE;
+    pending *q = NULL;
+    if (direction == DG_DIR_RESPONSE) {
+        q = take_response(c, e, tvb, pinfo);
+        *orphan = !q;
+    } else if (direction == DG_DIR_REQUEST) {
+        give_up_sent_again(c, e, pinfo);
+    } else if (analysis && analysis->direction) {
+        q = take_unchanged(c, e, tvb, pinfo, length);
+        if (!q) give_up_sent_again(c, e, pinfo);
+    } else {
+        /* Neither the transport nor an analysis can tell: the order decides. */
+        q = take_answered(c, e, tvb, pinfo, length, unchanged);
+        if (!q && analysis && analysis->is_returned && analysis->is_returned(c->analysis, &pinfo->src)) {
+            q = take_oldest(c, tvb, pinfo);
+            *orphan = !q;
+        }
+    }
+    return q;
+}
+
+dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count, guint length,
+                             guint8 transport_direction)
+{
+    capture_state *c = current_capture();
+    c->frame = pinfo->num;
+    c->lost_count = 0;
+    forget_clock(c, pinfo);
+    forget_requests(c);
+    forget_keys(c);
+    if (analysis && analysis->see) analysis->see(c->analysis, tvb, pinfo);
+    guint8 verdict = direction_of(c, tvb, pinfo, transport_direction);
+    guint8 direction = verdict & ~DG_DIR_FROM_SOURCE;
+    if (verdict == (DG_DIR_RESPONSE | DG_DIR_FROM_SOURCE) && c->guessed) orphan_guessed_from(c, pinfo);
+    key_entry *e = entry_for(c, keys, key_count);
+    gboolean again = same_again(c, e, tvb, pinfo, length);
+    gboolean unchanged = again && direction != DG_DIR_REQUEST && unchanged_return(c, e, pinfo);
+    c->last_frame = pinfo->num;
+    if (again && !unchanged) {
+        dg_frame_pairing *fp = new_record(DG_ROLE_DUPLICATE);
+        fp->duplicate_of = e->last_frame;
+        return with_lost(c, fp);
+    }
+    if (unchanged) direction = DG_DIR_ANY; /* the waiting request, come back */
+
+    gboolean orphan;
+    pending *q = classify(c, e, tvb, pinfo, length, direction, unchanged, &orphan);
+    dg_frame_pairing *fp;
+    if (q)
+        fp = answer(c, q, tvb, pinfo);
+    else if (orphan && transport_direction == DG_DIR_ANY && (fp = adopt_orphan(c, e, tvb, pinfo)) != NULL)
+        ;
+    else if (orphan)
+        fp = new_record(DG_ROLE_ORPHAN);
+    else
+        fp = new_request(c, e, tvb, pinfo, length, keys[0], direction == DG_DIR_ANY);
+    remember_last(c, e, tvb, pinfo, length, fp->role);
+    e->last_record = fp;
+    return with_lost(c, fp);
+}
+
+/* A request not answered: lost when a later message proved it (given_up_in),
+ * or, once the capture has been read, when a later request was answered (the
+ * first pass waits for max_overtaken of them, in case of reordering, which
+ * the end of the capture cuts short) or the capture went on for longer than
+ * the timeout after it. One sent at the capture's very end is in flight. */
+gboolean known_lost(const dg_transaction *t)
+{
+    if (t->given_up_in) return TRUE;
+    if (!capture) return FALSE;
+    if (capture->answered_max > t->seq) return TRUE;
+    nstime_t waited;
+    nstime_delta(&waited, &capture->previous_time, &t->request_time);
+    return nstime_to_sec(&waited) > protocol->pairing->timeout;
+}
+
+/* The requests this message proved lost, each linked. The expert info goes
+ * here in the first pass (one pass, a live capture), where nothing later can
+ * be shown; once the capture has been read (tshark -2, the GUI) it sits on
+ * the lost request itself and this message keeps the link. */
+void show_lost(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    for (guint i = 0; i < fp->lost_count; i++) {
+        const dg_lost *l = &fp->lost[i];
+        proto_item *item = proto_tree_add_uint(tree, hf_no_response_to, tvb, 0, 0, l->txn->request_frame);
+        proto_item_set_generated(item);
+        if (PINFO_FD_VISITED(pinfo)) continue;
+        nstime_t since;
+        nstime_delta(&since, &pinfo->abs_ts, &l->txn->request_time);
+        proto_tree_add_expert_format(tree, pinfo, &ei_no_response, tvb, 0, 0,
+                                     "No response to frame %u (%s 0x%" G_GINT64_MODIFIER "x), sent %.3f ms before",
+                                     l->txn->request_frame, key_name, l->key, nstime_to_msec(&since));
+    }
+}
+
 void show(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     proto_item *item;
@@ -482,9 +745,14 @@ void show(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, proto_t
         if (t->response_frame) {
             item = proto_tree_add_uint(tree, hf_response_in, tvb, 0, 0, t->response_frame);
             proto_item_set_generated(item);
-        } else if (PINFO_FD_VISITED(pinfo)) {
-            /* Only once the whole capture has been read can "never" be said. */
-            proto_tree_add_expert(tree, pinfo, &ei_no_response, tvb, 0, 0);
+        } else if (PINFO_FD_VISITED(pinfo) && known_lost(t)) {
+            /* Only once the whole capture has been read can "never" be said
+             * here; in one pass the frame that proved it says so (show_lost). */
+            if (t->given_up_in)
+                proto_tree_add_expert_format(tree, pinfo, &ei_no_response, tvb, 0, 0,
+                                             "No response seen (given up in frame %u)", t->given_up_in);
+            else
+                proto_tree_add_expert(tree, pinfo, &ei_no_response, tvb, 0, 0);
         }
         break;
     case DG_ROLE_RESPONSE:
@@ -506,6 +774,7 @@ void show(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, proto_t
     }
     if (fp->role == DG_ROLE_REQUEST && analysis && analysis->show_sent && fp->analysis)
         analysis->show_sent(fp->analysis, tvb, pinfo, tree);
+    if (fp->lost_count) show_lost(fp, tvb, pinfo, tree);
 }
 
 /* --- statistics ---------------------------------------------------------- */
@@ -518,7 +787,6 @@ const char *const st_duplicates = "Duplicates";
 const char *const st_orphans = "Responses to requests not captured";
 const char *const st_rtt = "Round trip (ms)";
 int st_pairing_id;
-guint64 st_request_count, st_answered_count; /* for "No response": requests not answered by the end */
 
 } /* namespace */
 
@@ -539,16 +807,25 @@ void dg_pairing_register(const dg_protocol *p)
                           "The frame this one answers", HFILL}},
         {&hf_time, {"Round trip", NULL, FT_RELATIVE_TIME, BASE_NONE, NULL, 0x0,
                     "Time from the request to this response", HFILL}},
+        {&hf_no_response_to, {"No response to", NULL, FT_FRAMENUM, BASE_NONE, FRAMENUM_TYPE(FT_FRAMENUM_REQUEST),
+                              0x0, "A request this message proves lost (its key reused, or its timeout passed)",
+                              HFILL}},
     };
     hf[0].hfinfo.abbrev = g_strdup_printf("%s.response_in", p->filter);
     hf[1].hfinfo.abbrev = g_strdup_printf("%s.request_in", p->filter);
     hf[2].hfinfo.abbrev = g_strdup_printf("%s.time", p->filter);
+    hf[3].hfinfo.abbrev = g_strdup_printf("%s.no_response_to", p->filter);
+    for (guint i = 0; i < p->node_count; i++)
+        if (p->nodes[i].flags & DG_KEY) {
+            key_name = p->nodes[i].name;
+            break;
+        }
     proto_register_field_array(*p->proto, hf, (int)G_N_ELEMENTS(hf));
 
     static ei_register_info ei[] = {
         {&ei_no_response, {NULL, PI_SEQUENCE, PI_WARN, "No response seen", EXPFILL}},
         {&ei_duplicate, {NULL, PI_SEQUENCE, PI_NOTE, "Duplicate message", EXPFILL}},
-        {&ei_out_of_order, {NULL, PI_SEQUENCE, PI_WARN, "Response out of order", EXPFILL}},
+        {&ei_out_of_order, {NULL, PI_SEQUENCE, PI_NOTE, "Response out of order", EXPFILL}},
     };
     ei[0].eiinfo.name = g_strdup_printf("%s.expert.no_response", p->filter);
     ei[1].eiinfo.name = g_strdup_printf("%s.expert.duplicate", p->filter);
@@ -562,7 +839,8 @@ void dg_pairing_register(const dg_protocol *p)
 }
 
 const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
-                                           const guint64 *keys, guint key_count, gint length, guint message)
+                                           const guint64 *keys, guint key_count, gint length, guint message,
+                                           guint8 direction)
 {
     /* A message cut short before its first key field answers and asks nothing. */
     if (key_count == 0) return NULL;
@@ -571,7 +849,7 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, 
     if (!fp) {
         if (PINFO_FD_VISITED(pinfo)) return NULL; /* not paired on the first pass: nothing to show */
         guint len = length > 0 ? (guint)length : tvb_captured_length(tvb);
-        fp = first_pass(tvb, pinfo, keys, key_count, len);
+        fp = first_pass(tvb, pinfo, keys, key_count, len, direction);
         p_add_proto_data(wmem_file_scope(), pinfo, *p->proto, frame_key + message, fp);
     }
     show(fp, tvb, pinfo, tree);
@@ -580,13 +858,11 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, 
 
 void dg_pairing_stats_init(const dg_protocol *, stats_tree *st)
 {
+    /* The section and its first rows, always in this order; the other rows
+     * appear with their first count (no rows of zeros). */
     st_pairing_id = stats_tree_create_node(st, st_pairing, 0, STAT_DT_INT, TRUE);
-    st_request_count = st_answered_count = 0;
     stats_tree_create_node(st, st_requests, st_pairing_id, STAT_DT_INT, FALSE);
     stats_tree_create_node(st, st_responses, st_pairing_id, STAT_DT_INT, FALSE);
-    stats_tree_create_node(st, st_lost, st_pairing_id, STAT_DT_INT, FALSE);
-    stats_tree_create_node(st, st_duplicates, st_pairing_id, STAT_DT_INT, FALSE);
-    stats_tree_create_node(st, st_orphans, st_pairing_id, STAT_DT_INT, FALSE);
     stats_tree_create_node(st, st_rtt, st_pairing_id, STAT_DT_FLOAT, FALSE);
     if (analysis && analysis->stats_init) analysis->stats_init(st, st_pairing_id);
 }
@@ -598,11 +874,9 @@ void dg_pairing_stats_packet(const dg_protocol *, stats_tree *st, packet_info *,
     switch (fp->role) {
     case DG_ROLE_REQUEST:
         tick_stat_node(st, st_requests, st_pairing_id, FALSE);
-        st_request_count++;
         break;
     case DG_ROLE_RESPONSE:
         tick_stat_node(st, st_responses, st_pairing_id, FALSE);
-        st_answered_count++;
         avg_stat_node_add_value_float(st, st_rtt, st_pairing_id, FALSE,
                                       (gfloat)(nstime_to_sec(&fp->txn->round_trip) * 1000.0));
         if (analysis && analysis->stats_response && fp->analysis)
@@ -616,9 +890,15 @@ void dg_pairing_stats_packet(const dg_protocol *, stats_tree *st, packet_info *,
         break;
     default: break;
     }
-    /* Every response answers one request, so once the capture has been read
-     * the requests not answered are the difference (one pass or two). */
-    set_stat_node(st, st_lost, st_pairing_id, FALSE, (gint)(st_request_count - st_answered_count));
+    /* Requests lost: those a later message proved lost, counted on that
+     * message, and those only the capture's end shows (known_lost), counted
+     * on themselves: the same as the expert infos, one pass or two. (A tap
+     * cannot tell the passes apart: tshark marks a frame visited before its
+     * taps run.) */
+    guint lost = fp->lost_count;
+    if (fp->role == DG_ROLE_REQUEST && !fp->txn->response_frame && !fp->txn->given_up_in && known_lost(fp->txn))
+        lost++;
+    if (lost) increase_stat_node(st, st_lost, st_pairing_id, FALSE, lost);
 }
 
 } /* extern "C" */

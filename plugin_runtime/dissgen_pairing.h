@@ -28,7 +28,16 @@ typedef struct dg_transaction {
     nstime_t request_time;   /* pinfo->abs_ts of the request */
     nstime_t round_trip;     /* response time - request time */
     guint64 seq;             /* requests in capture order, from 1 */
+    guint32 given_up_in;     /* no response: the frame that proved it (the key
+                              * reused, the timeout passed); 0 while not known */
 } dg_transaction;
+
+/* The requests a message proved lost: each was given up while this message
+ * was paired (its key reused, or its timeout passed). */
+typedef struct dg_lost {
+    const dg_transaction *txn;
+    guint64 key;             /* its first key value, for the expert's text */
+} dg_lost;
 
 enum dg_role {
     DG_ROLE_REQUEST = 1,
@@ -37,14 +46,19 @@ enum dg_role {
     DG_ROLE_ORPHAN = 4 /* a response (the analysis says so) whose request is not in the capture */
 };
 
-/* What the first pass found for one message of a frame. Later issues add
- * their per-frame results here (as members at the end). */
+/* Or-ed into an analysis' direction(): the message's source alone says so,
+ * and that source sends nothing the other way. */
+enum { DG_DIR_FROM_SOURCE = 0x10 };
+
+/* What the first pass found for one message of a frame. */
 typedef struct dg_frame_pairing {
     dg_transaction *txn;     /* NULL for a duplicate */
     guint8 role;             /* dg_role */
-    gboolean out_of_order;   /* response: a later request was answered first */
+    guint8 out_of_order;     /* response: a later request was answered first */
+    guint16 lost_count;      /* requests this message proved lost */
     guint32 duplicate_of;    /* duplicate: the frame it repeats */
     void *analysis;          /* response: the analysis's comparison; request: its sent() result */
+    const dg_lost *lost;     /* lost_count of them, or NULL */
 } dg_frame_pairing;
 
 /* What one protocol knows about its requests and responses. Every callback
@@ -78,6 +92,19 @@ typedef struct dg_analysis {
     void *(*sent)(void *capture, tvbuff_t *tvb, packet_info *pinfo);
     /* Every pass: shows a sent() result. */
     void (*show_sent)(const void *result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+    /* First pass, before pairing: what the message's own bytes and source say
+     * it is, DG_DIR_REQUEST or DG_DIR_RESPONSE, or DG_DIR_ANY when they cannot
+     * tell. With this callback a message that cannot tell is a request unless
+     * it is its key's waiting request come back unchanged (unchanged()). */
+    guint8 (*direction)(void *capture, tvbuff_t *tvb, packet_info *pinfo);
+    /* Whether `message` (its first `length` bytes, the message the rules
+     * decoded) can be `request` come back untouched by the other side (a
+     * frame no station processed); NULL: the same bytes. */
+    gboolean (*unchanged)(tvbuff_t *request, tvbuff_t *message, guint length);
+    /* Whether `message`, a response whose key matches no waiting request, is
+     * `request` come back with its key changed (the same request otherwise);
+     * NULL: it may be. */
+    gboolean (*key_changed)(tvbuff_t *request, tvbuff_t *message);
 } dg_analysis;
 
 #ifdef __cplusplus
@@ -91,11 +118,13 @@ void dg_pairing_register(const dg_protocol *p);
 /* After a message was decoded: pairs it on the first pass, then shows the
  * pairing in `tree`. `keys` are the values of the DG_KEY fields in decoding
  * order; `length` the bytes the message took; `message` its number within the
- * frame (0 for the first). Without a tree only the expert infos are raised
+ * frame (0 for the first); `direction` what the transport says (dg_direction:
+ * to the hooked port a request, from it a response). Without a tree only the expert infos are raised
  * (their severity reaches the Expert column). Returns what was found, for
  * the statistics. */
 const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
-                                           const guint64 *keys, guint key_count, gint length, guint message);
+                                           const guint64 *keys, guint key_count, gint length, guint message,
+                                           guint8 direction);
 
 void dg_pairing_stats_init(const dg_protocol *p, stats_tree *st);
 void dg_pairing_stats_packet(const dg_protocol *p, stats_tree *st, packet_info *pinfo, const dg_frame_pairing *fp);

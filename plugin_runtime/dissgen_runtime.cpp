@@ -1270,17 +1270,14 @@ const char *stats_node_name(const dg_node *n, const char *what)
     return g_strdup_printf("%s%s (%s)", n->name, what, hfi ? hfi->abbrev : stats_protocol->filter);
 }
 
-int *stats_node_ids;       /* per node: its stats tree node, or 0 */
-char **stats_node_names;   /* per node: that node's name, or NULL */
+char **stats_node_names;   /* per node: that node's name, or NULL (no statistics) */
 int stats_frames_id;
 
 void stats_init(stats_tree *st)
 {
     const dg_protocol *p = stats_protocol;
     guint n_nodes = p->node_count;
-    g_free(stats_node_ids);
     if (stats_node_names) g_strfreev(stats_node_names);
-    stats_node_ids = g_new0(int, n_nodes ? n_nodes : 1);
     stats_node_names = g_new0(char *, n_nodes + 1);
     stats_frames_id = stats_tree_create_node(st, "Messages", 0, STAT_DT_INT, FALSE);
     for (guint i = 0; i < n_nodes; i++) {
@@ -1289,8 +1286,8 @@ void stats_init(stats_tree *st)
         if (is_repeated(n)) what = " per message";
         else if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM) what = "";
         if (!what) continue;
+        /* The node itself appears with its first count: no rows of zeros. */
         stats_node_names[i] = (char *)stats_node_name(n, what);
-        stats_node_ids[i] = stats_tree_create_node(st, stats_node_names[i], 0, STAT_DT_INT, TRUE);
     }
     if (p->pairing) dg_pairing_stats_init(p, st);
 }
@@ -1304,7 +1301,7 @@ tap_packet_status stats_packet(stats_tree *st, packet_info *pinfo, epan_dissect_
     for (guint i = 0; i < t->count; i++) {
         const dg_tap_record *r = &t->records[i];
         const dg_node *n = &p->nodes[r->node];
-        if (!stats_node_ids[r->node]) continue;
+        if (!stats_node_names[r->node]) continue;
         const char *label = NULL;
         if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM && !is_repeated(n)) {
             header_field_info *hfi = proto_registrar_get_nth(*n->hf);
@@ -1318,8 +1315,8 @@ tap_packet_status stats_packet(stats_tree *st, packet_info *pinfo, epan_dissect_
             g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "u", r->value);
             label = buf;
         }
-        tick_stat_node(st, stats_node_names[r->node], 0, TRUE);
-        tick_stat_node(st, label, stats_node_ids[r->node], FALSE);
+        int id = tick_stat_node(st, stats_node_names[r->node], 0, TRUE);
+        tick_stat_node(st, label, id, FALSE);
     }
     if (p->pairing) dg_pairing_stats_packet(p, st, pinfo, t->pairing);
     return TAP_PACKET_REDRAW;
@@ -1503,7 +1500,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     proto_item_set_len(root, offset);
     if (p->pairing) {
         const dg_frame_pairing *fp =
-            dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, *messages - 1);
+            dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, *messages - 1, st.direction);
         if (st.tap) st.tap->pairing = fp;
     }
 

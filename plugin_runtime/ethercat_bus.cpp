@@ -440,7 +440,9 @@ void check_wkc(const bus_model *m, const datagram *s, const datagram *b, events 
     guint n;
     gint32 expected = expected_wkc(m, s, shares, &n);
     gint32 got = (gint32)b->wkc - (gint32)s->wkc;
-    if (expected < 0 || got == expected) return;
+    /* A counter that went down is the ESC analysis's finding (wkc_down), not
+     * a count of slaves: no "got -N" here. */
+    if (expected < 0 || got < 0 || got == expected) return;
     wmem_strbuf_t *text = wmem_strbuf_new(wmem_file_scope(), "");
     wmem_strbuf_append_printf(text, "%s: expected working counter %d, got %d", command_name(s->cmd), expected, got);
     gint32 missing = expected - got;
@@ -1141,14 +1143,10 @@ const char *const st_wkc_error = "Working counter not raised";
 const char *const st_al = "AL state changes";
 const char *const st_mailbox = "Mailbox datagrams";
 const char *const st_wkc_expected = "Unexpected working counter";
-int st_slaves_id;
 } /* namespace */
 
-void bus_stats_init(stats_tree *st, int parent)
-{
-    st_slaves_id = stats_tree_create_node(st, st_slaves, parent, STAT_DT_INT, TRUE);
-    stats_tree_create_node(st, st_wkc_expected, parent, STAT_DT_INT, FALSE);
-}
+/* Rows appear with their first count (no rows of zeros). */
+void bus_stats_init(stats_tree *, int) {}
 
 void bus_stats_frame(stats_tree *st, int parent, const bus_frame *f)
 {
@@ -1158,8 +1156,8 @@ void bus_stats_frame(stats_tree *st, int parent, const bus_frame *f)
         const addressed *a = &f->d[i];
         if (a->position < 0) continue;
         g_snprintf(label, sizeof label, "Position %d", a->position);
-        tick_stat_node(st, st_slaves, parent, TRUE);
-        int id = tick_stat_node(st, label, st_slaves_id, TRUE);
+        int slaves_id = tick_stat_node(st, st_slaves, parent, TRUE);
+        int id = tick_stat_node(st, label, slaves_id, TRUE);
         tick_stat_node(st, st_datagrams, id, FALSE);
         if (a->stats & ST_WKC_ERROR) tick_stat_node(st, st_wkc_error, id, FALSE);
         if (a->stats & ST_AL_CHANGE) tick_stat_node(st, st_al, id, FALSE);
@@ -1203,9 +1201,9 @@ void bus_register(int proto, const char *filter)
     proto_register_subtree_array(ett, (int)G_N_ELEMENTS(ett));
 
     static ei_register_info ei[] = {
-        {&ei_count, {NULL, PI_PROTOCOL, PI_ERROR, "Slave count differs from the network design", EXPFILL}},
-        {&ei_model, {NULL, PI_PROTOCOL, PI_ERROR, "Slave model differs from the network design", EXPFILL}},
-        {&ei_ok, {NULL, PI_PROTOCOL, PI_NOTE, "The bus matches the network design", EXPFILL}},
+        {&ei_count, {NULL, PI_PROTOCOL, PI_WARN, "Slave count differs from the network design", EXPFILL}},
+        {&ei_model, {NULL, PI_PROTOCOL, PI_WARN, "Slave model differs from the network design", EXPFILL}},
+        {&ei_ok, {NULL, PI_PROTOCOL, PI_CHAT, "The bus matches the network design", EXPFILL}},
         {&ei_wkc, {NULL, PI_PROTOCOL, PI_WARN, "Working counter differs from the expected one", EXPFILL}},
     };
     const char *ei_names[] = {"network.count", "network.model", "network.ok", "wkc"};

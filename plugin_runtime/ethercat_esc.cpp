@@ -158,6 +158,67 @@ int esc_is_response(void *capture, const address *request_src, const address *sr
     return -1;
 }
 
+/* What a frame's source and working counters say it is. Once returns were
+ * seen marked, the master's address is a frame sent and the marked one a
+ * frame returned. Otherwise a working counter above 0 says a slave processed
+ * the frame (a master sends every working counter as 0): returned, whether
+ * or not the capture marks returns and whether or not its request was
+ * captured. A frame with every working counter 0 cannot tell by itself. */
+guint8 esc_direction(void *capture, tvbuff_t *tvb, packet_info *pinfo)
+{
+    const capture_hints *h = (const capture_hints *)capture;
+    const address *src = &pinfo->src;
+    if (h->marking_seen && src->type == AT_ETHER && src->len == 6) {
+        const guint8 *b = (const guint8 *)src->data;
+        if (memcmp(b + 1, h->master + 1, 5) == 0) {
+            if (b[0] == h->master[0]) return DG_DIR_REQUEST | DG_DIR_FROM_SOURCE;
+            if (b[0] == (h->master[0] | 0x02)) return DG_DIR_RESPONSE | DG_DIR_FROM_SOURCE;
+        }
+    }
+    datagram d[max_datagrams];
+    guint header_length;
+    guint n = read_frame(tvb, &header_length, d, max_datagrams);
+    for (guint i = 0; i < n; i++)
+        if (d[i].wkc != 0) return DG_DIR_RESPONSE;
+    return DG_DIR_ANY;
+}
+
+/* A frame that no slave processed comes back as it was sent, except for the
+ * auto-increment address of auto-increment and broadcast datagrams, which
+ * every slave it passes advances. */
+gboolean esc_unchanged(tvbuff_t *request, tvbuff_t *message, guint message_length)
+{
+    guint length = tvb_captured_length(request);
+    if (message_length != length || tvb_captured_length(message) < length) return FALSE;
+    datagram d[max_datagrams];
+    guint header_length;
+    guint n = read_frame(request, &header_length, d, max_datagrams);
+    const guint8 *sent = (const guint8 *)tvb_get_ptr(request, 0, (gint)length);
+    guint from = 0; /* bytes before `from` are compared */
+    for (guint i = 0; i < n; i++) {
+        if (!advances_adp(d[i].cmd)) continue;
+        guint adp = (guint)d[i].offset + 2;
+        if (tvb_memeql(message, (gint)from, sent + from, adp - from) != 0) return FALSE;
+        from = adp + 2;
+    }
+    return from >= length || tvb_memeql(message, (gint)from, sent + from, length - from) == 0;
+}
+
+/* A returned frame whose index matches no frame sent is the one frame
+ * waiting only if its datagrams are that frame's but for the index (the same
+ * commands and addresses): otherwise it answers a frame not captured. */
+gboolean esc_key_changed(tvbuff_t *request, tvbuff_t *message)
+{
+    datagram s[max_datagrams], b[max_datagrams];
+    guint sent_length, back_length;
+    guint n = read_frame(request, &sent_length, s, max_datagrams);
+    if (read_frame(message, &back_length, b, max_datagrams) != n) return FALSE;
+    for (guint i = 0; i < n; i++)
+        if (s[i].cmd != b[i].cmd || s[i].ado != b[i].ado || (!advances_adp(s[i].cmd) && s[i].adp != b[i].adp))
+            return FALSE;
+    return TRUE;
+}
+
 /* The master's address with the locally administered bit set: a returned frame. */
 gboolean esc_is_returned(void *capture, const address *src)
 {
@@ -301,12 +362,10 @@ void esc_show_sent(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tr
 
 const char *const st_wkc = "Working counter per command (returned)";
 const char *const st_wkc_down = "Working counter went down";
-int st_wkc_id;
 
+/* Rows appear with their first count (no rows of zeros). */
 void esc_stats_init(stats_tree *st, int parent)
 {
-    st_wkc_id = stats_tree_create_node(st, st_wkc, parent, STAT_DT_INT, TRUE);
-    stats_tree_create_node(st, st_wkc_down, parent, STAT_DT_INT, FALSE);
     bus_stats_init(st, parent);
 }
 
@@ -316,8 +375,8 @@ void esc_stats_response(stats_tree *st, int parent, const void *data)
     char label[32];
     for (guint i = 0; i < r->count; i++) {
         const compared *c = &r->d[i];
-        tick_stat_node(st, st_wkc, parent, TRUE);
-        int cmd_id = tick_stat_node(st, command_name(c->back.cmd), st_wkc_id, TRUE);
+        int wkc_id = tick_stat_node(st, st_wkc, parent, TRUE);
+        int cmd_id = tick_stat_node(st, command_name(c->back.cmd), wkc_id, TRUE);
         g_snprintf(label, sizeof label, "working counter %u", c->back.wkc);
         tick_stat_node(st, label, cmd_id, FALSE);
         if (wkc_added(c) < 0) tick_stat_node(st, st_wkc_down, parent, FALSE);
@@ -377,4 +436,7 @@ extern "C" const dg_analysis dg_ethercat_esc = {
     esc_stats_response,
     esc_sent,
     esc_show_sent,
+    esc_direction,
+    esc_unchanged,
+    esc_key_changed,
 };

@@ -37,7 +37,9 @@ FIELDS = ["frame.number", "ecatr.header.length", "ecatr.datagram.cmd", "ecatr.da
           "ecatr.datagram.data", "ecatr.datagram.wkc", "ecatr.request_in", "ecatr.esc.wkc_added",
           "ecatr.esc.slaves_passed", "ecatr.esc.data_changed", "ecatr.expert.duplicate",
           "ecatr.expert.out_of_order", "ecatr.expert.changed", "ecatr.expert.frame_length",
-          "ecatr.expert.write_changed", "ecatr.expert.wkc_down", "ecatr.expert.forwarding"]
+          "ecatr.expert.write_changed", "ecatr.expert.wkc_down", "ecatr.expert.forwarding",
+          "ecatr.expert.no_response", "ecatr.no_response_to"]
+LOST_RETURNS = 5   # returns removed from a copy of the first capture: a live capture reports them
 check = Checks()
 
 
@@ -125,15 +127,40 @@ def normalise(rows, numbers):
     """Frame numbers (own and ecatr.request_in) as positions among the EtherCAT frames."""
     pos = {n: k for k, n in enumerate(numbers)}
     out = []
-    req = FIELDS.index("ecatr.request_in")
+    links = [FIELDS.index("ecatr.request_in"), FIELDS.index("ecatr.no_response_to")]
     for r in rows:
         r = r + [""] * (len(FIELDS) - len(r))
         r = list(r)
         r[0] = str(pos.get(int(r[0]), "?"))
-        if r[req]:
-            r[req] = str(pos.get(int(r[req]), "?"))
+        for k in links:
+            if r[k]:
+                r[k] = ",".join(str(pos.get(int(x), "?")) for x in r[k].split(","))
         out.append(r)
     return out
+
+
+def without_returns(src, dst, count):
+    """A copy of the capture with `count` returned frames removed (spread over it, none near
+    its end); the positions, among the copy's EtherCAT frames, of the requests they answered."""
+    cap, frames = ethercat_frames(src)
+    master = {bytes(cap.packets[k].data[6:12]) for k in frames if not cap.packets[k].data[6] & 0x02}
+    waiting, pairs = {}, []
+    for k in frames:
+        p = cap.packets[k]
+        key = tuple(d["idx"] for d in pr.ecat_datagrams(p))
+        src_mac = bytes(p.data[6:12])
+        if src_mac in master:
+            waiting[key] = k
+        elif key in waiting:
+            pairs.append((waiting.pop(key), k))
+    chosen = [pairs[(2 * n + 1) * (len(pairs) - 20) // (2 * count)] for n in range(count)]
+    removed = {back for _sent, back in chosen}
+    cap.packets = [p for k, p in enumerate(cap.packets) if k not in removed]
+    cap.write(dst)
+    os.chmod(dst, 0o644)
+    _cap, kept = ethercat_frames(dst)
+    tags = [cap.packets[k].tag for k in kept]
+    return {tags.index(sent) for sent, _back in chosen}
 
 
 def live(env, ns, path, stop, expect_frames):
@@ -195,9 +222,14 @@ def main():
             if "permission" in probe.stderr.lower() or "capabilit" in probe.stderr.lower():
                 print("SKIPPED: an ordinary user with CAP_NET_RAW cannot capture here: %s" % probe.stderr.strip())
                 return SKIP
+            runs = []
             for name in files:
                 with open(os.path.join(corpus_dir, name), "rb") as fh:
-                    path = env.add_file(name, fh.read())
+                    runs.append((name, env.add_file(name, fh.read()), None))
+            lossy = "lossy-" + files[0]
+            lost = without_returns(runs[0][1], env.path(lossy), LOST_RETURNS)
+            runs.append((lossy, env.path(lossy), lost))
+            for name, path, lost in runs:
                 cap, frames = ethercat_frames(path)
                 numbers = [k + 1 for k in frames]
                 want = normalise(file_decode(env, path), numbers)
@@ -213,6 +245,12 @@ def main():
                               name, " ".join(stop), len(got), paired,
                               "; first difference at EtherCAT frame %d:\n  live %s\n  file %s" % (
                                   diff[0], got[diff[0]], want[diff[0]]) if diff else ""))
+                    if lost is not None:
+                        k_expert, k_link = FIELDS.index("ecatr.expert.no_response"), FIELDS.index("ecatr.no_response_to")
+                        named = {int(x) for r in got if r[k_expert] for x in r[k_link].split(",") if x}
+                        check(named == lost, "%s %s: live, each lost frame is reported by a later frame "
+                              "naming it (%s, removed returns of %s)" % (name, " ".join(stop), sorted(named),
+                                                                        sorted(lost)))
     finally:
         ns.__exit__()
     print("\n%d failed" % len(check.failed))

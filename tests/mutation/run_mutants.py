@@ -77,6 +77,9 @@ TESTS = {
     "quiet": integration("test_quiet.py"),
     "differential": integration("ecat_differential.py", "--frames", "2000", "--max-datagrams", "20",
                                 "--malformed", "200"),
+    "transactions": integration("test_transactions.py"),
+    "losses": integration("test_losses.py"),
+    "losses_corpus": integration("test_losses.py", "--with-corpus"),
 }
 
 

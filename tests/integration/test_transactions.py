@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The generic pairing knows direction: a message to the hooked port is a request, one from it
+a response (tests/rules/transactions.xml, UDP port 47480, keys: transaction and unit).
+
+  test_transactions.py --dissgen build/bin/dissgen --source-dir .
+
+A response never opens a transaction and a request never answers one: a response whose request
+was not captured is linked to nothing, and the request that follows with the same key waits
+for its own response. A request sent again with the same key gives up the first one, which is
+reported lost (with -2 on itself, in one pass on the request that proved it). Needs no corpus.
+"""
+
+import os
+import struct
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from tshark_env import Checks, TsharkEnv  # noqa: E402
+import pcapgen  # noqa: E402
+
+check = Checks()
+PORT = 47480
+CLIENT, SERVER = b"\x0a\x00\x00\x01", b"\x0a\x00\x00\x02"
+
+# (ms, direction, transaction, unit): the capture, frame by frame.
+MESSAGES = [
+    (0, "response", 1, 1),    # 1: its request was not captured: an orphan
+    (10, "request", 1, 1),    # 2: a new request, not an answer to 1
+    (11, "response", 1, 1),   # 3: answers 2
+    (20, "request", 2, 1),    # 4: lost: sent again as 5
+    (30, "request", 2, 1),    # 5
+    (31, "response", 2, 1),   # 6: answers 5
+    (50, "request", 4, 1),    # 7
+    (51, "request", 4, 2),    # 8: another unit, another key
+    (52, "response", 4, 2),   # 9: answers 8
+    (53, "response", 4, 1),   # 10: answers 7
+    (60, "response", 5, 1),   # 11: an orphan
+    (70, "response", 5, 1),   # 12: another orphan (a response never answers a response)
+    (80, "request", 5, 1),    # 13
+    (81, "response", 5, 1),   # 14: answers 13
+]
+PAIRS = {3: 2, 6: 5, 9: 8, 10: 7, 14: 13}
+LOST = {4: 5}  # lost request: the frame that proves it
+
+
+def frame(direction, transaction, unit, n):
+    payload = struct.pack(">HBBI", transaction, unit, 3, n)
+    sport, dport = (40000, PORT) if direction == "request" else (PORT, 40000)
+    src, dst = (CLIENT, SERVER) if direction == "request" else (SERVER, CLIENT)
+    u = struct.pack("!HHHH", sport, dport, 8 + len(payload), 0) + payload
+    ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src, dst)
+    ip = ip[:10] + struct.pack("!H", pcapgen.ip_checksum(ip)) + ip[12:]
+    macs = b"\x02\x00\x00\x00\x00\x02\x02\x00\x00\x00\x00\x01"
+    return macs + b"\x08\x00" + ip + u
+
+
+def write(path):
+    out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
+    for n, (ms, direction, transaction, unit) in enumerate(MESSAGES):
+        data = frame(direction, transaction, unit, n + 1)
+        out.append(struct.pack("<IIII", 1_700_000_000, ms * 1000, len(data), len(data)) + data)
+    with open(path, "wb") as fh:
+        fh.write(b"".join(out))
+
+
+def decode(env, path, two_pass):
+    fields = ["frame.number", "txnp.request_in", "txnp.response_in", "txnp.expert.no_response",
+              "txnp.no_response_to", "txnp.time"]
+    args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"] + (["-2"] if two_pass else [])
+    for f in fields:
+        args += ["-e", f]
+    rows = {}
+    for line in env.tshark(args).stdout.splitlines():
+        cols = line.split("\t") + [""] * len(fields)
+        rows[int(cols[0])] = dict(zip(fields[1:], cols[1:]))
+    return rows
+
+
+def main():
+    import argparse
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--dissgen", required=True)
+    ap.add_argument("--source-dir", required=True)
+    args = ap.parse_args()
+    with TsharkEnv() as env:
+        env.install_plugin(args.dissgen, os.path.join(args.source_dir, "tests", "rules", "transactions.xml"))
+        env.assert_plugin_loaded("txnp")
+        path = env.path("transactions.pcap")
+        write(path)
+        os.chmod(path, 0o644)
+        for two_pass in (True, False):
+            mode = "-2" if two_pass else "one pass"
+            rows = decode(env, path, two_pass)
+            got = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
+            check(got == PAIRS, "%s: each response answers its own request, orphans answer nothing "
+                  "(%s)" % (mode, got))
+            if two_pass:
+                back = {int(r["txnp.response_in"]): n for n, r in rows.items() if r["txnp.response_in"]}
+                check(back == PAIRS, "%s: each answered request links its response (%s)" % (mode, back))
+                flagged = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
+                check(flagged == set(LOST), "%s: no_response exactly on the lost request %s (%s)" % (
+                    mode, sorted(LOST), sorted(flagged)))
+            else:
+                flagged = {n: r["txnp.no_response_to"] for n, r in rows.items() if r["txnp.expert.no_response"]}
+                want = {proof: str(lost) for lost, proof in LOST.items()}
+                check(flagged == want, "%s: no_response on the frame that proves the loss, naming it "
+                      "(%s, want %s)" % (mode, flagged, want))
+            times = {n: r["txnp.time"] for n, r in rows.items() if r["txnp.time"]}
+            want = {n: "%.9f" % ((MESSAGES[n - 1][0] - MESSAGES[m - 1][0]) / 1000) for n, m in PAIRS.items()}
+            check(times == want, "%s: round trips are the timestamps' differences (%s)" % (mode, times))
+    print("all checks passed" if not check.failed else "%d checks failed" % len(check.failed))
+    return 1 if check.failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
