@@ -282,8 +282,9 @@ def slave_stats(env, path, two_pass):
     args = ["-r", path, "-q", "-z", "ecatr,tree"] + (["-2"] if two_pass else [])
     out, pos = {}, None
     for line in env.tshark(args).stdout.splitlines():
-        label = line[:41].strip()
-        cols = line[41:].split()
+        # (columns are as wide as the longest label: split at the gap after it)
+        label, _, rest = line.strip().partition("  ")
+        cols = rest.split()
         if line.startswith("  Position "):
             pos = int(label.split()[1])
             out[pos] = {}

@@ -179,8 +179,9 @@ def stats_tree(env, path, two_pass):
         if inside and not line.startswith(" "):
             break
         if inside and line.startswith(" ") and not line.startswith("  "):
-            label = line[:41].strip()
-            cols = line[41:].split()
+            # (columns are as wide as the longest label: split at the gap after it)
+            label, _, rest = line.strip().partition("  ")
+            cols = rest.split()
             items[label] = cols
     return items
 
