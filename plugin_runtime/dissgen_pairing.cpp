@@ -1,27 +1,26 @@
 /* Request/response pairing across frames: see dissgen_pairing.h.
  *
  * First pass, per message, in capture order:
- *  1. The key: the values of the rule file's key fields.
- *  2. The same bytes from the same source as the last message with that key,
- *     within a hundredth of the timeout, when that message was a response or
- *     the message just before: a duplicate (a frame captured twice); it is not
- *     paired. (A sender repeating a request it got no answer to repeats it
- *     later, or after other messages: that is a new request. So is the very
- *     request again from its sender, at any time: never its own answer.)
- *     Except where the analysis cannot tell the directions apart (returns not
- *     marked, as from a simulator): there a request's copy right after it is
- *     a frame that came back unprocessed, its response.
- *  3. Pending requests of that key older than the timeout, or overtaken by
- *     the responses to more than max_overtaken later requests, are given up
- *     (they keep "no response"). The oldest remaining one whose source the
- *     analysis does not rule out is answered by this message. Without an
- *     analysis, or when it cannot tell, the order decides: the first message
- *     of a key is the request, the next one its response.
- *  4. Otherwise the message is a new request and waits, unless the analysis
- *     knows it for a response: then it answers the one request still
- *     waiting, whatever its key (the analysis reports what changed), or, when
- *     none or several are waiting, a request that was not captured (an
- *     orphan).
+ *  1. Requests that can no longer be answered are given up: older than the
+ *     timeout, or overtaken by the responses to more than max_overtaken later
+ *     requests. Given up unanswered, a request is lost, and this message is
+ *     the one that proves it (give_up: its expert info in one pass).
+ *  2. The direction: the transport's (to the hooked port a request, from it
+ *     a response), else what the analysis reads from the message itself.
+ *  3. The same bytes from the same source as the last message with that key,
+ *     soon after it (within_copy_window), when that message was a response or
+ *     the message just before: a duplicate (a frame captured twice); it is
+ *     not paired. Except where the analysis cannot tell the directions apart
+ *     (returns not marked): a request's copy right after it is a frame that
+ *     came back unprocessed, its response.
+ *  4. A response answers its key's oldest waiting request that its source
+ *     fits (else the one request waiting if only its key changed), or is an
+ *     orphan (its request was not captured). A request gives up its key's
+ *     waiting requests from the same sender and waits. A message whose
+ *     direction nothing tells: with an analysis that reads directions, a new
+ *     request unless it is its key's waiting request come back untouched;
+ *     without one, the order decides (the first message of a key is the
+ *     request, the next one its response).
  * Nothing here is touched on later passes.
  */
 #include "dissgen_pairing.h"
@@ -479,9 +478,6 @@ void give_up_sent_again(capture_state *c, key_entry *e, const packet_info *pinfo
         if (!q->done && addresses_equal(&q->src, &pinfo->src)) give_up(c, q);
 }
 
-/* A message known to be a response: the oldest waiting request of its key
- * whose source does not rule it out, else the one request waiting if its key
- * came back changed (take_oldest); NULL: an orphan. */
 /* Messages taken for requests only for want of a better idea, from a source
  * now known to send responses only (a slave's marked return), were
  * responses whose requests were not captured: orphans, not lost. */
