@@ -189,7 +189,7 @@ def expand_synopsis(synopsis, out):
     if s.startswith("... "):
         s = "dissgen fields FILE.xml " + s[4:]
     s = re.sub(r"\[([^\]]*)\]", lambda m: m.group(1).split("|")[0].strip(), s)
-    words = [METAVARIABLES.get(w, w).format(out=out) for w in s.split()]
+    words = [shlex.quote(METAVARIABLES[w].format(out=out)) if w in METAVARIABLES else w for w in s.split()]
     unknown = [w for w in words if re.fullmatch(r"[A-Z][A-Z0-9_]*(\.xml|\.\.\.)?", w)]
     if unknown:
         raise ValueError("no stand-in for %s (add it to METAVARIABLES)" % ", ".join(unknown))
