@@ -13,6 +13,9 @@
 # alone (for yourself, run: build/bin/dissgen install rules/ethercat.xml).
 # Wireshark run as root ignores per-user plugins, so as root tshark runs as
 # the unprivileged user "nobody".
+# Under `set -o pipefail` a reader that stops early (head, grep -q) kills the
+# writer with SIGPIPE and fails the script, depending on timing: every reader
+# here reads its input to the end (awk 'NR <= N' instead of head).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -39,36 +42,41 @@ generated="$demo_home/ethercat-demo.pcap"
 # administered bit of the master's source address (10:10:... -> 12:10:...).
 returned="eth.src == 12:10:10:10:10:10"
 
-section "samples/replay-sdo-error.pcapng, a real capture: $(tshark_as_user -r "$real" | wc -l) frames, ECATR in the Protocol column"
+# (Counts are taken in assignments, so that a failing tshark stops the script.)
+frames=$(tshark_as_user -r "$real" | wc -l)
+section "samples/replay-sdo-error.pcapng, a real capture: $frames frames, ECATR in the Protocol column"
 tshark_as_user -r "$real" -c 6
 
 section "the bus scan: what came back (BRD counts the slaves in the working counter, APWR gives the one slave station address 0x1000)"
-echo "frame  command      ADP     ADO     WKC"
+echo "frame  ADP     ADO     WKC  Info"
 tshark_as_user -r "$real" -Y "frame.number <= 24 && $returned" -T fields \
   -e frame.number -e _ws.col.Info -e ecatr.datagram.adp -e ecatr.datagram.ado -e ecatr.datagram.wkc |
-  awk -F'\t' '{printf "%5s  %-12s %-7s %-7s %s\n", $1, $2, $3, $4, $5}'
+  awk -F'\t' '{printf "%5s  %-7s %-7s %-4s %s\n", $1, $3, $4, $5, $2}'
 
 section "a mailbox exchange: CoE SDO uploads written to the slave's mailbox (ADO 0x1000), answers read back (0x1100)"
-echo "(first 16 data bytes: mailbox header, CoE header 0x2000 request / 0x3000 response, SDO command, index, subindex, data)"
+echo "(the rules decode the mailbox: mailbox header, CoE header, SDO command, index and subindex, in the Info column)"
+echo "frame  ADO     abort code  Info"
 tshark_as_user -r "$real" \
   -Y "$returned && ecatr.datagram.wkc == 1 && (ecatr.datagram.ado == 0x1000 || ecatr.datagram.ado == 0x1100)" \
-  -T fields -e frame.number -e _ws.col.Info -e ecatr.datagram.ado -e ecatr.datagram.data |
-  awk -F'\t' '{printf "%5s  %-14s ADO %s  %s\n", $1, $2, $3, substr($4, 1, 47)}' | tail -6
-echo "(frame 544: SDO command 0x80, abort: object 0x1001 does not exist, abort code 0x06020000)"
+  -T fields -e frame.number -e _ws.col.Info -e ecatr.datagram.ado -e ecatr.datagram.mbx.coe.sdoreq.abortcode |
+  awk -F'\t' '{printf "%5s  %-7s %-11s %s\n", $1, $3, $4, $2}' | tail -6
+echo "(frame 544: the slave aborts the upload, object 0x1001 does not exist, abort code 0x06020000)"
 
 section "frame 544 as Wireshark's tree shows it, from rules/ethercat.xml"
 tshark_as_user -r "$real" -V -O ecatr -Y "frame.number == 544" | sed -n '/^EtherCAT/,$p' | cut -c1-100
 
-section "repeated frames: distributed-clock drift compensation, FRMW of the system time (ADO 0x0910), $(
-  tshark_as_user -r "$real" -Y "ecatr.datagram.cmd == 0x0e && $returned" | wc -l) returned"
+dc_returned=$(tshark_as_user -r "$real" -Y "ecatr.datagram.cmd == 0x0e && $returned" | wc -l)
+section "repeated frames: distributed-clock drift compensation, FRMW of the system time (ADO 0x0910), $dc_returned returned"
 echo "(working counter 0: no slave processed them, as with the BWR to 0x0910 in the scan)"
-echo "frame  time         command     ADO     WKC"
+echo "frame  time        ADO     WKC  Info"
 tshark_as_user -r "$real" -Y "ecatr.datagram.cmd == 0x0e && $returned" -T fields \
   -e frame.number -e frame.time_relative -e _ws.col.Info -e ecatr.datagram.ado -e ecatr.datagram.wkc |
-  awk -F'\t' '{printf "%5s  %.6f s  %-11s %-7s %s\n", $1, $2, $3, $4, $5}' | head -4
+  awk -F'\t' 'NR <= 4 {printf "%5s  %.6f s  %-7s %-4s %s\n", $1, $2, $4, $5, $3}'
 
 section "cyclic process data (LRW, logical addressing), from the generated samples/ethercat-demo.pcap"
-echo "frame  logical address  lengths  data  working counters (one per datagram of the frame)"
+echo "(lengths and working counters: one per datagram of the frame; data: the LRW's)"
+echo "frame  logical address  lengths  WKC    data"
 tshark_as_user -r "$generated" -Y "ecatr.datagram.cmd == 0x0c" -T fields -e frame.number \
   -e ecatr.datagram.lad -e ecatr.datagram.len -e ecatr.datagram.data -e ecatr.datagram.wkc \
-  -E occurrence=a -E aggregator=, | head -5
+  -E occurrence=a -E aggregator=, |
+  awk -F'\t' 'NR <= 5 {printf "%5s  %-16s %-8s %-6s %s\n", $1, $2, $3, $5, $4}'

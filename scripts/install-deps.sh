@@ -7,7 +7,9 @@ packages=(cmake g++ make pkg-config libwireshark-dev tshark libglib2.0-dev libxm
           libgtest-dev python3 util-linux clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  # (No `| grep -q`: under pipefail its early exit could fail the query and
+  # count an installed package as missing.)
+  [[ "$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null)" == *"install ok installed"* ]] || missing+=("$p")
 done
 [ ${#missing[@]} -eq 0 ] && exit 0
 echo "installing: ${missing[*]}"

@@ -109,13 +109,18 @@ def _make_readable(path):
 
 
 class TsharkEnv:
-    def __init__(self, keep=False, prefix="dissgen-tshark-", tshark="tshark"):
+    def __init__(self, keep=False, prefix="dissgen-tshark-", tshark="tshark", home=None):
+        """home: an existing HOME to use (another process's TsharkEnv), left in place."""
         self.as_nobody = os.geteuid() == 0
-        base = tempfile.gettempdir()
-        if self.as_nobody and not readable_by_others(base):
-            base = "/tmp"
-        self.home = tempfile.mkdtemp(prefix=prefix, dir=base)
-        os.chmod(self.home, 0o755)
+        if home:
+            self.home = home
+            keep = True
+        else:
+            base = tempfile.gettempdir()
+            if self.as_nobody and not readable_by_others(base):
+                base = "/tmp"
+            self.home = tempfile.mkdtemp(prefix=prefix, dir=base)
+            os.chmod(self.home, 0o755)
         self.keep = keep
         self.tshark_bin = shutil.which(tshark) or tshark
         self.abi = wireshark_abi()
