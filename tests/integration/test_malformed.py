@@ -111,10 +111,17 @@ class Malformed(unittest.TestCase):
         self.assertIn("the repeat flag 'More' says another follows, but no data is left", rows[0][2])
 
     def test_header_length_longer_than_the_datagrams(self):
+        """A header Length of 34 over a 14-byte datagram: the 20 bytes after it are the
+        Ethernet padding. Zeros there are padding; anything else is reported."""
         f = Frame([Datagram(cmd=1, data=b"\xaa\xbb", wkc=1)], header_length=14 + 20)
-        rows = self.decode([(frame_bytes(f), len(frame_bytes(f)))], ["ecatr.datagram.cmd", "_ws.expert.message"])
-        self.assertEqual(rows[0][0], "0x01")
-        self.assertIn("'Datagrams' is 34 bytes, but its fields end after 14: 20 bytes are not decoded", rows[0][1])
+        zeros = frame_bytes(f)
+        self.assertEqual(zeros[30:], bytes(30), "Ethernet pads the frame with zeros")
+        other = zeros[:40] + b"\x5a" + zeros[41:]
+        rows = self.decode([(zeros, len(zeros)), (other, len(other))],
+                           ["ecatr.datagram.cmd", "ecatr.padding", "_ws.expert.message"])
+        self.assertEqual(rows[0], ["0x01", "00" * 20, ""])
+        self.assertEqual(rows[1][0:2], ["0x01", ""])
+        self.assertEqual(rows[1][2], "'Datagrams' is 34 bytes, but its fields end after 14: 20 bytes are not decoded")
 
     def test_over_a_hundred_empty_datagrams(self):
         f = Frame([Datagram(cmd=0, idx=i & 0xFF) for i in range(124)])
