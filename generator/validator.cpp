@@ -449,6 +449,9 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
         if (!own.empty() && is_reserved_expert_name(proto_.filter, own))
             diags_.error(n.line, "filter name '" + own + "' is reserved for the protocol's expert infos; "
                                  "give " + quote(n) + " or its container another 'filter'");
+        if (!own.empty() && is_reserved_runtime_field(proto_.filter, own))
+            diags_.error(n.line, "filter name '" + own + "' is reserved for the zero padding after a container's "
+                                 "fields; give " + quote(n) + " or its container another 'filter'");
         if (!own.empty() && !reserved_pairing_name(proto_, own).empty())
             diags_.error(n.line, "filter name '" + own + "' is reserved for " + reserved_pairing_name(proto_, own) +
                                  "; give " + quote(n) + " or its container another 'filter'");
@@ -893,6 +896,12 @@ std::string name_without_index(const std::string& name) {
 bool is_reserved_expert_name(const std::string& protocol_filter, const std::string& field_filter) {
     for (const char* expert : kExpertNames)
         if (field_filter == protocol_filter + ".expert." + expert) return true;
+    return false;
+}
+
+bool is_reserved_runtime_field(const std::string& protocol_filter, const std::string& field_filter) {
+    for (const char* name : kRuntimeFieldNames)
+        if (field_filter == protocol_filter + "." + name) return true;
     return false;
 }
 

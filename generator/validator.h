@@ -38,6 +38,11 @@ constexpr const char* kFragmentNames[] = {"fragments",        "fragment",
 
 bool is_reserved_expert_name(const std::string& protocol_filter, const std::string& field_filter);
 
+// Fields the runtime registers for every protocol as P.NAME (plugin_runtime/
+// dissgen_runtime.cpp): the zero padding after a known-length container's fields.
+constexpr const char* kRuntimeFieldNames[] = {"padding"};
+bool is_reserved_runtime_field(const std::string& protocol_filter, const std::string& field_filter);
+
 // issue 11: fields and expert infos the runtime registers as P.NAME for a
 // protocol with <pairing> (plugin_runtime/dissgen_pairing.cpp), and for the
 // "ethercat-esc" analysis (plugin_runtime/ethercat_esc.cpp).

@@ -761,6 +761,25 @@ void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
     *offset += len;
 }
 
+/* P.padding: the zero bytes between the end of a known-length container's
+ * fields and the end of its length. One protocol per plugin, like stats_protocol. */
+int hf_padding = -1;
+
+/* Whether the `length` bytes at offset are captured and all zero. Bytes the
+ * capture did not keep are not known to be zero. */
+gboolean all_zero(const dg_state *st, gint offset, gint length)
+{
+    static const guint8 zeros[64] = {0};
+    if (offset < 0 || length > st->packet_end - offset) return FALSE;
+    while (length > 0) {
+        gint n = MIN(length, (gint)sizeof zeros);
+        if (tvb_memeql(st->tvb, offset, zeros, (size_t)n) != 0) return FALSE;
+        offset += n;
+        length -= n;
+    }
+    return TRUE;
+}
+
 void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
                        gboolean in_summary, dg_summaries *sink)
 {
@@ -804,11 +823,18 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     st->stopped = st->stopped || was_stopped;
     if (!st->stopped && length >= 0 && *offset < inner_end &&
         (n->length_kind == DG_LEN_FIXED || n->length_kind == DG_LEN_FIELD)) {
-        /* The length says more than the fields hold: say so, then skip to the end. */
-        proto_tree_add_expert_format(subtree, st->pinfo, &st->p->ei->unused, st->tvb, *offset, inner_end - *offset,
-                                     "'%s' is %" G_GINT64_MODIFIER "d bytes, but its fields end after %d: "
-                                     "%d bytes are not decoded",
-                                     n->name, length, *offset - start, inner_end - *offset);
+        if (all_zero(st, *offset, inner_end - *offset)) {
+            /* Zero bytes up to the length: padding, which senders may add (to
+             * a minimum length, or a length rounded up). Nothing is wrong. */
+            if (subtree) proto_tree_add_item(subtree, hf_padding, st->tvb, *offset, inner_end - *offset, ENC_NA);
+        } else {
+            /* The length says more than the fields hold: say so, then skip to the end. */
+            proto_tree_add_expert_format(subtree, st->pinfo, &st->p->ei->unused, st->tvb, *offset,
+                                         inner_end - *offset,
+                                         "'%s' is %" G_GINT64_MODIFIER "d bytes, but its fields end after %d: "
+                                         "%d bytes are not decoded",
+                                         n->name, length, *offset - start, inner_end - *offset);
+        }
     }
     if (!st->stopped && length >= 0) *offset = inner_end;
     if (st->stopped && !was_stopped && (n->flags & DG_SKIP_MALFORMED) && length >= 0) {
@@ -1369,6 +1395,13 @@ void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett,
 {
     *p->proto = proto_register_protocol(p->name, p->short_name, p->filter);
     proto_register_field_array(*p->proto, hf, hf_count);
+    /* Wireshark keeps a pointer to it: a static array, a name that lives until exit. */
+    static hf_register_info padding[] = {
+        {&hf_padding, {"Padding", NULL, FT_BYTES, BASE_NONE, NULL, 0x0,
+                       "Zero bytes after a container's fields, up to the end of its length", HFILL}},
+    };
+    padding[0].hfinfo.abbrev = g_strdup_printf("%s.padding", p->filter);
+    proto_register_field_array(*p->proto, padding, (int)G_N_ELEMENTS(padding));
     proto_register_subtree_array(ett, ett_count);
     expert_module_t *experts = expert_register_protocol(*p->proto);
     expert_register_field_array(experts, ei, ei_count);

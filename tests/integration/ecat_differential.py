@@ -630,12 +630,13 @@ def ours_shows(payload):
     the expert infos as (filter name, offset in the EtherCAT payload, message) in tree order,
     and the regions (start, end, container, ours stops inside) of datagram data where ours reports what the rules
     inside find (registers, mailboxes: the Wireshark comparison checks those; container None:
-    a faulty mailbox, where ours stops with an expert info of its own)."""
+    a faulty mailbox, where ours stops with an expert info of its own), and the ecatr.padding
+    value (hex; "" when none): zeros after the datagrams, up to the header's Length."""
     experts, summaries, regions = [], [], []
     size = len(payload)
     if size < 2:
         experts.append(("truncated", 0, "Truncated: 'Length' needs 2 bytes, only %d left" % size))
-        return 0, "EtherCAT", experts, regions
+        return 0, "EtherCAT", experts, regions, ""
     h = struct.unpack("<H", payload[:2])[0]
     length, ftype = h & 0x7FF, h >> 12
     name = "Datagrams" if ftype == 1 else "Payload"
@@ -644,7 +645,7 @@ def ours_shows(payload):
         experts.append(("past_end", 2, "'%s' has length %d, past the end of its data (%d bytes left)"
                         % (name, length, size - 2)))
     if ftype != 1:
-        return 0, "EtherCAT", experts, regions
+        return 0, "EtherCAT", experts, regions, ""
     end = size if past_end else 2 + length
     off, items, stopped = 2, 0, False
 
@@ -708,14 +709,18 @@ def ours_shows(payload):
             experts.append(("more_no_data", off, "'Datagram': the repeat flag 'More' says another follows, "
                             "but no data is left"))
             break
+    padding = ""
     if not stopped and not past_end and off < end:
-        experts.append(("unused", off, "'Datagrams' is %d bytes, but its fields end after %d: %d bytes are not "
-                        "decoded" % (length, off - 2, end - off)))
+        if any(payload[off:end]):
+            experts.append(("unused", off, "'Datagrams' is %d bytes, but its fields end after %d: %d bytes are not "
+                            "decoded" % (length, off - 2, end - off)))
+        else:       # zeros up to the header's Length: padding, no expert info
+            padding = payload[off:end].hex()
     if len(summaries) > 1:
         info = "Datagram \u00d7%d: %s" % (len(summaries), ", ".join(summaries))
     else:
         info = summaries[0]
-    return items, info, experts, regions
+    return items, info, experts, regions, padding
 
 
 # The container rules/ethercat.xml decodes a datagram's data as, by ours_view().
@@ -741,7 +746,7 @@ def inside_data(experts, regions):
 def extras_command(cap):
     return ["-r", cap, "-T", "fields", "-E", "header=n", "-E", "separator=/t", "-E", "quote=d",
             "-E", "occurrence=a", "-E", "aggregator=,", "-e", "frame.number", "-e", "ecatr.datagram",
-            "-e", "_ws.col.Info"]
+            "-e", "_ws.col.Info", "-e", "ecatr.padding"]
 
 
 def experts_command(cap):
@@ -750,11 +755,11 @@ def experts_command(cap):
 
 
 def parse_extras(text, pdml_path):
-    """-> {frame: {"items": n, "info": text, "experts": [(name, offset, message)]}}"""
+    """-> {frame: {"items": n, "info": text, "padding": hex, "experts": [(name, offset, message)]}}"""
     out = {}
     for line in text.splitlines():
-        num, dgs, info = [c[1:-1] if len(c) >= 2 and c[0] == c[-1] == '"' else c for c in line.split("\t")]
-        out[int(num)] = {"items": len(dgs.split(",")) if dgs else 0, "info": info, "experts": []}
+        num, dgs, info, padding = [c[1:-1] if len(c) >= 2 and c[0] == c[-1] == '"' else c for c in line.split("\t")]
+        out[int(num)] = {"items": len(dgs.split(",")) if dgs else 0, "info": info, "padding": padding, "experts": []}
     # Only our expert items are read here, so mending the labels does not matter.
     pdml = tshark_env.read_tshark_output(pdml_path, xml=True)
     for _, packet in ET.iterparse(io.BytesIO(pdml.encode("utf-8"))):
@@ -771,7 +776,7 @@ def parse_extras(text, pdml_path):
                 # (ecatr.expert.changed, ...) are test_pairing's to check.
                 name = child.get("name", "")
                 if name.startswith("ecatr.expert.") and name[len("ecatr.expert."):] in OUR_EXPERTS:
-                    out.setdefault(num, {"items": 0, "info": "", "experts": []})["experts"].append(
+                    out.setdefault(num, {"items": 0, "info": "", "padding": "", "experts": []})["experts"].append(
                         (child.get("name")[len("ecatr.expert."):], int(item.get("pos")) - base, child.get("showname")))
         packet.clear()
     return out
@@ -803,15 +808,17 @@ def info_agrees(got, implied):
 
 
 def compare_extras(num, payload, got):
-    """Problems of one frame: ecatr.datagram items, Info, expert infos against ours_shows()."""
-    items, info, experts, regions = ours_shows(payload)
-    got = got or {"items": 0, "info": None, "experts": []}
+    """Problems of one frame: ecatr.datagram items, Info, padding, expert infos against ours_shows()."""
+    items, info, experts, regions, padding = ours_shows(payload)
+    got = got or {"items": 0, "info": None, "padding": "", "experts": []}
     got_experts, problems = inside_data(got["experts"], regions)
     got = dict(got, experts=got_experts)
     if got["items"] != items:
         problems.append("ours: %d ecatr.datagram items, the bytes imply %d" % (got["items"], items))
     if not info_agrees(got["info"], info):
         problems.append("ours: Info %r, the bytes imply %r" % (got["info"], info))
+    if got["padding"] != padding:
+        problems.append("ours: padding %r, the bytes imply %r" % (got["padding"], padding))
     if got["experts"] != experts:
         problems.append("ours: expert infos %s, the bytes imply %s" % (got["experts"], experts))
     return [{"frame": num, "what": p} for p in problems]
@@ -831,7 +838,7 @@ class Stats:
         self.failures = []
         self.frames_with_explanations = defaultdict(int)
         self.notes = defaultdict(int)
-        self.extras_frames = 0      # frames whose ecatr.datagram items, Info and experts were checked
+        self.extras_frames = 0      # frames whose ecatr.datagram items, Info, padding and experts were checked
         self.extras_experts = 0
         self.deep = ecat_deep.DeepStats()
 
@@ -1182,8 +1189,8 @@ def report(stats, args, extra=""):
         print_failures(stats, args.show)
     if stats.extras_frames:
         print()
-        print("ecatr.datagram items, Info column and expert infos (name, position, message) checked against "
-              "the bytes on %d frames (%d expert infos)" % (stats.extras_frames, stats.extras_experts))
+        print("ecatr.datagram items, Info column, padding and expert infos (name, position, message) checked "
+              "against the bytes on %d frames (%d expert infos)" % (stats.extras_frames, stats.extras_experts))
     if DEEP:
         print()
         print(stats.deep.report())

@@ -103,6 +103,8 @@ class Frame:
     ts: float = 0.0
     note: str = ""                   # why this frame exists (e.g. "m_on_last", "truncated")
     odd_lengths: bool = False        # a header or datagram Length disagrees with the bytes
+    padding: bytes = b""             # bytes after the datagrams, inside the header's Length
+                                     # (zeros: a master keeping the Length at a minimum)
 
     def more_bits(self):
         bits = []
@@ -118,7 +120,7 @@ class Frame:
         return b"".join(d.encode(m) for d, m in zip(self.datagrams, self.more_bits()))
 
     def ecat_payload(self):
-        body = self.body()
+        body = self.body() + self.padding
         length = len(body) if self.header_length is None else self.header_length
         hdr = (length & 0x7FF) | ((self.header_reserved & 1) << 11) | ((self.header_type & 0xF) << 12)
         return struct.pack("<H", hdr) + body
@@ -183,7 +185,7 @@ def truth(f, number=None):
                   "more": m, "irq": d.irq, "data": d.data.hex(), "wkc": d.wkc})
         dgs.append(g)
     t = {"encap": f.encap,
-         "header": {"length": len(body) if f.header_length is None else f.header_length,
+         "header": {"length": len(body) + len(f.padding) if f.header_length is None else f.header_length,
                     "reserved": f.header_reserved, "type": f.header_type},
          "datagrams": dgs,
          "note": f.note}

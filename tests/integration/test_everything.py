@@ -428,8 +428,13 @@ class Expected:
         offset = self.node_list(n.children, item, offset, inner_end, in_summary or bool(n.pieces))
         self.stopped = self.stopped or was_stopped
         if not self.stopped and length >= 0 and offset < inner_end:
-            self.expert(item, "unused", "'%s' is %d bytes, but its fields end after %d: %d bytes are not decoded"
-                        % (n.name, length, offset - start, inner_end - offset), stop=False)
+            gap = self.buf[offset:inner_end]
+            if any(gap):
+                self.expert(item, "unused", "'%s' is %d bytes, but its fields end after %d: %d bytes are not decoded"
+                            % (n.name, length, offset - start, inner_end - offset), stop=False)
+            else:   # zeros up to the length: padding, no expert info
+                label = gap[:36].hex() + (ELLIPSIS if len(gap) > 36 else "")   # bytes without separators
+                item.children.append(Item("Padding: " + label, PROTO + ".padding", gap.hex()))
         if not self.stopped and length >= 0:
             offset = inner_end
         if n.pieces:
@@ -496,11 +501,12 @@ class Gen:
         return bytes(self.rng.getrandbits(8) for _ in range(n))
 
 
-def build_message(g, kind=None, nsec=None, nrec=None, bad=None):
+def build_message(g, kind=None, nsec=None, nrec=None, bad=None, env_padding=0):
     """One random message for tests/rules/everything.xml: valid unless `bad` (a dict)
     sets a field to a wrong value: total, tail_size, words, nsec_field, blob_length
-    (the values written), env_size / env_extra (a short / a long Envelope),
-    last_record_more, last_item_more (a repeat flag set on the last instance)."""
+    (the values written), env_size / env_extra (a short / a long Envelope, its extra
+    bytes not all zero), last_record_more, last_item_more (a repeat flag set on the last
+    instance). env_padding: the Envelope holds that many zero bytes after its fields."""
     rng = g.rng
     bad = bad or {}
     m = Message()
@@ -691,13 +697,13 @@ def build_message(g, kind=None, nsec=None, nrec=None, bad=None):
     m.close(tb)
     m.blob("2nd address", "evry.f2nd_address", g.bytes(3), "address")
     # ---- Envelope: length from a field, fixed fields inside (bytes beyond them are skipped)
-    extra = bad.get("env_extra", 0)
+    extra = bad.get("env_extra", env_padding)
     size = bad.get("env_size", 3 + extra)
     m.number("Envelope size", "evry.envelope_size", 1, size, "dec")
     e = m.open("Envelope", "evry.envelope", "field", size)
     ea = m.number("Env a", "evry.envelope.env_a", 2, g.val(16), "hex")
     eb = m.number("Env b", "evry.envelope.env_b", 1, g.val(8), "dec")
-    m.data += g.bytes(extra)
+    m.data += bytes(b or 0x5a for b in g.bytes(extra)) if "env_extra" in bad else bytes(extra)
     m.close(e, [ea, "/", eb])
     m.blob("Wide words", "evry.wide_words", g.bytes(words * 2), "origin", "field")
     m.blob("Pad copy", "evry.pad_copy", g.bytes(pad + 4), "origin", "field")
@@ -757,7 +763,8 @@ def valid_cases(g, n):
     for i in range(n):
         kind = kinds[i % len(kinds)] if i < 3 * len(kinds) else None
         cases.append(Case(build_message(g, kind=kind, nsec=i % 4 if i < 8 else None,
-                                        nrec=1 + i % 4 if i < 8 else None), udp=i % 3 == 2))
+                                        nrec=1 + i % 4 if i < 8 else None,
+                                        env_padding=(0, 0, 0, 1, 0, 2, 0, 40)[i % 8]), udp=i % 3 == 2))
     return cases
 
 
@@ -856,6 +863,8 @@ class Everything(TsharkTestCase, unittest.TestCase):
         assert listing.returncode == 0, listing.stderr
         cls.listing = [line.split("\t") for line in listing.stdout.splitlines()]
         cls.fields = [f[0] for f in cls.listing[1:]]
+        # and the field the runtime registers for every protocol (not a rule file's)
+        cls.shown = cls.fields + [PROTO + ".padding"]
         g = Gen(ARGS.seed)
         cls.valid = valid_cases(g, ARGS.messages)
         cls.malformed = malformed_cases(g)
@@ -865,11 +874,11 @@ class Everything(TsharkTestCase, unittest.TestCase):
             shutil.copy(cap, ARGS.keep_pcap)
         extra = ["_ws.col.Protocol", "_ws.col.Info", "_ws.expert.message"]
         args = ["-r", cap, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=|"]
-        for f in cls.fields + extra:
+        for f in cls.shown + extra:
             args += ["-e", f]
         p = cls.env.tshark(args, check=False)
         cls.fields_stderr = p.stderr
-        cls.columns = cls.fields + extra
+        cls.columns = cls.shown + extra
         cls.rows = [dict(zip(cls.columns, line.split("\t"))) for line in p.stdout.splitlines()]
         v = cls.env.tshark(["-r", cap, "-V"], check=False)
         cls.verbose_text, cls.verbose_stderr = v.stdout, v.stderr
@@ -894,12 +903,12 @@ class Everything(TsharkTestCase, unittest.TestCase):
         bad = []
         for i in range(first, last):
             want = self.cases[i].expected.fields()
-            for f in self.fields:
+            for f in self.shown:
                 got = self.rows[i].get(f, "")
                 exp = "|".join(want.get(f, []))
                 if got != exp:
                     bad.append("%s: %s = %r, expected %r" % (self.where(i), f, got, exp))
-            unknown = set(want) - set(self.fields)
+            unknown = set(want) - set(self.shown)
             if unknown:
                 bad.append("%s: the test expects fields the rules do not have: %s" % (self.where(i), unknown))
         self.assertEqual(bad[:20], [], "%d mismatches" % len(bad))
@@ -992,7 +1001,7 @@ class Everything(TsharkTestCase, unittest.TestCase):
             parts = line.split("\t")
             if parts[0] == "F" and (parts[2] == PROTO or parts[2].startswith(PROTO + ".")):
                 registered[parts[2]] = parts
-        self.assertEqual(sorted(registered), sorted(self.fields + ["%s.expert.%s" % (PROTO, k) for k in list(EXPERTS) + list(OTHER_EXPERTS)]))
+        self.assertEqual(sorted(registered), sorted(self.shown + ["%s.expert.%s" % (PROTO, k) for k in list(EXPERTS) + list(OTHER_EXPERTS)]))
         bad = []
         for name in self.fields:
             ftype, mask = REGISTERED[name]

@@ -7,16 +7,18 @@ raise a Wireshark exception ("[Malformed Packet: ECATR]"), every defect must
 carry one of our expert infos where it happens, and what is there must still
 be decoded.
 """
+import io
 import os
 import random
 import struct
 import sys
 import unittest
+import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pcapgen  # noqa: E402
 from pcapgen import Datagram, Frame  # noqa: E402
-from tshark_env import TsharkEnv, run_unittests  # noqa: E402
+from tshark_env import TsharkEnv, read_tshark_output, run_unittests  # noqa: E402
 
 ARGS = None
 ETH_HEADER = b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01" + b"\x88\xa4"
@@ -111,10 +113,105 @@ class Malformed(unittest.TestCase):
         self.assertIn("the repeat flag 'More' says another follows, but no data is left", rows[0][2])
 
     def test_header_length_longer_than_the_datagrams(self):
+        """A header Length of 34 over a 14-byte datagram: the 20 bytes after it are the
+        Ethernet padding. Zeros there are padding; anything else is reported."""
         f = Frame([Datagram(cmd=1, data=b"\xaa\xbb", wkc=1)], header_length=14 + 20)
-        rows = self.decode([(frame_bytes(f), len(frame_bytes(f)))], ["ecatr.datagram.cmd", "_ws.expert.message"])
-        self.assertEqual(rows[0][0], "0x01")
-        self.assertIn("'Datagrams' is 34 bytes, but its fields end after 14: 20 bytes are not decoded", rows[0][1])
+        zeros = frame_bytes(f)
+        self.assertEqual(zeros[30:], bytes(30), "Ethernet pads the frame with zeros")
+        other = zeros[:40] + b"\x5a" + zeros[41:]
+        rows = self.decode([(zeros, len(zeros)), (other, len(other))],
+                           ["ecatr.datagram.cmd", "ecatr.padding", "_ws.expert.message"])
+        self.assertEqual(rows[0], ["0x01", "00" * 20, ""])
+        self.assertEqual(rows[1][0:2], ["0x01", ""])
+        self.assertEqual(rows[1][2], "'Datagrams' is 34 bytes, but its fields end after 14: 20 bytes are not decoded")
+
+    def padded_frames(self):
+        """One short datagram (12 to 14 bytes) inside a header Length of 14 (as TwinCAT sends
+        it) or 28 (as ethercrab does): first the rest in zeros, then with one non-zero byte at
+        each place of it in turn, then zeros with non-zero bytes after the Length (the
+        Ethernet padding, outside the datagrams). -> [(frame bytes, padding offset in the
+        frame, padding length, place of the non-zero byte or None)]"""
+        out = []
+        for declared in (14, 28):
+            for data_len in (0, 1, 2):
+                size = 12 + data_len
+                pad = declared - size
+                d = Datagram(cmd=4, idx=len(out) & 0xFF, adp=0x1001, ado=0x0130, data=bytes(range(1, data_len + 1)),
+                             wkc=1)
+                at = 14 + 2 + size
+                out.append((frame_bytes(Frame([d], padding=bytes(pad))), at, pad, None))
+                for k in range(pad):
+                    padding = bytearray(pad)
+                    padding[k] = 1 + (k * 37) % 255
+                    d = Datagram(cmd=4, idx=len(out) & 0xFF, adp=0x1001, ado=0x0130,
+                                 data=bytes(range(1, data_len + 1)), wkc=1)
+                    out.append((frame_bytes(Frame([d], padding=bytes(padding))), at, pad, k))
+                d = Datagram(cmd=4, idx=len(out) & 0xFF, adp=0x1001, ado=0x0130, data=bytes(range(1, data_len + 1)),
+                             wkc=1)
+                f = frame_bytes(Frame([d], padding=bytes(pad), pad=False))
+                out.append((f + b"\xff" * max(60 - len(f), 1), at, pad, None))
+        return out
+
+    def padding_and_experts(self, cap, two_pass):
+        """{frame: ([(padding pos, size, value)], [(our expert, pos, message)])} from the PDML."""
+        pdml = self.env.path("padding.pdml")
+        with open(pdml, "w") as fh:
+            self.env.tshark(["-r", cap, "-T", "pdml"] + (["-2"] if two_pass else []), stdout=fh)
+        out = {}
+        for _, packet in ET.iterparse(io.BytesIO(read_tshark_output(pdml, xml=True).encode("utf-8"))):
+            if packet.tag != "packet":
+                continue
+            num = int(packet.find("proto[@name='geninfo']/field[@name='num']").get("show"))
+            padding, experts = [], []
+            for item in packet.iter("field"):
+                if item.get("name") == "ecatr.padding":
+                    padding.append((int(item.get("pos")), int(item.get("size")), item.get("value")))
+                if item.get("name") == "_ws.expert":
+                    for child in item.findall("field"):
+                        if child.get("name") in OUR_EXPERTS:
+                            experts.append((child.get("name"), int(item.get("pos")), child.get("showname")))
+            out[num] = (padding, experts)
+            packet.clear()
+        return out
+
+    def test_zero_padding_is_shown_as_padding_and_other_bytes_are_reported(self):
+        frames = self.padded_frames()
+        rows = self.decode([(f, len(f)) for f, _, _, _ in frames], ["ecatr.datagram.cmd"])
+        self.assertEqual([r[0] for r in rows], ["0x04"] * len(frames))
+        cap = self.env.add_file("padded.pcap", pcap([(f, len(f)) for f, _, _, _ in frames]))
+        nonzero = 0
+        for two_pass in (False, True):
+            shown = self.padding_and_experts(cap, two_pass)
+            for number, (f, at, pad, k) in enumerate(frames, 1):
+                padding, experts = shown[number]
+                where = "frame %d (%d bytes of padding, non-zero byte at %s%s)" % (
+                    number, pad, k, ", -2" if two_pass else "")
+                if k is None:
+                    self.assertEqual(experts, [], where)
+                    self.assertEqual(padding, [(at, pad, "00" * pad)] if pad else [], where)
+                else:
+                    nonzero += 1
+                    self.assertEqual(padding, [], where)
+                    self.assertEqual(experts, [("ecatr.expert.unused", at,
+                                                "'Datagrams' is %d bytes, but its fields end after %d: "
+                                                "%d bytes are not decoded" % (at - 16 + pad, at - 16, pad))], where)
+        self.assertEqual(nonzero, 2 * (2 + 1 + 16 + 15 + 14))
+
+    def test_padding_cut_short_by_the_capture(self):
+        """Zeros the capture did not keep are not known to be zeros: a header Length past the
+        captured bytes is reported as before, with no padding item."""
+        packets, cuts = [], []
+        for declared in (14, 28):
+            size = 13
+            for cut in range(0, declared - size):
+                f = Frame([Datagram(cmd=4, idx=len(packets), data=b"\x01", wkc=1)], padding=bytes(declared - size),
+                          truncate_to=2 + size + cut, pad=False)
+                packets.append(pcapgen.encode_frame(f))
+                cuts.append((declared, size + cut))
+        rows = self.decode(packets, ["ecatr.datagram.cmd", "ecatr.padding", "_ws.expert.message"])
+        for row, (declared, left) in zip(rows, cuts):
+            self.assertEqual(row, ["0x04", "", "'Datagrams' has length %d, past the end of its data (%d bytes left)"
+                                   % (declared, left)])
 
     def test_over_a_hundred_empty_datagrams(self):
         f = Frame([Datagram(cmd=0, idx=i & 0xFF) for i in range(124)])

@@ -6,8 +6,9 @@ EtherNet/IP plugins step over the nodes that feed nothing (generator/quiet.cpp)
 and the pairing does its first-pass work only. A tap listener (here `-z
 io,stat,0`, which shows nothing per packet) turns that off, so the packet lines
 of the two runs must be the same, byte for byte: on generated EtherCAT frames
-of every command with malformed variants (truncated frames, lengths that lie),
-on the shipped samples, and on the corpus captures when ../shared/corpus is
+of every command with malformed variants (truncated frames, lengths that lie)
+and bytes after the datagrams inside the header's Length (zeros: padding, no
+expert info; or not), on the shipped samples, and on the corpus captures when ../shared/corpus is
 there; in one pass and with -2. The generated frames are also shown with an
 Expert column: a quiet walk raises its expert infos without their text (the
 pairing's too), so the same frames must show a severity there. (Which one, when
@@ -34,6 +35,29 @@ def corpus_captures(kind):
     return [os.path.join(folder, f) for f in sorted(os.listdir(folder)) if f.endswith((".pcap", ".pcapng"))]
 
 
+def padded_frames():
+    """A 13-byte datagram inside a header Length of 14 or 28 bytes: the rest zeros (padding,
+    no expert info), or with a non-zero byte (the unused expert info, a warning), or cut
+    short by the capture inside the zeros (not known to be zero: the datagrams are past the
+    end, an error). -> [(frame, severity in the Expert column in one pass)], a second apart
+    from the rest of the capture and from one another (nothing pairs with them)."""
+    frames = []
+
+    def frame(padding, severity, **kw):
+        d = pcapgen.Datagram(cmd=4, idx=0xA0 + len(frames), adp=0x1001, ado=0x0130, data=b"\x01", wkc=1)
+        frames.append((pcapgen.Frame([d], padding=bytes(padding), ts=1704070000.0 + len(frames), **kw), severity))
+
+    for declared in (14, 28):
+        size = declared - 13
+        frame(bytes(size), "")
+        for k in sorted({0, size - 1}):
+            padding = bytearray(size)
+            padding[k] = 0x80
+            frame(padding, "Warning")
+        frame(bytes(size), "Error", truncate_to=2 + 13 + size // 2, pad=False)
+    return frames
+
+
 class QuietWalk(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -42,6 +66,7 @@ class QuietWalk(unittest.TestCase):
             cls.env.install_plugin(ARGS.dissgen, os.path.join(ARGS.source_dir, "rules", rules))
         frames = pcapgen.random_frames(14, 3000, max_datagrams=12, m_on_last=40, truncated=80, other_types=20,
                                        odd_lengths=40)
+        frames += [f for f, _ in padded_frames()]
         cls.generated = cls.env.add_file("quiet.pcap", pcapgen.pcap_bytes(frames))
 
     @classmethod
@@ -80,6 +105,12 @@ class QuietWalk(unittest.TestCase):
             self.assertGreater(len(with_experts[1]), 100, "the malformed frames raise expert infos")
             self.assertEqual(with_experts[0], with_experts[1], "frames with a severity in the Expert column%s"
                              % (" (-2)" if extra else ""))
+        # The padded frames at the end (one pass: with -2 each also has no response).
+        severities = [s for _, s in padded_frames()]
+        for lines in self.packet_lines(self.generated, columns):
+            shown = [line.split()[1] if line.split()[1] in ("Error", "Warning", "Note", "Chat") else ""
+                     for line in lines[-len(severities):]]
+            self.assertEqual(shown, severities, "Expert column of the padded frames")
 
     def test_samples(self):
         samples = os.path.join(os.path.abspath(ARGS.source_dir), "samples")

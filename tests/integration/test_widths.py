@@ -27,9 +27,9 @@ the `in` lists, bytes that differ in each position). For each message the test
 knows what it wrote and checks every field's -T fields values (so every length,
 count, branch and repeat), the Info column (the summaries, formatted by the
 runtime from its own reading of the values), and the expert infos, by message
-and by filter name, for frames with a Box longer than its fields, a repeat flag
-set with nothing after it, a Box past the end of the data and a bit group cut
-short.
+and by filter name, for frames with a Box longer than its fields (zeros after them
+are padding, wdth.padding, with no expert info), a repeat flag set with nothing
+after it, a Box past the end of the data and a bit group cut short.
 
     test_widths.py --dissgen build/bin/dissgen --source-dir .  [--write-rules]
 
@@ -186,9 +186,11 @@ class Message:
             self.field(name, punct(data, " ", 1 << 30))
 
 
-def build_message(g, note="valid", box_extra=None, last_record_more=False, end_after_box=False, cut_group=None):
+def build_message(g, note="valid", box_extra=None, box_zeros=(), last_record_more=False, end_after_box=False,
+                  cut_group=None):
     """All 16 containers. box_extra {(w, order): n}: that Box length says n bytes more than
-    its fields (and the bytes are there); last_record_more: the last container's last Record
+    its fields (and the bytes are there: zeros but for one random byte, all zeros for the
+    combinations in box_zeros); last_record_more: the last container's last Record
     has its flag set (and nothing follows); end_after_box: the last container's Box length
     says 1-3 bytes more, and the message ends after its fields; cut_group: the message
     ends after that many bytes of the last container's bit group."""
@@ -251,9 +253,16 @@ def build_message(g, note="valid", box_extra=None, last_record_more=False, end_a
             m.experts.append(("past_end", "'Box' has length %d, past the end of its data (2 bytes left)" % (2 + extra)))
             return m
         if extra:
-            m.data += g.bytes(extra)
-            m.experts.append(("unused", "'Box' is %d bytes, but its fields end after 2: %d bytes are not decoded"
-                              % (2 + extra, extra)))
+            # zeros are padding (no expert info); one other byte anywhere among them is reported
+            gap = bytearray(extra)
+            if (w, order) not in box_zeros:
+                gap[rng.randrange(extra)] = rng.randrange(1, 256)
+            m.data += gap
+            if any(gap):
+                m.experts.append(("unused", "'Box' is %d bytes, but its fields end after 2: %d bytes are not decoded"
+                                  % (2 + extra, extra)))
+            else:
+                m.field("padding", bytes(gap).hex())
         nrec = rng.randint(1, 3)
         for i in range(nrec):
             more = i < nrec - 1 or (last and last_record_more)
@@ -271,6 +280,8 @@ def cases(g, n):
     out = [build_message(g) for _ in range(n)]
     for k, combo in enumerate(COMBOS):
         out.append(build_message(g, "Box of %s longer than its fields" % seg(*combo), box_extra={combo: 1 + k % 3}))
+        out.append(build_message(g, "Box of %s padded with zeros" % seg(*combo), box_extra={combo: 1 + k % 3},
+                                 box_zeros=(combo,)))
     for _ in range(3):
         out.append(build_message(g, "last Record has its flag set", last_record_more=True))
         out.append(build_message(g, "last Box past the end", end_after_box=True))
@@ -297,7 +308,8 @@ class Widths(TsharkTestCase, unittest.TestCase):
         cls.cases = cases(g, ARGS.messages)
         cap = cls.env.add_file("widths.pcap", pcap([(frame(c.data), len(frame(c.data))) for c in cls.cases]))
         listing = subprocess_lines([ARGS.dissgen, "fields", rules])
-        cls.fields = [line.split("\t")[0] for line in listing[1:]]
+        # and the field the runtime registers for every protocol
+        cls.fields = [line.split("\t")[0] for line in listing[1:]] + [PROTO + ".padding"]
         experts = ["%s.expert.%s" % (PROTO, e) for e in EXPERT_NAMES]
         extra = ["_ws.col.Info", "_ws.expert.message"] + experts
         args = ["-r", cap, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=|"]
