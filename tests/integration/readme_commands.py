@@ -58,6 +58,7 @@ SKIP = [
 # files it must have made). {home}: the reader's HOME, {plugins}: its per-user plugin
 # folder, {out}: the stand-in for DIR.
 EXPECT = [
+    (r"^dissgen install query\.xml\b", r"^installed .*/dissgen_query\.so ", ["{plugins}/dissgen_query.so"]),
     (r"dissgen install rules/ethercat\.xml$", r"^installed .*/dissgen_ethercat\.so ",
      ["{plugins}/dissgen_ethercat.so"]),
     (r"dissgen install rules/enip\.xml$", r"^installed .*/dissgen_enip\.so ", ["{plugins}/dissgen_enip.so"]),
