@@ -1364,6 +1364,16 @@ gboolean dg_protocol_names_free(const dg_protocol *p)
     return FALSE;
 }
 
+void dg_name_fields(hf_register_info *hf, const char *const *names, guint count, const char *filter)
+{
+    for (guint i = 0; i < count; i++) hf[i].hfinfo.abbrev = g_strdup_printf("%s.%s", filter, names[i]);
+}
+
+void dg_name_experts(ei_register_info *ei, const char *const *names, guint count, const char *filter)
+{
+    for (guint i = 0; i < count; i++) ei[i].eiinfo.name = g_strdup_printf("%s.%s", filter, names[i]);
+}
+
 void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett, int ett_count,
                  ei_register_info *ei, int ei_count)
 {
