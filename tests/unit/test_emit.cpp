@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "emit_cpp.h"
+#include "runtime_names.h"
 #include "test_support.h"
 
 namespace dissgen::testing {
@@ -299,17 +300,23 @@ TEST(Validate, IfhookNodesHaveNoFixedSizeAndMayHoldThePduLength) {
 namespace dissgen::testing {
 namespace {
 
-// The validator reserves kExpertNames because the emitter registers exactly those.
-TEST(Emit, ExpertInfosAreExactlyTheReservedNames) {
+// The emitter registers exactly the runtime's list of every protocol's expert
+// infos, the ones the validator reserves.
+TEST(Emit, ExpertInfosAreExactlyTheRuntimesList) {
     Front f = front_end(rules("<node name=\"A\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
     std::string code = emit_cpp(*f.proto, "t.xml");
-    size_t registered = 0;
+    size_t registered = 0, listed = 0;
     for (size_t at = code.find("\"tst.expert."); at != std::string::npos; at = code.find("\"tst.expert.", at + 1))
         ++registered;
-    EXPECT_EQ(registered, sizeof kExpertNames / sizeof kExpertNames[0]);
-    for (const char* name : kExpertNames)
-        EXPECT_TRUE(contains(code, std::string("\"tst.expert.") + name + "\"")) << name;
+    for (const RuntimeName& n : name_group(NameGroup::When::Always).names) {
+        if (n.kind != RuntimeName::Kind::Expert) continue;
+        ++listed;
+        EXPECT_TRUE(contains(code, std::string("{ &ei_tst.") + n.id + ", { \"tst." + n.name + "\", " + n.group))
+            << n.name;
+    }
+    EXPECT_EQ(registered, listed);
+    EXPECT_GE(listed, 7u);
 }
 
 // issue 11: <pairing> marks its key fields DG_KEY (every instance of a
