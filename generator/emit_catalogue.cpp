@@ -388,7 +388,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
 std::string list_bus_fields(const Catalogue& cat, const BusOptions& opt, const std::string& filter) {
     std::string out;
     for (const Field& f : make_bus_layout(cat, opt, filter).fields)
-        out += f.filter + "\t" + f.type.type + "\t" + f.label + "\n";
+        out += f.filter + "\t" + f.type.type + "\t" + f.label + "\t" + kEsiSource + "\n";
     return out;
 }
 

@@ -673,15 +673,15 @@ std::string emit_cpp(const Protocol& proto, const std::string& source_name, cons
 
 std::string list_fields(const Protocol& proto) {
     std::ostringstream out;
-    out << proto.filter << "\tFT_PROTOCOL\t" << proto.name << "\n";
+    out << proto.filter << "\tFT_PROTOCOL\t" << proto.name << "\t" << kRulesSource << "\n";
     for_each_node(proto.nodes, [&](const Node& n) {
         if (n.filter_name.empty()) return;
-        out << n.filter_name << "\t" << field_type(n).type << "\t" << n.name << "\n";
+        out << n.filter_name << "\t" << field_type(n).type << "\t" << n.name << "\t" << kRulesSource << "\n";
     });
-    bool reassembles = false;  // issue 10a
-    for_each_node(proto.nodes, [&](const Node& n) { reassembles = reassembles || n.reassembles(); });
-    if (reassembles)
-        for (const auto& fr : fragment_fields(proto)) out << fr.filter << "\t" << fr.type << "\t" << fr.name << "\n";
+    for (const NameGroup* g : name_groups_of(proto))
+        for (const RuntimeName& n : g->names)
+            if (n.kind == RuntimeName::Kind::Field || n.kind == RuntimeName::Kind::Expert)
+                out << proto.filter << "." << n.name << "\t" << n.type << "\t" << n.label << "\t" << g->source << "\n";
     return out.str();
 }
 

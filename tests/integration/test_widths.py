@@ -297,7 +297,8 @@ class Widths(TsharkTestCase, unittest.TestCase):
         cls.cases = cases(g, ARGS.messages)
         cap = cls.env.add_file("widths.pcap", pcap([(frame(c.data), len(frame(c.data))) for c in cls.cases]))
         listing = subprocess_lines([ARGS.dissgen, "fields", rules])
-        cls.fields = [line.split("\t")[0] for line in listing[1:]]
+        # the rule file's fields (the fourth column says "rules"), not the runtime's expert infos
+        cls.fields = [line.split("\t")[0] for line in listing[1:] if line.split("\t")[3] == "rules"]
         experts = ["%s.expert.%s" % (PROTO, e) for e in EXPERT_NAMES]
         extra = ["_ws.col.Info", "_ws.expert.message"] + experts
         args = ["-r", cap, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=|"]

@@ -89,6 +89,14 @@ TEST(Docs, ManualNamingExampleGivesTheNamesItStates) {
         std::string fields = list_fields(*f.proto);
         for (const char* name : {"name.working_counter_wkc\t", "name.cmd\t", "name.type\t"})
             EXPECT_NE(fields.find(name), std::string::npos) << fields;
+        // The listing the manual shows is how `dissgen fields` begins.
+        const std::string manual = read_file(source_path("docs/manual.md"));
+        const std::string marker = "$ dissgen fields naming.xml\n";
+        size_t at = manual.find(marker);
+        ASSERT_NE(at, std::string::npos);
+        at += marker.size();
+        std::string shown = manual.substr(at, manual.find("...\n", at) - at);
+        EXPECT_EQ(fields.substr(0, shown.size()), shown);
         return;
     }
     FAIL() << "naming example not found";
