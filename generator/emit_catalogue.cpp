@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "network_reader.h"
+#include "../plugin_runtime/dissgen_names.h"
 
 namespace dissgen {
 
@@ -183,7 +184,7 @@ BusLayout make_bus_layout(const Catalogue& cat, const BusOptions& opt, const std
                           e.entry.name + "\n" + e.entry.data_type + "\n" + std::to_string(e.entry.bit_length);
         auto it = field_of.find(key);
         if (it != field_of.end()) return it->second;
-        std::string base = filter + ".pdo." + segment(owner);
+        std::string base = filter + "." + DG_BUS_PDO_PREFIX + segment(owner);
         std::string pdo = segment(e.pdo_name), name = segment(e.entry.name);
         if (!pdo.empty()) base += "." + pdo;
         base += "." + (name.empty() ? "entry_" + hexn(e.entry.index, 4).substr(2) + "_" +
@@ -387,7 +388,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
 std::string list_bus_fields(const Catalogue& cat, const BusOptions& opt, const std::string& filter) {
     std::string out;
     for (const Field& f : make_bus_layout(cat, opt, filter).fields)
-        out += f.filter + "\t" + f.type.type + "\t" + f.label + "\n";
+        out += f.filter + "\t" + f.type.type + "\t" + f.label + "\t" + kEsiSource + "\n";
     return out;
 }
 

@@ -22,7 +22,8 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& options, const s
 // (BITn: the smallest unsigned type that holds n bits; unknown types: bytes).
 FieldType pdo_field_type(const std::string& data_type, unsigned bits);
 
-// One line per PDO field, as list_fields() prints the rule fields.
+// One line per PDO field, as list_fields() prints the rule fields, from kEsiSource.
+constexpr const char* kEsiSource = "esi";
 std::string list_bus_fields(const Catalogue& cat, const BusOptions& options, const std::string& filter);
 
 }  // namespace dissgen

@@ -2,6 +2,7 @@
 #include "emit_cpp.h"
 
 #include "quiet.h"
+#include "runtime_names.h"
 
 #include "validator.h"
 
@@ -258,6 +259,7 @@ private:
     void tables_10b();  // issue 10b
     void protocol_struct();
     void register_functions();
+    void expert_entries();
     // issue 10a
     bool uses_reassembly() const;
     void extra_table();
@@ -524,26 +526,26 @@ void Emitter::register_functions() {
         if (n->is_container()) o_ << ",\n        &" << ett(*n);
     if (uses_reassembly()) o_ << ",\n        &frag_ett_fragment,\n        &frag_ett_fragments";
     o_ << "\n    };\n\n    static ei_register_info ei[] = {\n";
-    const char* experts[][4] = {
-        {"truncated", "PI_MALFORMED", "PI_ERROR", "The packet ends inside a field"},
-        {"past_end", "PI_MALFORMED", "PI_ERROR", "A length field points past the end of its data"},
-        {"more_no_data", "PI_MALFORMED", "PI_ERROR", "The repeat flag says more follow, but no data is left"},
-        {"count_short", "PI_MALFORMED", "PI_ERROR", "Fewer instances than the count field says"},
-        {"bad_length", "PI_MALFORMED", "PI_ERROR", "A length or count is missing or negative"},
-        {"unused", "PI_PROTOCOL", "PI_WARN", "A length says more bytes than its fields hold"},
-        {"bad_offset", "PI_MALFORMED", "PI_ERROR", "An offset table entry is out of order or out of range"},
-    };
-    const size_t expert_count = sizeof experts / sizeof experts[0];
-    for (size_t i = 0; i < expert_count; ++i)
-        o_ << "        { &ei_" << f << "." << experts[i][0] << ", { \"" << f << ".expert." << experts[i][0] << "\", "
-           << experts[i][1] << ", " << experts[i][2] << ", \"" << experts[i][3] << "\", EXPFILL } }"
-           << (i + 1 < expert_count ? ",\n" : "\n");
+    expert_entries();
     o_ << "    };\n\n"
        << "    if (!dg_protocol_names_free(&" << f << "_protocol))\n        return;\n"
        << "    dg_register(&" << f << "_protocol, hf, " << (first ? "0" : "(int)G_N_ELEMENTS(hf)")
        << ", ett, (int)G_N_ELEMENTS(ett), ei, (int)G_N_ELEMENTS(ei));\n}\n\n"
        << "void proto_reg_handoff_" << f << "(void)\n{\n    dg_handoff(&" << f << "_protocol);\n}\n\n"
        << "DG_DECLARE_PLUGIN(proto_register_" << f << ", proto_reg_handoff_" << f << ")\n";
+}
+
+// The expert infos every protocol registers (dg_experts), from the runtime's list.
+void Emitter::expert_entries() {
+    const std::string& f = p_.filter;
+    std::vector<const RuntimeName*> experts;
+    for (const RuntimeName& n : name_group(NameGroup::When::Always).names)
+        if (n.kind == RuntimeName::Kind::Expert) experts.push_back(&n);
+    for (size_t i = 0; i < experts.size(); ++i) {
+        const RuntimeName& e = *experts[i];
+        o_ << "        { &ei_" << f << "." << e.id << ", { " << c_string(f + "." + e.name) << ", " << e.group << ", "
+           << e.severity << ", " << c_string(e.label) << ", EXPFILL } }" << (i + 1 < experts.size() ? ",\n" : "\n");
+    }
 }
 
 // --- issue 10a ---------------------------------------------------------------
@@ -622,23 +624,10 @@ void Emitter::extra_table() {
 }  // namespace
 
 std::vector<FragmentField> fragment_fields(const Protocol& proto) {
-    const std::string& f = proto.filter;
-    return {
-        {"fragments", "Message fragments", f + ".fragments", "FT_NONE", "BASE_NONE"},
-        {"fragment", "Message fragment", f + ".fragment", "FT_FRAMENUM", "BASE_NONE"},
-        {"fragment_overlap", "Message fragment overlap", f + ".fragment.overlap", "FT_BOOLEAN", "BASE_NONE"},
-        {"fragment_overlap_conflicts", "Message fragment overlapping with conflicting data",
-         f + ".fragment.overlap.conflicts", "FT_BOOLEAN", "BASE_NONE"},
-        {"fragment_multiple_tails", "Message has multiple tail fragments", f + ".fragment.multiple_tails",
-         "FT_BOOLEAN", "BASE_NONE"},
-        {"fragment_too_long_fragment", "Message fragment too long", f + ".fragment.too_long_fragment", "FT_BOOLEAN",
-         "BASE_NONE"},
-        {"fragment_error", "Message defragmentation error", f + ".fragment.error", "FT_FRAMENUM", "BASE_NONE"},
-        {"fragment_count", "Message fragment count", f + ".fragment.count", "FT_UINT32", "BASE_DEC"},
-        {"reassembled_in", "Reassembled in", f + ".reassembled_in", "FT_FRAMENUM", "BASE_NONE"},
-        {"reassembled_length", "Reassembled length", f + ".reassembled.length", "FT_UINT32", "BASE_DEC"},
-        {"reassembled_data", "Reassembled data", f + ".reassembled.data", "FT_BYTES", "BASE_NONE"},
-    };
+    std::vector<FragmentField> out;
+    for (const RuntimeName& n : name_group(NameGroup::When::Reassembly).names)
+        out.push_back({n.id, n.label, proto.filter + "." + n.name, n.type, n.display});
+    return out;
 }
 
 // issue 10a: the Wireshark type of string, stringz, ipv4, int, float and time leaves.
@@ -684,15 +673,15 @@ std::string emit_cpp(const Protocol& proto, const std::string& source_name, cons
 
 std::string list_fields(const Protocol& proto) {
     std::ostringstream out;
-    out << proto.filter << "\tFT_PROTOCOL\t" << proto.name << "\n";
+    out << proto.filter << "\tFT_PROTOCOL\t" << proto.name << "\t" << kRulesSource << "\n";
     for_each_node(proto.nodes, [&](const Node& n) {
         if (n.filter_name.empty()) return;
-        out << n.filter_name << "\t" << field_type(n).type << "\t" << n.name << "\n";
+        out << n.filter_name << "\t" << field_type(n).type << "\t" << n.name << "\t" << kRulesSource << "\n";
     });
-    bool reassembles = false;  // issue 10a
-    for_each_node(proto.nodes, [&](const Node& n) { reassembles = reassembles || n.reassembles(); });
-    if (reassembles)
-        for (const auto& fr : fragment_fields(proto)) out << fr.filter << "\t" << fr.type << "\t" << fr.name << "\n";
+    for (const NameGroup* g : name_groups_of(proto))
+        for (const RuntimeName& n : g->names)
+            if (n.kind == RuntimeName::Kind::Field || n.kind == RuntimeName::Kind::Expert)
+                out << proto.filter << "." << n.name << "\t" << n.type << "\t" << n.label << "\t" << g->source << "\n";
     return out.str();
 }
 

@@ -21,8 +21,8 @@ struct FieldType {
 
 FieldType field_type(const Node& n);
 
-// issue 10a: the fragment fields a reassembling protocol registers
-// (Wireshark's fragment_items): C identifier stem, name, filter name, type, display.
+// The fragment fields a reassembling protocol registers (Wireshark's
+// fragment_items): C identifier stem, name, filter name, type, display.
 struct FragmentField {
     std::string ident, name, filter, type, display;
 };
@@ -44,7 +44,12 @@ struct EmbeddedTables {
 // `source_name` is the rule file's base name, quoted in the header comment.
 std::string emit_cpp(const Protocol& proto, const std::string& source_name, const EmbeddedTables* extra = nullptr);
 
-// One line per field: filter name, Wireshark type, display name.
+// One line per field: filter name, Wireshark type, display name and where it
+// comes from: kRulesSource for the rule file's fields (first, in document
+// order), then what the runtime registers for the protocol, each with its
+// NameGroup's source ("runtime", "reassembly", "pairing", an analysis).
+// Expert infos are listed too: Wireshark registers each as an FT_NONE field.
+constexpr const char* kRulesSource = "rules";
 std::string list_fields(const Protocol& proto);
 
 }  // namespace dissgen

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "validator.h"
 
+#include "runtime_names.h"
+
 #include <algorithm>
 #include <cctype>
 #include <map>
@@ -56,7 +58,7 @@ private:
     void check_enum_ranges(const Node& n);
     void check_handoff(const Node& n);
     void check_reassembly(Node& n);
-    void check_fragment_names();
+    void check_runtime_name(const Node& n);
     // issue 10b
     void check_layout(Node& n);
     void check_peek(Node& n, When& w);
@@ -67,6 +69,7 @@ private:
     Diagnostics& diags_;
     std::map<const Node*, bool> needs_slot_;
     std::map<std::string, const Node*> filter_owner_;
+    std::vector<const NameGroup*> runtime_names_;  // the names the runtime registers for this protocol
 };
 
 void Validator::run() {
@@ -87,8 +90,8 @@ void Validator::run() {
     });
     check_pdulength();
     check_pairing();
+    runtime_names_ = name_groups_of(proto_);
     assign_filter_names(proto_.nodes, proto_.filter);
-    check_fragment_names();
     assign_slots();
 }
 
@@ -446,16 +449,8 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
         }
         std::string own = n.segment.empty() ? "" : prefix + "." + n.segment;
         n.filter_name = own;
-        if (!own.empty() && is_reserved_expert_name(proto_.filter, own))
-            diags_.error(n.line, "filter name '" + own + "' is reserved for the protocol's expert infos; "
-                                 "give " + quote(n) + " or its container another 'filter'");
-        if (!own.empty() && is_reserved_runtime_field(proto_.filter, own))
-            diags_.error(n.line, "filter name '" + own + "' is reserved for the zero padding after a container's "
-                                 "fields; give " + quote(n) + " or its container another 'filter'");
-        if (!own.empty() && !reserved_pairing_name(proto_, own).empty())
-            diags_.error(n.line, "filter name '" + own + "' is reserved for " + reserved_pairing_name(proto_, own) +
-                                 "; give " + quote(n) + " or its container another 'filter'");
         if (!own.empty()) {
+            check_runtime_name(n);
             auto [it, inserted] = filter_owner_.emplace(own, &n);
             if (!inserted)
                 diags_.error(n.line, "duplicate filter name '" + own + "' (also used by " + quote(*it->second) +
@@ -615,17 +610,14 @@ void Validator::check_reassembly(Node& n) {
         if (*r.ref) check_reference(n, **r.ref, r.what);
 }
 
-// The fragment fields every reassembling protocol registers (P.fragments, ...).
-void Validator::check_fragment_names() {
-    bool reassembles = false;
-    for_each_node(proto_.nodes, [&](const Node& n) { reassembles = reassembles || n.reassembles(); });
-    if (!reassembles) return;
-    for (const char* name : kFragmentNames) {
-        auto it = filter_owner_.find(proto_.filter + "." + name);
-        if (it != filter_owner_.end())
-            diags_.error(it->second->line, "filter name '" + it->first + "' is taken by the reassembly's fragment "
-                                           "fields; give " + quote(*it->second) + " another 'filter'");
-    }
+// A field may not take a name the runtime registers for the protocol: two
+// fields of one name and different types make Wireshark refuse filters on it.
+void Validator::check_runtime_name(const Node& n) {
+    auto clash = runtime_name_clash(runtime_names_, proto_.filter, n.filter_name);
+    if (clash)
+        diags_.error(n.line, "filter name '" + n.filter_name + "' is reserved for " +
+                                 clash->description(proto_.filter) + "; give " + quote(n) +
+                                 " or its container another 'filter'");
 }
 
 // --- issue 10b: <when>, otherwise, windows ------------------------------
@@ -891,29 +883,6 @@ std::string name_without_index(const std::string& name) {
     std::string out = name;
     for (size_t at; (at = out.find("{i}")) != std::string::npos;) out.erase(at, 3);
     return out;
-}
-
-bool is_reserved_expert_name(const std::string& protocol_filter, const std::string& field_filter) {
-    for (const char* expert : kExpertNames)
-        if (field_filter == protocol_filter + ".expert." + expert) return true;
-    return false;
-}
-
-bool is_reserved_runtime_field(const std::string& protocol_filter, const std::string& field_filter) {
-    for (const char* name : kRuntimeFieldNames)
-        if (field_filter == protocol_filter + "." + name) return true;
-    return false;
-}
-
-std::string reserved_pairing_name(const Protocol& proto, const std::string& field_filter) {
-    if (!proto.pairing) return "";
-    for (const char* name : kPairingNames)
-        if (field_filter == proto.filter + "." + name) return "the request/response pairing (<pairing>)";
-    if (proto.pairing->analysis == "ethercat-esc") {
-        for (const char* name : kEthercatEscNames)
-            if (field_filter == proto.filter + "." + name) return "the ethercat-esc analysis";
-    }
-    return "";
 }
 
 std::string segment_from_name(const std::string& name) {

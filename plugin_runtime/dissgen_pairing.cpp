@@ -796,21 +796,9 @@ void dg_pairing_register(const dg_protocol *p)
         if (p->pairing->analysis && strcmp(a->name, p->pairing->analysis) == 0) analysis = a;
 
     /* Wireshark keeps pointers to these: static arrays, names that live until exit. */
-    static hf_register_info hf[] = {
-        {&hf_response_in, {"Response in", NULL, FT_FRAMENUM, BASE_NONE, FRAMENUM_TYPE(FT_FRAMENUM_RESPONSE), 0x0,
-                           "The frame that answers this one", HFILL}},
-        {&hf_request_in, {"Request in", NULL, FT_FRAMENUM, BASE_NONE, FRAMENUM_TYPE(FT_FRAMENUM_REQUEST), 0x0,
-                          "The frame this one answers", HFILL}},
-        {&hf_time, {"Round trip", NULL, FT_RELATIVE_TIME, BASE_NONE, NULL, 0x0,
-                    "Time from the request to this response", HFILL}},
-        {&hf_no_response_to, {"No response to", NULL, FT_FRAMENUM, BASE_NONE, FRAMENUM_TYPE(FT_FRAMENUM_REQUEST),
-                              0x0, "A request this message proves lost (its key reused, or its timeout passed)",
-                              HFILL}},
-    };
-    hf[0].hfinfo.abbrev = g_strdup_printf("%s.response_in", p->filter);
-    hf[1].hfinfo.abbrev = g_strdup_printf("%s.request_in", p->filter);
-    hf[2].hfinfo.abbrev = g_strdup_printf("%s.time", p->filter);
-    hf[3].hfinfo.abbrev = g_strdup_printf("%s.no_response_to", p->filter);
+    static hf_register_info hf[] = {DG_PAIRING_FIELDS(DG_HF_ROW)};
+    static const char *const names[] = {DG_PAIRING_FIELDS(DG_FIELD_NAME)};
+    dg_name_fields(hf, names, G_N_ELEMENTS(hf), p->filter);
     for (guint i = 0; i < p->node_count; i++)
         if (p->nodes[i].flags & DG_KEY) {
             key_name = p->nodes[i].name;
@@ -818,14 +806,9 @@ void dg_pairing_register(const dg_protocol *p)
         }
     proto_register_field_array(*p->proto, hf, (int)G_N_ELEMENTS(hf));
 
-    static ei_register_info ei[] = {
-        {&ei_no_response, {NULL, PI_SEQUENCE, PI_WARN, "No response seen", EXPFILL}},
-        {&ei_duplicate, {NULL, PI_SEQUENCE, PI_NOTE, "Duplicate message", EXPFILL}},
-        {&ei_out_of_order, {NULL, PI_SEQUENCE, PI_NOTE, "Response out of order", EXPFILL}},
-    };
-    ei[0].eiinfo.name = g_strdup_printf("%s.expert.no_response", p->filter);
-    ei[1].eiinfo.name = g_strdup_printf("%s.expert.duplicate", p->filter);
-    ei[2].eiinfo.name = g_strdup_printf("%s.expert.out_of_order", p->filter);
+    static ei_register_info ei[] = {DG_PAIRING_EXPERTS(DG_EI_ROW)};
+    static const char *const ei_names[] = {DG_PAIRING_EXPERTS(DG_EXPERT_NAME)};
+    dg_name_experts(ei, ei_names, G_N_ELEMENTS(ei), p->filter);
     expert_module_t *experts = expert_register_protocol(*p->proto);
     expert_register_field_array(experts, ei, (int)G_N_ELEMENTS(ei));
 

@@ -1390,18 +1390,26 @@ gboolean dg_protocol_names_free(const dg_protocol *p)
     return FALSE;
 }
 
+void dg_name_fields(hf_register_info *hf, const char *const *names, guint count, const char *filter)
+{
+    for (guint i = 0; i < count; i++) hf[i].hfinfo.abbrev = g_strdup_printf("%s.%s", filter, names[i]);
+}
+
+void dg_name_experts(ei_register_info *ei, const char *const *names, guint count, const char *filter)
+{
+    for (guint i = 0; i < count; i++) ei[i].eiinfo.name = g_strdup_printf("%s.%s", filter, names[i]);
+}
+
 void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett, int ett_count,
                  ei_register_info *ei, int ei_count)
 {
     *p->proto = proto_register_protocol(p->name, p->short_name, p->filter);
     proto_register_field_array(*p->proto, hf, hf_count);
     /* Wireshark keeps a pointer to it: a static array, a name that lives until exit. */
-    static hf_register_info padding[] = {
-        {&hf_padding, {"Padding", NULL, FT_BYTES, BASE_NONE, NULL, 0x0,
-                       "Zero bytes after a container's fields, up to the end of its length", HFILL}},
-    };
-    padding[0].hfinfo.abbrev = g_strdup_printf("%s.padding", p->filter);
-    proto_register_field_array(*p->proto, padding, (int)G_N_ELEMENTS(padding));
+    static hf_register_info runtime_hf[] = {DG_RUNTIME_FIELDS(DG_HF_ROW)};
+    static const char *const names[] = {DG_RUNTIME_FIELDS(DG_FIELD_NAME)};
+    dg_name_fields(runtime_hf, names, G_N_ELEMENTS(runtime_hf), p->filter);
+    proto_register_field_array(*p->proto, runtime_hf, (int)G_N_ELEMENTS(runtime_hf));
     proto_register_subtree_array(ett, ett_count);
     expert_module_t *experts = expert_register_protocol(*p->proto);
     expert_register_field_array(experts, ei, ei_count);

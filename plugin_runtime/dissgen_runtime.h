@@ -10,6 +10,7 @@
 #pragma once
 
 #include "dissgen_compat.h"
+#include "dissgen_names.h"
 
 /* Node kinds and length forms (RULES-SPEC "Lengths and bit fields"). */
 enum dg_kind { DG_LEAF = 0, DG_CONTAINER = 1 };
@@ -199,15 +200,11 @@ typedef struct dg_node {
 #endif
 } dg_node;
 
-/* Expert infos every generated protocol registers. */
+/* The expert infos of every protocol, one member per row of
+ * DG_RUNTIME_EXPERTS (dissgen_names.h), which the generated code registers. */
+#define DG_EXPERT_MEMBER(id, name, group, severity, summary) expert_field id;
 typedef struct dg_experts {
-    expert_field truncated;    /* packet ends inside a field */
-    expert_field past_end;     /* a length field points past its container or the packet */
-    expert_field more_no_data; /* repeat flag set, but no data left */
-    expert_field count_short;  /* count says more instances than the data holds */
-    expert_field bad_length;   /* negative or missing length / count */
-    expert_field unused;       /* a known-length container's fields end before it does */
-    expert_field bad_offset;   /* issue 10: an offset table entry out of order or out of range */
+    DG_RUNTIME_EXPERTS(DG_EXPERT_MEMBER)
 } dg_experts;
 
 typedef struct dg_hook {
@@ -298,6 +295,12 @@ gboolean dg_protocol_names_free(const dg_protocol *p);
 /* Registers the protocol's hf/ett/expert arrays. */
 void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett, int ett_count,
                  ei_register_info *ei, int ei_count);
+
+/* Sets the abbrev of each of `count` fields (or the name of each expert
+ * info) to "FILTER.NAME", names[i] being the NAME of the i-th row of a list
+ * of dissgen_names.h. The strings live until Wireshark exits. */
+void dg_name_fields(hf_register_info *hf, const char *const *names, guint count, const char *filter);
+void dg_name_experts(ei_register_info *ei, const char *const *names, guint count, const char *filter);
 
 /* Handoff: adds the protocol to its ethertype/hook tables and makes sure it,
  * not another plugin that registered the same values, is the default. */

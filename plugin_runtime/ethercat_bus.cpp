@@ -1169,46 +1169,16 @@ void bus_stats_frame(stats_tree *st, int parent, const bus_frame *f)
 
 void bus_register(int proto, const char *filter)
 {
-    static hf_register_info hf[] = {
-        {&hf_process_data, {"Process data", NULL, FT_NONE, BASE_NONE, NULL, 0x0,
-                            "One slave's PDO entries in this logical datagram (designed, or identified from its SII)", HFILL}},
-        {&hf_wkc_expected, {"Expected working counter", NULL, FT_UINT16, BASE_DEC, NULL, 0x0,
-                            "From the ENI's cyclic commands (Cnt), else from the slaves' FMMU configuration", HFILL}},
-        {&hf_slave, {"Slave", NULL, FT_NONE, BASE_NONE, NULL, 0x0,
-                     "The slave this datagram addresses, as the capture shows it", HFILL}},
-        {&hf_position, {"Position", NULL, FT_UINT16, BASE_DEC, NULL, 0x0, "Position on the segment, from 0", HFILL}},
-        {&hf_station, {"Station address", NULL, FT_UINT16, BASE_HEX, NULL, 0x0,
-                       "Configured station address (register 0x0010)", HFILL}},
-        {&hf_alias, {"Station alias", NULL, FT_UINT16, BASE_HEX, NULL, 0x0, "Configured station alias (register 0x0012)",
-                     HFILL}},
-        {&hf_vendor, {"Vendor id", NULL, FT_UINT32, BASE_HEX, NULL, 0x0, "From the SII EEPROM (word 0x0008)", HFILL}},
-        {&hf_product, {"Product code", NULL, FT_UINT32, BASE_HEX, NULL, 0x0, "From the SII EEPROM (word 0x000A)", HFILL}},
-        {&hf_revision, {"Revision", NULL, FT_UINT32, BASE_HEX, NULL, 0x0, "From the SII EEPROM (word 0x000C)", HFILL}},
-        {&hf_serial, {"Serial number", NULL, FT_UINT32, BASE_HEX, NULL, 0x0, "From the SII EEPROM (word 0x000E)", HFILL}},
-        {&hf_name, {"Model", NULL, FT_STRING, BASE_NONE, NULL, 0x0,
-                    "The device type of the ESI catalogue embedded with --esi", HFILL}},
-        {&hf_pdo_entry, {"PDO entry", NULL, FT_STRING, BASE_NONE, NULL, 0x0,
-                         "A PDO entry the master mapped over CoE that has no registered field: its object "
-                         "(index:subindex), with the ESI name and type when the model's ESI file has it", HFILL}},
-        {&hf_pdo_value, {"Value", NULL, FT_UINT64, BASE_DEC, NULL, 0x0,
-                         "The PDO entry's bits (up to 64), least significant first, as an unsigned number", HFILL}},
-    };
-    const char *names[] = {"process_data", "wkc.expected", "slave", "slave.position", "slave.station", "slave.alias", "slave.vendor",
-                           "slave.product", "slave.revision", "slave.serial", "slave.name", "pdo.entry", "pdo.value"};
-    for (guint i = 0; i < G_N_ELEMENTS(hf); i++) hf[i].hfinfo.abbrev = g_strdup_printf("%s.%s", filter, names[i]);
+    static hf_register_info hf[] = {DG_BUS_FIELDS(DG_HF_ROW)};
+    static const char *const names[] = {DG_BUS_FIELDS(DG_FIELD_NAME)};
+    dg_name_fields(hf, names, G_N_ELEMENTS(hf), filter);
     proto_register_field_array(proto, hf, (int)G_N_ELEMENTS(hf));
     static gint *ett[] = {&ett_slave, &ett_process_data, &ett_pdo_entry};
     proto_register_subtree_array(ett, (int)G_N_ELEMENTS(ett));
 
-    static ei_register_info ei[] = {
-        {&ei_count, {NULL, PI_PROTOCOL, PI_WARN, "Slave count differs from the network design", EXPFILL}},
-        {&ei_model, {NULL, PI_PROTOCOL, PI_WARN, "Slave model differs from the network design", EXPFILL}},
-        {&ei_ok, {NULL, PI_PROTOCOL, PI_CHAT, "The bus matches the network design", EXPFILL}},
-        {&ei_wkc, {NULL, PI_PROTOCOL, PI_WARN, "Working counter differs from the expected one", EXPFILL}},
-    };
-    const char *ei_names[] = {"network.count", "network.model", "network.ok", "wkc"};
-    for (guint i = 0; i < G_N_ELEMENTS(ei); i++)
-        ei[i].eiinfo.name = g_strdup_printf("%s.expert.%s", filter, ei_names[i]);
+    static ei_register_info ei[] = {DG_BUS_EXPERTS(DG_EI_ROW)};
+    static const char *const ei_names[] = {DG_BUS_EXPERTS(DG_EXPERT_NAME)};
+    dg_name_experts(ei, ei_names, G_N_ELEMENTS(ei), filter);
     expert_register_field_array(expert_register_protocol(proto), ei, (int)G_N_ELEMENTS(ei));
 }
 

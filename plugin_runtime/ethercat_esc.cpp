@@ -386,37 +386,16 @@ void esc_stats_response(stats_tree *st, int parent, const void *data)
 
 void esc_register(int proto, const char *filter)
 {
-    static hf_register_info hf[] = {
-        {&hf_esc, {"Out and back (ESC forwarding)", NULL, FT_NONE, BASE_NONE, NULL, 0x0,
-                   "What the segment did to the frame, datagram by datagram", HFILL}},
-        {&hf_datagram, {"Datagram", NULL, FT_NONE, BASE_NONE, NULL, 0x0, "One returned datagram against the one sent",
-                        HFILL}},
-        {&hf_wkc_added, {"Working counter added", NULL, FT_INT32, BASE_DEC, NULL, 0x0,
-                         "Returned working counter minus the one sent", HFILL}},
-        {&hf_slaves_passed, {"Slaves passed", NULL, FT_UINT16, BASE_DEC, NULL, 0x0,
-                             "How far the auto-increment address advanced (auto-increment and broadcast commands)",
-                             HFILL}},
-        {&hf_data_changed, {"Data changed", NULL, FT_BOOLEAN, BASE_NONE, NULL, 0x0,
-                            "The data came back different from what was sent", HFILL}},
-    };
-    const char *names[] = {"esc", "esc.datagram", "esc.wkc_added", "esc.slaves_passed", "esc.data_changed"};
-    for (guint i = 0; i < G_N_ELEMENTS(hf); i++) hf[i].hfinfo.abbrev = g_strdup_printf("%s.%s", filter, names[i]);
+    static hf_register_info hf[] = {DG_ESC_FIELDS(DG_HF_ROW)};
+    static const char *const names[] = {DG_ESC_FIELDS(DG_FIELD_NAME)};
+    dg_name_fields(hf, names, G_N_ELEMENTS(hf), filter);
     proto_register_field_array(proto, hf, (int)G_N_ELEMENTS(hf));
     static gint *ett[] = {&ett_esc, &ett_datagram};
     proto_register_subtree_array(ett, (int)G_N_ELEMENTS(ett));
 
-    static ei_register_info ei[] = {
-        {&ei_changed, {NULL, PI_PROTOCOL, PI_ERROR, "Returned datagram's command, index, length or address changed",
-                       EXPFILL}},
-        {&ei_frame_length, {NULL, PI_PROTOCOL, PI_ERROR, "Returned frame's length changed", EXPFILL}},
-        {&ei_write_changed, {NULL, PI_PROTOCOL, PI_ERROR, "Written data came back changed", EXPFILL}},
-        {&ei_wkc_down, {NULL, PI_PROTOCOL, PI_ERROR, "Working counter went down", EXPFILL}},
-        {&ei_forwarding, {NULL, PI_PROTOCOL, PI_WARN,
-                          "Auto-increment address advanced differently from the frame's other datagrams", EXPFILL}},
-    };
-    const char *ei_names[] = {"changed", "frame_length", "write_changed", "wkc_down", "forwarding"};
-    for (guint i = 0; i < G_N_ELEMENTS(ei); i++)
-        ei[i].eiinfo.name = g_strdup_printf("%s.expert.%s", filter, ei_names[i]);
+    static ei_register_info ei[] = {DG_ESC_EXPERTS(DG_EI_ROW)};
+    static const char *const ei_names[] = {DG_ESC_EXPERTS(DG_EXPERT_NAME)};
+    dg_name_experts(ei, ei_names, G_N_ELEMENTS(ei), filter);
     expert_register_field_array(expert_register_protocol(proto), ei, (int)G_N_ELEMENTS(ei));
     bus_register(proto, filter);
 }
@@ -424,7 +403,7 @@ void esc_register(int proto, const char *filter)
 } /* namespace */
 
 extern "C" const dg_analysis dg_ethercat_esc = {
-    "ethercat-esc",
+    DG_ANALYSIS_ETHERCAT_ESC,
     esc_register,
     esc_capture_new,
     NULL, /* see */

@@ -73,7 +73,7 @@ EXPECT = [
     (r"^tshark -G fields \| grep ecatr\.pdo\.el1004", r"\tecatr\.pdo\.el1004\.channel_1\.input\t", []),
     (r"^dissgen esi ", r"^0x00000002 0x044c2c52 0x00120000 ", []),
     (r"^dissgen generate ", None, ["{out}/dissgen_ethercat.cpp"]),
-    (r"^dissgen fields rules/ethercat\.xml$", r"^ecatr\.datagram\.cmd\tFT_UINT8\tCommand$", []),
+    (r"^dissgen fields rules/ethercat\.xml$", r"^ecatr\.datagram\.cmd\tFT_UINT8\tCommand\trules$", []),
     (r"^dissgen fields .*--esi .*--network ", r"^ecatr\.pdo\.el1004\.channel_1\.input\t", []),
     (r"^dissgen --version$", r"^dissgen \d+\.\d+", []),
     (r"^dissgen --help$", r"^ +dissgen esi PATH\.\.\.$", []),

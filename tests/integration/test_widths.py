@@ -308,8 +308,10 @@ class Widths(TsharkTestCase, unittest.TestCase):
         cls.cases = cases(g, ARGS.messages)
         cap = cls.env.add_file("widths.pcap", pcap([(frame(c.data), len(frame(c.data))) for c in cls.cases]))
         listing = subprocess_lines([ARGS.dissgen, "fields", rules])
+        # the rule file's fields (the fourth column says "rules"), not the runtime's expert infos,
         # and the field the runtime registers for every protocol
-        cls.fields = [line.split("\t")[0] for line in listing[1:]] + [PROTO + ".padding"]
+        cls.fields = [line.split("	")[0] for line in listing[1:] if line.split("	")[3] in ("rules", "runtime")
+                      and line.split("	")[1] != "FT_NONE"]
         experts = ["%s.expert.%s" % (PROTO, e) for e in EXPERT_NAMES]
         extra = ["_ws.col.Info", "_ws.expert.message"] + experts
         args = ["-r", cap, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=|"]

@@ -19,21 +19,32 @@ struct Example {
     std::string xml;
 };
 
+// The rule files a document shows: ```xml blocks, and here-documents of a
+// shell block that write a rule file (`cat > query.xml <<'END'` ... `END`,
+// whose body is a <root>).
 std::vector<Example> examples_in(const std::string& doc) {
     std::vector<Example> out;
     std::istringstream in(read_file(source_path(doc)));
-    std::string line, xml;
+    static const std::regex heredoc(R"(^cat > \S+\.xml <<'(\w+)'$)");
+    std::string line, xml, end_marker;
     int number = 0, start = 0;
     bool inside = false;
     while (std::getline(in, line)) {
         ++number;
+        std::smatch m;
         if (!inside && line.rfind("```xml", 0) == 0) {
             inside = true;
+            end_marker = "```";
             start = number + 1;
             xml.clear();
-        } else if (inside && line.rfind("```", 0) == 0) {
+        } else if (!inside && std::regex_match(line, m, heredoc)) {
+            inside = true;
+            end_marker = m[1].str();
+            start = number + 1;
+            xml.clear();
+        } else if (inside && line.rfind(end_marker, 0) == 0) {
             inside = false;
-            out.push_back({doc, start, xml});
+            if (end_marker == "```" || xml.rfind("<root", 0) == 0) out.push_back({doc, start, xml});
         } else if (inside) {
             xml += line + "\n";
         }
@@ -89,6 +100,14 @@ TEST(Docs, ManualNamingExampleGivesTheNamesItStates) {
         std::string fields = list_fields(*f.proto);
         for (const char* name : {"name.working_counter_wkc\t", "name.cmd\t", "name.type\t"})
             EXPECT_NE(fields.find(name), std::string::npos) << fields;
+        // The listing the manual shows is how `dissgen fields` begins.
+        const std::string manual = read_file(source_path("docs/manual.md"));
+        const std::string marker = "$ dissgen fields naming.xml\n";
+        size_t at = manual.find(marker);
+        ASSERT_NE(at, std::string::npos);
+        at += marker.size();
+        std::string shown = manual.substr(at, manual.find("...\n", at) - at);
+        EXPECT_EQ(fields.substr(0, shown.size()), shown);
         return;
     }
     FAIL() << "naming example not found";

@@ -5,8 +5,10 @@
 
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "emit_cpp.h"
+#include "runtime_names.h"
 #include "test_support.h"
 
 namespace dissgen::testing {
@@ -212,6 +214,26 @@ TEST(Emit, IdentifiersStayUniqueWhenTheFallbackIsTaken) {
             EXPECT_TRUE(declared.insert(line).second) << "declared twice: " << line;
 }
 
+// The lines of `dissgen fields` that come from `source` (the fourth column).
+std::vector<std::string> listed_from(const std::string& listing, const std::string& source) {
+    std::vector<std::string> out;
+    std::istringstream in(listing);
+    for (std::string line; std::getline(in, line);)
+        if (line.size() > source.size() && line.compare(line.size() - source.size() - 1, std::string::npos,
+                                                        "\t" + source) == 0)
+            out.push_back(line);
+    return out;
+}
+
+// What `dissgen fields` should list from the runtime's names of `group`.
+std::vector<std::string> runtime_lines(const std::string& filter, const NameGroup& group) {
+    std::vector<std::string> out;
+    for (const RuntimeName& n : group.names)
+        if (n.kind == RuntimeName::Kind::Field || n.kind == RuntimeName::Kind::Expert)
+            out.push_back(filter + "." + n.name + "\t" + n.type + "\t" + n.label + "\t" + group.source);
+    return out;
+}
+
 TEST(ListFields, OneLinePerFieldInDocumentOrder) {
     Front f = front_end("<root name=\"My Proto\" abbreviation=\"MYP\" ethertype=\"1\" byteorder=\"little\">\n"
                         "  <node name=\"Header\" length=\"2byte\">\n"
@@ -225,30 +247,66 @@ TEST(ListFields, OneLinePerFieldInDocumentOrder) {
                         "  </node>\n"
                         "</root>\n");
     ASSERT_TRUE(f.ok()) << f.messages();
-    EXPECT_EQ(list_fields(*f.proto),
-              "myp\tFT_PROTOCOL\tMy Proto\n"
-              "myp.header\tFT_NONE\tHeader\n"
-              "myp.header.length\tFT_UINT16\tLength\n"
-              "myp.header.more\tFT_BOOLEAN\tMore\n"
-              "myp.mac\tFT_BYTES\tMAC\n"
-              "myp.f6\tFT_UINT8\t命令\n"
-              "myp.data\tFT_BYTES\tData\n");
+    const std::string rule_lines = "myp\tFT_PROTOCOL\tMy Proto\trules\n"
+                                   "myp.header\tFT_NONE\tHeader\trules\n"
+                                   "myp.header.length\tFT_UINT16\tLength\trules\n"
+                                   "myp.header.more\tFT_BOOLEAN\tMore\trules\n"
+                                   "myp.mac\tFT_BYTES\tMAC\trules\n"
+                                   "myp.f6\tFT_UINT8\t命令\trules\n"
+                                   "myp.data\tFT_BYTES\tData\trules\n";
+    std::string expected = rule_lines;
+    for (const std::string& line : runtime_lines("myp", name_group(NameGroup::When::Always))) expected += line + "\n";
+    EXPECT_EQ(list_fields(*f.proto), expected);
+    EXPECT_TRUE(contains(expected, "myp.expert.truncated\tFT_NONE\tThe packet ends inside a field\truntime\n"));
+    EXPECT_TRUE(contains(expected, "myp.padding\tFT_BYTES\tPadding\truntime\n"));
 }
 
+// The rule file's fields first, then each part of the runtime the protocol
+// uses, each line saying where it comes from.
 TEST(ListFields, ShippedEthercat) {
     Front f = front_end(read_file(source_path("rules/ethercat.xml")));
     ASSERT_TRUE(f.ok()) << f.messages();
     std::string fields = list_fields(*f.proto);
-    EXPECT_EQ(fields.rfind("ecatr\tFT_PROTOCOL\tEtherCAT\n", 0), 0u) << fields;
-    for (const char* line : {"ecatr.header\tFT_NONE\tHeader\n", "ecatr.header.length\tFT_UINT16\tLength\n",
-                             "ecatr.header.type\tFT_UINT16\tType\n", "ecatr.datagram\tFT_NONE\tDatagram\n",
-                             "ecatr.datagram.cmd\tFT_UINT8\tCommand\n", "ecatr.datagram.adp\tFT_UINT16\tSlave address (ADP)\n",
-                             "ecatr.datagram.lad\tFT_UINT32\tLogical address\n", "ecatr.datagram.len\tFT_UINT16\tLength\n",
-                             "ecatr.datagram.more\tFT_BOOLEAN\tMore\n", "ecatr.datagram.data\tFT_BYTES\tData\n",
-                             "ecatr.payload\tFT_BYTES\tPayload\n"})
+    EXPECT_EQ(fields.rfind("ecatr\tFT_PROTOCOL\tEtherCAT\trules\n", 0), 0u) << fields;
+    for (const char* line : {"ecatr.header\tFT_NONE\tHeader\trules\n", "ecatr.header.length\tFT_UINT16\tLength\trules\n",
+                             "ecatr.header.type\tFT_UINT16\tType\trules\n", "ecatr.datagram\tFT_NONE\tDatagram\trules\n",
+                             "ecatr.datagram.cmd\tFT_UINT8\tCommand\trules\n",
+                             "ecatr.datagram.adp\tFT_UINT16\tSlave address (ADP)\trules\n",
+                             "ecatr.datagram.lad\tFT_UINT32\tLogical address\trules\n",
+                             "ecatr.datagram.len\tFT_UINT16\tLength\trules\n",
+                             "ecatr.datagram.more\tFT_BOOLEAN\tMore\trules\n",
+                             "ecatr.datagram.data\tFT_BYTES\tData\trules\n", "ecatr.payload\tFT_BYTES\tPayload\trules\n",
+                             "ecatr.response_in\tFT_FRAMENUM\tResponse in\tpairing\n",
+                             "ecatr.no_response_to\tFT_FRAMENUM\tNo response to\tpairing\n",
+                             "ecatr.esc.wkc_added\tFT_INT32\tWorking counter added\tethercat-esc\n",
+                             "ecatr.slave\tFT_NONE\tSlave\tethercat-esc\n",
+                             "ecatr.slave.position\tFT_UINT16\tPosition\tethercat-esc\n",
+                             "ecatr.pdo.value\tFT_UINT64\tValue\tethercat-esc\n",
+                             "ecatr.expert.wkc\tFT_NONE\tWorking counter differs from the expected one\tethercat-esc\n",
+                             "ecatr.reassembled_in\tFT_FRAMENUM\tReassembled in\treassembly\n"})
         EXPECT_NE(fields.find(line), std::string::npos) << line << "\nin:\n" << fields;
     EXPECT_EQ(fields.find("ecatr.datagrams"), std::string::npos);  // filter=""
     EXPECT_EQ(fields.find("ecatr.datagram.address\t"), std::string::npos);
+    EXPECT_EQ(fields.find("ecatr.pdo.\t"), std::string::npos);  // a prefix is no field
+    // Every line is from the rules or a part of the runtime, the rules' lines first.
+    std::string expected;
+    for (const std::string& line : listed_from(fields, "rules")) expected += line + "\n";
+    for (const NameGroup* g : name_groups_of(*f.proto))
+        for (const std::string& line : runtime_lines("ecatr", *g)) expected += line + "\n";
+    EXPECT_EQ(fields, expected);
+    EXPECT_EQ(name_groups_of(*f.proto).size(), 4u);  // runtime, reassembly, pairing, ethercat-esc
+}
+
+// Without <pairing>, none of the pairing's or an analysis' names.
+TEST(ListFields, OnlyThePartsOfTheRuntimeTheProtocolUses) {
+    Front f = front_end(rules("  <node name=\"Slave\" length=\"1byte\" displaytype=\"numberdec\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    std::string fields = list_fields(*f.proto);
+    EXPECT_TRUE(contains(fields, "tst.slave\tFT_UINT8\tSlave\trules\n")) << fields;
+    EXPECT_TRUE(listed_from(fields, "pairing").empty()) << fields;
+    EXPECT_TRUE(listed_from(fields, "ethercat-esc").empty()) << fields;
+    EXPECT_TRUE(listed_from(fields, "reassembly").empty()) << fields;
+    EXPECT_EQ(listed_from(fields, "runtime").size(), runtime_lines("tst", name_group(NameGroup::When::Always)).size());
 }
 
 // ifhook: its ranges go after every 'in' list, and only rows of nodes that have
@@ -299,17 +357,23 @@ TEST(Validate, IfhookNodesHaveNoFixedSizeAndMayHoldThePduLength) {
 namespace dissgen::testing {
 namespace {
 
-// The validator reserves kExpertNames because the emitter registers exactly those.
-TEST(Emit, ExpertInfosAreExactlyTheReservedNames) {
+// The emitter registers exactly the runtime's list of every protocol's expert
+// infos, the ones the validator reserves.
+TEST(Emit, ExpertInfosAreExactlyTheRuntimesList) {
     Front f = front_end(rules("<node name=\"A\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
     std::string code = emit_cpp(*f.proto, "t.xml");
-    size_t registered = 0;
+    size_t registered = 0, listed = 0;
     for (size_t at = code.find("\"tst.expert."); at != std::string::npos; at = code.find("\"tst.expert.", at + 1))
         ++registered;
-    EXPECT_EQ(registered, sizeof kExpertNames / sizeof kExpertNames[0]);
-    for (const char* name : kExpertNames)
-        EXPECT_TRUE(contains(code, std::string("\"tst.expert.") + name + "\"")) << name;
+    for (const RuntimeName& n : name_group(NameGroup::When::Always).names) {
+        if (n.kind != RuntimeName::Kind::Expert) continue;
+        ++listed;
+        EXPECT_TRUE(contains(code, std::string("{ &ei_tst.") + n.id + ", { \"tst." + n.name + "\", " + n.group))
+            << n.name;
+    }
+    EXPECT_EQ(registered, listed);
+    EXPECT_GE(listed, 7u);
 }
 
 // issue 11: <pairing> marks its key fields DG_KEY (every instance of a

@@ -301,12 +301,12 @@ TEST(BusTables, CatalogueAloneRegistersAFieldPerModelEntry) {
                                    "    NULL, 0, NULL, 0,\n    NULL, 0"));
     EXPECT_TRUE(contains(t.tables, "    { 0x1a10, 0, 0, 4, 1 },\n"));
     EXPECT_EQ(list_bus_fields(cat, {nullptr, false}, "ecatr"),
-              "ecatr.pdo.el1004.channel_1.input\tFT_BOOLEAN\tEL1004 Channel 1.Input\n"
-              "ecatr.pdo.el1004.channel_2.input\tFT_BOOLEAN\tEL1004 Channel 2.Input\n"
-              "ecatr.pdo.el1004.channel_3.input\tFT_BOOLEAN\tEL1004 Channel 3.Input\n"
-              "ecatr.pdo.el2004.channel_1.output\tFT_BOOLEAN\tEL2004 Channel 1.Output\n"
-              "ecatr.pdo.el2004.channel_1.mode\tFT_UINT8\tEL2004 Channel 1.Mode\n"
-              "ecatr.pdo.el2004.channel_1.setpoint\tFT_INT16\tEL2004 Channel 1.Setpoint\n");
+              "ecatr.pdo.el1004.channel_1.input\tFT_BOOLEAN\tEL1004 Channel 1.Input\tesi\n"
+              "ecatr.pdo.el1004.channel_2.input\tFT_BOOLEAN\tEL1004 Channel 2.Input\tesi\n"
+              "ecatr.pdo.el1004.channel_3.input\tFT_BOOLEAN\tEL1004 Channel 3.Input\tesi\n"
+              "ecatr.pdo.el2004.channel_1.output\tFT_BOOLEAN\tEL2004 Channel 1.Output\tesi\n"
+              "ecatr.pdo.el2004.channel_1.mode\tFT_UINT8\tEL2004 Channel 1.Mode\tesi\n"
+              "ecatr.pdo.el2004.channel_1.setpoint\tFT_INT16\tEL2004 Channel 1.Setpoint\tesi\n");
 }
 
 TEST(BusTables, BitNTakesTheSmallestFieldThatHoldsIt) {
@@ -324,9 +324,9 @@ TEST(BusTables, FieldTypesFollowTheDataType) {
     ASSERT_TRUE(r.ok);
     std::string fields = list_bus_fields(cat, {&r.net, false}, "ecatr");
     EXPECT_EQ(fields,
-              "ecatr.pdo.el2004.channel_1.output\tFT_BOOLEAN\tEL2004 Channel 1.Output\n"
-              "ecatr.pdo.el2004.channel_1.mode\tFT_UINT8\tEL2004 Channel 1.Mode\n"
-              "ecatr.pdo.el2004.channel_1.setpoint\tFT_INT16\tEL2004 Channel 1.Setpoint\n");
+              "ecatr.pdo.el2004.channel_1.output\tFT_BOOLEAN\tEL2004 Channel 1.Output\tesi\n"
+              "ecatr.pdo.el2004.channel_1.mode\tFT_UINT8\tEL2004 Channel 1.Mode\tesi\n"
+              "ecatr.pdo.el2004.channel_1.setpoint\tFT_INT16\tEL2004 Channel 1.Setpoint\tesi\n");
 }
 
 }  // namespace
@@ -353,7 +353,7 @@ TEST(ManualBus, WorkedExampleGivesTheFieldsItShows) {
     if (!corpus_catalogue({"Beckhoff_EK11xx.xml", "Beckhoff_EL1xxx.xml"}, cat)) GTEST_SKIP() << "corpus absent";
     NetRead r = read_net(read_file(source_path("tests/network/soem_design.xml")), cat);
     ASSERT_TRUE(r.ok) << r.diags.format("soem_design.xml");
-    EXPECT_EQ(manual_block("--network soem_design.xml | grep pdo\n"),
+    EXPECT_EQ(manual_block("--network soem_design.xml | grep pdo.el\n"),
               list_bus_fields(cat, {&r.net, false}, "ecatr"));
     // The listing of `dissgen esi`, filtered as the manual does.
     std::string listing = list_catalogue(cat), shown;
