@@ -16,11 +16,11 @@ enum class ByteOrder { Big, Little };
 
 enum class Display {
     Address, NumberHex, NumberDec, Bool, Origin, Enum, NonDisplay,
-    // issue 10a
+    // values shown as text, addresses, signed and floating-point numbers, times
     String, StringZ, IPv4, Int, Float, Time
 };
 
-// issue 10a: direction="request|response" (Any: no such attribute)
+// direction="request|response" (Any: no such attribute)
 enum class Direction { Any, Request, Response };
 
 enum class LengthKind {
@@ -47,7 +47,7 @@ struct EnumItem {
     uint64_t value = 0;
     std::string name;
     int line = 0;
-    // issue 10a: value="LOW-HIGH" (a range; value is LOW)
+    // value="LOW-HIGH" (a range; value is LOW)
     uint64_t high = 0;
     bool is_range = false;
 };
@@ -65,7 +65,7 @@ struct SummaryPiece {
     size_t group = 0;       // > 0: an optional part of the next `group` pieces
 };
 
-// issue 10b: one <when> condition of a node: an earlier field (`field`) or
+// One <when> condition of a node: an earlier field (`field`) or
 // a later one whose position is known when the node starts (`peek`).
 struct When {
     FieldRef ref;
@@ -120,7 +120,7 @@ struct Node {
     int slot = -1;                         // value slot, -1 when nobody refers to it
     std::vector<SummaryPiece> summary_pieces;
 
-    // --- issue 10a: display attributes, repeat="rest", direction, hand-off, reassembly ---
+    // --- display attributes, repeat="rest", direction, hand-off, reassembly ---
     std::string encoding = "utf-8";        // string, stringz: "ascii" or "utf-8"
     bool encoding_given = false;
     std::string unit = "ns";               // time: "ns", "us", "ms" or "s"
@@ -137,7 +137,7 @@ struct Node {
             if (e.is_range) return true;
         return false;
     }
-    // --- issue 10b: alternatives, multi-field conditions, look-ahead, register maps ---
+    // --- alternatives, multi-field conditions, look-ahead, register maps ---
     std::vector<When> whens;                // <when field|peek="XPATH" in="LIST"/> children, ANDed
     bool otherwise = false;                 // otherwise="true": member of the previous sibling's chain
     bool skip_malformed = false;            // malformed="skip": a malformed spot inside spoils only this container
@@ -148,7 +148,7 @@ struct Node {
     // derived by the validator
     uint64_t place_bytes = 0;               // a window child's fixed size
     bool is_window() const { return base.has_value(); }
-    // --- issue 10: offset tables ---
+    // --- offset tables ---
     // offsets="XPATH" from="XPATH": instance i starts offset[i] bytes after the
     // start of `from` and ends where instance i+1 starts (the last one: at the
     // end of the enclosing container). offsets selects a repeated numeric leaf.
@@ -178,7 +178,7 @@ struct Hook {
     int line = 0;
 };
 
-// --- issue 11: request/response pairing (<pairing> in <root>) ---
+// --- request/response pairing (<pairing> in <root>) ---
 // A message is a request until a later one with the same key values answers
 // it. Key fields are numeric leaves; in a repeated node every instance's
 // value is part of the key, in order.
@@ -209,7 +209,7 @@ struct Protocol {
     int64_t pdulengthadd = 0;
     int line = 0;
     std::vector<std::unique_ptr<Node>> nodes;
-    // issue 11: request/response pairing, when the file declares it
+    // request/response pairing, when the file declares it
     std::unique_ptr<Pairing> pairing;
 
     // --- derived by the validator ---

@@ -30,23 +30,23 @@ const std::vector<std::string> kRootAttributes = {"name",   "abbreviation", "eth
 const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displaytype", "repeat",
                                                   "count",  "filter",    "byteorder",   "description",
                                                   "if",     "in",        "summary",     "ifhook",
-                                                  // issue 10a
+                                                  // text, time, hand-off and reassembly
                                                   "encoding", "unit", "direction", "dissector", "reassemble-id",
                                                   "reassemble-offset", "reassemble-seq", "reassemble-last",
                                                   "reassemble-more",
-                                                  // issue 10b
+                                                  // alternatives and register windows
                                                   "otherwise", "base", "at", "stride", "instances",
                                                   "malformed",
-                                                  // issue 10: offset tables
+                                                  // offset tables
                                                   "offsets", "from"};
 const std::vector<std::string> kEnumAttributes = {"value", "name"};
 const std::vector<std::string> kHookAttributes = {"table", "value"};
-const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};  // issue 10b
-const std::vector<std::string> kPairingAttributes = {"timeout", "analysis"};  // issue 11
+const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};
+const std::vector<std::string> kPairingAttributes = {"timeout", "analysis"};
 const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
                                                 "origin",  "enum",      "nondisplay",
-                                                // issue 10a
+                                                // typed values shown as text
                                                 "string",  "stringz",   "ipv4",      "int",
                                                 "float",   "time"};
 
@@ -253,11 +253,11 @@ private:
     std::unique_ptr<Node> parse_node(xmlNode* el, Node* parent, int depth);
     void parse_enum(xmlNode* el, Node& node);
     void parse_hook(xmlNode* el, Protocol& proto);
-    void parse_10a_attributes(std::map<std::string, std::string>& attrs, int line, Node& node);
-    void defer_10a_refs(Node& node, xmlNode* el);
+    void parse_text_direction_handoff_attributes(std::map<std::string, std::string>& attrs, int line, Node& node);
+    void defer_reassembly_refs(Node& node, xmlNode* el);
     bool parse_enum_range(const std::string& text, EnumItem& item);
-    void parse_when(xmlNode* el, Node& node, xmlNode* node_el);                   // issue 10b
-    void parse_layout_attributes(std::map<std::string, std::string>& attrs, Node& node);  // issue 10b
+    void parse_when(xmlNode* el, Node& node, xmlNode* node_el);
+    void parse_layout_attributes(std::map<std::string, std::string>& attrs, Node& node);
     void parse_pairing(xmlNode* el, Protocol& proto);
     void parse_length(const std::string& text, int line, Node& node, xmlNode* el);
     void parse_display(const std::string& text, int line, Node& node);
@@ -402,7 +402,7 @@ void Parser::parse_hook(xmlNode* el, Protocol& proto) {
     proto.hooks.push_back(hook);
 }
 
-// issue 11: <pairing timeout="0.1" analysis="ethercat-esc"><key field="XPATH"/>...</pairing>
+// Request/response pairing: <pairing timeout="0.1" analysis="ethercat-esc"><key field="XPATH"/>...</pairing>
 void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
     int line = line_of(el);
     if (proto.pairing) {
@@ -478,7 +478,7 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
         if (parse_byteorder(attrs["byteorder"], node->line, order)) node->byteorder_given = order;
     }
     if (attrs.count("displaytype")) parse_display(attrs["displaytype"], node->line, *node);
-    if (attrs.count("repeat") && trim(attrs["repeat"]) == "rest") node->repeat_rest = true;  // issue 10a
+    if (attrs.count("repeat") && trim(attrs["repeat"]) == "rest") node->repeat_rest = true;
     else if (attrs.count("repeat")) node->repeat = make_ref(attrs["repeat"], node->line, "repeat", false);
     if (attrs.count("count")) node->count = make_ref(attrs["count"], node->line, "count", true);
     if (attrs.count("if")) node->if_field = make_ref(attrs["if"], node->line, "if", false);
@@ -490,7 +490,7 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
         parse_value_list(attrs["ifhook"], node->line, "ifhook", node->hook_list);
     }
     parse_length(attrs.count("length") ? attrs["length"] : "", node->line, *node, el);
-    parse_10a_attributes(attrs, node->line, *node);
+    parse_text_direction_handoff_attributes(attrs, node->line, *node);
     parse_layout_attributes(attrs, *node);
 
     for (xmlNode* c = el->children; c; c = c->next) {
@@ -511,7 +511,7 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
     if (node->count) defer(*node->count, el, node->line, "count");
     if (node->if_field) defer(*node->if_field, el, node->line, "if");
     if (node->length_kind == LengthKind::Field) defer(node->length_ref, el, node->line, "length");
-    defer_10a_refs(*node, el);
+    defer_reassembly_refs(*node, el);
     return node;
 }
 
@@ -528,13 +528,13 @@ void Parser::parse_enum(xmlNode* el, Node& node) {
                                     "': expected hex (0x0a) or decimal, or a range such as 0x11-0x1f");
         return;
     }
-    if (!item.is_range) item.high = item.value;  // issue 10a
+    if (!item.is_range) item.high = item.value;  // a single value is the range [value, value]
     item.name = attrs["name"];
     for (xmlNode* c = el->children; c; c = c->next) unexpected_child(c, "enum", {});
     node.enums.push_back(item);
 }
 
-// issue 10b: <when field="XPATH" in="LIST"/> or <when peek="XPATH" in="LIST"/>.
+// <when field="XPATH" in="LIST"/> or <when peek="XPATH" in="LIST"/>.
 // The XPath is evaluated from the node, as 'if' is.
 void Parser::parse_when(xmlNode* el, Node& node, xmlNode*) {
     When w;
@@ -557,7 +557,7 @@ void Parser::parse_when(xmlNode* el, Node& node, xmlNode*) {
     node.whens.push_back(std::move(w));
 }
 
-// issue 10b: otherwise="true", base="XPATH [op N]", at="ADDR", stride="N", instances="M".
+// Alternatives and register windows: otherwise="true", base="XPATH [op N]", at="ADDR", stride="N", instances="M".
 void Parser::parse_layout_attributes(std::map<std::string, std::string>& attrs, Node& node) {
     if (attrs.count("otherwise")) {
         if (trim(attrs["otherwise"]) == "true")
@@ -707,8 +707,9 @@ void Parser::defer(FieldRef& ref, xmlNode* context, int line, const std::string&
     if (!ref.xpath.empty()) pending_.push_back({&ref, context, line, attribute});
 }
 
-// issue 10a: encoding, unit, direction, dissector and the reassemble-* fields.
-void Parser::parse_10a_attributes(std::map<std::string, std::string>& attrs, int line, Node& node) {
+// The attributes of typed values and hand-off: encoding, unit, direction,
+// dissector and the reassemble-* fields.
+void Parser::parse_text_direction_handoff_attributes(std::map<std::string, std::string>& attrs, int line, Node& node) {
     if (attrs.count("encoding")) {
         node.encoding = trim(attrs["encoding"]);
         node.encoding_given = true;
@@ -745,7 +746,9 @@ void Parser::parse_10a_attributes(std::map<std::string, std::string>& attrs, int
         if (attrs.count(r.attribute)) *r.ref = make_ref(attrs[r.attribute], line, r.attribute, r.arithmetic);
 }
 
-void Parser::defer_10a_refs(Node& node, xmlNode* el) {
+// Resolves the reassemble-* XPaths once the whole file is parsed, as the
+// other field references are.
+void Parser::defer_reassembly_refs(Node& node, xmlNode* el) {
     struct { const char* attribute; std::optional<FieldRef>* ref; } refs[] = {
         {"reassemble-id", &node.reassemble_id},     {"reassemble-offset", &node.reassemble_offset},
         {"reassemble-seq", &node.reassemble_seq},   {"reassemble-last", &node.reassemble_last},

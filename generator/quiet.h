@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Which nodes a packet walk may step over when nobody sees them (issue 14).
+// Which nodes a packet walk may step over when nobody sees them (no tree,
+// no tap listener).
 #pragma once
 
 #include "model.h"

@@ -16,7 +16,7 @@ std::string quote(const Node& n) { return "'" + n.name + "'"; }
 
 std::string at_line(const Node& n) { return " (line " + std::to_string(n.line) + ")"; }
 
-// issue 10a: displays that show whole bytes and never join a bit group.
+// Displays that show whole bytes and never join a bit group.
 bool is_byte_display(Display d) {
     return d == Display::Origin || d == Display::Address || d == Display::String || d == Display::StringZ ||
            d == Display::IPv4 || d == Display::Float || d == Display::Time;
@@ -44,7 +44,7 @@ private:
     void check_fixed_container(const Node& n);
     void check_reference(Node& n, const FieldRef& ref, const std::string& what);
     void check_pdulength();
-    void check_pairing();  // issue 11
+    void check_pairing();
     void check_hook_list(const Node& n);
     bool offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const Node* t, uint64_t& offset,
                    bool& fixed) const;
@@ -52,17 +52,17 @@ private:
     void assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, const std::string& prefix);
     void mark_slot(Node* n) { if (n) needs_slot_[n] = true; }
     void assign_slots();
-    // issue 10a
-    void check_10a(Node& n);
+    // display types, range enums, repeat="rest", direction, hand-off, reassembly
+    void check_display_direction_handoff(Node& n);
     void check_string_display(Node& n);
     void check_enum_ranges(const Node& n);
     void check_handoff(const Node& n);
     void check_reassembly(Node& n);
     void check_runtime_name(const Node& n);
-    // issue 10b
+    // <when>, otherwise, windows
     void check_layout(Node& n);
     void check_peek(Node& n, When& w);
-    void check_offsets(Node& n);  // issue 10: offset tables
+    void check_offsets(Node& n);  // offsets="XPATH" from="XPATH"
     bool known_before(const Node* t, const Node& n) const;
 
     Protocol& proto_;
@@ -84,8 +84,8 @@ void Validator::run() {
         if (n.if_field) check_reference(n, *n.if_field, "if");
         if (n.has_hook) check_hook_list(n);
         if (n.summary) parse_summary(n);
-        check_10a(n);
-        check_layout(n);  // issue 10b
+        check_display_direction_handoff(n);
+        check_layout(n);
         check_offsets(n);
     });
     check_pdulength();
@@ -170,8 +170,8 @@ void Validator::check_leaf_display(Node& n) {
     }
 }
 
-// Groups consecutive bit fields into whole-byte integers (RULES-SPEC,
-// "Lengths and bit fields"); recurses into containers.
+// Groups consecutive bit fields into whole-byte integers (docs/manual.md,
+// "Lengths, bit fields, repetition, conditions"); recurses into containers.
 void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
     std::vector<Node*> group;
     unsigned group_bits = 0;
@@ -201,7 +201,7 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
         else if (n.has_hook)
             diags_.error(n.line, "bit field " + quote(n) + " cannot have 'ifhook': it shares bytes with its "
                                  "neighbours in a bit group");
-        else if (n.direction != Direction::Any)  // issue 10a
+        else if (n.direction != Direction::Any)
             diags_.error(n.line, "bit field " + quote(n) + " cannot have 'direction': it shares bytes with its "
                                  "neighbours in a bit group");
         // A bit field written without a displaytype shows its value in hex: the
@@ -460,7 +460,7 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
     }
 }
 
-// issue 11: key fields are numeric leaves, each named once.
+// <pairing> key fields are numeric leaves, each named once.
 void Validator::check_pairing() {
     if (!proto_.pairing) return;
     std::map<const Node*, int> seen;
@@ -488,9 +488,9 @@ void Validator::assign_slots() {
     proto_.slot_count = next;
 }
 
-// --- issue 10a: display types, range enums, repeat="rest", direction, hand-off, reassembly ---
+// --- display types, range enums, repeat="rest", direction, hand-off, reassembly ---
 
-void Validator::check_10a(Node& n) {
+void Validator::check_display_direction_handoff(Node& n) {
     if (n.repeat_rest && n.count)
         diags_.error(n.line, "node " + quote(n) + " has both repeat=\"rest\" and 'count'; use one of them");
     if (n.encoding_given && n.display != Display::String && n.display != Display::StringZ)
@@ -620,7 +620,7 @@ void Validator::check_runtime_name(const Node& n) {
                                  " or its container another 'filter'");
 }
 
-// --- issue 10b: <when>, otherwise, windows ------------------------------
+// --- <when>, otherwise, windows ------------------------------------------
 
 std::string lines_of(const Node& n) { return quote(n) + at_line(n); }
 
@@ -704,7 +704,7 @@ void Validator::check_layout(Node& n) {
         n.place_bytes = *size;
 }
 
-// issue 10: offsets="XPATH" from="XPATH". The offsets are the values of every
+// offsets="XPATH" from="XPATH". The offsets are the values of every
 // instance of an earlier repeated numeric leaf; from is an earlier field or
 // container (its first byte) or a container around n (the start of its
 // content). Each instance runs to the next offset, the last to the end of its

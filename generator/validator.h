@@ -19,7 +19,7 @@ std::string segment_from_name(const std::string& name);
 
 bool is_valid_filter_segment(const std::string& s);
 
-// issue 10b: a node's name without its "{i}" (instance number) markers, for
+// A node's name without its "{i}" (instance number) markers, for
 // the filter name of a block repeated at a stride.
 std::string name_without_index(const std::string& name);
 
