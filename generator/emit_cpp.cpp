@@ -67,15 +67,15 @@ struct Layout {
     };
     std::vector<Piece> pieces;
     std::map<const Node*, int> piece_first;
-    // issue 10b: table rows for <when>, peeks, windows and their places
+    // table rows for <when>, peeks, windows and their places
     std::map<const Node*, int> when_first;
     std::map<const Node*, int> window_index;
     std::vector<std::string> whens, peeks, peek_lengths, windows, places;
-    bool uses_10b() const { return !whens.empty() || !windows.empty(); }
-    bool node_uses_10b(const Node& n) const { return when_first.count(&n) || window_index.count(&n) || n.otherwise; }
+    bool uses_layout_tables() const { return !whens.empty() || !windows.empty(); }
+    bool node_uses_layout_columns(const Node& n) const { return when_first.count(&n) || window_index.count(&n) || n.otherwise; }
 };
 
-void layout_10b(Layout& l);
+void layout_conditions_and_windows(Layout& l);
 
 std::string ident_for(const Protocol& proto, const Node& n) {
     std::string base = n.filter_name.empty() ? proto.filter + "_" + (n.segment.empty() ? n.name : n.segment)
@@ -125,15 +125,15 @@ Layout make_layout(const Protocol& proto) {
                                     p.leaf && p.leaf->is_container() ? p.leaf->doc_index - 1 : -1});
         }
     }
-    layout_10b(l);
+    layout_conditions_and_windows(l);
     return l;
 }
 
 std::string ref_of(const FieldRef* r);
 
-// issue 10b: <when> rows (their 'in' lists after every other list), peeks,
+// <when> rows (their 'in' lists after every other list), peeks,
 // windows and their places sorted by address.
-void layout_10b(Layout& l) {
+void layout_conditions_and_windows(Layout& l) {
     for (const Node* n : l.nodes) {
         if (n->whens.empty()) continue;
         l.when_first[n] = static_cast<int>(l.whens.size());
@@ -204,7 +204,7 @@ std::string flags_of(const Node& n, bool pairing_key) {
     if (n.in_bit_group) f.push_back("DG_GROUP");
     if (n.group_first) f.push_back("DG_GROUP_FIRST");
     if (n.group_last) f.push_back("DG_GROUP_LAST");
-    if (pairing_key) f.push_back("DG_KEY");  // issue 11
+    if (pairing_key) f.push_back("DG_KEY");
     if (n.skip_malformed) f.push_back("DG_SKIP_MALFORMED");
     if (f.empty()) return "0";
     std::string out;
@@ -256,11 +256,11 @@ private:
     void value_strings();
     void tables();
     void node_table();
-    void tables_10b();  // issue 10b
+    void condition_and_window_tables();
     void protocol_struct();
     void register_functions();
     void expert_entries();
-    // issue 10a
+    // typed values, hand-off and reassembly (dg_extra)
     bool uses_reassembly() const;
     void extra_table();
     void fragment_declarations();
@@ -272,7 +272,7 @@ private:
     std::string vals(const Node& n) const { return l_.ident.at(&n) + "_vals"; }
     bool has_hf(const Node& n) const { return !n.filter_name.empty(); }
     bool uses_val64(const Node& n) const { return value_bytes(n) > 4; }
-    bool is_pairing_key(const Node& n) const {  // issue 11
+    bool is_pairing_key(const Node& n) const {
         if (!p_.pairing) return false;
         for (const PairingKey& k : p_.pairing->keys)
             if (k.field.target == &n) return true;
@@ -283,7 +283,7 @@ private:
     std::string source_;
     const EmbeddedTables* extra_;
     Layout l_;
-    std::map<const Node*, uint64_t> quiet_;  // issue 14: nodes stepped over when unseen, and their sizes
+    std::map<const Node*, uint64_t> quiet_;  // nodes stepped over when unseen, and their sizes
     std::ostringstream o_;
 };
 
@@ -377,12 +377,12 @@ void Emitter::tables() {
         first = false;
     }
     o_ << "\n};\n\n";
-    tables_10b();
+    condition_and_window_tables();
     if (extra_) o_ << extra_->tables;
 }
 
-// issue 10b: the tables of <when> conditions, peeks and windows, where used.
-void Emitter::tables_10b() {
+// The tables of <when> conditions, peeks and windows, where used.
+void Emitter::condition_and_window_tables() {
     auto table = [&](const char* type, const char* name, const std::vector<std::string>& rows, const char* comment) {
         if (rows.empty()) return;
         o_ << "/* " << comment << " */\nstatic const " << type << " " << p_.filter << "_" << name << "[] = {";
@@ -424,19 +424,19 @@ void Emitter::node_table() {
         // Members after the ifhook ranges default to none; a node that uses them
         // spells out everything before them.
         const bool quiet = quiet_.count(&n) > 0;
-        const bool uses_extra = extra_index_.count(&n) > 0, uses_10b = l_.node_uses_10b(n) || quiet;
-        if (!n.has_hook && (uses_extra || uses_10b)) o_ << ", 0, 0";
-        // issue 10a: the node's dg_extra
+        const bool uses_extra = extra_index_.count(&n) > 0, needs_layout_columns = l_.node_uses_layout_columns(n) || quiet;
+        if (!n.has_hook && (uses_extra || needs_layout_columns)) o_ << ", 0, 0";
+        // the node's dg_extra
         if (uses_extra)
             o_ << ", &" << p_.filter << "_extra[" << extra_index_.at(&n) << "]";
-        else if (uses_10b)
+        else if (needs_layout_columns)
             o_ << ", NULL";
-        // issue 10b: <when> rows (first, count), alternative flags, window index
-        if (uses_10b)
+        // <when> rows (first, count), alternative flags, window index
+        if (needs_layout_columns)
             o_ << ",\n      " << (l_.when_first.count(&n) ? l_.when_first.at(&n) : 0) << ", " << n.whens.size() << ", "
                << (n.otherwise ? "DG_ALT_OTHERWISE" : "0") << ", "
                << (l_.window_index.count(&n) ? l_.window_index.at(&n) : -1);
-        // issue 14: the bytes a walk with no tree and no tap steps over
+        // quiet_size: the bytes a walk with no tree and no tap steps over
         if (quiet) o_ << ", " << quiet_.at(&n) << "u";
         o_ << " },\n";
     }
@@ -450,7 +450,7 @@ void Emitter::protocol_struct() {
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);\n";
     if (pdu) o_ << "static int dissect_" << f << "_stream(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);\n";
     size_t hook_count = p_.hooks.size() + (p_.ethertype ? 1 : 0);
-    if (p_.pairing) {  // issue 11
+    if (p_.pairing) {
         char timeout[32];
         std::snprintf(timeout, sizeof timeout, "%.9g", p_.pairing->timeout);
         o_ << "\n/* Request/response pairing (<pairing>, line " << p_.pairing->line
@@ -469,21 +469,21 @@ void Emitter::protocol_struct() {
        << (pdu ? p_.pdu_fixed_len - value_bytes(*pdu) : 0) << ", " << p_.pdulengthadd;
     // Members after pdu_add default to none; a protocol that uses later ones
     // spells out everything before them.
-    const bool bus = extra_ && !extra_->bus_symbol.empty();  // issue 12
-    const bool pairing = p_.pairing != nullptr, after_10b = l_.uses_10b() || pairing || bus;
-    if (uses_reassembly())  // issue 10a
+    const bool bus = extra_ && !extra_->bus_symbol.empty();
+    const bool pairing = p_.pairing != nullptr, needs_layout_members = l_.uses_layout_tables() || pairing || bus;
+    if (uses_reassembly())
         o_ << ",\n    &" << f << "_reassembly, &" << f << "_fragment_items";
-    else if (after_10b)
+    else if (needs_layout_members)
         o_ << ",\n    NULL, NULL";
-    if (after_10b) {  // issue 10b
+    if (needs_layout_members) {
         auto name = [&](const char* table, bool used) { return used ? f + "_" + table : std::string("NULL"); };
         o_ << ",\n    " << name("whens", !l_.whens.empty()) << ", " << name("peeks", !l_.peeks.empty()) << ", "
            << name("peek_lengths", !l_.peek_lengths.empty()) << ", " << name("windows", !l_.windows.empty()) << ", "
            << name("places", !l_.places.empty());
     }
-    if (pairing) o_ << ",\n    &" << f << "_pairing";  // issue 11
+    if (pairing) o_ << ",\n    &" << f << "_pairing";
     else if (bus) o_ << ",\n    NULL";
-    if (bus) o_ << ",\n    &" << extra_->bus_symbol;  // issue 12
+    if (bus) o_ << ",\n    &" << extra_->bus_symbol;
     o_ << "\n};\n\n";
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
        << "    return dg_dissect(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";
@@ -509,7 +509,7 @@ void Emitter::register_functions() {
            << ", HFILL } }";
         first = false;
     }
-    if (uses_reassembly()) {  // issue 10a: the fragment fields of Wireshark's reassembly API
+    if (uses_reassembly()) {  // the fragment fields of Wireshark's reassembly API
         for (const auto& fr : fragment_fields(p_)) {
             o_ << (first ? "" : ",\n") << "        { &frag_hf_" << fr.ident << ",\n          { " << c_string(fr.name)
                << ", " << c_string(fr.filter) << ", " << fr.type << ", " << fr.display << ", NULL, 0x0, NULL, HFILL } }";
@@ -548,7 +548,7 @@ void Emitter::expert_entries() {
     }
 }
 
-// --- issue 10a ---------------------------------------------------------------
+// --- typed values, hand-off and reassembly ------------------------------------
 
 bool Emitter::uses_reassembly() const {
     for (const Node* n : l_.nodes)
@@ -612,7 +612,7 @@ void Emitter::extra_table() {
            << ", " << slot(n->reassemble_id) << ", "
            << ref_of(n->reassemble_offset ? &*n->reassemble_offset : nullptr) << ", " << slot(n->reassemble_seq)
            << ", " << slot(n->reassemble_last) << ", " << slot(n->reassemble_more);
-        // issue 10: offset tables (the struct defaults them to none)
+        // offset tables (the struct defaults them to none)
         if (n->is_located() || n->keeps_values)
             o_ << ", " << slot(n->offsets) << ", " << (n->from_up ? -1 : slot(n->from)) << ", " << n->from_up << ", "
                << (n->keeps_values ? 1 : 0);
@@ -630,7 +630,7 @@ std::vector<FragmentField> fragment_fields(const Protocol& proto) {
     return out;
 }
 
-// issue 10a: the Wireshark type of string, stringz, ipv4, int, float and time leaves.
+// The Wireshark type of string, stringz, ipv4, int, float and time leaves.
 std::optional<FieldType> typed_field_type(const Node& n) {
     unsigned bytes = value_bytes(n);
     switch (n.display) {
@@ -663,7 +663,7 @@ FieldType field_type(const Node& n) {
     std::string base = "BASE_DEC";
     if (n.display == Display::NumberHex) base = "BASE_HEX";
     if (n.display == Display::Enum) base = bytes > 4 ? "BASE_HEX|BASE_VAL64_STRING" : "BASE_HEX";
-    if (n.display == Display::Enum && n.has_enum_ranges()) base = "BASE_HEX|BASE_RANGE_STRING";  // issue 10a
+    if (n.display == Display::Enum && n.has_enum_ranges()) base = "BASE_HEX|BASE_RANGE_STRING";
     return {type, base, mask};
 }
 
