@@ -8,7 +8,7 @@
 #include <epan/packet.h>
 #include <epan/expert.h>
 #include <epan/proto.h>
-/* issue 10a: reassembly and hand-off. reassemble.h and show_exception.h have no C++ guards;
+/* Reassembly and hand-off. reassemble.h and show_exception.h have no C++ guards;
  * packet-tcp.h includes reassemble.h outside its own, so they come first. */
 #include <epan/exceptions.h>
 #ifdef __cplusplus
@@ -60,14 +60,14 @@ extern "C" {
 #define dg_tvb_get_uint64 tvb_get_guint64
 #endif
 
-/* issue 10a: 4.4 renamed tvb_find_guint8 too. */
+/* 4.4 renamed tvb_find_guint8 too (stringz leaves look for their NUL). */
 #if DG_WS_AT_LEAST(4, 4)
 #define dg_tvb_find_uint8 tvb_find_uint8
 #else
 #define dg_tvb_find_uint8 tvb_find_guint8
 #endif
 
-/* issue 10b: the text of an item without one set (the window instance
+/* The text of an item without one set (the window instance
  * labels). 4.6 (4.5 development) added an out-parameter for where the value
  * starts; 4.0 and 4.4 have two parameters. */
 #if DG_WS_AT_LEAST(4, 5)

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-/* Item labels built without printf (issue 14). Wireshark formats a label
+/* Item labels built without printf. Wireshark formats a label
  * with g_vsnprintf, which costs over a thousand instructions for a few
  * conversions; these appends cost tens, and the text then goes in as "%s".
  * Labels longer than Wireshark's ITEM_LABEL_LENGTH are cut, as Wireshark

@@ -1,4 +1,4 @@
-/* Request/response pairing across frames (issue 11), declared in the rule
+/* Request/response pairing across frames, declared in the rule
  * file by <pairing> (key fields) and used by every protocol the same way.
  *
  * State lives in Wireshark's per-capture memory (wmem_file_scope) and is

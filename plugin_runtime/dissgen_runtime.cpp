@@ -40,7 +40,7 @@ struct dg_tap_record {
 struct dg_tap_data {
     dg_tap_record *records;
     guint count, capacity;
-    const dg_frame_pairing *pairing; /* issue 11: what the pairing found, or NULL */
+    const dg_frame_pairing *pairing; /* what the pairing found, or NULL */
 };
 
 /* Each plugin links its own copy of the runtime and holds one protocol, so
@@ -48,7 +48,7 @@ struct dg_tap_data {
 const dg_protocol *stats_protocol;
 int stats_tap = -1;
 
-/* issue 10: every value of an offset leaf (extra->keep_values) in this
+/* Every value of an offset leaf (extra->keep_values) in this
  * message, in instance order; reset when its repetition starts. */
 struct dg_table {
     guint64 *values;
@@ -59,7 +59,7 @@ struct dg_table {
 /* Text being built (summaries, the Info column): a buffer of the caller's
  * (on its stack) or in the packet pool, moved to the pool when it outgrows
  * it, with inline appends. wmem_strbuf_new() and its appends cost several
- * times more, and summary lines run this on every frame (issue 14). */
+ * times more, and summary lines run this on every frame. */
 struct dg_text {
     wmem_allocator_t *pool;
     char *data;   /* NUL-terminated */
@@ -127,24 +127,24 @@ struct dg_state {
     packet_info *pinfo;
     dg_slot *slots;
     guint8 *present;      /* per slot: decoded in this message (instance) */
-    dg_table *tables;     /* issue 10: per slot, allocated at the first offset leaf */
+    dg_table *tables;     /* offset tables: per slot, allocated at the first offset leaf */
     gint packet_end;      /* captured bytes */
     gboolean stopped;     /* a malformed spot was reported: decode nothing more */
     gboolean want_text;   /* summaries are shown: a visible tree, or columns */
     gboolean want_info;   /* the Info column is shown (pinfo->cinfo) */
-    gboolean quiet;       /* issue 14: no tree, no tap listener: step over quiet nodes (dg_node.quiet_size) */
+    gboolean quiet;       /* no tree, no tap listener: step over quiet nodes (dg_node.quiet_size) */
     dg_text *info;  /* the Info column being built (want_info) */
     dg_text *text;  /* scratch for one container's summary (want_text) */
     guint64 group_value;  /* the bit group being decoded */
     guint32 hook_value;   /* pinfo->match_uint on entry: the hook (or Decode As) value, for ifhook */
     dg_tap_data *tap;     /* what the stats tree counts; NULL when nobody listens */
-    guint8 direction;     /* issue 10a: DG_DIR_REQUEST/RESPONSE when a port hook matched, else DG_DIR_ANY */
-    /* issue 10b: where each list of siblings being decoded started (the
+    guint8 direction;     /* DG_DIR_REQUEST/RESPONSE when a port hook matched, else DG_DIR_ANY */
+    /* where each list of siblings being decoded started (the
      * message, then each open container), for peeks counted from a container */
     gint list_starts[DG_MAX_LISTS];
     gint list_ends[DG_MAX_LISTS]; /* and where each ends: a peek reads nothing beyond */
     guint lists;
-    /* issue 11: the values of the <pairing> key fields (DG_KEY), in decoding order */
+    /* the values of the <pairing> key fields (DG_KEY), in decoding order */
     guint64 *keys;
     guint key_count, key_capacity;
 };
@@ -247,7 +247,7 @@ gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char
     return TRUE;
 }
 
-/* issue 10: the table of the offset leaf in `slot`, allocated on first use. */
+/* The table of the offset leaf in `slot`, allocated on first use. */
 dg_table *table_of(dg_state *st, gint16 slot)
 {
     if (!st->tables) st->tables = wmem_alloc0_array(st->pinfo->pool, dg_table, st->p->slot_count);
@@ -268,7 +268,7 @@ void table_append(dg_state *st, const dg_node *n, guint64 value)
     t->values[t->count++] = value;
 }
 
-/* issue 10: an offset leaf's repetition starts a new, empty table; the slot
+/* An offset leaf's repetition starts a new, empty table; the slot
  * says it is there, even when no instance follows (a count of 0). */
 void table_reset(dg_state *st, const dg_node *n, gint offset)
 {
@@ -363,7 +363,7 @@ const char *enum_name(const header_field_info *hfi, guint64 value)
     return try_val_to_str((guint32)value, (const value_string *)hfi->strings);
 }
 
-/* issue 10a: a time leaf's count of units as an nstime. */
+/* A time leaf's count of units as an nstime. */
 nstime_t time_of(const dg_node *n, guint64 value)
 {
     guint64 per_second = n->extra && n->extra->units_per_second ? n->extra->units_per_second : 1000000000u;
@@ -373,7 +373,7 @@ nstime_t time_of(const dg_node *n, guint64 value)
     return t;
 }
 
-/* issue 10a: the values of string, stringz, ipv4, int, float and time leaves,
+/* The values of string, stringz, ipv4, int, float and time leaves,
  * for summaries and the Info column (as the tree item shows them). */
 void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
 {
@@ -533,7 +533,7 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
                   gboolean in_summary);
 void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary);
 
-/* issue 14: a numeric leaf's item from its bytes already read (a bit group's
+/* A numeric leaf's item from its bytes already read (a bit group's
  * whole value: Wireshark masks and shifts it by the field's bitmask), which
  * costs Wireshark about a third less than proto_tree_add_item() reading them
  * again. Unsigned displays only; the others are added from the bytes. */
@@ -569,7 +569,7 @@ void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     if (n->flags & DG_GROUP_LAST) *offset += n->length;
 }
 
-/* --- issue 10a: strings, hand-off to other dissectors, reassembly ------- */
+/* --- strings, hand-off to other dissectors, reassembly ------------------ */
 
 /* The encoding a non-numeric leaf's item is added with. */
 guint item_encoding(const dg_node *n)
@@ -704,7 +704,7 @@ void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
         break;
     case DG_LEN_REST: length = end - *offset; break;
     default:
-        /* issue 10a: a stringz without a length runs to its NUL, included. */
+        /* a stringz without a length runs to its NUL, included. */
         length = n->show == DG_SHOW_STRINGZ ? stringz_length(st, *offset, end) : 0;
         break;
     }
@@ -733,7 +733,7 @@ void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
     guint64 value = 0;
     proto_item *item = NULL;
     if (n->extra && (n->extra->dissector || n->extra->reassemble_id >= 0) && len > 0) {
-        dissect_handoff(st, n, tree, *offset, len); /* issue 10a */
+        dissect_handoff(st, n, tree, *offset, len);
         store(st, n, 0, *offset, len);
         *offset += len;
         return;
@@ -741,7 +741,7 @@ void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
     /* The value is read only when store() uses it, the item added only when
      * there is a tree. */
     if (n->show == DG_SHOW_TIME) {
-        /* issue 10a: a count of units; the item shows it as seconds. */
+        /* a count of units; the item shows it as seconds. */
         value = read_uint(st->tvb, *offset, (guint)len, encoding_of(n));
         if (tree) {
             nstime_t t = time_of(n, value);
@@ -815,7 +815,7 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     /* Decode what is there even when the length overruns. */
     gboolean was_stopped = st->stopped;
     st->stopped = FALSE;
-    if (n->window >= 0) /* issue 10b: children at addresses, not one after another */
+    if (n->window >= 0) /* a window: children at addresses, not one after another */
         dissect_window(st, n, subtree, offset, inner_end, in_summary || n->summary_count > 0);
     else
         dissect_list(st, n->first_child, n->child_count, subtree, offset, inner_end,
@@ -916,7 +916,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
 {
     gint64 wanted = -1;
     if (n->count.slot >= 0 && !ref_value(st, &n->count, n, "count", tree, *offset, &wanted)) return;
-    if (n->extra && n->extra->keep_values) table_reset(st, n, *offset); /* issue 10 */
+    if (n->extra && n->extra->keep_values) table_reset(st, n, *offset); /* a new table for this repetition */
     dg_summaries summaries;
     gboolean collect = summaries_begin(st, n, in_summary, &summaries);
 
@@ -951,7 +951,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     if (collect) summaries_end(st, n, &summaries);
 }
 
-/* issue 10: whether entry k of offset table t, placed at base, lies in
+/* Whether entry k of offset table t, placed at base, lies in
  * [low, end]; otherwise reports it (bad_offset), which ends the node. */
 gboolean entry_ok(dg_state *st, const dg_node *n, proto_tree *tree, const dg_table *t, guint k, gint64 base,
                   gint64 low, gint end, gint first)
@@ -966,7 +966,7 @@ gboolean entry_ok(dg_state *st, const dg_node *n, proto_tree *tree, const dg_tab
     return FALSE;
 }
 
-/* issue 10: offsets="XPATH" from="XPATH". Instance i covers [base +
+/* offsets="XPATH" from="XPATH". Instance i covers [base +
  * offset[i], base + offset[i+1]), the last one [base + offset[last], end).
  * An offset before the bytes not yet decoded, past the end, or smaller than
  * the one before is reported (bad_offset) and ends the node; the instances
@@ -1034,7 +1034,7 @@ gboolean hook_holds(const dg_state *st, const dg_node *n)
     return in_ranges(st->p, n->hook_first, n->hook_count, st->hook_value);
 }
 
-/* --- issue 10b: <when>, otherwise, windows ----------------------------- */
+/* --- <when>, otherwise, windows ----------------------------------------- */
 
 /* The value of the leaf a peek reads ahead, when its bytes are there. */
 gboolean peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guint64 *out)
@@ -1100,7 +1100,7 @@ gboolean selected_conditional(const dg_state *st, const dg_node *n, gint offset,
 {
     gboolean otherwise = (n->alt & DG_ALT_OTHERWISE) != 0;
     if (otherwise && *chain_taken) return FALSE;
-    guint8 direction = n->extra ? n->extra->direction : (guint8)DG_DIR_ANY; /* issue 10a */
+    guint8 direction = n->extra ? n->extra->direction : (guint8)DG_DIR_ANY;
     gboolean conditional = otherwise || n->hook_count || n->if_slot >= 0 || n->when_count || direction;
     gboolean holds = (!n->hook_count || hook_holds(st, n)) && (n->if_slot < 0 || condition_holds(st, n)) &&
                      (!direction || direction == st->direction) && whens_hold(st, n, offset);
@@ -1152,7 +1152,7 @@ void dissect_place(dg_state *st, const dg_place *pl, proto_tree *tree, gint star
                    gboolean in_summary)
 {
     const dg_node *c = &st->p->nodes[pl->node];
-    if (st->quiet && c->quiet_size && c->quiet_size <= pl->size) return; /* issue 14: unseen, cannot be malformed */
+    if (st->quiet && c->quiet_size && c->quiet_size <= pl->size) return; /* unseen, cannot be malformed */
     gboolean no_chain = FALSE;
     if (!selected(st, c, start, &no_chain)) return;
     guint32 i = 0;
@@ -1233,7 +1233,7 @@ void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offs
 void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
                   gboolean in_summary)
 {
-    gboolean chain_taken = FALSE; /* issue 10b */
+    gboolean chain_taken = FALSE; /* a conditional sibling was decoded: its otherwise members are not */
     if (st->lists < DG_MAX_LISTS) {
         st->list_starts[st->lists] = *offset;
         st->list_ends[st->lists] = end;
@@ -1247,7 +1247,7 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
             continue;
         }
         if (n->extra && n->extra->offsets_slot >= 0)
-            dissect_located(st, n, tree, offset, end, in_summary); /* issue 10 */
+            dissect_located(st, n, tree, offset, end, in_summary); /* offset table */
         else if (is_repeated(n))
             dissect_repeated(st, n, tree, offset, end, in_summary);
         else
@@ -1415,11 +1415,11 @@ void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett,
     expert_register_field_array(experts, ei, ei_count);
     register_dissector(p->filter, p->dissect, *p->proto);
     register_stats_tree(p);
-    if (p->reassembly) reassembly_table_register(p->reassembly, &addresses_reassembly_table_functions); /* issue 10a */
+    if (p->reassembly) reassembly_table_register(p->reassembly, &addresses_reassembly_table_functions);
     if (p->pairing) dg_pairing_register(p);
 }
 
-/* issue 10a: the dissectors that dissector= names. A name this Wireshark does
+/* The dissectors that dissector= names. A name this Wireshark does
  * not have is reported once, here, and that leaf's bytes are shown raw. */
 static void find_handoff_dissectors(const dg_protocol *p)
 {
@@ -1464,7 +1464,7 @@ void dg_handoff(const dg_protocol *p)
     }
 }
 
-/* issue 10a: request when the port the hook (or Decode As) matched is the
+/* Request when the port the hook (or Decode As) matched is the
  * destination port, response when it is only the source port. */
 static guint8 direction_of(const packet_info *pinfo)
 {
@@ -1528,7 +1528,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
         st.text = &scratch_text;
     }
     if (stats_tap >= 0 && have_tap_listener(stats_tap)) st.tap = wmem_new0(pinfo->pool, dg_tap_data);
-    /* issue 14: nobody sees items or the text of expert infos without a tree
+    /* nobody sees items or the text of expert infos without a tree
      * and without a tap listener (the Expert dialog and -z expert are taps):
      * quiet nodes are stepped over, expert infos are raised without text
      * (their severity still reaches the Expert column). */

@@ -12,7 +12,7 @@
 #include "dissgen_compat.h"
 #include "dissgen_names.h"
 
-/* Node kinds and length forms (RULES-SPEC "Lengths and bit fields"). */
+/* Node kinds and length forms (docs/manual.md, "Lengths, bit fields, repetition, conditions"). */
 enum dg_kind { DG_LEAF = 0, DG_CONTAINER = 1 };
 enum dg_length_kind {
     DG_LEN_FIXED = 0,    /* bytes in dg_node.length */
@@ -23,7 +23,7 @@ enum dg_length_kind {
 /* How a leaf's value is shown; used for summaries and the Info column. */
 enum dg_show {
     DG_SHOW_HEX = 0, DG_SHOW_DEC, DG_SHOW_BOOL, DG_SHOW_ENUM, DG_SHOW_ADDRESS, DG_SHOW_BYTES, DG_SHOW_HIDDEN,
-    /* issue 10a */
+    /* values shown as text, addresses, signed and floating-point numbers, times */
     DG_SHOW_STRING, DG_SHOW_STRINGZ, DG_SHOW_IPV4, DG_SHOW_INT, DG_SHOW_FLOAT, DG_SHOW_TIME
 };
 enum dg_flags {
@@ -33,7 +33,7 @@ enum dg_flags {
     DG_GROUP = 1 << 3,       /* member of a bit group */
     DG_GROUP_FIRST = 1 << 4, /* first member: reads the group's bytes */
     DG_GROUP_LAST = 1 << 5,  /* last member: moves past the group's bytes */
-    DG_KEY = 1 << 6,         /* issue 11: a <pairing> key field (dissgen_pairing.h) */
+    DG_KEY = 1 << 6,         /* a <pairing> key field (dissgen_pairing.h) */
     DG_SKIP_MALFORMED = 1 << 7 /* malformed="skip": a malformed spot inside spoils only this container */
 };
 
@@ -64,7 +64,7 @@ typedef struct dg_summary_piece {
 #endif
 } dg_summary_piece;
 
-/* issue 10a: what few nodes need (direction, repeat="rest", strings, times,
+/* What few nodes need (direction, repeat="rest", strings, times,
  * hand-off, reassembly), kept out of dg_node so that it costs the others one
  * pointer. */
 enum dg_direction { DG_DIR_ANY = 0, DG_DIR_REQUEST = 1, DG_DIR_RESPONSE = 2 };
@@ -80,7 +80,7 @@ typedef struct dg_extra {
     gint16 reassemble_seq;    /* slot of the fragment number, or -1 */
     gint16 reassemble_last;   /* slot of the "last fragment" flag, or -1 */
     gint16 reassemble_more;   /* slot of the "more fragments" flag, or -1 */
-    /* issue 10: offsets="XPATH" from="XPATH". Instance i of the node starts
+    /* offsets="XPATH" from="XPATH". Instance i of the node starts
      * offset[i] bytes after the base and ends where instance i+1 starts (the
      * last: at the end of its container). The base is the first byte of the
      * field in from_slot, or (from_slot -1) the start of the from_up-th
@@ -99,9 +99,9 @@ typedef struct dg_extra {
 #endif
 } dg_extra;
 
-/* issue 10: the most entries an offset table may have; longer ones are malformed. */
+/* The most entries an offset table may have; longer ones are malformed. */
 #define DG_MAX_TABLE 1024
-/* issue 10b: <when> conditions, otherwise, windows (register maps). */
+/* <when> conditions, otherwise, windows (register maps). */
 enum dg_alt_flags {
     DG_ALT_OTHERWISE = 1 << 0  /* otherwise="true": only when no earlier member of its chain was decoded */
 };
@@ -170,14 +170,14 @@ typedef struct dg_node {
 #else
     guint16 hook_first, hook_count;
 #endif
-    /* issue 10a: NULL for nodes without string/time/int/float/ipv4 attributes,
+    /* NULL for nodes without string/time/int/float/ipv4 attributes,
      * repeat="rest", direction, dissector or reassembly. */
 #ifdef __cplusplus
     const dg_extra *extra = NULL;
 #else
     const dg_extra *extra;
 #endif
-    /* issue 10b: <when> conditions (dg_protocol.whens), DG_ALT_* flags, and
+    /* <when> conditions (dg_protocol.whens), DG_ALT_* flags, and
      * the window (dg_protocol.windows) of a container with 'base'. Generated
      * code gives them only for nodes that use them. */
 #ifdef __cplusplus
@@ -189,7 +189,7 @@ typedef struct dg_node {
     guint8 alt;
     gint16 window;
 #endif
-    /* issue 14: > 0 when nothing but the node's own items depends on it
+    /* quiet_size: > 0 when nothing but the node's own items depends on it
      * (no value others read, no summary, key or hand-off) and it cannot be
      * malformed within these many bytes: a walk with no tree and no tap
      * listener steps over it when they are there. */
@@ -212,7 +212,7 @@ typedef struct dg_hook {
     guint32 value;
 } dg_hook;
 
-/* issue 11: request/response pairing declared by <pairing> in the rule file
+/* Request/response pairing declared by <pairing> in the rule file
  * (dissgen_pairing.cpp). Key fields carry DG_KEY. */
 typedef struct dg_pairing {
     double timeout;          /* seconds a request waits for its response */
@@ -244,7 +244,7 @@ typedef struct dg_protocol {
     gint16 pdu_node;         /* -1 when the protocol has no pdulength */
     guint32 pdu_offset;
     gint64 pdu_add;
-    /* issue 10a: reassembly across frames (NULL when no node reassembles). */
+    /* reassembly across frames (NULL when no node reassembles). */
 #ifdef __cplusplus
     reassembly_table *reassembly = NULL;
     const fragment_items *fragments = NULL;
@@ -252,7 +252,7 @@ typedef struct dg_protocol {
     reassembly_table *reassembly;
     const fragment_items *fragments;
 #endif
-    /* issue 10b: tables of <when> conditions, peeks and windows (NULL when unused). */
+    /* tables of <when> conditions, peeks and windows (NULL when unused). */
 #ifdef __cplusplus
     const dg_when *whens = NULL;
     const dg_peek *peeks = NULL;
@@ -266,14 +266,14 @@ typedef struct dg_protocol {
     const dg_window *windows;
     const dg_place *places;
 #endif
-    /* issue 11: request/response pairing, NULL when the rule file has none.
+    /* request/response pairing, NULL when the rule file has none.
      * Generated code gives it only for protocols that have one. */
 #ifdef __cplusplus
     const dg_pairing *pairing = nullptr;
 #else
     const dg_pairing *pairing;
 #endif
-    /* issue 12: the ESI catalogue and network design embedded with --esi /
+    /* the ESI catalogue and network design embedded with --esi /
      * --network (dissgen_bus.h), NULL when none. Generated code gives it only
      * when the tables are embedded. */
 #ifdef __cplusplus

@@ -1,4 +1,4 @@
-/* The EtherCAT bus as the capture shows it (issue 12): the slave model the
+/* The EtherCAT bus as the capture shows it: the slave model the
  * master's own frames reveal, and the check against the designed network.
  *
  * What is learnt, on the first pass, from each returned frame together with

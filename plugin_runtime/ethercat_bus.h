@@ -1,4 +1,4 @@
-/* The EtherCAT bus as the capture shows it (issue 12): what ethercat_esc.cpp
+/* The EtherCAT bus as the capture shows it: what ethercat_esc.cpp
  * and ethercat_bus.cpp share. ethercat_esc.cpp compares each returned frame
  * with the one sent; ethercat_bus.cpp learns the slaves from the same frames
  * (count, positions, station addresses, identities from the SII EEPROM) and

@@ -1,5 +1,5 @@
 /* What an EtherCAT slave controller (ESC) does to a frame on its way round
- * the segment, as a dissgen pairing analysis (issue 11): rule files enable it
+ * the segment, as a dissgen pairing analysis: rule files enable it
  * with <pairing analysis="ethercat-esc">. See ethercat_esc.cpp for the rules.
  */
 #pragma once
