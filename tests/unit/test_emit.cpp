@@ -329,7 +329,7 @@ TEST(Emit, IfhookRangesFollowTheInListsOnTheirRowsOnly) {
     // Kind: no extra columns; Encap: ranges 2-3; IO: its 'in' at 0-1, ifhook at 4.
     EXPECT_TRUE(contains(code, ", 0, 0, 0, 0, 0, 1, 0, 0 },\n    /* 1: line 4 */")) << code;
     // Encap and IO feed nothing else: a walk nobody sees steps over their 2 bytes
-    // (issue 14), the last column, which needs the ones before it spelled out.
+    // (quiet_size), the last column, which needs the ones before it spelled out.
     EXPECT_TRUE(contains(code, ", 0, 0, 0, 0, 2, 2, NULL,\n      0, 0, 0, -1, 2u },\n    /* 2: line 5 */")) << code;
     EXPECT_TRUE(contains(code, ", 4, 1, NULL,\n      0, 0, 0, -1, 2u },\n};")) << code;
 }
@@ -376,7 +376,7 @@ TEST(Emit, ExpertInfosAreExactlyTheRuntimesList) {
     EXPECT_GE(listed, 7u);
 }
 
-// issue 11: <pairing> marks its key fields DG_KEY (every instance of a
+// <pairing> marks its key fields DG_KEY (every instance of a
 // repeated one) and gives the protocol a dg_pairing; without it nothing changes.
 TEST(Pairing, KeysAreFlaggedAndThePairingIsEmitted) {
     Front f = front_end(rules("  <pairing timeout=\"0.25\" analysis=\"ethercat-esc\">\n"

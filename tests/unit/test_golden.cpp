@@ -32,11 +32,11 @@ TEST(Golden, ShippedEthercatRules) { check_golden("rules/ethercat.xml", "dissgen
 
 TEST(Golden, PaperExample) { check_golden("tests/rules/paper_example.xml", "dissgen_paper_example.cpp.golden"); }
 
-// issue 10a: typed values, range enums, repeat="rest", direction, hand-off, reassembly.
-TEST(Golden, Display10a) { check_golden("tests/rules/display10a.xml", "dissgen_display10a.cpp.golden"); }
-// issue 10b: <when>, peek, otherwise and register windows.
+// Typed values, range enums, repeat="rest", direction, hand-off, reassembly.
+TEST(Golden, TypedValues) { check_golden("tests/rules/display10a.xml", "dissgen_display10a.cpp.golden"); }
+// <when>, peek, otherwise and register windows.
 TEST(Golden, LayoutRules) { check_golden("tests/rules/layout.xml", "dissgen_layout.cpp.golden"); }
-// issue 10: summaries naming summarised containers, optional parts {?...}.
+// Summaries naming summarised containers, optional parts {?...}.
 TEST(Golden, SummaryParts) { check_golden("tests/rules_ok/summary_parts.xml", "dissgen_summary_parts.cpp.golden"); }
 
 TEST(Golden, OutputIsDeterministicAndHasNoPaths) {

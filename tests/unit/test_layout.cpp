@@ -1,4 +1,4 @@
-// Issue 10b: <when> conditions, peek look-ahead, otherwise chains and
+// <when> conditions, peek look-ahead, otherwise chains and
 // register windows, through the parser, the validator and the emitter.
 // (Misuses: one file each in tests/rules_err; behaviour with tshark:
 // tests/integration/test_layout.py.)
@@ -105,7 +105,7 @@ TEST(Layout, OtherwiseChains) {
     EXPECT_TRUE(find(*f.proto, "B")->otherwise);
     EXPECT_TRUE(find(*f.proto, "C")->is_conditional());
     std::string code = emit_cpp(*f.proto, "t.xml");
-    EXPECT_TRUE(contains(code, "0, 0, DG_ALT_OTHERWISE, -1, 1u }")) << code;  // quiet: 1 byte (issue 14)
+    EXPECT_TRUE(contains(code, "0, 0, DG_ALT_OTHERWISE, -1, 1u }")) << code;  // quiet: 1 byte
 }
 
 const char* kWindow =

@@ -1,4 +1,4 @@
-// Issue 10: offset tables (offsets="XPATH" from="XPATH"): instances of a node
+// Offset tables (offsets="XPATH" from="XPATH"): instances of a node
 // placed by the values of an earlier repeated leaf, through the parser, the
 // validator and the emitter. (Misuses: tests/rules_err/offsets_*.xml and
 // from_*.xml; behaviour with tshark: tests/integration/test_enip.py.)

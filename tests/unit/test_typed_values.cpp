@@ -1,4 +1,4 @@
-// Issue 10a in the generator: string/stringz/ipv4/int/float/time displays,
+// Typed values in the generator: string/stringz/ipv4/int/float/time displays,
 // range enums, repeat="rest", direction, dissector= and reassembly, from the
 // parsed model to the registered field types and the emitted tables.
 #include <gtest/gtest.h>
@@ -15,7 +15,7 @@ FieldType type_of(const Protocol& p, const std::string& name) {
     return n ? field_type(*n) : FieldType{};
 }
 
-TEST(Display10a, FieldTypesOfTheNewDisplays) {
+TEST(TypedValues, FieldTypesOfTheTypedDisplays) {
     Front f = front_end(rules("  <node name=\"text\" length=\"8byte\" displaytype=\"string\"/>\n"
                               "  <node name=\"z\" displaytype=\"stringz\"/>\n"
                               "  <node name=\"zfixed\" length=\"4byte\" displaytype=\"stringz\" encoding=\"ascii\"/>\n"
@@ -59,13 +59,13 @@ TEST(Display10a, FieldTypesOfTheNewDisplays) {
     EXPECT_TRUE(contains(code, "{ ENC_UTF_8, 1, 0, DG_DIR_ANY, NULL, -1, {-1, 0, 0}, -1, -1, -1 }"));
 }
 
-TEST(Display10a, LengthsFromAnIntOrTimeField) {
+TEST(TypedValues, LengthsFromAnIntOrTimeField) {
     Front f = front_end(rules("  <node name=\"n\" length=\"1byte\" displaytype=\"int\"/>\n"
                               "  <node name=\"data\" length=\"../node[@name='n']\"/>\n"));
     EXPECT_TRUE(f.ok()) << f.messages();
 }
 
-TEST(Display10a, RangeEnumsBecomeARangeString) {
+TEST(TypedValues, RangeEnumsBecomeARangeString) {
     Front f = front_end(rules("  <node name=\"code\" length=\"2byte\" displaytype=\"enum\">\n"
                               "    <enum value=\"0\" name=\"OK\"/>\n"
                               "    <enum value=\"0x0011-0x001f\" name=\"State\"/>\n"
@@ -88,7 +88,7 @@ TEST(Display10a, RangeEnumsBecomeARangeString) {
     EXPECT_TRUE(contains(code, "VALS(tst_plain_vals)"));
 }
 
-TEST(Display10a, RepeatRestIsARepetition) {
+TEST(TypedValues, RepeatRestIsARepetition) {
     Front f = front_end(rules("  <node name=\"item\" length=\"2byte\" displaytype=\"numberhex\" repeat=\"rest\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
     const Node* n = find(*f.proto, "item");
@@ -98,7 +98,7 @@ TEST(Display10a, RepeatRestIsARepetition) {
     EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "{ ENC_UTF_8, 1000000000, 1, DG_DIR_ANY, NULL"));
 }
 
-TEST(Display10a, DirectionIsAConditionAndIsEmitted) {
+TEST(TypedValues, DirectionIsAConditionAndIsEmitted) {
     Front f = front_end(rules("  <hook table=\"udp.port\" value=\"502\"/>\n"
                               "  <node name=\"ask\" length=\"2byte\" direction=\"request\"/>\n"
                               "  <node name=\"box\" length=\"4byte\">\n"
@@ -114,7 +114,7 @@ TEST(Display10a, DirectionIsAConditionAndIsEmitted) {
     EXPECT_TRUE(contains(code, "DG_DIR_RESPONSE"));
 }
 
-TEST(Display10a, HandOffAndReassemblyTables) {
+TEST(TypedValues, HandOffAndReassemblyTables) {
     Front f = front_end(rules("  <node name=\"id\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
                               "  <node name=\"offset\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
                               "  <node name=\"last\" length=\"1byte\" displaytype=\"bool\"/>\n"
@@ -136,7 +136,7 @@ TEST(Display10a, HandOffAndReassemblyTables) {
     EXPECT_TRUE(contains(fields, "tst.fragment.count\tFT_UINT32\t"));
 }
 
-TEST(Display10a, NoReassemblyNoFragmentFields) {
+TEST(TypedValues, NoReassemblyNoFragmentFields) {
     Front f = front_end(rules("  <node name=\"frame\" length=\"rest\" dissector=\"eth_withoutfcs\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
     EXPECT_FALSE(contains(list_fields(*f.proto), "fragment"));
