@@ -453,7 +453,7 @@ def main(argv=None):
     ap.add_argument("--rules", default=os.path.join(ROOT, "rules", "ethercat.xml"))
     ap.add_argument("--same-depth", action="store_true",
                     help="the rules without their <pairing> block: no pairing, ESC analysis or bus model, which "
-                         "Wireshark's plugin does not do; the two then decode the same (issue 10's comparison)")
+                         "Wireshark's plugin does not do; the two then decode the same, a like-for-like comparison")
     ap.add_argument("--runs", type=int, default=3, help="tshark runs per configuration and mode (default 3)")
     ap.add_argument("--frames", type=int, default=200000, help="frames in the capture (default 200000)")
     ap.add_argument("--seed", type=int, default=1)
