@@ -105,8 +105,13 @@ class QuietWalk(unittest.TestCase):
             self.assertGreater(len(with_experts[1]), 100, "the malformed frames raise expert infos")
             self.assertEqual(with_experts[0], with_experts[1], "frames with a severity in the Expert column%s"
                              % (" (-2)" if extra else ""))
-        # The padded frames at the end (one pass: with -2 each also has no response).
+        # The padded frames at the end (one pass: with -2 each also has no response). A frame
+        # that proves earlier requests lost (ecatr.no_response_to: the first one a second
+        # after the rest) carries that warning too.
         severities = [s for _, s in padded_frames()]
+        links = self.env.tshark(["-r", self.env.readable(self.generated), "-T", "fields",
+                                 "-e", "ecatr.no_response_to"]).stdout.splitlines()[-len(severities):]
+        severities = [s or ("Warning" if link else "") for s, link in zip(severities, links)]
         for lines in self.packet_lines(self.generated, columns):
             shown = [line.split()[1] if line.split()[1] in ("Error", "Warning", "Note", "Chat") else ""
                      for line in lines[-len(severities):]]

@@ -310,8 +310,8 @@ class Widths(TsharkTestCase, unittest.TestCase):
         listing = subprocess_lines([ARGS.dissgen, "fields", rules])
         # the rule file's fields (the fourth column says "rules"), not the runtime's expert infos,
         # and the field the runtime registers for every protocol
-        cls.fields = [line.split("	")[0] for line in listing[1:] if line.split("	")[3] in ("rules", "runtime")
-                      and line.split("	")[1] != "FT_NONE"]
+        rows = [line.split("\t") for line in listing[1:]]
+        cls.fields = [r[0] for r in rows if r[3] == "rules" or (r[3] == "runtime" and r[1] != "FT_NONE")]
         experts = ["%s.expert.%s" % (PROTO, e) for e in EXPERT_NAMES]
         extra = ["_ws.col.Info", "_ws.expert.message"] + experts
         args = ["-r", cap, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=|"]
