@@ -26,8 +26,8 @@ std::vector<std::string> split_words(const std::string& s) {
 }
 
 // The runtime's sources, compiled into every plugin.
-const char* const kRuntimeSources[] = {"dissgen_runtime.cpp", "dissgen_pairing.cpp", "ethercat_esc.cpp",
-                                      "ethercat_bus.cpp"};
+const char* const kRuntimeSources[] = {"dissgen_runtime.cpp", "dissgen_pairing.cpp",
+                                      "ethercat/ethercat_esc.cpp", "ethercat/ethercat_bus.cpp"};
 
 bool has_runtime(const fs::path& dir) {
     std::error_code ec;

@@ -18,10 +18,10 @@
 #include <iostream>
 
 #include "build_plugin.h"
-#include "emit_catalogue.h"
+#include "ethercat/emit_catalogue.h"
 #include "emit_cpp.h"
-#include "esi_reader.h"
-#include "network_reader.h"
+#include "ethercat/esi_reader.h"
+#include "ethercat/network_reader.h"
 #include "parser.h"
 #include "validator.h"
 #include "wireshark_env.h"

@@ -25,7 +25,7 @@
  */
 #include "dissgen_pairing.h"
 
-#include "ethercat_esc.h"
+#include "ethercat/ethercat_esc.h"
 
 #include <epan/proto_data.h>
 #include <epan/expert.h>

@@ -219,7 +219,7 @@ typedef struct dg_pairing {
     const char *analysis;    /* NULL, or a protocol analysis ("ethercat-esc") */
 } dg_pairing;
 
-struct dg_bus; /* dissgen_bus.h */
+struct dg_bus; /* ethercat/ethercat_design.h */
 
 typedef struct dg_protocol {
     const char *name;        /* long name, e.g. "EtherCAT" */
@@ -274,7 +274,7 @@ typedef struct dg_protocol {
     const dg_pairing *pairing;
 #endif
     /* issue 12: the ESI catalogue and network design embedded with --esi /
-     * --network (dissgen_bus.h), NULL when none. Generated code gives it only
+     * --network (ethercat/ethercat_design.h), NULL when none. Generated code gives it only
      * when the tables are embedded. */
 #ifdef __cplusplus
     const struct dg_bus *bus = nullptr;

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "network_reader.h"
-#include "../plugin_runtime/dissgen_names.h"
+#include "../../plugin_runtime/dissgen_names.h"
 
 namespace dissgen {
 
@@ -262,7 +262,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
     BusLayout l = make_bus_layout(cat, opt, filter);
     const Network* net = opt.network;
     EmbeddedTables t;
-    t.includes = "#include \"dissgen_bus.h\"\n";
+    t.includes = "#include \"ethercat/ethercat_design.h\"\n";
     std::ostringstream d;
     for (const Field& f : l.fields) d << "static int " << f.ident << " = -1;\n";
     t.declarations = d.str();
