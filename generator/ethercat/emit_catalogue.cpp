@@ -367,10 +367,10 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
             o << "};\n\n";
         }
     }
-    t.bus_symbol = filter + "_bus";
+    t.analysis_data = filter + "_bus";
     o << "/* Referenced by the run-time slave model; kept in the plugin even while unused. */\n"
-      << "extern G_GNUC_INTERNAL const dg_bus " << t.bus_symbol << ";\n"
-      << "const dg_bus " << t.bus_symbol << " = {\n"
+      << "extern G_GNUC_INTERNAL const dg_bus " << t.analysis_data << ";\n"
+      << "const dg_bus " << t.analysis_data << " = {\n"
       << "    " << filter << "_devices, " << l.devices.size() << ", " << filter << "_pdo_entries, " << l.entries.size()
       << ", " << filter << "_pdos, " << l.pdos.size() << ", " << filter << "_maps, " << l.maps.size()
       << ",\n    " << (net ? filter + "_slaves" : "NULL") << ", " << slave_count << ", "
