@@ -18,4 +18,9 @@ const Analysis* find_analysis(const std::string& name) {
     return nullptr;
 }
 
+std::vector<std::string> analysis_runtime_sources(const Protocol& proto) {
+    const Analysis* a = proto.pairing ? find_analysis(proto.pairing->analysis) : nullptr;
+    return a ? a->runtime_sources : std::vector<std::string>{};
+}
+
 }  // namespace dissgen

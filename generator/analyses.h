@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "model.h"
+
 namespace dissgen {
 
 struct Analysis {
@@ -21,5 +23,9 @@ const std::vector<Analysis>& analyses();
 
 // The analysis called `name`, or nullptr.
 const Analysis* find_analysis(const std::string& name);
+
+// The runtime sources a plugin of `proto` compiles beyond the generic runtime:
+// those of the analysis its pairing names, none without one.
+std::vector<std::string> analysis_runtime_sources(const Protocol& proto);
 
 }  // namespace dissgen
