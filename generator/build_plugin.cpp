@@ -25,9 +25,9 @@ std::vector<std::string> split_words(const std::string& s) {
     return words;
 }
 
-// The runtime's sources, compiled into every plugin.
-const char* const kRuntimeSources[] = {"dissgen_runtime.cpp", "dissgen_pairing.cpp", "ethercat_esc.cpp",
-                                      "ethercat_bus.cpp"};
+// The generic runtime's sources, compiled into every plugin; an analysis's
+// own come from the request (BuildRequest::analysis_sources).
+const char* const kRuntimeSources[] = {"dissgen_runtime.cpp", "dissgen_pairing.cpp"};
 
 bool has_runtime(const fs::path& dir) {
     std::error_code ec;
@@ -76,6 +76,12 @@ std::string build_and_install(const BuildRequest& req, std::string& installed_pa
         }
     } cleanup{dir};
 
+    for (const std::string& extra : req.analysis_sources) {
+        std::error_code ec;
+        if (!fs::exists(fs::path(req.runtime_dir) / extra, ec))
+            return "the plugin runtime in " + req.runtime_dir + " lacks " + extra + ", which these rules use";
+    }
+
     fs::path source = dir / (req.stem + ".cpp");
     std::ofstream(source) << req.generated_source;
     fs::path output = dir / (req.stem + ".so");
@@ -94,6 +100,7 @@ std::string build_and_install(const BuildRequest& req, std::string& installed_pa
         for (const std::string& w : split_words(extra)) cmd.push_back(w);
     cmd.push_back(source.string());
     for (const char* runtime_source : kRuntimeSources) cmd.push_back(req.runtime_dir + "/" + runtime_source);
+    for (const std::string& extra : req.analysis_sources) cmd.push_back(req.runtime_dir + "/" + extra);
     cmd.push_back("-o");
     cmd.push_back(output.string());
     cmd.push_back("-Wl,--no-undefined");

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace dissgen {
 
@@ -12,6 +13,9 @@ struct BuildRequest {
     std::string stem;              // rule file stem: plugin is dissgen_<stem>.so
     std::string target_dir;        // where the plugin goes
     std::string runtime_dir;       // plugin_runtime sources
+    // Beyond the generic runtime, relative to runtime_dir: what the rules use
+    // (analysis_runtime_sources), so a plugin carries no other analysis's code.
+    std::vector<std::string> analysis_sources;
 };
 
 // Returns "" on success, else a message for the user.

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "emit_cpp.h"
 
+#include "analyses.h"
 #include "quiet.h"
 #include "runtime_names.h"
 
@@ -453,10 +454,14 @@ void Emitter::protocol_struct() {
     if (p_.pairing) {
         char timeout[32];
         std::snprintf(timeout, sizeof timeout, "%.9g", p_.pairing->timeout);
+        const Analysis* analysis = find_analysis(p_.pairing->analysis);
         o_ << "\n/* Request/response pairing (<pairing>, line " << p_.pairing->line
-           << "): timeout in seconds, analysis. */\n"
-           << "static const dg_pairing " << f << "_pairing = { " << timeout << ", "
-           << (p_.pairing->analysis.empty() ? "NULL" : c_string(p_.pairing->analysis)) << " };\n";
+           << "): timeout in seconds, analysis. */\n";
+        if (analysis)
+            o_ << "/* The " << c_string(analysis->name) << " analysis, compiled in from the runtime. */\n"
+               << "extern \"C\" const struct dg_analysis " << analysis->symbol << ";\n";
+        o_ << "static const dg_pairing " << f << "_pairing = { " << timeout << ", "
+           << (analysis ? "&" + analysis->symbol : std::string("NULL")) << " };\n";
     }
     o_ << "\nstatic dg_protocol " << f << "_protocol = {\n"
        << "    " << c_string(p_.name) << ", " << c_string(p_.abbreviation) << ", " << c_string(f) << ",\n"
@@ -469,8 +474,8 @@ void Emitter::protocol_struct() {
        << (pdu ? p_.pdu_fixed_len - value_bytes(*pdu) : 0) << ", " << p_.pdulengthadd;
     // Members after pdu_add default to none; a protocol that uses later ones
     // spells out everything before them.
-    const bool bus = extra_ && !extra_->bus_symbol.empty();
-    const bool pairing = p_.pairing != nullptr, needs_layout_members = l_.uses_layout_tables() || pairing || bus;
+    const bool data = extra_ && !extra_->analysis_data.empty();
+    const bool pairing = p_.pairing != nullptr, needs_layout_members = l_.uses_layout_tables() || pairing || data;
     if (uses_reassembly())
         o_ << ",\n    &" << f << "_reassembly, &" << f << "_fragment_items";
     else if (needs_layout_members)
@@ -482,8 +487,8 @@ void Emitter::protocol_struct() {
            << name("places", !l_.places.empty());
     }
     if (pairing) o_ << ",\n    &" << f << "_pairing";
-    else if (bus) o_ << ",\n    NULL";
-    if (bus) o_ << ",\n    &" << extra_->bus_symbol;
+    else if (data) o_ << ",\n    NULL";
+    if (data) o_ << ",\n    &" << extra_->analysis_data;
     o_ << "\n};\n\n";
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
        << "    return dg_dissect(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";

@@ -38,7 +38,7 @@ struct EmbeddedTables {
     std::string declarations;             // hf variables
     std::string tables;                   // constant data, before the protocol
     std::vector<std::string> hf_entries;  // hf_register_info initializers
-    std::string bus_symbol;               // the dg_bus defined in `tables`
+    std::string analysis_data;            // defined in `tables`, for the pairing's analysis (dg_protocol)
 };
 
 // `source_name` is the rule file's base name, quoted in the header comment.

@@ -17,11 +17,12 @@
 #include <fstream>
 #include <iostream>
 
+#include "analyses.h"
 #include "build_plugin.h"
-#include "emit_catalogue.h"
+#include "ethercat/emit_catalogue.h"
 #include "emit_cpp.h"
-#include "esi_reader.h"
-#include "network_reader.h"
+#include "ethercat/esi_reader.h"
+#include "ethercat/network_reader.h"
 #include "parser.h"
 #include "validator.h"
 #include "wireshark_env.h"
@@ -268,7 +269,8 @@ int cmd_install(const std::string& path, const std::string& dir, bool system, co
         std::cerr << "dissgen: cannot find the plugin runtime (dissgen_runtime.cpp); set DISSGEN_RUNTIME_DIR\n";
         return 1;
     }
-    BuildRequest req{generate_source(*l.proto, path, bus), plugin_basename(path), target_dir, runtime};
+    BuildRequest req{generate_source(*l.proto, path, bus), plugin_basename(path), target_dir, runtime,
+                     analysis_runtime_sources(*l.proto)};
     std::string installed;
     std::string error = build_and_install(req, installed);
     if (!error.empty()) {

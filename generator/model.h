@@ -191,11 +191,8 @@ struct Pairing {
     int line = 0;
     std::vector<PairingKey> keys;
     double timeout = 1.0;   // seconds a request waits for its response
-    std::string analysis;   // "" or a protocol analysis of the runtime ("ethercat-esc")
+    std::string analysis;   // "" or the name of a protocol analysis (analyses.h)
 };
-
-// Analyses the runtime knows (plugin_runtime/dissgen_pairing.cpp).
-constexpr const char* kPairingAnalyses[] = {"ethercat-esc"};
 
 struct Protocol {
     std::string name;

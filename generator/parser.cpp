@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "parser.h"
 
+#include "analyses.h"
+
 #include <libxml/parser.h>
 #include <libxml/tree.h>
 #include <libxml/xpath.h>
@@ -426,8 +428,9 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
     }
     if (attrs.count("analysis")) {
         pairing.analysis = trim(attrs["analysis"]);
-        std::vector<std::string> known(std::begin(kPairingAnalyses), std::end(kPairingAnalyses));
-        if (std::find(known.begin(), known.end(), pairing.analysis) == known.end())
+        std::vector<std::string> known;
+        for (const Analysis& a : analyses()) known.push_back(a.name);
+        if (!find_analysis(pairing.analysis))
             diags_.error(line, "unknown analysis '" + attrs["analysis"] + "'; valid: " + join(known, ", "));
     }
     std::vector<xmlNode*> key_elements;

@@ -25,7 +25,6 @@
  */
 #include "dissgen_pairing.h"
 
-#include "ethercat_esc.h"
 
 #include <epan/proto_data.h>
 #include <epan/expert.h>
@@ -34,9 +33,6 @@
 #include <string.h>
 
 namespace {
-
-/* The analyses the runtime knows, by the name the rule file gives. */
-const dg_analysis *const analyses[] = {&dg_ethercat_esc};
 
 /* Key of the per-frame state (p_add_proto_data), plus the message number. */
 const guint32 frame_key = 0x70616972u; /* "pair" */
@@ -791,9 +787,7 @@ extern "C" {
 void dg_pairing_register(const dg_protocol *p)
 {
     protocol = p;
-    analysis = NULL;
-    for (const dg_analysis *a : analyses)
-        if (p->pairing->analysis && strcmp(a->name, p->pairing->analysis) == 0) analysis = a;
+    analysis = p->pairing->analysis; /* the generated code names it */
 
     /* Wireshark keeps pointers to these: static arrays, names that live until exit. */
     static hf_register_info hf[] = {DG_PAIRING_FIELDS(DG_HF_ROW)};

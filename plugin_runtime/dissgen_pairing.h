@@ -12,7 +12,8 @@
  *
  * Later passes (tshark -2, the GUI in any order, display filters) only read
  * what the first pass stored, so they show the same items. A protocol
- * analysis (dg_analysis; the one for EtherCAT is ethercat_esc.cpp) adds what
+ * analysis (dg_analysis, each in its own folder, named by the generated
+ * code in dg_pairing; EtherCAT's is ethercat/ethercat_esc.cpp) adds what
  * one protocol knows about how its responses relate to its requests.
  */
 #pragma once
@@ -68,7 +69,7 @@ typedef struct dg_analysis {
     /* Registers the analysis's own fields and expert infos (once, at start-up). */
     void (*register_info)(int proto, const char *filter);
     /* Capture-wide state, allocated in wmem_file_scope (e.g. the EtherCAT
-     * slave model, which reads p->bus), or NULL. */
+     * slave model, which reads p->analysis_data), or NULL. */
     void *(*capture_new)(const dg_protocol *p);
     /* First pass, every message in capture order, before pairing. */
     void (*see)(void *capture, tvbuff_t *tvb, packet_info *pinfo);

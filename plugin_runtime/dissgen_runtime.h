@@ -214,12 +214,12 @@ typedef struct dg_hook {
 
 /* Request/response pairing declared by <pairing> in the rule file
  * (dissgen_pairing.cpp). Key fields carry DG_KEY. */
+struct dg_analysis; /* dissgen_pairing.h; each analysis defines its own in its folder */
+
 typedef struct dg_pairing {
     double timeout;          /* seconds a request waits for its response */
-    const char *analysis;    /* NULL, or a protocol analysis ("ethercat-esc") */
+    const struct dg_analysis *analysis; /* NULL, or the protocol analysis the rule file names */
 } dg_pairing;
-
-struct dg_bus; /* dissgen_bus.h */
 
 typedef struct dg_protocol {
     const char *name;        /* long name, e.g. "EtherCAT" */
@@ -273,13 +273,14 @@ typedef struct dg_protocol {
 #else
     const dg_pairing *pairing;
 #endif
-    /* the ESI catalogue and network design embedded with --esi /
-     * --network (dissgen_bus.h), NULL when none. Generated code gives it only
-     * when the tables are embedded. */
+    /* Data for the pairing's analysis, built from other inputs than the rule
+     * file (for the EtherCAT analysis: the ESI catalogue and network design
+     * of --esi / --network); only the analysis knows its type. NULL when none;
+     * generated code gives it only when there is some. */
 #ifdef __cplusplus
-    const struct dg_bus *bus = nullptr;
+    const void *analysis_data = nullptr;
 #else
-    const struct dg_bus *bus;
+    const void *analysis_data;
 #endif
 } dg_protocol;
 

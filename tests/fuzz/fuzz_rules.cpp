@@ -8,10 +8,10 @@
 #include <string>
 
 #include "diagnostics.h"
-#include "emit_catalogue.h"
+#include "ethercat/emit_catalogue.h"
 #include "emit_cpp.h"
-#include "esi_reader.h"
-#include "network_reader.h"
+#include "ethercat/esi_reader.h"
+#include "ethercat/network_reader.h"
 #include "parser.h"
 #include "validator.h"
 

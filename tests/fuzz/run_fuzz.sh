@@ -21,8 +21,8 @@ trap 'rm -rf "$work"' EXIT
 clang++ -std=c++17 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
   -I"$src/generator" $(pkg-config --cflags libxml-2.0) \
   "$here/fuzz_rules.cpp" \
-  "$src"/generator/{diagnostics,model,text_util,parser,validator,runtime_names,quiet,emit_cpp}.cpp \
-  "$src"/generator/{xml_input,esi_reader,network_reader,emit_catalogue}.cpp \
+  "$src"/generator/{diagnostics,model,analyses,text_util,parser,validator,runtime_names,quiet,emit_cpp}.cpp \
+  "$src"/generator/xml_input.cpp "$src"/generator/ethercat/{esi_reader,network_reader,emit_catalogue}.cpp \
   $(pkg-config --libs libxml-2.0) -o "$work/fuzz_rules"
 
 mkdir -p "$work/corpus"

@@ -393,7 +393,9 @@ TEST(Pairing, KeysAreFlaggedAndThePairingIsEmitted) {
     ASSERT_EQ(f.proto->pairing->keys.size(), 1u);
     EXPECT_EQ(f.proto->pairing->keys[0].field.target, find(*f.proto, "Id"));
     std::string code = emit_cpp(*f.proto, "t.xml");
-    EXPECT_TRUE(contains(code, "static const dg_pairing tst_pairing = { 0.25, \"ethercat-esc\" };")) << code;
+    // The generated code names the analysis object: the runtime looks nothing up.
+    EXPECT_TRUE(contains(code, "extern \"C\" const struct dg_analysis dg_ethercat_esc;")) << code;
+    EXPECT_TRUE(contains(code, "static const dg_pairing tst_pairing = { 0.25, &dg_ethercat_esc };")) << code;
     EXPECT_TRUE(contains(code, "&tst_pairing\n};")) << code;
     EXPECT_TRUE(contains(code, "DG_SHOW_HEX, DG_NUMERIC|DG_KEY,")) << code;
     EXPECT_EQ(code.find("DG_SHOW_DEC, DG_NUMERIC|DG_KEY"), std::string::npos) << "only the key is flagged";

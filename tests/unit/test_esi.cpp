@@ -10,7 +10,7 @@
 #include <regex>
 #include <sstream>
 
-#include "esi_reader.h"
+#include "ethercat/esi_reader.h"
 #include "test_support.h"
 #include "xml_input.h"
 

@@ -8,9 +8,9 @@
 #include <regex>
 #include <sstream>
 
-#include "emit_catalogue.h"
-#include "esi_reader.h"
-#include "network_reader.h"
+#include "ethercat/emit_catalogue.h"
+#include "ethercat/esi_reader.h"
+#include "ethercat/network_reader.h"
 #include "test_support.h"
 
 namespace dissgen::testing {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "runtime_names.h"
+#include "analyses.h"
 #include "test_support.h"
 
 namespace dissgen::testing {
@@ -128,11 +129,11 @@ TEST(RuntimeNames, APrefixLeavesItsOwnNameFree) {
 }
 
 TEST(RuntimeNames, EveryAnalysisHasItsNames) {
-    for (const char* analysis : kPairingAnalyses) {
+    for (const Analysis& analysis : analyses()) {
         bool found = false;
         for (const NameGroup& g : runtime_name_groups())
-            found = found || (g.when == When::Analysis && std::string(g.analysis) == analysis);
-        EXPECT_TRUE(found) << analysis;
+            found = found || (g.when == When::Analysis && g.analysis == analysis.name);
+        EXPECT_TRUE(found) << analysis.name;
     }
 }
 

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "network_reader.h"
-#include "../plugin_runtime/dissgen_names.h"
+#include "../../plugin_runtime/dissgen_names.h"
 
 namespace dissgen {
 
@@ -262,7 +262,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
     BusLayout l = make_bus_layout(cat, opt, filter);
     const Network* net = opt.network;
     EmbeddedTables t;
-    t.includes = "#include \"dissgen_bus.h\"\n";
+    t.includes = "#include \"ethercat/ethercat_design.h\"\n";
     std::ostringstream d;
     for (const Field& f : l.fields) d << "static int " << f.ident << " = -1;\n";
     t.declarations = d.str();
@@ -367,10 +367,10 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
             o << "};\n\n";
         }
     }
-    t.bus_symbol = filter + "_bus";
+    t.analysis_data = filter + "_bus";
     o << "/* Referenced by the run-time slave model; kept in the plugin even while unused. */\n"
-      << "extern G_GNUC_INTERNAL const dg_bus " << t.bus_symbol << ";\n"
-      << "const dg_bus " << t.bus_symbol << " = {\n"
+      << "extern G_GNUC_INTERNAL const dg_bus " << t.analysis_data << ";\n"
+      << "const dg_bus " << t.analysis_data << " = {\n"
       << "    " << filter << "_devices, " << l.devices.size() << ", " << filter << "_pdo_entries, " << l.entries.size()
       << ", " << filter << "_pdos, " << l.pdos.size() << ", " << filter << "_maps, " << l.maps.size()
       << ",\n    " << (net ? filter + "_slaves" : "NULL") << ", " << slave_count << ", "

@@ -6,7 +6,7 @@
  * C++ only, inside the runtime. */
 #pragma once
 
-#include "dissgen_bus.h"
+#include "ethercat_design.h"
 #include "dissgen_pairing.h"
 
 namespace dg_ecat {

@@ -138,7 +138,7 @@ void check_forwarding(result *r)
 void *esc_capture_new(const dg_protocol *p)
 {
     capture_hints *h = wmem_new0(wmem_file_scope(), capture_hints);
-    h->bus = bus_new(p->bus);
+    h->bus = bus_new(static_cast<const dg_bus *>(p->analysis_data));
     return h;
 }
 

@@ -1,10 +1,10 @@
 /* The EtherCAT bus as dissgen knows it at build time: the device catalogue of
  * the ESI files given to `dissgen install --esi`, and the designed network of
  * `--network` (a design or an ENI file). The generator writes these tables
- * into the plugin as constant data (see generator/emit_catalogue.cpp); the
+ * into the plugin as constant data (see generator/ethercat/emit_catalogue.cpp); the
  * run-time slave model reads them. Plain C data, no constructors. */
-#ifndef DISSGEN_BUS_H
-#define DISSGEN_BUS_H
+#ifndef DISSGEN_ETHERCAT_DESIGN_H
+#define DISSGEN_ETHERCAT_DESIGN_H
 
 #include <glib.h>
 

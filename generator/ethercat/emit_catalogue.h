@@ -1,5 +1,5 @@
 // Stage 3b: the ESI catalogue and the network design -> the plugin's static
-// bus tables (plugin_runtime/dissgen_bus.h) and a registered field for every
+// bus tables (plugin_runtime/ethercat/ethercat_design.h) and a registered field for every
 // PDO entry of the designed slaves. emit_cpp() places the pieces.
 #pragma once
 

@@ -1,0 +1,31 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The protocol analyses a rule file can name with <pairing analysis="...">.
+// Each lives in its own folder of plugin_runtime/ (its dg_analysis object and
+// the sources that define it) and, when it reads more input than the rule
+// file, of generator/. Adding one: its folders and one entry in analyses.cpp.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "model.h"
+
+namespace dissgen {
+
+struct Analysis {
+    std::string name;                          // the rule file's <pairing analysis="...">
+    std::string symbol;                        // its dg_analysis object in the runtime
+    std::vector<std::string> runtime_sources;  // relative to the runtime folder
+};
+
+// Every analysis, in registration order.
+const std::vector<Analysis>& analyses();
+
+// The analysis called `name`, or nullptr.
+const Analysis* find_analysis(const std::string& name);
+
+// The runtime sources a plugin of `proto` compiles beyond the generic runtime:
+// those of the analysis its pairing names, none without one.
+std::vector<std::string> analysis_runtime_sources(const Protocol& proto);
+
+}  // namespace dissgen
