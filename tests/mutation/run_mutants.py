@@ -85,6 +85,7 @@ TESTS = {
     "bus_coe": integration("test_bus_model.py", "--only", "coe"),
     "pairing": integration("test_pairing.py", "--quick"),
     "pairing_full": integration("test_pairing.py"),
+    "esc_commands": integration("test_esc_commands.py"),
     "malformed_skip": integration("test_malformed_skip.py"),
     "quiet": integration("test_quiet.py"),
     "live_capture": integration("test_live_capture.py"),
