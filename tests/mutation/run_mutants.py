@@ -86,6 +86,7 @@ TESTS = {
     "pairing": integration("test_pairing.py", "--quick"),
     "pairing_full": integration("test_pairing.py"),
     "esc_commands": integration("test_esc_commands.py"),
+    "ecat_figures": integration("test_ecat_figures.py"),
     "malformed_skip": integration("test_malformed_skip.py"),
     "quiet": integration("test_quiet.py"),
     "live_capture": integration("test_live_capture.py"),
