@@ -34,8 +34,13 @@ datagrams): it names the whole test instead (pairing_full in tests/mutation/run_
    The same with one sent frame stamped an hour ahead, between a request and its answer, and
    with a real gap of an hour in the middle: every answer is still paired (forgetting goes by
    a clock that one odd timestamp does not move).
+6. Orphan returns (generated frames): a return whose request was not captured, arriving while
+   several requests wait (and while none does), answers none of them: it carries no
+   ecatr.request_in, each waiting request is paired with its own return, and no expert info
+   is raised; one pass and -2.
 
-Exit 77 with "SKIPPED: ..." when the corpus is not there.
+Parts 5 and 6 need no corpus; without it they run all the same, then the test exits 77 with
+"SKIPPED: ..." (parts 1 to 4 need the corpus).
 """
 
 import argparse
@@ -525,6 +530,47 @@ def forgetting_checks(env):
             check_paired(env, path, pairs, what, two_pass)
 
 
+MASTER = b"\x00\x1b\x21\x00\x00\x01"
+RETURNED = bytes([MASTER[0] | 0x02]) + MASTER[1:]
+
+
+def orphan_frames(waiting):
+    """A first exchange (the capture shows its slaves mark returned frames), then `waiting`
+    requests sent, the return of a request that was not captured, and the returns of the
+    waiting ones in order. Returns (frames, {return's frame number: request's})."""
+    t = [1704067200.0]
+
+    def frame(idx, src, wkc):
+        t[0] += 0.0002
+        return pcapgen.Frame([pcapgen.Datagram(cmd=4, idx=idx, adp=0x1001, ado=0x0130, data=bytes(2), wkc=wkc)],
+                             src_mac=src, ts=t[0])
+    frames = [frame(0x01, MASTER, 0), frame(0x01, RETURNED, 1)]
+    pairs = {2: 1}
+    requests = {}
+    for k in range(waiting):
+        frames.append(frame(0x10 + k, MASTER, 0))
+        requests[0x10 + k] = len(frames)
+    frames.append(frame(0x7f, RETURNED, 1))  # the orphan: its request is not in the capture
+    for k in range(waiting):
+        frames.append(frame(0x10 + k, RETURNED, 1))
+        pairs[len(frames)] = requests[0x10 + k]
+    return frames, pairs
+
+
+def orphan_checks(env):
+    print("\n== orphan returns among waiting requests (generated frames)")
+    for waiting in (0, 2, 3):
+        frames, pairs = orphan_frames(waiting)
+        name = "orphan-%d-waiting.pcap" % waiting
+        path = env.add_file(name, pcapgen.pcap_bytes(frames))
+        for two_pass in (False, True):
+            what = "an orphan return while %d requests wait" % waiting
+            check_paired(env, path, pairs, what, two_pass)
+            rows = decode(env, path, two_pass=two_pass)
+            experts = {e: sorted(with_expert(rows, e)) for e in EXPERTS if with_expert(rows, e)}
+            check(not experts, "%s%s: no expert infos (%s)" % (what, " (-2)" if two_pass else "", experts))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--dissgen", required=True)
@@ -537,12 +583,17 @@ def main():
         if os.path.isdir(corpus_dir) else []
     if args.quick:
         files = [f for f in files if os.path.getsize(os.path.join(corpus_dir, f)) < 1 << 20]
-    if not files:
-        print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng)" % corpus_dir)
-        return SKIP
     with TsharkEnv() as env:
         env.install_plugin(args.dissgen, os.path.join(args.source_dir, "rules", "ethercat.xml"))
         env.assert_plugin_loaded("ecatr")
+        orphan_checks(env)
+        if not files:
+            forgetting_checks(env)
+            print("\n%d failed" % len(check.failed))
+            if check.failed:
+                return 1
+            print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng): parts 1 to 4 not run" % corpus_dir)
+            return SKIP
         local = []
         for f in files:  # readable by the tshark user
             with open(os.path.join(corpus_dir, f), "rb") as fh:

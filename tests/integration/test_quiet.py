@@ -15,9 +15,19 @@ pairing's too), so the same frames must show a severity there. (Which one, when
 a frame has several, is Wireshark's business: without a tree the last one
 raised, with a tree the highest.)
 
+The same comparison runs on every rule file of tests/rules/ and rules/ (each plugin alone,
+as the only plugin tshark loads), on captures that exercise it: the messages the rule
+file's own test builds (or, for tests/rules/quiet_bits.xml, bit groups with whole-byte
+members that feed nothing, with random values), each also cut short at up to 24 places.
+A rule file without a capture here fails the test.
+
     test_quiet.py --dissgen build/bin/dissgen --source-dir .
 """
+import glob
 import os
+import random
+import struct
+import subprocess
 import sys
 import unittest
 
@@ -117,6 +127,11 @@ class QuietWalk(unittest.TestCase):
                      for line in lines[-len(severities):]]
             self.assertEqual(shown, severities, "Expert column of the padded frames")
 
+    def test_generated_enip_messages(self):
+        cap = self.env.add_file("enip.pcap", pcap(with_cuts(enip_frames(), cut_frames=len(enip_frames()))))
+        self.check(cap)
+        self.assertIn("ENIPR", self.env.tshark(["-r", cap]).stdout)
+
     def test_samples(self):
         samples = os.path.join(os.path.abspath(ARGS.source_dir), "samples")
         for name in sorted(os.listdir(samples)):
@@ -131,6 +146,184 @@ class QuietWalk(unittest.TestCase):
         for path in captures:
             with self.subTest(capture=os.path.basename(path)):
                 self.check(path)
+
+
+# --------------------------------------------------------------------------- every rule file
+
+def eth_frame(ethertype, payload):
+    f = b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01" + struct.pack("!H", ethertype) + bytes(payload)
+    return f + bytes(max(0, 60 - len(f)))
+
+
+def udp_frame(port, payload):
+    return pcapgen.udp_ethernet_frame(bytes(payload), port)
+
+
+def widths_frames():
+    import test_widths as m
+    return [m.frame(c.data) for c in m.cases(m.Gen(15), 40)]
+
+
+def everything_frames():
+    import test_everything as m
+    g = m.Gen(2024)
+    return [c.packet() for c in m.valid_cases(g, 60) + m.malformed_cases(g)]
+
+
+def layout_frames():
+    import test_layout as m
+    out = []
+    for records, cut in m.valid_packets(random.Random(10), 60) + m.malformed_packets():
+        frame = m.udp_frame(b"".join(r.encode() for r in records))
+        out.append((frame if cut is None else frame[:m.UDP_HEAD + cut], len(frame)))
+    return out
+
+
+def display10a_frames():
+    import test_display10a as m
+    a, b = bytes(range(48)), bytes(range(100, 148))
+    return [m.to_port(m.values_message()), m.to_port(bytes([3]) + m.inner_frame((10, 1, 2, 3))),
+            m.to_port(bytes([4]) + b"\x01\x02\x03"),
+            m.to_port(m.fragment(7, 0, False, a[:16])), m.to_port(m.fragment(7, 32, True, a[32:])),
+            m.to_port(m.fragment(8, 0, False, b[:16])), m.to_port(m.fragment(7, 16, False, a[16:32])),
+            m.to_port(m.piece(1, 0, True, b"abc")), m.to_port(m.piece(1, 1, False, b"def")),
+            m.to_port(bytes([8, 1, 0x11, 0x22])), m.to_port(bytes([8, 2, 0x33])), m.to_port(bytes([8, 3, 0x44])),
+            m.to_port(bytes([7, 1, 2, 3, 4, 5, 6])), m.from_port(bytes([2, 1, 2, 3, 4, 5, 6, 7]))]
+
+
+def skip_frames():
+    import test_malformed_skip as m
+    return [m.frame(m.SKIP, payload) for payload in (m.GOOD, m.BAD_INSIDE, m.BAD_LENGTH)]
+
+
+def ethercat_frames():
+    frames = pcapgen.random_frames(21, 150, max_datagrams=6, m_on_last=4, truncated=6, other_types=2,
+                                   odd_lengths=4) + pcapgen.demo_frames()
+    return [pcapgen.encode_frame(f) for f in frames]
+
+
+def enip_frames():
+    import test_enip as m
+    msgs = [m.REGISTER, m.GET_ATTR, m.GET_ATTR_ERROR, m.LIST_IDENTITY_REQ, m.LIST_IDENTITY_REPLY,
+            m.LIST_SERVICES_REPLY, m.FORWARD_OPEN_REPLY,
+            m.unconnected(m.cip_request(0x0E, bytes.fromhex("20012401"))),
+            m.unconnected(m.unconnected_send(m.cip_request(0x0E, bytes.fromhex("20012401300700")))),
+            m.unconnected(m.multiple_service([m.cip_request(0x0E, bytes.fromhex("20012401")),
+                                              m.cip_request(0x01, bytes.fromhex("20022401"))]))]
+    return [m.udp(50000, 44818, x) for x in msgs] + [m.udp(2222, 2222, m.IO_FRAME)]
+
+
+def handoff_frames():
+    import test_edges as m
+    rng = random.Random(4)
+    out = []
+    for n in (0, 1, 46):
+        inner = m.inner_frame(bytes(rng.getrandbits(8) for _ in range(n)))
+        for kind in (1, 2, 3):
+            tail = m.inner_frame(b"\x01\x02") if kind == 3 else b"\xbe\xef"
+            out.append(udp_frame(47490, struct.pack("!BH", kind, len(inner)) + inner + tail))
+    return out
+
+
+def offsets_frames():
+    import test_edges as m
+    out = []
+    for kind in m.KINDS:
+        for entries, gap, shift in (([(1, b"ab"), (2, b""), (3, b"xyz")], 1, 0), ([(9, b"q")], 0, 0),
+                                    ([(1, b"a"), (2, b"b")], 0, 1)):
+            out.append(udp_frame(47493, m.offsets_message(kind, entries, gap, shift)[0]))
+    return out
+
+
+def quiet_bits_frames():
+    """tests/rules/quiet_bits.xml with random values: whole-byte members in the middle of groups."""
+    rng = random.Random(5)
+    out = []
+    for _ in range(40):
+        n = rng.randint(0, 4)
+        header = (rng.getrandbits(4) << 12 | rng.getrandbits(8) << 4 | rng.getrandbits(4)).to_bytes(2, "big")
+        body = header + struct.pack("!H", rng.choice([0, 7, 255, 256, 0xFFFF, rng.getrandbits(16)])) + bytes([n])
+        for _ in range(n):
+            body += rng.getrandbits(32).to_bytes(4, "little") + bytes([rng.getrandbits(8)]) + \
+                struct.pack("<H", rng.getrandbits(16))
+        body += rng.getrandbits(32).to_bytes(4, "big") + bytes([rng.getrandbits(8)])
+        out.append(udp_frame(47494, body))
+    return out
+
+
+# Rule file (relative to the source folder) -> the captures that exercise it.
+CAPTURES = {
+    "tests/rules/widths.xml": widths_frames,
+    "tests/rules/everything.xml": everything_frames,
+    "tests/rules/layout.xml": layout_frames,
+    "tests/rules/display10a.xml": display10a_frames,
+    "tests/rules/skip.xml": skip_frames,
+    "tests/rules/paper_example.xml": ethercat_frames,
+    "tests/rules/handoff.xml": handoff_frames,
+    "tests/rules/offsets_from.xml": offsets_frames,
+    "tests/rules/quiet_bits.xml": quiet_bits_frames,
+    # QuietWalk: with Wireshark's own plugins, the samples and the corpus
+    "rules/ethercat.xml": None,
+    "rules/enip.xml": None,
+}
+
+
+def with_cuts(frames, places=24, cut_frames=12):
+    """Each frame as it is, and the first cut_frames of them (and every tenth after) also cut
+    short (the original length kept) at up to `places` places inside the message (after the
+    Ethernet header, or the IPv4 and UDP headers)."""
+    out = []
+    for k, f in enumerate(frames):
+        data, orig = f if isinstance(f, tuple) else (f, len(f))
+        out.append((data, orig))
+        if k < cut_frames or k % 10 == 0:
+            head = 14
+            if data[12:14] == b"\x08\x00" and len(data) > 14:
+                head += (data[14] & 0x0F) * 4 + 8
+            step = max(1, (len(data) - head) // places)
+            out += [(data[:cut], orig) for cut in range(head + 1, len(data), step)]
+    return out
+
+
+def pcap(packets):
+    out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
+    for i, (data, orig) in enumerate(packets):
+        out.append(struct.pack("<IIII", 1704067200 + i // 1000, (i % 1000) * 1000, len(data), orig) + data)
+    return b"".join(out)
+
+
+class EveryRuleFile(unittest.TestCase):
+    def test_every_rule_file_has_captures(self):
+        src = os.path.abspath(ARGS.source_dir)
+        files = {os.path.relpath(p, src) for p in glob.glob(os.path.join(src, "tests", "rules", "*.xml")) +
+                 glob.glob(os.path.join(src, "rules", "*.xml"))}
+        self.assertEqual(sorted(files - set(CAPTURES)), [], "rule files without captures in CAPTURES")
+
+    def test_summary_lines_alike_with_and_without_a_tap_listener(self):
+        for rules, frames in sorted(CAPTURES.items()):
+            if frames is None:
+                continue
+            with self.subTest(rules=rules), TsharkEnv() as env:
+                # This plugin alone: a rule file whose names Wireshark's own plugins take
+                # (the paper's ECAT) decodes too.
+                folder = os.path.join(env.home, "alone")
+                epan = os.path.join(folder, env.abi, "epan")
+                os.makedirs(epan)
+                subprocess.run([ARGS.dissgen, "install", os.path.join(ARGS.source_dir, rules), "--dir", epan],
+                               check=True, capture_output=True)
+                subprocess.run(["chmod", "-R", "a+rX", env.home], check=True)
+                base = env.env
+                env.env = lambda: dict(base(), WIRESHARK_PLUGIN_DIR=folder)
+                packets = with_cuts(frames())
+                cap = env.add_file("rules.pcap", pcap(packets))
+                walk = QuietWalk()
+                walk.env = env
+                walk.check(cap)
+                proto = subprocess.run([ARGS.dissgen, "fields", os.path.join(ARGS.source_dir, rules)],
+                                       capture_output=True, text=True, check=True).stdout.split("\t")[0]
+                layers = env.tshark(["-r", cap, "-T", "fields", "-e", "frame.protocols"]).stdout.splitlines()
+                ours = sum(1 for line in layers if proto in line.split(":"))
+                self.assertGreater(ours, len(packets) // 2, "%s: the plugin decodes the captures" % rules)
 
 
 if __name__ == "__main__":

@@ -52,9 +52,16 @@ def unit(gtest_filter):
     return command
 
 
+def corpus_differential(src, build):
+    return integration("ecat_differential.py", "--corpus",
+                       os.path.join(src, "..", "shared", "corpus", "ethercat"))(src, build)
+
+
 # The tests a mutant may name, each short (seconds), each a real test of the suite.
 # Golden files are not among them: they record the emitter's output and a changed
 # output is regenerated on purpose, so a mutant must be killed by behaviour.
+# Every integration script, and every part a script can run alone (--only), has a name
+# here (check_coverage): a bug only one part catches must be able to name that part.
 TESTS = {
     "unit": unit("-Golden*"),
     "rules_err": unit("Files/RulesErr.*:Files/RulesOk.*:RuleFolders.*"),
@@ -69,18 +76,54 @@ TESTS = {
     "info_column": integration("test_info_column.py"),
     "layout": integration("test_layout.py"),
     "bus_tables": integration("test_bus_tables.py"),
+    "bus_identities": integration("test_bus_model.py", "--only", "identities"),
+    "bus_network": integration("test_bus_model.py", "--only", "network"),
+    "bus_wkc": integration("test_bus_model.py", "--only", "wkc"),
+    "bus_stats": integration("test_bus_model.py", "--only", "stats"),
+    "bus_eni": integration("test_bus_model.py", "--only", "eni"),
     "bus_pdo": integration("test_bus_model.py", "--only", "pdo"),
     "bus_coe": integration("test_bus_model.py", "--only", "coe"),
     "pairing": integration("test_pairing.py", "--quick"),
     "pairing_full": integration("test_pairing.py"),
+    "esc_commands": integration("test_esc_commands.py"),
+    "ecat_figures": integration("test_ecat_figures.py"),
+    "edges_handoff": integration("test_edges.py", "--only", "handoff"),
+    "edges_peek": integration("test_edges.py", "--only", "peek"),
+    "edges_offsets": integration("test_edges.py", "--only", "offsets"),
     "malformed_skip": integration("test_malformed_skip.py"),
     "quiet": integration("test_quiet.py"),
+    "live_capture": integration("test_live_capture.py"),
     "differential": integration("ecat_differential.py", "--frames", "2000", "--max-datagrams", "20",
                                 "--malformed", "200"),
+    "corpus_differential": corpus_differential,
     "transactions": integration("test_transactions.py"),
     "losses": integration("test_losses.py"),
     "losses_corpus": integration("test_losses.py", "--with-corpus"),
+    "findings": integration("test_findings.py"),
+    "corpus_padding": integration("test_corpus_padding.py"),
+    "plugin_contents": integration("test_plugin_contents.py"),
+    "reserved_names": integration("test_reserved_names.py"),
 }
+
+
+def check_coverage(source_dir):
+    """What no TESTS name reaches: integration scripts not named, and parts of a script
+    (its PARTS = (...) tuple, chosen with --only) that no name selects and that no name
+    running the whole script covers."""
+    commands = [c("SRC", "BUILD") for c in TESTS.values()]
+    folder = os.path.join(source_dir, "tests", "integration")
+    missing = []
+    for path in sorted(glob.glob(os.path.join(folder, "test_*.py"))) + [os.path.join(folder, "ecat_differential.py")]:
+        script = os.path.basename(path)
+        runs = [c[c.index(x) + 1:] for c in commands for x in c if x.endswith("/" + script)]
+        if not runs:
+            missing.append(script)
+            continue
+        m = re.search(r"^PARTS = \(([^)]*)\)", open(path, encoding="utf-8").read(), re.M)
+        for part in re.findall(r'"([^"]+)"', m.group(1)) if m else []:
+            if not any(r[r.index("--only") + 1] == part for r in runs if "--only" in r):
+                missing.append("%s --only %s" % (script, part))
+    return missing
 
 
 class Mutant:
@@ -203,6 +246,10 @@ def main(argv=None):
         for m in mutants:
             print("%-34s %-36s %s" % (m.name, m.file, " ".join(m.tests)))
         return 0
+    uncovered = check_coverage(args.source_dir)
+    if uncovered:
+        print("the TESTS table names no way to run: %s (add a name for each)" % ", ".join(uncovered))
+        return 1
     if args.check:
         bad = 0
         for m in mutants:

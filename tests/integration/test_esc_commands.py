@@ -1,0 +1,194 @@
+#!/usr/bin/env python3
+"""What the segment did, for every EtherCAT command: rules/ethercat.xml's ethercat-esc analysis
+on generated frame pairs (a frame from the master's MAC, its return from the same MAC with the
+locally administered bit set), with real tshark, one pass and -2.
+
+For each of the 15 commands (NOP, the reads APRD FPRD BRD LRD, the writes APWR FPWR BWR LWR,
+the read/writes APRW FPRW BRW LRW, ARMW, FRMW), one pair per case below, each pair with
+indexes of its own. What each returned frame must show is worked out here from the ESC rules
+of the manual (an independent statement of them, not the plugin's code): the command, index,
+length and address (ADO; the ADP of configured-address commands and NOP; the logical address)
+never change; auto-increment and broadcast commands advance their ADP by the slaves passed;
+writes keep their data; the working counter only grows.
+
+  clean           what a working segment returns: WKC +1, ADP +2 where it advances, new data
+                  where the command reads
+  data altered    the data came back with one byte other: ecatr.expert.write_changed on the
+                  writes only, ecatr.esc.data_changed on all
+  wkc down        sent with 5, back with 3: ecatr.expert.wkc_down, ecatr.esc.wkc_added -2
+  wkc unchanged   0 and 0: neither
+  ado changed     (logical: the logical address) ecatr.expert.changed on every command
+  adp moved       by 3: slaves passed for the advancing commands, ecatr.expert.changed on the
+                  others
+  forwarding      (advancing commands) three datagrams, the last advanced by one more:
+                  ecatr.expert.forwarding on it alone
+
+Every returned frame carries ecatr.request_in of its request and ecatr.esc.* per datagram
+(ecatr.esc.wkc_added, ecatr.esc.slaves_passed on advancing commands only,
+ecatr.esc.data_changed), and exactly the expert infos above (counted per datagram); every sent
+frame ecatr.response_in (-2) and no expert info.
+
+    test_esc_commands.py --dissgen build/bin/dissgen --source-dir .
+"""
+import argparse
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pcapgen as pg  # noqa: E402
+from tshark_env import Checks, TsharkEnv  # noqa: E402
+
+NAMES = pg.CMD_NAMES
+WRITES = {2, 5, 8, 11}                  # APWR FPWR BWR LWR
+DATA_READ = {1, 3, 4, 6, 7, 9, 10, 12, 13, 14}  # every command whose data a slave fills in
+ADVANCING = {1, 2, 3, 7, 8, 9, 13}      # auto-increment and broadcast
+LOGICAL = {10, 11, 12}
+EXPERTS = ["changed", "frame_length", "write_changed", "wkc_down", "forwarding", "duplicate", "out_of_order",
+           "no_response"]
+ESC = ["ecatr.esc.wkc_added", "ecatr.esc.slaves_passed", "ecatr.esc.data_changed"]
+FIELDS = ["frame.number", "ecatr.request_in", "ecatr.response_in"] + ESC + ["ecatr.expert." + e for e in EXPERTS]
+MASTER = b"\x00\x1b\x21\x3c\x55\x10"
+RETURNED = bytes([MASTER[0] | 0x02]) + MASTER[1:]
+check = Checks()
+
+
+def datagram(cmd, idx, adp=0xfffe, ado=0x1000, lad=0x00012340, data=b"\x11\x22\x33\x44", wkc=0):
+    return pg.Datagram(cmd=cmd, idx=idx, adp=adp, ado=ado, lad=lad if cmd in LOGICAL else 0, data=data, wkc=wkc)
+
+
+def returned(d, wkc=None, advance=2, data=None, ado=None, adp=None):
+    """What a segment returns for datagram d; the keywords change what the rules fix."""
+    back = pg.Datagram(**vars(d))
+    back.wkc = d.wkc + 1 if wkc is None else wkc
+    if d.cmd in ADVANCING:
+        back.adp = (d.adp + advance) & 0xFFFF
+    if data is not None:
+        back.data = data
+    elif d.cmd in DATA_READ:
+        back.data = bytes(b ^ 0xA5 for b in d.data)
+    if ado is not None:
+        if d.cmd in LOGICAL:
+            back.lad = d.lad ^ (ado << 16)
+        else:
+            back.ado = ado
+    if adp is not None:
+        if d.cmd in LOGICAL:
+            back.lad = (d.lad & 0xFFFF0000) | adp
+        else:
+            back.adp = adp
+    return back
+
+
+class Case:
+    """One frame pair and what its return must show, datagram by datagram."""
+    def __init__(self, what, cmd, sent, back, expect):
+        self.what, self.cmd, self.sent, self.back = what, cmd, sent, back
+        self.expect = expect    # {field: [value per occurrence]}
+
+
+def expected(sent, back, experts):
+    """The ecatr.esc.* values from the two frames' datagrams (what the rules say), and the
+    expert infos the case raises: {name: count}."""
+    e = {"ecatr.esc.wkc_added": [str(b.wkc - s.wkc) for s, b in zip(sent, back)],
+         "ecatr.esc.slaves_passed": [str((b.adp - s.adp) & 0xFFFF) for s, b in zip(sent, back)
+                                     if s.cmd in ADVANCING],
+         "ecatr.esc.data_changed": ["1" if s.data != b.data else "0" for s, b in zip(sent, back)]}
+    for name in EXPERTS:
+        e["ecatr.expert." + name] = ["1"] * experts.get(name, 0)
+    return e
+
+
+def cases():
+    out = []
+    idx = [0]
+
+    def add(what, cmd, sent, back, experts):
+        out.append(Case(what, cmd, sent, back, expected(sent, back, experts)))
+
+    def nxt():
+        idx[0] += 1
+        return idx[0]
+
+    for cmd in sorted(NAMES):
+        d = datagram(cmd, nxt())
+        add("clean", cmd, [d], [returned(d)], {})
+        d = datagram(cmd, nxt())
+        add("data altered", cmd, [d], [returned(d, data=bytes([d.data[0] ^ 0x5A]) + d.data[1:])],
+            {"write_changed": 1} if cmd in WRITES else {})
+        d = datagram(cmd, nxt(), wkc=5)
+        add("wkc down", cmd, [d], [returned(d, wkc=3)], {"wkc_down": 1})
+        d = datagram(cmd, nxt(), wkc=0)
+        add("wkc unchanged", cmd, [d], [returned(d, wkc=0)], {})
+        d = datagram(cmd, nxt())
+        add("ado changed", cmd, [d], [returned(d, ado=0x1100)], {"changed": 1})
+        d = datagram(cmd, nxt(), adp=0x1001)
+        add("adp moved", cmd, [d], [returned(d, adp=0x1004)], {} if cmd in ADVANCING else {"changed": 1})
+        if cmd in ADVANCING:
+            ds = [datagram(cmd, nxt(), adp=(-k) & 0xFFFF, ado=0x0130) for k in range(3)]
+            add("forwarding", cmd, ds, [returned(ds[0]), returned(ds[1]), returned(ds[2], advance=3)],
+                {"forwarding": 1})
+    return out
+
+
+def frames_of(cs):
+    frames, t = [], 1704067200.0
+    for c in cs:
+        frames.append(pg.Frame(c.sent, src_mac=MASTER, ts=t))
+        frames.append(pg.Frame(c.back, src_mac=RETURNED, ts=t + 0.000150))
+        t += 0.001
+    return frames
+
+
+def decode(env, path, two_pass):
+    args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"] + (["-2"] if two_pass else [])
+    for f in FIELDS:
+        args += ["-e", f]
+    rows = {}
+    for line in env.tshark(args).stdout.splitlines():
+        cols = (line.split("\t") + [""] * len(FIELDS))[:len(FIELDS)]
+        rows[int(cols[0])] = {f: (v.split(",") if v else []) for f, v in zip(FIELDS[1:], cols[1:])}
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--dissgen", required=True)
+    ap.add_argument("--source-dir", required=True)
+    args = ap.parse_args()
+    cs = cases()
+    covered = {(c.what, c.cmd) for c in cs}
+    check(all(("clean", cmd) in covered for cmd in NAMES), "every command has its cases (%d pairs)" % len(cs))
+    with TsharkEnv() as env:
+        env.install_plugin(args.dissgen, os.path.join(args.source_dir, "rules", "ethercat.xml"))
+        env.assert_plugin_loaded("ecatr")
+        path = env.add_file("esc-commands.pcap", pg.pcap_bytes(frames_of(cs)))
+        for two_pass in (False, True):
+            tag = " (-2)" if two_pass else ""
+            rows = decode(env, path, two_pass)
+            bad_requests, bad_returns = [], []
+            for k, c in enumerate(cs):
+                sent_no, back_no = 2 * k + 1, 2 * k + 2
+                r = rows[sent_no]
+                want_sent = {f: [] for f in FIELDS[1:]}
+                if two_pass:
+                    want_sent["ecatr.response_in"] = [str(back_no)]
+                if r != want_sent:
+                    bad_requests.append((sent_no, c.what, NAMES[c.cmd], {f: v for f, v in r.items() if v}))
+                want = dict(c.expect, **{"ecatr.request_in": [str(sent_no)], "ecatr.response_in": []})
+                got = rows[back_no]
+                diff = {f: (got[f], want[f]) for f in want if got[f] != want[f]}
+                if diff:
+                    bad_returns.append("%s %s (frame %d): %s" % (NAMES[c.cmd], c.what, back_no, diff))
+            check(not bad_requests, "sent frames%s: paired, no expert info%s" % (
+                tag, ": %s" % bad_requests[:4] if bad_requests else ""))
+            for cmd in sorted(NAMES):
+                mine = [b for b in bad_returns if b.startswith(NAMES[cmd] + " ")]
+                check(not mine, "%s%s: returned frames show what the rules say (%s)%s" % (
+                    NAMES[cmd], tag, ", ".join(c.what for c in cs if c.cmd == cmd),
+                    "".join("\n       " + b for b in mine[:4])))
+    print("\n%d failed" % len(check.failed))
+    return 1 if check.failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
