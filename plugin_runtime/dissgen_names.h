@@ -68,7 +68,9 @@
       "The frame this one answers")                                                                       \
     X(time, "time", FT_RELATIVE_TIME, BASE_NONE, NULL, "Round trip", "Time from the request to this response") \
     X(no_response_to, "no_response_to", FT_FRAMENUM, BASE_NONE, FRAMENUM_TYPE(FT_FRAMENUM_REQUEST),          \
-      "No response to", "A request this message proves lost (its key reused, or its timeout passed)")
+      "No response to", "A request this message proves lost (its key reused, or its timeout passed)")     \
+    X(no_request, "no_request", FT_NONE, BASE_NONE, NULL, "Request not captured",                           \
+      "A response whose request is not in the capture (it answers nothing)")
 
 #define DG_PAIRING_EXPERTS(X)                                                                              \
     X(no_response, "expert.no_response", PI_SEQUENCE, PI_WARN, "No response seen")                          \

@@ -105,7 +105,7 @@ const dg_analysis *analysis;
 const char *key_name = "key"; /* the first key field's name, for texts */
 capture_state *capture; /* NULL between captures */
 
-int hf_response_in = -1, hf_request_in = -1, hf_time = -1, hf_no_response_to = -1;
+int hf_response_in = -1, hf_request_in = -1, hf_time = -1, hf_no_response_to = -1, hf_no_request = -1;
 expert_field ei_no_response = EI_INIT, ei_duplicate = EI_INIT, ei_out_of_order = EI_INIT;
 
 guint key_hash(gconstpointer v)
@@ -757,6 +757,10 @@ void show(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, proto_t
                                          "Response to frame %u came back after the response to a later request",
                                          t->request_frame);
         if (analysis && analysis->show && fp->analysis) analysis->show(fp->analysis, tvb, pinfo, tree);
+        break;
+    case DG_ROLE_ORPHAN:
+        item = proto_tree_add_item(tree, hf_no_request, tvb, 0, 0, ENC_NA);
+        proto_item_set_generated(item);
         break;
     case DG_ROLE_DUPLICATE:
         proto_tree_add_expert_format(tree, pinfo, &ei_duplicate, tvb, 0, 0,

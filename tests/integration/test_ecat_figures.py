@@ -5,12 +5,13 @@ faults, with real tshark.
 
 1. Statistics (`tshark -q -z ecatr,tree`, one pass and -2): every row of "Requests and
    responses" equals a count of the fields and expert infos tshark -2 -T fields shows:
-     Requests            frames with ecatr.response_in or ecatr.expert.no_response
+     Requests            the other frames with a datagram index (a pairing key): answered,
+                         lost, or still in flight when the capture ends
      Responses           frames with ecatr.request_in
      No response         ecatr.expert.no_response
      Duplicates          ecatr.expert.duplicate
      Responses to requests not captured
-                         the other frames with a datagram index (a pairing key)
+                         ecatr.no_request
      Round trip (ms)     count, average, minimum and maximum of ecatr.time
      Working counter per command (returned)
                          the returned datagrams compared (one ecatr.esc.wkc_added each), per
@@ -45,7 +46,7 @@ import pcaprewrite as pr  # noqa: E402
 from tshark_env import Checks, TsharkEnv  # noqa: E402
 
 SKIP = 77
-FIELDS = ["frame.number", "ecatr.response_in", "ecatr.request_in", "ecatr.time", "ecatr.expert.no_response",
+FIELDS = ["frame.number", "ecatr.response_in", "ecatr.no_request", "ecatr.request_in", "ecatr.time", "ecatr.expert.no_response",
           "ecatr.expert.duplicate", "ecatr.expert.wkc_down", "ecatr.expert.wkc", "ecatr.datagram.idx",
           "ecatr.datagram.cmd", "ecatr.datagram.wkc", "ecatr.esc.wkc_added"]
 MASTER = b"\x00\x1b\x21\x3c\x55\x10"
@@ -103,15 +104,15 @@ def figures(rows):
         f[path] = 0
     times = []
     for r in rows.values():
-        request = bool(r["ecatr.response_in"] or r["ecatr.expert.no_response"])
         response = bool(r["ecatr.request_in"])
         duplicate = bool(r["ecatr.expert.duplicate"])
+        orphan = bool(r["ecatr.no_request"])
+        request = bool(r["ecatr.datagram.idx"]) and not (response or duplicate or orphan)
         add(("Requests",), request)
         add(("Responses",), response)
         add(("No response",), bool(r["ecatr.expert.no_response"]))
         add(("Duplicates",), duplicate)
-        add(("Responses to requests not captured",),
-            bool(r["ecatr.datagram.idx"]) and not (request or response or duplicate))
+        add(("Responses to requests not captured",), orphan)
         add(("Working counter went down",), len(r["ecatr.expert.wkc_down"]))
         add(("Unexpected working counter",), len(r["ecatr.expert.wkc"]))
         if response:
