@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Issue 14: a walk nobody sees steps over quiet nodes, and nothing shown changes.
+"""Quiet nodes: a walk nobody sees steps over quiet nodes, and nothing shown changes.
 
 With no tree and no tap listener (tshark's summary lines), the EtherCAT and
 EtherNet/IP plugins step over the nodes that feed nothing (generator/quiet.cpp)
