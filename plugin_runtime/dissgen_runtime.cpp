@@ -929,7 +929,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
             st->stopped = FALSE; /* the data simply ended: siblings may still be empty-length */
             break;
         }
-        if (n->extra && n->extra->repeat_rest && *offset >= end) break; /* issue 10a: repeat="rest" */
+        if (n->extra && n->extra->repeat_rest && *offset >= end) break; /* repeat="rest": stop where the data ends */
         clear_slots(st, n);
         gint before = *offset;
         dissect_instance(st, n, tree, offset, end, in_summary, collect ? &summaries : NULL);

@@ -626,7 +626,7 @@ DG_FIXED = [("Command", 1), ("Index", 1)]
 
 def ours_shows(payload):
     """What the bytes imply ecatr shows besides the field values, by rules/ethercat.xml and
-    the runtime's rules (RULES-SPEC): the number of ecatr.datagram items, the Info column, and
+    the runtime's rules (docs/manual.md): the number of ecatr.datagram items, the Info column, and
     the expert infos as (filter name, offset in the EtherCAT payload, message) in tree order,
     and the regions (start, end, container, ours stops inside) of datagram data where ours reports what the rules
     inside find (registers, mailboxes: the Wireshark comparison checks those; container None:

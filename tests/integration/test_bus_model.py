@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The bus as the capture shows it, and the network check (issue 12), with real tshark.
+"""The bus as the capture shows it, and the network check, with real tshark.
 
 1. Identities: on every real capture of ../shared/corpus/ethercat, the slaves the plugin
    reports per position (ecatr.slave.position/station/vendor/product/revision) are the ones

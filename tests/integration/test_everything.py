@@ -8,7 +8,7 @@ generated plugin must show: every field's -T fields value in tree order, the
 -V tree line by line (bit masks in both byte orders, hex widths, enum names
 and "Unknown (0x..)", True/False, addresses, bytes, hidden fields left out,
 summaries on nested containers) and the Info column; a small model of the
-decoding rules of RULES-SPEC (class Expected) walks what the encoder wrote over
+decoding rules of docs/manual.md (class Expected) walks what the encoder wrote over
 the bytes actually captured. The messages travel on
 the ethertype and on the UDP hook. Malformed messages (truncated, lengths past
 the end, negative lengths, short counts, repeat flags with nothing after
@@ -295,7 +295,7 @@ OTHER_EXPERTS = ("bad_offset",)
 
 
 class Expected:
-    """Walks the written nodes the way RULES-SPEC says a packet is decoded, over the
+    """Walks the written nodes the way docs/manual.md says a packet is decoded, over the
     bytes actually captured (`cut`), and collects what tshark must show: the tree,
     the expert messages and the Info column."""
 
@@ -828,7 +828,7 @@ def dissgen(*args):
 
 
 def naming_rule(xml_path, proto):
-    """The display-filter names RULES-SPEC gives the nodes of a rule file, computed here."""
+    """The display-filter names docs/manual.md gives the nodes of a rule file, computed here."""
     root = ET.parse(xml_path).getroot()
     names, position = [], [0]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Alternatives, multi-field conditions, look-ahead and register maps (issue 10b)
+"""Alternatives, multi-field conditions, look-ahead and register maps
 with real tshark: tests/rules/layout.xml.
 
 Records of a made-up UDP protocol (kind, mode, address, length, data, counter,

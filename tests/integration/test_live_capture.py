@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Live capture (issue 11): real EtherCAT captures replayed on a veth pair, decoded live.
+"""Live capture: real EtherCAT captures replayed on a veth pair, decoded live.
 
   test_live_capture.py --dissgen build/bin/dissgen --source-dir . [--corpus DIR]
 

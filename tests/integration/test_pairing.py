@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Out and back (issue 11): EtherCAT frames paired with their returns, on the real captures
+"""Out and back: EtherCAT frames paired with their returns, on the real captures
 of ../shared/corpus/ethercat and on copies of them with faults injected.
 
   test_pairing.py --dissgen build/bin/dissgen --source-dir . [--corpus DIR] [--quick]

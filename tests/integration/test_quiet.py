@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Issue 14: a walk nobody sees steps over quiet nodes, and nothing shown changes.
+"""Quiet nodes: a walk nobody sees steps over quiet nodes, and nothing shown changes.
 
 With no tree and no tap listener (tshark's summary lines), the EtherCAT and
 EtherNet/IP plugins step over the nodes that feed nothing (generator/quiet.cpp)
@@ -179,8 +179,8 @@ def layout_frames():
     return out
 
 
-def display10a_frames():
-    import test_display10a as m
+def typed_values_frames():
+    import test_typed_values as m
     a, b = bytes(range(48)), bytes(range(100, 148))
     return [m.to_port(m.values_message()), m.to_port(bytes([3]) + m.inner_frame((10, 1, 2, 3))),
             m.to_port(bytes([4]) + b"\x01\x02\x03"),
@@ -256,7 +256,7 @@ CAPTURES = {
     "tests/rules/widths.xml": widths_frames,
     "tests/rules/everything.xml": everything_frames,
     "tests/rules/layout.xml": layout_frames,
-    "tests/rules/display10a.xml": display10a_frames,
+    "tests/rules/typed_values.xml": typed_values_frames,
     "tests/rules/skip.xml": skip_frames,
     "tests/rules/paper_example.xml": ethercat_frames,
     "tests/rules/handoff.xml": handoff_frames,

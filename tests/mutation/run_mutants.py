@@ -72,7 +72,7 @@ TESTS = {
     "enip": integration("test_enip.py"),
     "loading": integration("test_plugin_loading.py"),
     "esi": unit("Esi*:Files/EsiErr.*:Design.*:Eni.*:Files/NetworkErr.*:BusTables.*:ManualBus.*:-*Golden*"),
-    "display10a": integration("test_display10a.py"),
+    "typed_values": integration("test_typed_values.py"),
     "info_column": integration("test_info_column.py"),
     "layout": integration("test_layout.py"),
     "bus_tables": integration("test_bus_tables.py"),

@@ -33,7 +33,7 @@ TEST(Golden, ShippedEthercatRules) { check_golden("rules/ethercat.xml", "dissgen
 TEST(Golden, PaperExample) { check_golden("tests/rules/paper_example.xml", "dissgen_paper_example.cpp.golden"); }
 
 // Typed values, range enums, repeat="rest", direction, hand-off, reassembly.
-TEST(Golden, TypedValues) { check_golden("tests/rules/display10a.xml", "dissgen_display10a.cpp.golden"); }
+TEST(Golden, TypedValues) { check_golden("tests/rules/typed_values.xml", "dissgen_typed_values.cpp.golden"); }
 // <when>, peek, otherwise and register windows.
 TEST(Golden, LayoutRules) { check_golden("tests/rules/layout.xml", "dissgen_layout.cpp.golden"); }
 // Summaries naming summarised containers, optional parts {?...}.

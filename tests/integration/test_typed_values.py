@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Issue 10a constructs with real tshark: tests/rules/display10a.xml.
+"""Typed values, hand-off and reassembly with real tshark: tests/rules/typed_values.xml.
 
 UDP messages to and from port 47480 carry, by their first byte: typed values
 (string, stringz, ipv4, int, float, time, a range enum), a request/response
@@ -10,7 +10,7 @@ frame, out of order and with one message missing a fragment; by number into
 raw bytes). Every value is checked against the bytes this script wrote, in one
 pass and with -2; malformed messages give our expert infos and the tree so far.
 
-    test_display10a.py --dissgen build/bin/dissgen --source-dir .
+    test_typed_values.py --dissgen build/bin/dissgen --source-dir .
 """
 import os
 import struct
@@ -26,8 +26,8 @@ ARGS = None
 ENV = None
 PORT = 47480
 CLIENT_PORT = 50000
-RULES = os.path.join("tests", "rules", "display10a.xml")
-MISSING_WARNING = "hands its bytes to the dissector \"no_such_dissector_10a\""
+RULES = os.path.join("tests", "rules", "typed_values.xml")
+MISSING_WARNING = "hands its bytes to the dissector \"no_such_dissector\""
 
 
 def to_port(payload):
@@ -119,7 +119,7 @@ def capture(name, frames):
     return ENV.add_file(name, pcap(frames))
 
 
-class Display10a(unittest.TestCase):
+class TypedValues(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         global ENV
