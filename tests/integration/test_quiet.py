@@ -235,6 +235,14 @@ def offsets_frames():
     return out
 
 
+def transactions_frames():
+    """tests/rules/transactions.xml: requests to the port and responses from it, paired,
+    orphaned and lost (test_transactions.py's messages)."""
+    import test_transactions as m
+    return [m.frame(direction, transaction, unit, n)
+            for n, (_ms, direction, transaction, unit) in enumerate(m.MESSAGES, 1)]
+
+
 def quiet_bits_frames():
     """tests/rules/quiet_bits.xml with random values: whole-byte members in the middle of groups."""
     rng = random.Random(5)
@@ -262,6 +270,7 @@ CAPTURES = {
     "tests/rules/handoff.xml": handoff_frames,
     "tests/rules/offsets_from.xml": offsets_frames,
     "tests/rules/quiet_bits.xml": quiet_bits_frames,
+    "tests/rules/transactions.xml": transactions_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,
