@@ -302,7 +302,9 @@ check "/usr/share/dissgen is gone" test ! -e /usr/share/dissgen
 check "/usr/share/doc/dissgen is gone" test ! -e /usr/share/doc/dissgen
 check "/usr/bin/dissgen is gone" test ! -e /usr/bin/dissgen
 find "$plugin_dir" -maxdepth 1 | sort >"$work/plugins-after"
-check "the plugin folder is as before the install" cmp -s "$work/plugins-before" "$work/plugins-after"
+plugins_changed=$(diff "$work/plugins-before" "$work/plugins-after" | grep '^[<>]' | tr '\n' ' ' || true)
+check "the plugin folder is as before the install${plugins_changed:+ (changed: $plugins_changed)}" \
+  test -z "$plugins_changed"
 HOME="$work/roothome" tshark -r "$work/ecat.pcap" -c 1 -T fields -e _ws.col.Protocol >"$work/out" 2>"$work/err"
 check "root's tshark is back to Wireshark's own EtherCAT dissector ($(cat "$work/out"))" \
   grep -qx "ECAT" "$work/out"
