@@ -68,6 +68,18 @@ def cyclic_capture(cycles=400):
     return packets
 
 
+def status_capture(cycles=400):
+    """A BRD of the AL status every millisecond, sent with the very same bytes every cycle
+    (one index, nothing the master sends changes): a cycle whose return was lost must not
+    make the next request look like a copy of the previous one."""
+    packets, t = [], 1_700_000_000 * 10**9
+    for n in range(cycles):
+        dgs = [(7, 0x05, 0x0000, 0x0130, b"\0\0", 0)]
+        packets.append(pr.Packet(ecat_frame(MASTER, dgs), t + n * 1_000_000))
+        packets.append(pr.Packet(returned(MASTER, dgs, 2), t + n * 1_000_000 + 60_000))
+    return packets
+
+
 def mailbox_capture(rounds=300):
     """Mailbox polling of three stations, two frames in flight at a time, indexes 0..15 in turn."""
     packets, t, idx = [], 1_700_000_000 * 10**9, 0
@@ -150,7 +162,7 @@ class Decoder:
         path = self.env.path("copy%d.%s" % (self.count, cap.kind))
         cap.write(path)
         os.chmod(path, 0o644)
-        fields = ["frame.number", "ecatr.no_response_to"] + self.values + self.experts
+        fields = ["frame.number", "ecatr.no_response_to", "ecatr.no_request"] + self.values + self.experts
         args = ["-r", path, "-Y", "ecatr", "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"]
         if two_pass:
             args.append("-2")
@@ -163,12 +175,13 @@ class Decoder:
             tag = tag_of[int(cols[0])]
             row = {"experts": [], "lost": set(), "negative": []}
             row["lost"] = {tag_of[int(x)] for x in cols[1].split(",") if x}
+            row["no_request"] = bool(cols[2])
             for k, f in enumerate(self.values):
-                if any(v.startswith("-") for v in cols[2 + k].split(",") if v):
+                if any(v.startswith("-") for v in cols[3 + k].split(",") if v):
                     row["negative"].append(f)
             for k, f in enumerate(self.experts):
-                if cols[2 + len(self.values) + k]:
-                    row["experts"] += [f] * len(cols[2 + len(self.values) + k].split(","))
+                if cols[3 + len(self.values) + k]:
+                    row["experts"] += [f] * len(cols[3 + len(self.values) + k].split(","))
             rows[tag] = row
         os.unlink(path)
         return rows
@@ -317,6 +330,36 @@ def orphan_checks(env, dec, name, base, pairs):
         os.unlink(path)
 
 
+def foreign_return_checks(dec, name, base, pairs):
+    """Another station's return (marked, working counter 1, an index and an address the
+    capture does not use) right after a request in the middle of the capture, while that
+    request waits: an orphan (ecatr.no_request), paired with nothing, nothing else changed."""
+    order = sorted(pairs)
+    if len(order) < 10:
+        return
+    request = pairs[order[len(order) // 2]]
+    used = {d["idx"] for p in base.packets for d in pr.ecat_datagrams(p)}
+    free = next((i for i in range(255, -1, -1) if i not in used), None)
+    if free is None:
+        return
+    sent = base.packets[request]
+    src = bytes(sent.data[6:12])
+    frame = ecat_frame(bytes([src[0] | 0x02]) + src[1:], [(4, free, 0x7777, 0x0999, b"\0\0", 1)])
+    foreign = pr.Packet(frame, sent.ts + 1, sent.ifid, tag=len(base.packets))
+    copy = clone(base)
+    copy.packets.insert(request + 1, foreign)
+    for two_pass in (True, False):
+        mode = "-2" if two_pass else "one pass"
+        before, after = dec.run(base, two_pass), dec.run(copy, two_pass)
+        orphan = after.get(foreign.tag, {})
+        check(orphan.get("no_request") and not orphan.get("experts") and not orphan.get("lost"),
+              "%s, %s: another station's return after frame %d is an orphan, nothing raised on it (%s)" % (
+                  name, mode, request + 1, orphan))
+        new = sorted(other_experts({t: r for t, r in after.items() if t != foreign.tag}) - other_experts(before))
+        lost = sorted((flagged(after) | named(after)) - (flagged(before) | named(before)))
+        check(not new and not lost, "%s, %s: nothing else changes (new %s, lost %s)" % (name, mode, new[:5], lost))
+
+
 def clone(cap):
     copy = pr.Capture(cap.kind, cap.endian, cap.header, list(cap.blocks) if cap.blocks else cap.blocks)
     copy.units = dict(cap.units)
@@ -341,6 +384,7 @@ def run_capture(env, dec, name, cap, summary, k=10):
     plain.unchanged = True
     deletion_checks(dec, name + " (unmarked)", plain, pairs, k, summary)
     orphan_checks(env, dec, name, cap, pairs)
+    foreign_return_checks(dec, name, cap, pairs)
 
 
 def main():
@@ -358,6 +402,7 @@ def main():
         env.assert_plugin_loaded("ecatr")
         dec = Decoder(env)
         for name, packets in (("generated cyclic LRW+FRMW", cyclic_capture()),
+                              ("generated status polling, the same bytes every cycle", status_capture()),
                               ("generated mailbox polling, two in flight", mailbox_capture())):
             path = env.path(name.split()[1] + ".pcap")
             generated(path, packets)
