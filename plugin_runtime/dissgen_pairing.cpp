@@ -199,15 +199,13 @@ gboolean same_again(const capture_state *c, const key_entry *e, tvbuff_t *tvb, p
 }
 
 /* A message the same as the last one (same_again) is a frame that came back
- * unprocessed, the request's response, when that one was a request and the
- * analysis cannot tell the directions apart (returns not marked, as from a
- * simulator). */
-gboolean unchanged_return(const capture_state *c, const key_entry *e, const packet_info *pinfo)
+ * unprocessed, the request's response, when that one was a request, nothing
+ * says this one is a request (its direction) and the analysis knows returns
+ * that carry no mark (an EtherCAT simulator's); a copy of anything else is a
+ * duplicate. */
+gboolean unchanged_return(const key_entry *e)
 {
-    if (e->last_role != DG_ROLE_REQUEST || !analysis || !analysis->is_response) return FALSE;
-    /* A copy of a returned frame that answered nothing (an orphan) is a duplicate. */
-    if (analysis->is_returned && analysis->is_returned(c->analysis, &pinfo->src)) return FALSE;
-    return analysis->is_response(c->analysis, &e->last_src, &pinfo->src) < 0;
+    return e->last_role == DG_ROLE_REQUEST && analysis && analysis->is_response;
 }
 
 /* Takes e out of the capture's least-recently-used list (if it is there). */
@@ -669,7 +667,7 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     if (verdict == (DG_DIR_RESPONSE | DG_DIR_FROM_SOURCE) && c->guessed) orphan_guessed_from(c, pinfo);
     key_entry *e = entry_for(c, keys, key_count);
     gboolean again = same_again(c, e, tvb, pinfo, length);
-    gboolean unchanged = again && direction != DG_DIR_REQUEST && unchanged_return(c, e, pinfo);
+    gboolean unchanged = again && direction != DG_DIR_REQUEST && unchanged_return(e);
     c->last_frame = pinfo->num;
     if (again && !unchanged) {
         dg_frame_pairing *fp = new_record(DG_ROLE_DUPLICATE);
