@@ -58,14 +58,7 @@ check = Checks()
 
 def decode(env, path, two_pass):
     """{frame number: {field: [values]}}."""
-    args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"] + (["-2"] if two_pass else [])
-    for f in FIELDS:
-        args += ["-e", f]
-    rows = {}
-    for line in env.tshark(args).stdout.splitlines():
-        cols = (line.split("\t") + [""] * len(FIELDS))[:len(FIELDS)]
-        rows[int(cols[0])] = {f: (v.split(",") if v else []) for f, v in zip(FIELDS[1:], cols[1:])}
-    return rows
+    return env.field_rows(path, FIELDS, two_pass)
 
 
 def stats_tree(env, path, two_pass):

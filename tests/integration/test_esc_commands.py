@@ -140,14 +140,8 @@ def frames_of(cs):
 
 
 def decode(env, path, two_pass):
-    args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"] + (["-2"] if two_pass else [])
-    for f in FIELDS:
-        args += ["-e", f]
-    rows = {}
-    for line in env.tshark(args).stdout.splitlines():
-        cols = (line.split("\t") + [""] * len(FIELDS))[:len(FIELDS)]
-        rows[int(cols[0])] = {f: (v.split(",") if v else []) for f, v in zip(FIELDS[1:], cols[1:])}
-    return rows
+    """{frame number: {field: [values]}}."""
+    return env.field_rows(path, FIELDS, two_pass)
 
 
 def main():

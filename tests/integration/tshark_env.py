@@ -194,6 +194,18 @@ class TsharkEnv:
             cmd = ["setpriv", "--reuid=%d" % NOBODY, "--regid=%d" % NOBODY, "--clear-groups"] + cmd
         return cmd
 
+    def field_rows(self, path, fields, two_pass=False):
+        """{frame number: {field: [values]}} of `tshark -T fields` for fields[1:] (fields[0]
+        is frame.number), every occurrence of each field."""
+        args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"] + (["-2"] if two_pass else [])
+        for f in fields:
+            args += ["-e", f]
+        rows = {}
+        for line in self.tshark(args).stdout.splitlines():
+            cols = (line.split("\t") + [""] * len(fields))[:len(fields)]
+            rows[int(cols[0])] = {f: (v.split(",") if v else []) for f, v in zip(fields[1:], cols[1:])}
+        return rows
+
     def tshark(self, args, check=True, stdout=None, timeout=1800):
         """Run tshark; return CompletedProcess (text stdout/stderr unless stdout is a file)."""
         cmd = self.command(args)
