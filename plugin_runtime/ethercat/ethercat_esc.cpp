@@ -219,14 +219,6 @@ gboolean esc_key_changed(tvbuff_t *request, tvbuff_t *message)
     return TRUE;
 }
 
-/* The master's address with the locally administered bit set: a returned frame. */
-gboolean esc_is_returned(void *capture, const address *src)
-{
-    const capture_hints *h = (const capture_hints *)capture;
-    if (!h->marking_seen || src->type != AT_ETHER || src->len != 6) return FALSE;
-    const guint8 *b = (const guint8 *)src->data;
-    return b[0] == (h->master[0] | 0x02) && memcmp(b + 1, h->master + 1, 5) == 0;
-}
 
 void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, packet_info *pinfo)
 {
@@ -408,7 +400,7 @@ extern "C" const dg_analysis dg_ethercat_esc = {
     esc_capture_new,
     NULL, /* see */
     esc_is_response,
-    esc_is_returned,
+    NULL, /* is_returned: esc_direction() says so, marked or not */
     esc_compare,
     esc_show,
     esc_stats_init,
