@@ -4,6 +4,7 @@
 #include "analyses.h"
 #include "quiet.h"
 #include "runtime_names.h"
+#include "text_util.h"
 
 #include "validator.h"
 
@@ -35,12 +36,6 @@ std::string c_string(const std::string& s) {
 }
 
 namespace {
-
-std::string hex(uint64_t v, int digits = 0) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "0x%0*llx", digits, static_cast<unsigned long long>(v));
-    return buf;
-}
 
 unsigned value_bytes(const Node& n) { return n.in_bit_group ? n.group_bytes : n.bits / 8; }
 

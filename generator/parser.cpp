@@ -269,6 +269,7 @@ private:
     bool parse_byteorder(const std::string& text, int line, ByteOrder& out);
     FieldRef make_ref(const std::string& text, int line, const std::string& attribute, bool arithmetic);
     void defer(FieldRef& ref, xmlNode* context, int line, const std::string& attribute);
+    std::string nothing_selected_hint(const PendingRef& p) const;
     void unexpected_child(xmlNode* child, const std::string& parent, const std::vector<std::string>& allowed);
     void resolve_all();
     Node* resolve(const PendingRef& p);
@@ -778,6 +779,43 @@ void Parser::resolve_all() {
     for (const PendingRef& p : pending_) p.ref->target = resolve(p);
 }
 
+// X in the first "@name='X'" (or "@name = \"X\"") of an XPath, "" if none.
+// A plain scan: std::regex recurses per character on long values.
+std::string named_in_xpath(const std::string& xpath) {
+    for (size_t at = xpath.find("@name"); at != std::string::npos; at = xpath.find("@name", at + 1)) {
+        size_t i = xpath.find_first_not_of(" \t", at + 5);
+        if (i == std::string::npos || xpath[i] != '=') continue;
+        i = xpath.find_first_not_of(" \t", i + 1);
+        if (i == std::string::npos || (xpath[i] != '\'' && xpath[i] != '"')) continue;
+        size_t end = xpath.find(xpath[i], i + 1);
+        if (end != std::string::npos) return xpath.substr(i + 1, end - i - 1);
+    }
+    return "";
+}
+
+// Where an XPath that selected nothing was evaluated from, and, when it
+// names a node (@name='X'), whether any node has that name: the two usual
+// mistakes are a wrong step ('..' one level too few) and a misspelt name.
+std::string Parser::nothing_selected_hint(const PendingRef& p) const {
+    std::string from = "<" + element_name(p.context) + ">";
+    if (auto it = by_xml_.find(p.context); it != by_xml_.end()) from = "node '" + it->second->name + "'";
+    std::string hint = " (evaluated from " + from + " on line " + std::to_string(line_of(p.context)) + ")";
+    const std::string wanted = named_in_xpath(p.ref->xpath);
+    if (wanted.empty()) return hint;
+    std::vector<std::string> names;
+    int first_line = 0;
+    for (const auto& [xml, node] : by_xml_) {
+        if (node->name == wanted && (first_line == 0 || node->line < first_line)) first_line = node->line;
+        names.push_back(node->name);
+    }
+    if (first_line)
+        return hint + "; node '" + wanted + "' is on line " + std::to_string(first_line) +
+               ": check the path's steps from there";
+    std::sort(names.begin(), names.end());
+    std::string near = closest_match(wanted, names);
+    return hint + "; no node is named '" + wanted + "'" + (near.empty() ? "" : " (did you mean '" + near + "'?)");
+}
+
 Node* Parser::resolve(const PendingRef& p) {
     const std::string where = "XPath '" + p.ref->xpath + "' in '" + p.attribute + "'";
     xmlXPathContextPtr ctx = xmlXPathNewContext(doc_);
@@ -798,7 +836,7 @@ Node* Parser::resolve(const PendingRef& p) {
     } else {
         int count = obj->nodesetval ? obj->nodesetval->nodeNr : 0;
         if (count == 0) {
-            diags_.error(p.line, where + " selects no node");
+            diags_.error(p.line, where + " selects no node" + nothing_selected_hint(p));
         } else if (count > 1) {
             diags_.error(p.line, where + " selects " + std::to_string(count) +
                                      " nodes; it must select exactly one");

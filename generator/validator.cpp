@@ -2,6 +2,7 @@
 #include "validator.h"
 
 #include "runtime_names.h"
+#include "text_util.h"
 
 #include <algorithm>
 #include <cctype>
@@ -46,8 +47,9 @@ private:
     void check_pdulength();
     void check_pairing();
     void check_hook_list(const Node& n);
+    void check_list_fits(int line, const std::vector<ValueRange>& list, const FieldRef& ref);
     bool offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const Node* t, uint64_t& offset,
-                   bool& fixed) const;
+                   const Node*& blocker) const;
     void parse_summary(Node& n);
     void assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, const std::string& prefix);
     void mark_slot(Node* n) { if (n) needs_slot_[n] = true; }
@@ -82,6 +84,8 @@ void Validator::run() {
         if (n.count) check_reference(n, *n.count, "count");
         if (n.repeat) check_reference(n, *n.repeat, "repeat");
         if (n.if_field) check_reference(n, *n.if_field, "if");
+        if (n.if_field) check_list_fits(n.line, n.in_list, *n.if_field);
+        for (const When& w : n.whens) check_list_fits(w.line, w.in_list, w.ref);
         if (n.has_hook) check_hook_list(n);
         if (n.summary) parse_summary(n);
         check_display_direction_handoff(n);
@@ -309,14 +313,15 @@ void Validator::check_reference(Node& n, const FieldRef& ref, const std::string&
 }
 
 // Finds the byte offset of `t` (of its bit group, for a bit field) from the
-// start of `nodes`; `fixed` turns false when a field before it has no fixed size.
+// start of `nodes`. `blocker` is set to the first node that keeps the offset
+// from being fixed: a container of `t` (or `t`) that is repeated or has an
+// `if`, or a field before it without a fixed size.
 bool Validator::offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const Node* t, uint64_t& offset,
-                          bool& fixed) const {
+                          const Node*& blocker) const {
     for (const auto& c : nodes) {
-        if (c.get() == t) return true;
         if (is_ancestor_or_self(c.get(), t)) {
-            if (c->is_repeated() || c->if_field) fixed = false;
-            return offset_of(c->children, t, offset, fixed);
+            if (!blocker && (c->is_repeated() || c->if_field)) blocker = c.get();
+            return c.get() == t || offset_of(c->children, t, offset, blocker);
         }
         if (c->in_bit_group) {
             if (c->group_last) offset += c->group_bytes;
@@ -324,9 +329,21 @@ bool Validator::offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const
         }
         auto b = fixed_bytes(*c);
         if (b) offset += *b;
-        else fixed = false;
+        else if (!blocker) blocker = c.get();
     }
     return false;
+}
+
+// Why a node keeps the pdulength field from a fixed place in every message.
+std::string pdulength_blocker(const Node& blocker, const Node& t) {
+    const std::string where = quote(blocker) + at_line(blocker);
+    const bool encloses = is_ancestor_or_self(&blocker, &t);
+    const std::string self = &blocker == &t ? "it" : "it is inside " + where + ", which";
+    if (blocker.is_repeated())
+        return encloses ? self + " is repeated" : where + " before it is repeated";
+    if (encloses) return self + " has an 'if': a message without it would have no length";
+    if (blocker.is_conditional()) return where + " before it is decoded only under a condition";
+    return where + " before it has no fixed length";
 }
 
 void Validator::check_pdulength() {
@@ -337,11 +354,12 @@ void Validator::check_pdulength() {
         return;
     }
     uint64_t offset = 0;
-    bool fixed = true;
-    offset_of(proto_.nodes, t, offset, fixed);
-    if (!fixed || t->is_repeated() || t->if_field) {
+    const Node* blocker = nullptr;
+    offset_of(proto_.nodes, t, offset, blocker);
+    if (blocker) {
         diags_.error(proto_.line, "pdulength field " + quote(*t) + " must be at a fixed offset from the start of the "
-                                                                     "message (only fixed-length fields before it)");
+                                                                     "message, in every message: " +
+                                      pdulength_blocker(*blocker, *t));
         return;
     }
     proto_.pdu_fixed_len = static_cast<unsigned>(offset) + (t->in_bit_group ? t->group_bytes : t->bits / 8);
@@ -360,6 +378,21 @@ void Validator::check_hook_list(const Node& n) {
     if (!n.hook_list.empty())
         diags_.warning(n.line, quote(n) + " has an 'ifhook' list that matches none of the root's ethertype and hook "
                                "values: it is decoded only through Decode As on such a value");
+}
+
+// An 'in' value the field cannot hold never matches: most likely the list
+// was written for a wider field (in="0x100-0x1ff" on a byte).
+void Validator::check_list_fits(int line, const std::vector<ValueRange>& list, const FieldRef& ref) {
+    const Node* t = ref.target;
+    if (!t || !t->is_numeric() || t->fixed_bits >= 64) return;
+    const uint64_t max = (uint64_t{1} << t->fixed_bits) - 1;
+    for (const ValueRange& r : list) {
+        if (r.high <= max) continue;
+        const std::string values = r.low == r.high ? hex(r.low) : hex(r.low) + "-" + hex(r.high);
+        diags_.warning(line, "'in' value " + values + " does not fit the " + std::to_string(t->fixed_bits) +
+                                 "-bit field " + quote(*t) + at_line(*t) + ": " +
+                                 (r.low > max ? "it never matches" : "values above " + hex(max) + " never match"));
+    }
 }
 
 // A summary template: literal text, {X} (the first node named X inside the
@@ -652,10 +685,12 @@ void Validator::check_layout(Node& n) {
         const Node* prev = previous_sibling(proto_, n);
         if (!prev)
             diags_.error(n.line, "otherwise=\"true\" on " + quote(n) + " needs a previous sibling with a condition "
-                                 "(if, <when>, ifhook) to be the alternative of; it is the first of its siblings");
+                                 "(if, <when>, ifhook, direction) to be the alternative of; it is the first of its "
+                                 "siblings");
         else if (!prev->is_conditional())
             diags_.error(n.line, "otherwise=\"true\" on " + quote(n) + " needs a previous sibling with a condition "
-                                 "(if, <when>, ifhook) or otherwise; " + lines_of(*prev) + " is always decoded");
+                                 "(if, <when>, ifhook, direction) or otherwise; " + lines_of(*prev) +
+                                 " is always decoded");
     }
     if (n.skip_malformed) {
         if (n.is_leaf())

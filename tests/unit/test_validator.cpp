@@ -379,6 +379,22 @@ TEST(Displays, EnumValuesMustFit) {
     EXPECT_EQ(std::count(m.begin(), m.end(), '\n'), 2) << m;
 }
 
+TEST(Conditions, InValuesMustFitTheFieldTheyTest) {
+    // in="0-7" on 3 bits and in="0xff" on a byte fit; one value more does not.
+    Front f = front_end(rules("  <node name=\"k\" length=\"3bit\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"f\" length=\"5bit\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"b\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"a\" length=\"1byte\" if=\"../node[@name='k']\" in=\"0-7\"/>\n"
+                              "  <node name=\"c\" length=\"1byte\" if=\"../node[@name='b']\" in=\"0xff\"/>\n"
+                              "  <node name=\"d\" length=\"1byte\" if=\"../node[@name='k']\" in=\"1,8\"/>\n"
+                              "  <node name=\"e\" length=\"1byte\"><when field=\"../node[@name='b']\" in=\"0x100\"/></node>\n"));
+    const std::string m = f.messages();
+    EXPECT_TRUE(f.ok()) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:7: warning: 'in' value 0x8 does not fit the 3-bit field 'k' (line 2): it never matches")) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:8: warning: 'in' value 0x100 does not fit the 8-bit field 'b' (line 4): it never matches")) << m;
+    EXPECT_EQ(std::count(m.begin(), m.end(), '\n'), 2) << m;
+}
+
 TEST(Displays, Warnings) {
     Front f = front_end(rules("  <node name=\"box\" displaytype=\"numberhex\"><node name=\"x\" length=\"1byte\"/></node>\n"
                               "  <node name=\"plain\" length=\"1byte\" displaytype=\"numberhex\"><enum value=\"1\" name=\"one\"/></node>\n"
