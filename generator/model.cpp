@@ -28,6 +28,7 @@ bool is_numeric_display(Display d) {
 }
 
 bool Node::is_numeric() const {
+    if (is_computed()) return display != Display::Float;
     if (!is_leaf() || !has_fixed_length()) return false;
     if (fixed_bits < 1 || fixed_bits > 64) return false;
     return is_numeric_display(display) || display == Display::NonDisplay;

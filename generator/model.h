@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "expression.h"
+
 namespace dissgen {
 
 enum class ByteOrder { Big, Little };
@@ -153,11 +155,15 @@ struct Node {
     // start of `from` and ends where instance i+1 starts (the last one: at the
     // end of the enclosing container). offsets selects a repeated numeric leaf.
     std::optional<FieldRef> offsets, from;
+    // value="EXPR": a computed leaf, shown as a generated item; takes no bytes
+    std::optional<Expr> value;
+    std::string value_text;                 // as written, for messages
     // derived by the validator
     bool keeps_values = false;              // an offsets table: every instance's value is kept
     unsigned from_up = 0;                   // from an enclosing container: k levels up (0: an earlier field)
     bool is_located() const { return offsets.has_value(); }
 
+    bool is_computed() const { return value.has_value(); }
     bool is_container() const { return !children.empty(); }
     bool is_leaf() const { return children.empty(); }
     bool is_repeated() const { return repeat.has_value() || count.has_value() || repeat_rest || offsets.has_value(); }

@@ -40,7 +40,9 @@ const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displa
                                                   "otherwise", "base", "at", "stride", "instances",
                                                   "malformed",
                                                   // offset tables
-                                                  "offsets", "from"};
+                                                  "offsets", "from",
+                                                  // computed values
+                                                  "value"};
 const std::vector<std::string> kEnumAttributes = {"value", "name"};
 const std::vector<std::string> kHookAttributes = {"table", "value"};
 const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};
@@ -264,6 +266,7 @@ private:
     void parse_length(const std::string& text, int line, Node& node, xmlNode* el);
     void parse_display(const std::string& text, int line, Node& node);
     void parse_in_list(const std::string& text, int line, Node& node);
+    void parse_value(const std::string& text, int line, Node& node);
     bool parse_value_list(const std::string& text, int line, const std::string& attribute,
                           std::vector<ValueRange>& out);
     bool parse_byteorder(const std::string& text, int line, ByteOrder& out);
@@ -494,6 +497,7 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
         parse_value_list(attrs["ifhook"], node->line, "ifhook", node->hook_list);
     }
     parse_length(attrs.count("length") ? attrs["length"] : "", node->line, *node, el);
+    if (attrs.count("value")) parse_value(attrs["value"], node->line, *node);
     parse_text_direction_handoff_attributes(attrs, node->line, *node);
     parse_layout_attributes(attrs, *node);
 
@@ -645,6 +649,17 @@ void Parser::parse_length(const std::string& raw, int line, Node& node, xmlNode*
         node.length_kind = LengthKind::Field;
         node.length_ref = make_ref(text, line, "length", true);
     }
+}
+
+void Parser::parse_value(const std::string& text, int line, Node& node) {
+    Expr expr;
+    std::string error;
+    if (!parse_expression(text, expr, error)) {
+        diags_.error(line, "bad value expression '" + text + "': " + error);
+        return;
+    }
+    node.value = std::move(expr);
+    node.value_text = text;
 }
 
 void Parser::parse_in_list(const std::string& text, int line, Node& node) {

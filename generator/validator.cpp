@@ -45,6 +45,9 @@ private:
     void check_fixed_container(const Node& n);
     void check_reference(Node& n, const FieldRef& ref, const std::string& what);
     void check_pdulength();
+    void check_computed(Node& n);
+    bool check_expr(Node& n, Expr& e);
+    const Node* find_earlier(const Node& n, const std::string& name);
     void check_pairing();
     void check_hook_list(const Node& n);
     void check_list_fits(int line, const std::vector<ValueRange>& list, const FieldRef& ref);
@@ -91,6 +94,7 @@ void Validator::run() {
         check_display_direction_handoff(n);
         check_layout(n);
         check_offsets(n);
+        if (n.is_computed()) check_computed(n);
     });
     check_pdulength();
     check_pairing();
@@ -145,6 +149,7 @@ void Validator::inherit_and_check_node(Node& n, ByteOrder inherited) {
 }
 
 void Validator::check_leaf_display(Node& n) {
+    if (n.is_computed()) return;  // check_computed
     if (n.length_kind == LengthKind::Children && n.display != Display::StringZ)
         diags_.warning(n.line, "leaf " + quote(n) + " has no length and no children: it takes no bytes");
     if (!n.display_given) n.display = Display::Origin;
@@ -249,6 +254,7 @@ void Validator::close_group(std::vector<Node*>& group, unsigned bits) {
 
 std::optional<uint64_t> Validator::fixed_bytes(const Node& n) const {
     if (n.is_repeated() || n.is_conditional()) return std::nullopt;
+    if (n.is_computed()) return 0;
     if (n.has_fixed_length()) return n.fixed_bits / 8;
     if (n.length_kind != LengthKind::Children || n.is_leaf()) return std::nullopt;
     return children_fixed_bytes(n);
@@ -521,6 +527,108 @@ void Validator::assign_slots() {
     proto_.slot_count = next;
 }
 
+// --- computed values ---------------------------------------------------------
+
+// The node named `name` closest above n in the file (the last one decoded
+// before it), or nullptr.
+const Node* Validator::find_earlier(const Node& n, const std::string& name) {
+    const Node* found = nullptr;
+    for_each_node(proto_.nodes, [&](Node& c) {
+        if (c.name == name && c.doc_index < n.doc_index) found = &c;
+    });
+    return found;
+}
+
+void Validator::check_computed(Node& n) {
+    const std::string what = "computed value " + quote(n);
+    if (n.is_container()) diags_.error(n.line, what + " cannot have children: it is one value");
+    if (n.length_kind != LengthKind::Children)
+        diags_.error(n.line, what + " takes no bytes: drop its 'length'");
+    if (n.is_repeated() || n.in_bit_group)
+        diags_.error(n.line, what + " cannot repeat: put it inside the repeated node instead");
+    if (n.dissector || n.reassembles())
+        diags_.error(n.line, what + " has no bytes to hand to a dissector or to reassemble");
+    if (!check_expr(n, *n.value)) return;
+    if (!n.display_given) n.display = n.value->is_float ? Display::Float : Display::NumberDec;
+    switch (n.display) {
+    case Display::NumberDec: case Display::NumberHex: case Display::Int: case Display::Bool:
+    case Display::Enum: case Display::Float: case Display::NonDisplay:
+        break;
+    default:
+        diags_.error(n.line, what + " is shown as " + display_name(n.display) +
+                                 "; a computed value is shown as numberdec, numberhex, int, bool, enum, float or "
+                                 "nondisplay");
+    }
+    n.bits = 64;
+}
+
+// Resolves the fields of an expression, checks that index has a repeat to
+// count, and types it: an operand that is a decimal or a float field makes
+// its operator work in double (comparisons and logic give 0 or 1).
+bool Validator::check_expr(Node& n, Expr& e) {
+    bool ok = true;
+    for (Expr& a : e.args) ok = check_expr(n, a) && ok;
+    if (!ok) return false;
+    const std::string in = " in the value of " + quote(n);
+    switch (e.op) {
+    case ExprOp::Int: return true;
+    case ExprOp::Float: e.is_float = true; return true;
+    case ExprOp::Index:
+        for (const Node* r = &n; r; r = r->parent)
+            if (r->is_repeated()) return true;
+        diags_.error(n.line, "'index'" + in + ": it is not inside a repeated node, so there is no instance to count");
+        return false;
+    case ExprOp::Field: {
+        const Node* t = find_earlier(n, e.name);
+        if (!t) {
+            const Node* later = nullptr;
+            for_each_node(proto_.nodes, [&](Node& c) { if (!later && c.name == e.name) later = &c; });
+            if (later) {
+                diags_.error(n.line, "{" + e.name + "}" + in + " is " + quote(*later) + at_line(*later) +
+                                         ", which comes after it; a value reads fields decoded before it");
+                return false;
+            }
+            std::vector<std::string> names;
+            for_each_node(proto_.nodes, [&](Node& c) { if (c.doc_index < n.doc_index) names.push_back(c.name); });
+            const std::string near = closest_match(e.name, names);
+            diags_.error(n.line, "{" + e.name + "}" + in + ": no node of that name comes before it" +
+                                     (near.empty() ? "" : " (did you mean {" + near + "}?)"));
+            return false;
+        }
+        if (!t->is_numeric() && !(t->is_computed() && t->display == Display::Float)) {
+            diags_.error(n.line, "{" + e.name + "}" + in + " is " + quote(*t) + at_line(*t) +
+                                     ", which is not numeric: it must be a leaf of 1-64 bits shown as a number, "
+                                     "or a computed value");
+            return false;
+        }
+        for (const Node* r = t; r; r = r->parent)
+            if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
+                diags_.error(n.line, "{" + e.name + "}" + in + " is inside repeated node " + quote(*r) + at_line(*r) +
+                                         ", which does not contain " + quote(n) +
+                                         "; use a field of the same instance or one outside every repeat");
+                return false;
+            }
+        e.target = const_cast<Node*>(t);
+        e.is_float = t->display == Display::Float;
+        mark_slot(e.target);
+        return true;
+    }
+    default:
+        break;
+    }
+    bool any_float = false;
+    for (const Expr& a : e.args) any_float = any_float || a.is_float;
+    if (any_float && expr_op_needs_integers(e.op)) {
+        diags_.error(n.line, std::string("operator '") + expr_op_text(e.op) + "'" + in +
+                                 " needs integers; an operand is a decimal or a float field");
+        return false;
+    }
+    const bool gives_truth = e.op == ExprOp::Not || e.op == ExprOp::And || e.op == ExprOp::Or ||
+                             (e.op >= ExprOp::Lt && e.op <= ExprOp::Ne);
+    e.is_float = any_float && !gives_truth;
+    return true;
+}
+
 // --- display types, range enums, repeat="rest", direction, hand-off, reassembly ---
 
 void Validator::check_display_direction_handoff(Node& n) {
@@ -548,6 +656,7 @@ void Validator::check_display_direction_handoff(Node& n) {
 }
 
 void Validator::check_string_display(Node& n) {
+    if (n.is_computed()) return;  // check_computed
     const std::string shown = display_name(n.display);
     switch (n.display) {
         case Display::String:

@@ -1,0 +1,187 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// A precedence-climbing parser for value="..." expressions (see expression.h).
+#include "expression.h"
+
+#include <cctype>
+#include <cerrno>
+#include <cstdlib>
+
+namespace dissgen {
+
+namespace {
+
+struct BinaryOp {
+    const char* text;
+    ExprOp op;
+    int precedence;  // higher binds tighter
+};
+
+// Longest spellings first, so that "<<" is not read as "<".
+const BinaryOp kBinary[] = {
+    {"||", ExprOp::Or, 1},  {"&&", ExprOp::And, 2},   {"<<", ExprOp::Shl, 9},   {">>", ExprOp::Shr, 9},
+    {"<=", ExprOp::Le, 8},  {">=", ExprOp::Ge, 8},    {"==", ExprOp::Eq, 7},    {"!=", ExprOp::Ne, 7},
+    {"|", ExprOp::BitOr, 3}, {"^", ExprOp::BitXor, 4}, {"&", ExprOp::BitAnd, 5}, {"<", ExprOp::Lt, 8},
+    {">", ExprOp::Gt, 8},   {"+", ExprOp::Add, 10},   {"-", ExprOp::Sub, 10},   {"*", ExprOp::Mul, 11},
+    {"/", ExprOp::Div, 11}, {"%", ExprOp::Mod, 11},
+};
+
+// Deep nesting is refused before it can exhaust the stack.
+constexpr int kMaxDepth = 64;
+
+class ExprParser {
+public:
+    explicit ExprParser(const std::string& text) : s_(text) {}
+
+    bool parse(Expr& out, std::string& error) {
+        bool ok = binary(out, 1, 0);
+        skip_space();
+        if (ok && pos_ < s_.size()) ok = fail("unexpected '" + s_.substr(pos_, 1) + "'");
+        if (ok && s_.find_first_not_of(" \t\r\n") == std::string::npos) ok = fail("empty expression");
+        if (!ok) error = error_;
+        return ok;
+    }
+
+private:
+    const std::string& s_;
+    size_t pos_ = 0;
+    std::string error_;
+
+    bool fail(const std::string& what) {
+        if (error_.empty()) error_ = what + " at character " + std::to_string(pos_ + 1);
+        return false;
+    }
+
+    void skip_space() {
+        while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+    }
+
+    const BinaryOp* peek_binary() {
+        skip_space();
+        for (const BinaryOp& b : kBinary)
+            if (s_.compare(pos_, std::char_traits<char>::length(b.text), b.text) == 0) return &b;
+        return nullptr;
+    }
+
+    // Operands joined by operators of at least `min_precedence`, left to right.
+    bool binary(Expr& out, int min_precedence, int depth) {
+        if (!unary(out, depth)) return false;
+        for (const BinaryOp* b = peek_binary(); b && b->precedence >= min_precedence; b = peek_binary()) {
+            pos_ += std::char_traits<char>::length(b->text);
+            Expr rhs;
+            if (!binary(rhs, b->precedence + 1, depth + 1)) return false;
+            Expr joined;
+            joined.op = b->op;
+            joined.args.push_back(std::move(out));
+            joined.args.push_back(std::move(rhs));
+            out = std::move(joined);
+        }
+        return true;
+    }
+
+    bool unary(Expr& out, int depth) {
+        if (depth > kMaxDepth) return fail("expression nested too deeply");
+        skip_space();
+        const char c = pos_ < s_.size() ? s_[pos_] : '\0';
+        if (c == '-' || c == '!' || c == '~') {
+            ++pos_;
+            Expr operand;
+            if (!unary(operand, depth + 1)) return false;
+            out.op = c == '-' ? ExprOp::Neg : c == '!' ? ExprOp::Not : ExprOp::BitNot;
+            out.args.push_back(std::move(operand));
+            return true;
+        }
+        if (c == '(') {
+            ++pos_;
+            if (!binary(out, 1, depth + 1)) return false;
+            skip_space();
+            if (pos_ >= s_.size() || s_[pos_] != ')') return fail("missing ')'");
+            ++pos_;
+            return true;
+        }
+        return operand(out);
+    }
+
+    bool operand(Expr& out) {
+        const char c = pos_ < s_.size() ? s_[pos_] : '\0';
+        if (c == '{') {
+            size_t end = s_.find('}', pos_ + 1);
+            if (end == std::string::npos) return fail("missing '}'");
+            out.op = ExprOp::Field;
+            out.name = s_.substr(pos_ + 1, end - pos_ - 1);
+            if (out.name.empty()) return fail("empty field name '{}'");
+            pos_ = end + 1;
+            return true;
+        }
+        if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return number(out);
+        if (s_.compare(pos_, 5, "index") == 0 &&
+            (pos_ + 5 >= s_.size() || !std::isalnum(static_cast<unsigned char>(s_[pos_ + 5])))) {
+            out.op = ExprOp::Index;
+            pos_ += 5;
+            return true;
+        }
+        if (c == '\0') return fail("expected a number, {field}, index or '(' but the expression ends");
+        return fail("expected a number, {field}, index or '(' but found '" + s_.substr(pos_, 1) + "'");
+    }
+
+    bool number(Expr& out) {
+        const size_t start = pos_;
+        const bool hex = s_.compare(pos_, 2, "0x") == 0 || s_.compare(pos_, 2, "0X") == 0;
+        size_t end = hex ? pos_ + 2 : pos_;
+        bool point = false;
+        while (end < s_.size() && (hex ? std::isxdigit(static_cast<unsigned char>(s_[end]))
+                                       : std::isdigit(static_cast<unsigned char>(s_[end])) || s_[end] == '.')) {
+            if (s_[end] == '.') {
+                if (point) break;
+                point = true;
+            }
+            ++end;
+        }
+        const std::string digits = s_.substr(start, end - start);
+        if (end < s_.size() && std::isalnum(static_cast<unsigned char>(s_[end])))
+            return fail("bad number '" + digits + s_[end] + "'");
+        if (digits == "." || (hex && digits.size() == 2)) return fail("bad number '" + digits + "'");
+        errno = 0;
+        if (point) {
+            out.op = ExprOp::Float;
+            out.real = std::strtod(digits.c_str(), nullptr);
+        } else {
+            out.op = ExprOp::Int;
+            unsigned long long v = std::strtoull(digits.c_str(), nullptr, hex ? 16 : 10);
+            if (errno == ERANGE || v > static_cast<unsigned long long>(INT64_MAX))
+                return fail("number '" + digits + "' is above 9223372036854775807");
+            out.integer = static_cast<int64_t>(v);
+        }
+        pos_ = end;
+        return true;
+    }
+};
+
+}  // namespace
+
+bool parse_expression(const std::string& text, Expr& out, std::string& error) {
+    out = Expr();
+    return ExprParser(text).parse(out, error);
+}
+
+const char* expr_op_text(ExprOp op) {
+    for (const BinaryOp& b : kBinary)
+        if (b.op == op) return b.text;
+    switch (op) {
+    case ExprOp::Neg: return "-";
+    case ExprOp::Not: return "!";
+    case ExprOp::BitNot: return "~";
+    default: return "";
+    }
+}
+
+bool expr_op_needs_integers(ExprOp op) {
+    switch (op) {
+    case ExprOp::Mod: case ExprOp::Shl: case ExprOp::Shr: case ExprOp::BitAnd:
+    case ExprOp::BitXor: case ExprOp::BitOr: case ExprOp::BitNot:
+        return true;
+    default:
+        return false;
+    }
+}
+
+}  // namespace dissgen

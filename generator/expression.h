@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Computed values: the expression of a node's value="..." attribute, parsed
+// into a tree here and checked by the validator (names resolved, types).
+//
+//   value="{Starting address} + index + 1"
+//   value="{Raw temperature} * 0.1 - 40"
+//
+// Operands: integers (decimal, 0x hex), decimals with a point (1.5),
+// {Name} (the value of an earlier numeric field), index (the instance number
+// of the innermost repeated node, from 0). Operators as in C, with C's
+// precedence: unary - ! ~; * / %; + -; << >>; < <= > >=; == !=; &; ^; |;
+// &&; ||; and parentheses.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace dissgen {
+
+struct Node;
+
+enum class ExprOp {
+    Int, Float, Field, Index,                  // operands
+    Neg, Not, BitNot,                          // unary
+    Mul, Div, Mod, Add, Sub, Shl, Shr,         // binary, arithmetic
+    Lt, Le, Gt, Ge, Eq, Ne,                    // binary, comparisons (0 or 1)
+    BitAnd, BitXor, BitOr, And, Or,            // binary, logic
+};
+
+struct Expr {
+    ExprOp op = ExprOp::Int;
+    int64_t integer = 0;            // Int
+    double real = 0;                // Float
+    std::string name;               // Field: the name between the braces
+    Node* target = nullptr;         // Field: resolved by the validator
+    std::vector<Expr> args;         // one (unary) or two (binary) operands
+    bool is_float = false;          // derived by the validator: evaluated in double
+};
+
+// Parses `text`; on a mistake returns false and sets `error` to a message
+// that says where ("... at character 7").
+bool parse_expression(const std::string& text, Expr& out, std::string& error);
+
+// The operator's spelling ("+", "<<", ...), "" for operands.
+const char* expr_op_text(ExprOp op);
+
+// Integer-only operators: % << >> & ^ | ~ (a float operand is an error).
+bool expr_op_needs_integers(ExprOp op);
+
+}  // namespace dissgen

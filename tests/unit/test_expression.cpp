@@ -1,0 +1,147 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Computed values: the value="..." expression parser, and the validator's
+// name resolution and typing of expressions.
+#include <gtest/gtest.h>
+
+#include "expression.h"
+#include "test_support.h"
+
+namespace dissgen::testing {
+namespace {
+
+// The tree in prefix form: "(+ 1 (* 2 3))", fields as {Name}, index as #.
+std::string prefix(const Expr& e) {
+    switch (e.op) {
+    case ExprOp::Int: return std::to_string(e.integer);
+    case ExprOp::Float: return std::to_string(e.real).substr(0, 4);
+    case ExprOp::Field: return "{" + e.name + "}";
+    case ExprOp::Index: return "#";
+    default: break;
+    }
+    std::string out = std::string("(") + expr_op_text(e.op);
+    for (const Expr& a : e.args) out += " " + prefix(a);
+    return out + ")";
+}
+
+std::string parsed(const std::string& text) {
+    Expr e;
+    std::string error;
+    return parse_expression(text, e, error) ? prefix(e) : "error: " + error;
+}
+
+TEST(Expression, PrecedenceAsInC) {
+    EXPECT_EQ(parsed("1 + 2 * 3"), "(+ 1 (* 2 3))");
+    EXPECT_EQ(parsed("(1 + 2) * 3"), "(* (+ 1 2) 3)");
+    EXPECT_EQ(parsed("10 - 4 - 3"), "(- (- 10 4) 3)");  // left to right
+    EXPECT_EQ(parsed("1 << 2 + 3"), "(<< 1 (+ 2 3))");
+    EXPECT_EQ(parsed("1 < 2 == 3 > 4"), "(== (< 1 2) (> 3 4))");
+    EXPECT_EQ(parsed("1 | 2 ^ 3 & 4"), "(| 1 (^ 2 (& 3 4)))");
+    EXPECT_EQ(parsed("1 || 2 && 3"), "(|| 1 (&& 2 3))");
+    EXPECT_EQ(parsed("-{A} % 7"), "(% (- {A}) 7)");
+    EXPECT_EQ(parsed("!~{A}"), "(! (~ {A}))");
+    EXPECT_EQ(parsed("1 <= 2 >= 3 != 4"), "(!= (>= (<= 1 2) 3) 4)");
+    EXPECT_EQ(parsed("8 >> 1 / 2"), "(>> 8 (/ 1 2))");
+}
+
+TEST(Expression, Operands) {
+    EXPECT_EQ(parsed("0x1F"), "31");
+    EXPECT_EQ(parsed("9223372036854775807"), "9223372036854775807");
+    EXPECT_EQ(parsed("0.25"), "0.25");
+    EXPECT_EQ(parsed(".5"), "0.50");
+    EXPECT_EQ(parsed("{Starting address} + index"), "(+ {Starting address} #)");
+    EXPECT_EQ(parsed("  index*2  "), "(* # 2)");
+}
+
+TEST(Expression, MistakesSayWhere) {
+    EXPECT_EQ(parsed(""), "error: expected a number, {field}, index or '(' but the expression ends at character 1");
+    EXPECT_EQ(parsed("1 +"), "error: expected a number, {field}, index or '(' but the expression ends at character 4");
+    EXPECT_EQ(parsed("(1"), "error: missing ')' at character 3");
+    EXPECT_EQ(parsed("{A"), "error: missing '}' at character 1");
+    EXPECT_EQ(parsed("{}"), "error: empty field name '{}' at character 1");
+    EXPECT_EQ(parsed("1 2"), "error: unexpected '2' at character 3");
+    EXPECT_EQ(parsed("0x"), "error: bad number '0x' at character 1");
+    EXPECT_EQ(parsed("12ab"), "error: bad number '12a' at character 1");
+    EXPECT_EQ(parsed("indexes"), "error: expected a number, {field}, index or '(' but found 'i' at character 1");
+    EXPECT_EQ(parsed("9223372036854775808"), "error: number '9223372036854775808' is above 9223372036854775807 at character 1");
+    EXPECT_EQ(parsed("A + 1"), "error: expected a number, {field}, index or '(' but found 'A' at character 1");
+}
+
+TEST(Expression, DeepNestingIsRefusedNotOverflowed) {
+    EXPECT_EQ(parsed(std::string(100000, '(') + "1" + std::string(100000, ')')).rfind("error: expression nested too deeply", 0), 0u);
+    EXPECT_EQ(parsed(std::string(100000, '-') + "1").rfind("error: expression nested too deeply", 0), 0u);
+    std::string long_sum = "1";
+    for (int i = 0; i < 20000; ++i) long_sum += "+1";
+    EXPECT_EQ(parsed(long_sum).rfind("(+ (+", 0), 0u);  // long but flat: fine
+}
+
+const char* const kHead =
+    "  <node name=\"Reference\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
+    "  <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+    "  <node name=\"Raw\" length=\"2byte\" displaytype=\"int\"/>\n";
+
+TEST(Computed, ResolvesTheClosestEarlierFieldAndTypes) {
+    Front f = front_end(rules(std::string(kHead) +
+                              "  <node name=\"Temperature\" value=\"{Raw} * 0.1 - 40\"/>\n"
+                              "  <node name=\"Registers\" count=\"../node[@name='Count']\">\n"
+                              "    <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "    <node name=\"Register\" value=\"{Reference} + index + {Count}\"/>\n"
+                              "    <node name=\"Hot\" value=\"{Temperature} &gt; 50\" displaytype=\"bool\"/>\n"
+                              "  </node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Node& temperature = *f.proto->nodes[3];
+    EXPECT_TRUE(temperature.value->is_float);
+    EXPECT_EQ(temperature.display, Display::Float);  // the default for a decimal expression
+    EXPECT_FALSE(temperature.is_numeric());           // not a length or a count
+    const Node& registers = *f.proto->nodes[4];
+    const Node& reg = *registers.children[1];
+    EXPECT_EQ(reg.display, Display::NumberDec);
+    EXPECT_FALSE(reg.value->is_float);
+    // {Count} is the one inside the instance, the closest above
+    EXPECT_EQ(reg.value->args[1].target, registers.children[0].get());
+    EXPECT_EQ(reg.value->args[0].args[0].target, f.proto->nodes[0].get());
+    EXPECT_GE(f.proto->nodes[0]->slot, 0);  // read at run time
+    const Node& hot = *registers.children[2];
+    EXPECT_FALSE(hot.value->is_float);  // a comparison gives 0 or 1
+    EXPECT_TRUE(hot.value->args[0].is_float);
+}
+
+TEST(Computed, Mistakes) {
+    Front f = front_end(rules(std::string(kHead) +
+                              "  <node name=\"Registers\" count=\"../node[@name='Count']\">\n"
+                              "    <node name=\"Value\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+                              "  </node>\n"
+                              "  <node name=\"T\" value=\"{Raw} * 0.5\"/>\n"
+                              "  <node name=\"A\" value=\"{Refrence} + 1\"/>\n"
+                              "  <node name=\"B\" value=\"index\"/>\n"
+                              "  <node name=\"C\" value=\"{Value}\"/>\n"
+                              "  <node name=\"D\" value=\"{T} % 2\"/>\n"
+                              "  <node name=\"E\" length=\"1byte\" value=\"1\"/>\n"
+                              "  <node name=\"F\" value=\"1\" displaytype=\"string\"/>\n"
+                              "  <node name=\"G\" value=\"{Later}\"/>\n"
+                              "  <node name=\"Later\" length=\"1byte\"/>\n"
+                              "  <node name=\"H\" value=\"{Later}\"/>\n"
+                              "  <node name=\"I\" value=\"1\"><node name=\"x\" length=\"1byte\"/></node>\n"));
+    const std::string m = f.messages();
+    EXPECT_TRUE(contains(m, "rules.xml:9: error: {Refrence} in the value of 'A': no node of that name comes before it (did you mean {Reference}?)")) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:10: error: 'index' in the value of 'B': it is not inside a repeated node")) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:11: error: {Value} in the value of 'C' is inside repeated node 'Registers' (line 5), which does not contain 'C'")) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:12: error: operator '%' in the value of 'D' needs integers")) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:13: error: computed value 'E' takes no bytes: drop its 'length'")) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:14: error: computed value 'F' is shown as string; a computed value is shown as numberdec")) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:15: error: {Later} in the value of 'G' is 'Later' (line 16), which comes after it; a value reads fields decoded before it")) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:17: error: {Later} in the value of 'H' is 'Later' (line 16), which is not numeric")) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:18: error: computed value 'I' cannot have children")) << m;
+    EXPECT_EQ(std::count(m.begin(), m.end(), '\n'), 9) << m;
+}
+
+TEST(Computed, IsANumericLeafForLengthsCountsAndConditions) {
+    Front f = front_end(rules(std::string(kHead) +
+                              "  <node name=\"Doubled\" value=\"{Count} * 2\"/>\n"
+                              "  <node name=\"Data\" length=\"../node[@name='Doubled']\"/>\n"
+                              "  <node name=\"More\" length=\"1byte\" if=\"../node[@name='Doubled']\" in=\"4\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_GE(f.proto->nodes[3]->slot, 0);
+}
+
+}  // namespace
+}  // namespace dissgen::testing
