@@ -35,6 +35,27 @@ std::string c_string(const std::string& s) {
     return out + "\"";
 }
 
+std::string c_array(const std::string& declaration, const std::vector<std::string>& rows) {
+    std::string out = declaration + "[] = {\n";
+    for (const std::string& row : rows) out += "    " + row + ",\n";
+    if (rows.empty()) out += "    {}\n";
+    return out + "};\n\n";
+}
+
+std::string named_row(const std::string& start, const std::vector<std::string>& setters) {
+    std::string out = start;
+    size_t column = 4 + out.size();
+    for (const std::string& s : setters) {
+        if (column + 1 + s.size() > 116) {
+            out += "\n       ";
+            column = 7;
+        }
+        out += "." + s;
+        column += 1 + s.size();
+    }
+    return out;
+}
+
 namespace {
 
 unsigned value_bytes(const Node& n) { return n.in_bit_group ? n.group_bytes : n.bits / 8; }
@@ -138,10 +159,10 @@ void layout_conditions_and_windows(Layout& l) {
             l.ranges.insert(l.ranges.end(), w.in_list.begin(), w.in_list.end());
             std::string ranges = std::to_string(in_first) + ", " + std::to_string(w.in_list.size());
             if (!w.peek) {
-                l.whens.push_back("{ " + std::to_string(w.ref.target ? w.ref.target->slot : -1) + ", -1, " + ranges + " }");
+                l.whens.push_back("dg_when_field(" + std::to_string(w.ref.target ? w.ref.target->slot : -1) + ", " + ranges + ")");
                 continue;
             }
-            l.whens.push_back("{ -1, " + std::to_string(l.peeks.size()) + ", " + ranges + " }");
+            l.whens.push_back("dg_when_peek(" + std::to_string(l.peeks.size()) + ", " + ranges + ")");
             l.peeks.push_back("{ " + std::to_string(w.ref.target->doc_index - 1) + ", " + std::to_string(w.offset) + ", " +
                               std::to_string(l.peek_lengths.size()) + ", " + std::to_string(w.lengths.size()) + ", " +
                               std::to_string(w.up) + ", " + std::to_string(w.target_up) + " }");
@@ -252,6 +273,10 @@ private:
     void value_strings();
     void tables();
     void node_table();
+    std::string node_row(const Node& n) const;
+    std::vector<std::string> summary_rows() const;
+    std::string protocol_row() const;
+    std::string extra_row(const Node& n) const;
     void condition_and_window_tables();
     void protocol_struct();
     void register_functions();
@@ -306,7 +331,7 @@ void Emitter::header() {
        << " * GNU General Public License, version 2 or later: so is the plugin.\n"
        << " * SPDX-License-Identifier: GPL-2.0-or-later\n"
        << " */\n"
-       << "#include \"dissgen_runtime.h\"\n" << (extra_ ? extra_->includes : "") << "\n";
+       << "#include \"dissgen_rows.h\"\n" << (extra_ ? extra_->includes : "") << "\n";
 }
 
 void Emitter::declarations() {
@@ -343,25 +368,11 @@ void Emitter::tables() {
     for (size_t i = 0; i < l_.children_flat.size(); ++i) o_ << (i ? ", " : " ") << l_.children_flat[i];
     o_ << " };\n\n";
     o_ << "static const dg_range " << p_.filter << "_ranges[] = {";
-    if (l_.ranges.empty()) o_ << " { 0, 0 }";
+    if (l_.ranges.empty()) o_ << " {}";  // C++ has no empty arrays
     for (size_t i = 0; i < l_.ranges.size(); ++i)
         o_ << (i ? ", " : " ") << "{ " << hex(l_.ranges[i].low) << ", " << hex(l_.ranges[i].high) << " }";
     o_ << " };\n\n";
-    bool parts = false;
-    for (const Layout::Piece& p : l_.pieces) parts = parts || p.group || p.node >= 0;
-    if (parts)
-        o_ << "/* Summary pieces: text, value slot; an optional part {?...}: -1 and how many pieces follow in\n"
-              " * it; a container's summary: the slot that says it was decoded, 0, its node index + 1. */\n";
-    o_ << "static const dg_summary_piece " << p_.filter << "_summary[] = {";
-    if (l_.pieces.empty()) o_ << " { NULL, -1 }";
-    for (size_t i = 0; i < l_.pieces.size(); ++i) {
-        const Layout::Piece& p = l_.pieces[i];
-        o_ << (i ? ",\n    " : "\n    ") << "{ " << (p.slot < 0 && !p.group ? c_string(p.text) : "NULL") << ", "
-           << p.slot;
-        if (p.group || p.node >= 0) o_ << ", " << p.group << ", " << p.node + 1;
-        o_ << " }";
-    }
-    o_ << (l_.pieces.empty() ? " };\n\n" : "\n};\n\n");
+    o_ << c_array("static const dg_summary_piece " + p_.filter + "_summary", summary_rows());
     o_ << "static const dg_hook " << p_.filter << "_hooks[] = {";
     bool first = true;
     if (p_.ethertype) {
@@ -377,15 +388,25 @@ void Emitter::tables() {
     if (extra_) o_ << extra_->tables;
 }
 
+// Summary pieces: text, a leaf's value, an optional part {?...}, a container's summary.
+std::vector<std::string> Emitter::summary_rows() const {
+    std::vector<std::string> rows;
+    for (const Layout::Piece& p : l_.pieces) {
+        if (p.group) rows.push_back("dg_optional(" + std::to_string(p.group) + ")");
+        else if (p.node >= 0) rows.push_back("dg_summary_of(" + std::to_string(p.slot) + ", " + std::to_string(p.node) + ")");
+        else if (p.slot >= 0) rows.push_back("dg_value(" + std::to_string(p.slot) + ")");
+        else rows.push_back("dg_text(" + c_string(p.text) + ")");
+    }
+    return rows;
+}
+
 // The tables of <when> conditions, peeks and windows, where used.
 void Emitter::condition_and_window_tables() {
     auto table = [&](const char* type, const char* name, const std::vector<std::string>& rows, const char* comment) {
         if (rows.empty()) return;
-        o_ << "/* " << comment << " */\nstatic const " << type << " " << p_.filter << "_" << name << "[] = {";
-        for (size_t i = 0; i < rows.size(); ++i) o_ << (i ? ",\n    " : "\n    ") << rows[i];
-        o_ << "\n};\n\n";
+        o_ << "/* " << comment << " */\n" << c_array("static const " + std::string(type) + " " + p_.filter + "_" + name, rows);
     };
-    table("dg_when", "whens", l_.whens, "<when> conditions: field slot, peek, in ranges (first, count)");
+    table("dg_when", "whens", l_.whens, "<when> conditions: on a field's value or a peek, in ranges (first, count)");
     table("dg_peek", "peeks", l_.peeks, "Look-ahead: target node, offset, field lengths (first, count), from the node (0) or its Nth container");
     table("dg_ref", "peek_lengths", l_.peek_lengths, "Field lengths between a node and the field it peeks at");
     table("dg_window", "windows", l_.windows, "Windows: base address, places (first, count), largest span, document order");
@@ -393,51 +414,46 @@ void Emitter::condition_and_window_tables() {
 }
 
 void Emitter::node_table() {
-    o_ << "/* One entry per <node>, in document order. Columns: name, hf, ett, kind, length kind, show, flags,\n"
-       << " * length, shift, bits, slot, length ref, count ref, repeat slot, if slot, in ranges (first, count),\n"
-       << " * children (first, count), slots inside (first, count), summary pieces (first, count). */\n";
-    o_ << "static const dg_node " << p_.filter << "_nodes[] = {\n";
-    for (const Node* np : l_.nodes) {
-        const Node& n = *np;
-        unsigned length = n.in_bit_group ? n.group_bytes : static_cast<unsigned>(n.fixed_bits / 8);
-        if (!n.has_fixed_length() && !n.in_bit_group) length = 0;
-        auto [slot_first, slot_count] = slot_span(n);
-        o_ << "    /* " << n.doc_index - 1 << ": line " << n.line << " */\n"
-           << "    { " << c_string(n.name) << ", " << (has_hf(n) ? "&" + hf(n) : "NULL") << ", "
-           << (n.is_container() ? "&" + ett(n) : "NULL") << ", " << (n.is_container() ? "DG_CONTAINER" : "DG_LEAF")
-           << ", " << length_kind_of(n) << ", " << show_of(n) << ", " << flags_of(n, is_pairing_key(n)) << ",\n      " << length << ", "
-           << n.shift << ", " << n.bits << ", " << n.slot << ", "
-           << ref_of(n.length_kind == LengthKind::Field ? &n.length_ref : nullptr) << ", "
-           << ref_of(n.count ? &*n.count : nullptr) << ", "
-           << (n.repeat && n.repeat->target ? n.repeat->target->slot : -1) << ", "
-           << (n.if_field && n.if_field->target ? n.if_field->target->slot : -1) << ", "
-           << (n.if_field ? l_.range_first.at(&n) : 0) << ", " << (n.if_field ? n.in_list.size() : 0) << ", "
-           << (n.is_container() ? l_.first_child.at(&n) : 0) << ", " << n.children.size() << ", " << slot_first
-           << ", " << slot_count << ", " << (l_.piece_first.count(&n) ? l_.piece_first.at(&n) : 0) << ", "
-           << n.summary_pieces.size();
-        // ifhook ranges (first, count): only where given, the struct defaults them to none.
-        if (n.has_hook) o_ << ", " << l_.hook_range_first.at(&n) << ", " << n.hook_list.size();
-        // Members after the ifhook ranges default to none; a node that uses them
-        // spells out everything before them.
-        const bool quiet = quiet_.count(&n) > 0;
-        const bool uses_extra = extra_index_.count(&n) > 0, needs_layout_columns = l_.node_uses_layout_columns(n) || quiet;
-        if (!n.has_hook && (uses_extra || needs_layout_columns)) o_ << ", 0, 0";
-        // the node's dg_extra
-        if (uses_extra)
-            o_ << ", &" << p_.filter << "_extra[" << extra_index_.at(&n) << "]";
-        else if (needs_layout_columns)
-            o_ << ", NULL";
-        // <when> rows (first, count), alternative flags, window index
-        if (needs_layout_columns)
-            o_ << ",\n      " << (l_.when_first.count(&n) ? l_.when_first.at(&n) : 0) << ", " << n.whens.size() << ", "
-               << (n.otherwise ? "DG_ALT_OTHERWISE" : "0") << ", "
-               << (l_.window_index.count(&n) ? l_.window_index.at(&n) : -1);
-        // quiet_size: the bytes a walk with no tree and no tap steps over
-        if (quiet) o_ << ", " << quiet_.at(&n) << "u";
-        o_ << " },\n";
-    }
-    if (l_.nodes.empty()) o_ << "    { NULL, NULL, NULL, 0, 0, 0, 0, 0, 0, 0, -1, {-1, 0, 0}, {-1, 0, 0}, -1, -1, 0, 0, 0, 0, 0, 0, 0, 0 }\n";
-    o_ << "};\n\n";
+    std::vector<std::string> rows;
+    for (const Node* n : l_.nodes) rows.push_back("/* " + std::to_string(n->doc_index - 1) + ": line " + std::to_string(n->line) + " */\n    " + node_row(*n));
+    o_ << "/* One entry per <node>, in document order. */\n"
+       << c_array("static const dg_node " + p_.filter + "_nodes", rows);
+}
+
+// A node's row: its kind, name and ids, then every value that is not "none".
+std::string Emitter::node_row(const Node& n) const {
+    std::string name = c_string(n.name), hf_ref = has_hf(n) ? "&" + hf(n) : "NULL";
+    std::string start = n.is_container() ? "dg_container(" + name + ", " + hf_ref + ", &" + ett(n) + ")"
+                                         : "dg_leaf(" + name + ", " + hf_ref + ")";
+    std::vector<std::string> set;
+    auto add = [&](const char* setter, const std::string& args) { set.push_back(setter + ("(" + args + ")")); };
+    auto pair = [](size_t first, size_t count) { return std::to_string(first) + ", " + std::to_string(count); };
+    if (n.is_leaf()) add("show", show_of(n));
+    if (std::string flags = flags_of(n, is_pairing_key(n)); flags != "0") add("flags", flags);
+    std::string length_kind = length_kind_of(n);
+    if (length_kind == "DG_LEN_FIELD") add("length_field", ref_of(&n.length_ref));
+    if (length_kind == "DG_LEN_REST") add("length_rest", "");
+    if (length_kind == "DG_LEN_CHILDREN") add("length_children", "");
+    unsigned length = n.in_bit_group ? n.group_bytes : static_cast<unsigned>(n.fixed_bits / 8);
+    if (length && (n.has_fixed_length() || n.in_bit_group)) add("length", std::to_string(length));
+    if (n.shift) add("shift", std::to_string(n.shift));
+    if (n.bits) add("bits", std::to_string(n.bits));
+    if (n.slot >= 0) add("slot", std::to_string(n.slot));
+    if (n.count) add("count", ref_of(&*n.count));
+    if (n.repeat && n.repeat->target) add("repeat", std::to_string(n.repeat->target->slot));
+    if (n.if_field)
+        add("if_in", std::to_string(n.if_field->target ? n.if_field->target->slot : -1) + ", " +
+                         pair(l_.range_first.at(&n), n.in_list.size()));
+    if (n.is_container()) add("children", pair(l_.first_child.at(&n), n.children.size()));
+    if (auto [first, count] = slot_span(n); count) add("slots", pair(first, count));
+    if (!n.summary_pieces.empty()) add("summary", pair(l_.piece_first.at(&n), n.summary_pieces.size()));
+    if (n.has_hook) add("hooks", pair(l_.hook_range_first.at(&n), n.hook_list.size()));
+    if (extra_index_.count(&n)) add("extra", "&" + p_.filter + "_extra[" + std::to_string(extra_index_.at(&n)) + "]");
+    if (!n.whens.empty()) add("whens", pair(l_.when_first.at(&n), n.whens.size()));
+    if (n.otherwise) add("alt", "DG_ALT_OTHERWISE");
+    if (l_.window_index.count(&n)) add("window", std::to_string(l_.window_index.at(&n)));
+    if (quiet_.count(&n)) add("quiet_size", std::to_string(quiet_.at(&n)) + "u");
+    return named_row(start, set);
 }
 
 void Emitter::protocol_struct() {
@@ -445,7 +461,6 @@ void Emitter::protocol_struct() {
     const Node* pdu = p_.pdulength ? p_.pdulength->target : nullptr;
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);\n";
     if (pdu) o_ << "static int dissect_" << f << "_stream(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);\n";
-    size_t hook_count = p_.hooks.size() + (p_.ethertype ? 1 : 0);
     if (p_.pairing) {
         char timeout[32];
         std::snprintf(timeout, sizeof timeout, "%.9g", p_.pairing->timeout);
@@ -458,38 +473,44 @@ void Emitter::protocol_struct() {
         o_ << "static const dg_pairing " << f << "_pairing = { " << timeout << ", "
            << (analysis ? "&" + analysis->symbol : std::string("NULL")) << " };\n";
     }
-    o_ << "\nstatic dg_protocol " << f << "_protocol = {\n"
-       << "    " << c_string(p_.name) << ", " << c_string(p_.abbreviation) << ", " << c_string(f) << ",\n"
-       << "    &proto_" << f << ", &ett_" << f << ", dissect_" << f << ", "
-       << (pdu ? "dissect_" + f + "_stream" : "NULL") << ",\n"
-       << "    " << f << "_nodes, " << l_.nodes.size() << ", " << f << "_children, 0, " << p_.nodes.size() << ",\n"
-       << "    " << f << "_ranges, " << f << "_summary, " << p_.slot_count << ", &ei_" << f << ",\n"
-       << "    " << f << "_hooks, " << hook_count << ",\n"
-       << "    " << (pdu ? pdu->doc_index - 1 : -1) << ", "
-       << (pdu ? p_.pdu_fixed_len - value_bytes(*pdu) : 0) << ", " << p_.pdulengthadd;
-    // Members after pdu_add default to none; a protocol that uses later ones
-    // spells out everything before them.
-    const bool data = extra_ && !extra_->analysis_data.empty();
-    const bool pairing = p_.pairing != nullptr, needs_layout_members = l_.uses_layout_tables() || pairing || data;
-    if (uses_reassembly())
-        o_ << ",\n    &" << f << "_reassembly, &" << f << "_fragment_items";
-    else if (needs_layout_members)
-        o_ << ",\n    NULL, NULL";
-    if (needs_layout_members) {
-        auto name = [&](const char* table, bool used) { return used ? f + "_" + table : std::string("NULL"); };
-        o_ << ",\n    " << name("whens", !l_.whens.empty()) << ", " << name("peeks", !l_.peeks.empty()) << ", "
-           << name("peek_lengths", !l_.peek_lengths.empty()) << ", " << name("windows", !l_.windows.empty()) << ", "
-           << name("places", !l_.places.empty());
-    }
-    if (pairing) o_ << ",\n    &" << f << "_pairing";
-    else if (data) o_ << ",\n    NULL";
-    if (data) o_ << ",\n    &" << extra_->analysis_data;
-    o_ << "\n};\n\n";
+    o_ << "\nstatic dg_protocol " << f << "_protocol =\n    " << protocol_row() << ";\n\n";
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
        << "    return dg_dissect(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";
     if (pdu)
         o_ << "static int dissect_" << f << "_stream(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
            << "    return dg_dissect_stream(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";
+}
+
+// The protocol's row: its names, entry points and tables; the tables it does not use stay NULL.
+std::string Emitter::protocol_row() const {
+    const std::string& f = p_.filter;
+    const Node* pdu = p_.pdulength ? p_.pdulength->target : nullptr;
+    size_t hook_count = p_.hooks.size() + (p_.ethertype ? 1 : 0);
+    std::vector<std::string> set = {
+        "ids(&proto_" + f + ", &ett_" + f + ")",
+        "dissect(dissect_" + f + ", " + (pdu ? "dissect_" + f + "_stream" : "NULL") + ")",
+        "nodes(" + f + "_nodes, " + std::to_string(l_.nodes.size()) + ")",
+        "children(" + f + "_children, 0, " + std::to_string(p_.nodes.size()) + ")",
+        "ranges(" + f + "_ranges)",
+        "pieces(" + f + "_summary)",
+        "slot_count(" + std::to_string(p_.slot_count) + ")",
+        "experts(&ei_" + f + ")",
+        "hooks(" + f + "_hooks, " + std::to_string(hook_count) + ")"};
+    if (pdu)
+        set.push_back("pdu_length(" + std::to_string(pdu->doc_index - 1) + ", " +
+                      std::to_string(p_.pdu_fixed_len - value_bytes(*pdu)) + ", " + std::to_string(p_.pdulengthadd) + ")");
+    if (uses_reassembly()) set.push_back("reassembly(&" + f + "_reassembly, &" + f + "_fragment_items)");
+    auto table = [&](const char* name, const std::vector<std::string>& rows) {
+        if (!rows.empty()) set.push_back(std::string(name) + "(" + f + "_" + name + ")");
+    };
+    table("whens", l_.whens);
+    table("peeks", l_.peeks);
+    table("peek_lengths", l_.peek_lengths);
+    table("windows", l_.windows);
+    table("places", l_.places);
+    if (p_.pairing) set.push_back("pairing(&" + f + "_pairing)");
+    if (extra_ && !extra_->analysis_data.empty()) set.push_back("analysis_data(&" + extra_->analysis_data + ")");
+    return named_row("dg_protocol_of(" + c_string(p_.name) + ", " + c_string(p_.abbreviation) + ", " + c_string(f) + ")", set);
 }
 
 void Emitter::register_functions() {
@@ -587,38 +608,39 @@ bool needs_extra(const Node& n) {
 }
 
 void Emitter::extra_table() {
-    std::vector<const Node*> with;
+    std::vector<std::string> rows;
     for (const Node* n : l_.nodes)
         if (needs_extra(*n)) {
-            extra_index_[n] = static_cast<int>(with.size());
-            with.push_back(n);
+            extra_index_[n] = static_cast<int>(rows.size());
+            rows.push_back("/* " + std::to_string(n->doc_index - 1) + ": " + n->name + " */\n    " + extra_row(*n));
         }
-    if (with.empty()) return;
+    if (rows.empty()) return;
+    o_ << "/* What few nodes need beyond dg_node. */\n" << c_array("static const dg_extra " + p_.filter + "_extra", rows);
+}
+
+// A node's dg_extra: every value that is not the default (UTF-8, nanoseconds, no reassembly).
+std::string Emitter::extra_row(const Node& n) const {
+    std::vector<std::string> set;
+    auto add = [&](const char* setter, const std::string& args) { set.push_back(setter + ("(" + args + ")")); };
     auto slot = [](const std::optional<FieldRef>& r) { return r && r->target ? r->target->slot : -1; };
-    o_ << "/* What few nodes need beyond dg_node. Columns: encoding, units per second, repeat=\"rest\", direction,\n"
-       << " * dissector, reassembly (id slot, offset ref, number slot, last-flag slot, more-flag slot)"
-       << (std::any_of(with.begin(), with.end(), [](const Node* n) { return n->is_located() || n->keeps_values; })
-               ? ",\n * and where offset tables are used: offsets slot, from slot, from levels up, values kept"
-               : "")
-       << ". */\n"
-       << "static const dg_extra " << p_.filter << "_extra[] = {\n";
-    for (const Node* n : with) {
-        const char* units = n->unit == "s" ? "1" : n->unit == "ms" ? "1000" : n->unit == "us" ? "1000000" : "1000000000";
-        const char* dir = n->direction == Direction::Request ? "DG_DIR_REQUEST"
-                          : n->direction == Direction::Response ? "DG_DIR_RESPONSE" : "DG_DIR_ANY";
-        o_ << "    /* " << n->doc_index - 1 << ": " << n->name << " */\n"
-           << "    { " << (n->encoding == "ascii" ? "ENC_ASCII" : "ENC_UTF_8") << ", " << units << ", "
-           << (n->repeat_rest ? 1 : 0) << ", " << dir << ", " << (n->dissector ? c_string(*n->dissector) : "NULL")
-           << ", " << slot(n->reassemble_id) << ", "
-           << ref_of(n->reassemble_offset ? &*n->reassemble_offset : nullptr) << ", " << slot(n->reassemble_seq)
-           << ", " << slot(n->reassemble_last) << ", " << slot(n->reassemble_more);
-        // offset tables (the struct defaults them to none)
-        if (n->is_located() || n->keeps_values)
-            o_ << ", " << slot(n->offsets) << ", " << (n->from_up ? -1 : slot(n->from)) << ", " << n->from_up << ", "
-               << (n->keeps_values ? 1 : 0);
-        o_ << " },\n";
-    }
-    o_ << "};\n\n";
+    if (n.encoding == "ascii") add("encoding", "ENC_ASCII");
+    if (n.unit == "s" || n.unit == "ms" || n.unit == "us")
+        add("units_per_second", n.unit == "s" ? "1" : n.unit == "ms" ? "1000" : "1000000");
+    if (n.repeat_rest) add("repeat_rest", "");
+    if (n.direction != Direction::Any)
+        add("direction", n.direction == Direction::Request ? "DG_DIR_REQUEST" : "DG_DIR_RESPONSE");
+    if (n.dissector) add("dissector", c_string(*n.dissector));
+    if (slot(n.reassemble_id) >= 0) add("reassemble_id", std::to_string(slot(n.reassemble_id)));
+    if (n.reassemble_offset && n.reassemble_offset->target) add("reassemble_offset", ref_of(&*n.reassemble_offset));
+    if (slot(n.reassemble_seq) >= 0) add("reassemble_seq", std::to_string(slot(n.reassemble_seq)));
+    if (slot(n.reassemble_last) >= 0) add("reassemble_last", std::to_string(slot(n.reassemble_last)));
+    if (slot(n.reassemble_more) >= 0) add("reassemble_more", std::to_string(slot(n.reassemble_more)));
+    // offset tables
+    if (slot(n.offsets) >= 0) add("offsets_slot", std::to_string(slot(n.offsets)));
+    if (!n.from_up && slot(n.from) >= 0) add("from_slot", std::to_string(slot(n.from)));
+    if (n.from_up) add("from_up", std::to_string(n.from_up));
+    if (n.keeps_values) add("keep_values", "");
+    return named_row("dg_node_extra()", set);
 }
 
 }  // namespace

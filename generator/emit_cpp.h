@@ -31,6 +31,14 @@ std::vector<FragmentField> fragment_fields(const Protocol& proto);
 // A C string literal of `s` (UTF-8 kept, control characters escaped).
 std::string c_string(const std::string& s);
 
+// `DECLARATION[] = { ... };` with one row a line; C++ has no empty arrays, so
+// a table without rows holds one empty row ({}).
+std::string c_array(const std::string& declaration, const std::vector<std::string>& rows);
+
+// A row of the runtime's tables (plugin_runtime/dissgen_rows.h): `start`, the
+// row's constructor, and its setters "name(value)", wrapped to fit a line.
+std::string named_row(const std::string& start, const std::vector<std::string>& setters);
+
 // Extra tables and fields from other inputs than the rule file (the ESI
 // catalogue and network design, emit_catalogue.h), placed by emit_cpp.
 struct EmbeddedTables {

@@ -250,6 +250,9 @@ BusLayout make_bus_layout(const Catalogue& cat, const BusOptions& opt, const std
     return l;
 }
 
+// The one row of a table without any (C++ has no empty arrays; the count says 0).
+constexpr const char* kEmptyRow = "    {}\n";
+
 std::string command_name(uint8_t cmd) {
     static const char* const kNames[] = {"NOP", "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD",
                                          "BWR", "BRW",  "LRD",  "LWR",  "LRW",  "ARMW", "FRMW"};
@@ -284,7 +287,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
           << c_string(e.entry.data_type) << ", "
           << (l.entry_field[i] < 0 ? "NULL" : "&" + l.fields[l.entry_field[i]].ident) << " },\n";
     }
-    if (l.entries.empty()) o << "    { 0, 0, 0, 0, 0, 0, -1, NULL, NULL, NULL }\n";
+    if (l.entries.empty()) o << kEmptyRow;
     o << "};\n\n";
 
     o << "/* The devices' PDOs: index, output, assigned by default, mapping (first, count). */\n"
@@ -292,7 +295,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
     for (const BusLayout::Pdo& p : l.pdos)
         o << "    { " << hexn(p.index, 4) << ", " << (p.output ? 1 : 0) << ", " << (p.assigned ? 1 : 0) << ", " << p.first
           << ", " << p.count << " },\n";
-    if (l.pdos.empty()) o << "    { 0, 0, 0, 0, 0 }\n";
+    if (l.pdos.empty()) o << kEmptyRow;
     o << "};\n\n";
     o << "/* The PDOs' mappings: object index, bit length, subindex. */\n"
       << "static const dg_map_entry " << filter << "_maps[] = {\n";
@@ -303,7 +306,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
               << static_cast<unsigned>(l.maps[k].subindex) << " },";
         o << "\n";
     }
-    if (l.maps.empty()) o << "    { 0, 0, 0 }\n";
+    if (l.maps.empty()) o << kEmptyRow;
     o << "};\n\n";
 
     o << "/* Device catalogue" << (opt.compact ? " (compact: the models of the network only)" : "")
@@ -319,7 +322,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
           << l.device_pdos[row].pdo_count << ", " << l.device_pdos[row].object_first << ", "
           << l.device_pdos[row].object_count << " },\n";
     }
-    if (l.devices.empty()) o << "    { 0, 0, 0, NULL, NULL, 0, 0, 0, 0, 0, 0 }\n";
+    if (l.devices.empty()) o << kEmptyRow;
     o << "};\n\n";
 
     size_t slave_count = net ? net->slaves.size() : 0, cyclic_count = net ? net->cyclic.size() : 0;
@@ -337,7 +340,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
                   << ", " << (sm.enable ? 1 : 0) << ", " << c_string(sm.type) << " },\n";
             sm_count += s.sms.size();
         }
-        if (!sm_count) o << "    { 0, 0, 0, 0, 0, NULL }\n";
+        if (!sm_count) o << kEmptyRow;
         o << "};\n\n";
         o << "/* The network of " << std::filesystem::path(net->file).filename().string()
           << " in bus order: position, station address, vendor, product code,\n"

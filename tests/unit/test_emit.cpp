@@ -194,7 +194,7 @@ TEST(Emit, FieldsWithoutFilterNameHaveNoHf) {
     Front f = front_end(rules("  <node name=\"Wrap\" filter=\"\"><node name=\"x\" length=\"1byte\"/></node>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
     std::string code = emit_cpp(*f.proto, "t.xml");
-    EXPECT_NE(code.find("{ \"Wrap\", NULL, &ett_"), std::string::npos) << code;
+    EXPECT_NE(code.find("dg_container(\"Wrap\", NULL, &ett_"), std::string::npos) << code;
     EXPECT_NE(code.find("\"tst.x\""), std::string::npos);
     EXPECT_EQ(code.find("\"tst.wrap\""), std::string::npos);
 }
@@ -310,8 +310,7 @@ TEST(ListFields, OnlyThePartsOfTheRuntimeTheProtocolUses) {
 }
 
 // ifhook: its ranges go after every 'in' list, and only rows of nodes that have
-// the attribute get the two extra columns (dg_node defaults them to none), so
-// generated code for rule files without it does not change.
+// the attribute name them (dg_node defaults them to none).
 TEST(Emit, IfhookRangesFollowTheInListsOnTheirRowsOnly) {
     Front f = front_end(rules("  <hook table=\"udp.port\" value=\"2222\"/>\n"
                               "  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
@@ -326,12 +325,20 @@ TEST(Emit, IfhookRangesFollowTheInListsOnTheirRowsOnly) {
     EXPECT_TRUE(contains(code, "static const dg_range tst_ranges[] = { { 0x1, 0x1 }, { 0x3, 0x3 }, "
                                "{ 0x0, 0x8ad }, { 0x8af, 0xffffffff }, { 0x8ae, 0x8ae } };"))
         << code;
-    // Kind: no extra columns; Encap: ranges 2-3; IO: its 'in' at 0-1, ifhook at 4.
-    EXPECT_TRUE(contains(code, ", 0, 0, 0, 0, 0, 1, 0, 0 },\n    /* 1: line 4 */")) << code;
-    // Encap and IO feed nothing else: a walk nobody sees steps over their 2 bytes
-    // (quiet_size), the last column, which needs the ones before it spelled out.
-    EXPECT_TRUE(contains(code, ", 0, 0, 0, 0, 2, 2, NULL,\n      0, 0, 0, -1, 2u },\n    /* 2: line 5 */")) << code;
-    EXPECT_TRUE(contains(code, ", 4, 1, NULL,\n      0, 0, 0, -1, 2u },\n};")) << code;
+    // A node's row, from its constructor to the next row or the table's end.
+    auto row = [&](const std::string& name) {
+        size_t start = code.find("dg_leaf(\"" + name + "\"");
+        if (start == std::string::npos) return std::string();
+        return code.substr(start, std::min(code.find("\n    /*", start), code.find("\n};", start)) - start);
+    };
+    // Kind: no ifhook ranges; Encap: ranges 2-3; IO: its 'in' at 0-1, ifhook at 4.
+    EXPECT_FALSE(contains(row("Kind"), ".hooks(")) << code;
+    EXPECT_TRUE(contains(row("Encap"), ".hooks(2, 2)")) << code;
+    EXPECT_TRUE(contains(row("IO"), ".if_in(0, 0, 2).hooks(4, 1)")) << code;
+    // Encap and IO feed nothing else: a walk nobody sees steps over their 2 bytes (quiet_size).
+    EXPECT_FALSE(contains(row("Kind"), ".quiet_size(")) << code;
+    EXPECT_TRUE(contains(row("Encap"), ".quiet_size(2u)")) << code;
+    EXPECT_TRUE(contains(row("IO"), ".quiet_size(2u)")) << code;
 }
 
 TEST(Validate, IfhookNodesHaveNoFixedSizeAndMayHoldThePduLength) {
@@ -396,9 +403,9 @@ TEST(Pairing, KeysAreFlaggedAndThePairingIsEmitted) {
     // The generated code names the analysis object: the runtime looks nothing up.
     EXPECT_TRUE(contains(code, "extern \"C\" const struct dg_analysis dg_ethercat_esc;")) << code;
     EXPECT_TRUE(contains(code, "static const dg_pairing tst_pairing = { 0.25, &dg_ethercat_esc };")) << code;
-    EXPECT_TRUE(contains(code, "&tst_pairing\n};")) << code;
-    EXPECT_TRUE(contains(code, "DG_SHOW_HEX, DG_NUMERIC|DG_KEY,")) << code;
-    EXPECT_EQ(code.find("DG_SHOW_DEC, DG_NUMERIC|DG_KEY"), std::string::npos) << "only the key is flagged";
+    EXPECT_TRUE(contains(code, ".pairing(&tst_pairing);")) << code;
+    EXPECT_TRUE(contains(code, ".show(DG_SHOW_HEX).flags(DG_NUMERIC|DG_KEY)")) << code;
+    EXPECT_EQ(code.find(".show(DG_SHOW_DEC).flags(DG_NUMERIC|DG_KEY)"), std::string::npos) << "only the key is flagged";
 }
 
 TEST(Pairing, AbsentMeansNoPairingCode) {

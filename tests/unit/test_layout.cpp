@@ -105,7 +105,7 @@ TEST(Layout, OtherwiseChains) {
     EXPECT_TRUE(find(*f.proto, "B")->otherwise);
     EXPECT_TRUE(find(*f.proto, "C")->is_conditional());
     std::string code = emit_cpp(*f.proto, "t.xml");
-    EXPECT_TRUE(contains(code, "0, 0, DG_ALT_OTHERWISE, -1, 1u }")) << code;  // quiet: 1 byte
+    EXPECT_TRUE(contains(code, ".alt(DG_ALT_OTHERWISE).quiet_size(1u),")) << code;  // quiet: 1 byte
 }
 
 const char* kWindow =
@@ -131,10 +131,11 @@ TEST(Layout, WindowChildrenArePlacedAndSortedByAddress) {
     std::string code = emit_cpp(*f.proto, "t.xml");
     // by address: Id (node 5), Status (4), FMMU (6); the largest span is 15*16+16;
     // the base is Addr's value (slot 1, after Len's) minus 16
-    EXPECT_TRUE(contains(code, "{ 5, 0x0, 4, 0, 1 },\n    { 4, 0x110, 2, 0, 1 },\n    { 6, 0x600, 16, 16, 16 }")) << code;
+    EXPECT_TRUE(contains(code, "{ 5, 0x0, 4, 0, 1 },\n    { 4, 0x110, 2, 0, 1 },\n    { 6, 0x600, 16, 16, 16 },")) << code;
     EXPECT_TRUE(contains(code, "{ {1, '-', 16}, 0, 3, 256, FALSE }")) << code;
-    EXPECT_TRUE(contains(code, "tst_whens, NULL") == false);
-    EXPECT_TRUE(contains(code, "NULL, NULL, NULL, tst_windows, tst_places")) << code;
+    EXPECT_FALSE(contains(code, ".whens(tst_whens)")) << code;
+    EXPECT_FALSE(contains(code, ".peeks(")) << code;
+    EXPECT_TRUE(contains(code, ".windows(tst_windows).places(tst_places)")) << code;
 }
 
 TEST(Layout, WindowLengthNeedNotBeItsChildrensSum) {

@@ -49,9 +49,9 @@ TEST(Offsets, FromAnEnclosingContainerCountsLevels) {
     // no slot for Box: the runtime takes the start of its content
     EXPECT_EQ(find(*f.proto, "Box")->slot, -1);
     std::string code = emit_cpp(*f.proto, "t.xml");
-    // Item's extra: offsets slot, from slot -1, 2 levels up, values not kept; Offset's: kept
-    EXPECT_TRUE(contains(code, ", 1, -1, 2, 0 },")) << code;
-    EXPECT_TRUE(contains(code, ", -1, -1, 0, 1 },")) << code;
+    // Item's extra: offsets slot, no from slot, 2 levels up, values not kept; Offset's: kept
+    EXPECT_TRUE(contains(code, "dg_node_extra().offsets_slot(1).from_up(2),")) << code;
+    EXPECT_TRUE(contains(code, "dg_node_extra().keep_values(),")) << code;
 }
 
 TEST(Offsets, EmittedInTheExtraTableAndWithTheNewExpert) {
@@ -59,8 +59,7 @@ TEST(Offsets, EmittedInTheExtraTableAndWithTheNewExpert) {
     ASSERT_TRUE(f.ok()) << f.messages();
     std::string code = emit_cpp(*f.proto, "t.xml");
     // Count is slot 0, Offset slot 1: Item reads the table in slot 1 from slot 0's first byte
-    EXPECT_TRUE(contains(code, ", 1, 0, 0, 0 },")) << code;
-    EXPECT_TRUE(contains(code, "offsets slot, from slot, from levels up, values kept")) << code;
+    EXPECT_TRUE(contains(code, "dg_node_extra().offsets_slot(1).from_slot(0),")) << code;
     EXPECT_TRUE(contains(code, "\"tst.expert.bad_offset\", PI_MALFORMED, PI_ERROR")) << code;
 }
 
@@ -68,7 +67,8 @@ TEST(Offsets, ProtocolsWithoutTablesKeepTheirExtraRowsShort) {
     Front f = front_end(rules("  <node name=\"Rest\" length=\"rest\" repeat=\"rest\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
     std::string code = emit_cpp(*f.proto, "t.xml");
-    EXPECT_FALSE(contains(code, "offsets slot")) << code;
+    EXPECT_TRUE(contains(code, "dg_node_extra().repeat_rest(),")) << code;
+    EXPECT_FALSE(contains(code, "offsets_slot")) << code;
 }
 
 TEST(Offsets, AReferenceIntoAPlacedInstanceFromOutsideIsRejected) {

@@ -55,8 +55,8 @@ TEST(TypedValues, FieldTypesOfTheTypedDisplays) {
 
     std::string code = emit_cpp(p, "t.xml");
     EXPECT_TRUE(contains(code, "DG_SHOW_STRINGZ")) << code;
-    EXPECT_TRUE(contains(code, "{ ENC_ASCII, 1000000000, 0, DG_DIR_ANY, NULL, -1, {-1, 0, 0}, -1, -1, -1 }"));
-    EXPECT_TRUE(contains(code, "{ ENC_UTF_8, 1, 0, DG_DIR_ANY, NULL, -1, {-1, 0, 0}, -1, -1, -1 }"));
+    EXPECT_TRUE(contains(code, "dg_node_extra().encoding(ENC_ASCII),")) << code;
+    EXPECT_TRUE(contains(code, "dg_node_extra().units_per_second(1),")) << code;
 }
 
 TEST(TypedValues, LengthsFromAnIntOrTimeField) {
@@ -95,7 +95,7 @@ TEST(TypedValues, RepeatRestIsARepetition) {
     EXPECT_TRUE(n->repeat_rest);
     EXPECT_FALSE(n->repeat.has_value());  // "rest" is not an XPath here
     EXPECT_TRUE(n->is_repeated());
-    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "{ ENC_UTF_8, 1000000000, 1, DG_DIR_ANY, NULL"));
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "dg_node_extra().repeat_rest(),"));
 }
 
 TEST(TypedValues, DirectionIsAConditionAndIsEmitted) {
@@ -128,9 +128,10 @@ TEST(TypedValues, HandOffAndReassemblyTables) {
     EXPECT_EQ(frame->reassemble_offset->operand, 32);
     std::string code = emit_cpp(*f.proto, "t.xml");
     // The id, offset and last fields get value slots 0, 1 and 2.
-    EXPECT_TRUE(contains(code, "\"eth_withoutfcs\", 0, {1, '*', 32}, -1, 2, -1 }")) << code;
+    EXPECT_TRUE(contains(code, "dg_node_extra().dissector(\"eth_withoutfcs\").reassemble_id(0).reassemble_offset({1, '*', 32})"
+                               ".reassemble_last(2),")) << code;
     EXPECT_TRUE(contains(code, "static reassembly_table tst_reassembly;"));
-    EXPECT_TRUE(contains(code, "&tst_reassembly, &tst_fragment_items"));
+    EXPECT_TRUE(contains(code, ".reassembly(&tst_reassembly, &tst_fragment_items)")) << code;
     std::string fields = list_fields(*f.proto);
     EXPECT_TRUE(contains(fields, "tst.reassembled_in\tFT_FRAMENUM\t"));
     EXPECT_TRUE(contains(fields, "tst.fragment.count\tFT_UINT32\t"));
