@@ -88,6 +88,9 @@ struct Layout {
     std::map<const Node*, int> when_first;
     std::map<const Node*, int> window_index;
     std::vector<std::string> whens, peeks, peek_lengths, windows, places;
+    // computed values: each one's operations, in postfix order
+    std::map<const Node*, std::pair<int, int>> expr_span;  // first, count
+    std::vector<ExprRow> exprs;
     bool uses_layout_tables() const { return !whens.empty() || !windows.empty(); }
     bool node_uses_layout_columns(const Node& n) const { return when_first.count(&n) || window_index.count(&n) || n.otherwise; }
 };
@@ -143,7 +146,27 @@ Layout make_layout(const Protocol& proto) {
         }
     }
     layout_conditions_and_windows(l);
+    for (const Node* n : l.nodes) {
+        if (!n->is_computed()) continue;
+        std::vector<ExprRow> rows = compile_expression(*n->value, n->display == Display::Float);
+        l.expr_span[n] = {static_cast<int>(l.exprs.size()), static_cast<int>(rows.size())};
+        l.exprs.insert(l.exprs.end(), rows.begin(), rows.end());
+    }
     return l;
+}
+
+// A computed value's operation: its code, then what that code reads.
+std::string expr_row(const ExprRow& r) {
+    std::string row = "dg_op(" + r.code + ")";
+    if (r.code == "DG_OP_INT") row = "dg_op_int(" + std::to_string(r.integer) + ")";
+    if (r.code == "DG_OP_FLOAT") {
+        char buf[40];
+        std::snprintf(buf, sizeof buf, "%.17g", r.real);
+        row = "dg_op_real(" + std::string(buf) + ")";
+    }
+    if (r.code.rfind("DG_OP_FIELD", 0) == 0)
+        row = "dg_op_field(" + r.code + ", " + std::to_string(r.slot) + ", " + std::to_string(r.bits) + ")";
+    return row;
 }
 
 std::string ref_of(const FieldRef* r);
@@ -231,6 +254,7 @@ std::string flags_of(const Node& n, bool pairing_key) {
 
 const char* length_kind_of(const Node& n) {
     if (n.in_bit_group) return "DG_LEN_FIXED";
+    if (n.is_computed()) return "DG_LEN_COMPUTED";
     switch (n.length_kind) {
         case LengthKind::Bits:
         case LengthKind::Bytes: return "DG_LEN_FIXED";
@@ -411,6 +435,9 @@ void Emitter::condition_and_window_tables() {
     table("dg_ref", "peek_lengths", l_.peek_lengths, "Field lengths between a node and the field it peeks at");
     table("dg_window", "windows", l_.windows, "Windows: base address, places (first, count), largest span, document order");
     table("dg_place", "places", l_.places, "Window children by address: node, address, size, stride, instances");
+    std::vector<std::string> exprs;
+    for (const ExprRow& r : l_.exprs) exprs.push_back(expr_row(r));
+    table("dg_expr_op", "exprs", exprs, "Computed values: their operations in postfix order");
 }
 
 void Emitter::node_table() {
@@ -434,6 +461,7 @@ std::string Emitter::node_row(const Node& n) const {
     if (length_kind == "DG_LEN_FIELD") add("length_field", ref_of(&n.length_ref));
     if (length_kind == "DG_LEN_REST") add("length_rest", "");
     if (length_kind == "DG_LEN_CHILDREN") add("length_children", "");
+    if (length_kind == "DG_LEN_COMPUTED") add("length_computed", "");
     unsigned length = n.in_bit_group ? n.group_bytes : static_cast<unsigned>(n.fixed_bits / 8);
     if (length && (n.has_fixed_length() || n.in_bit_group)) add("length", std::to_string(length));
     if (n.shift) add("shift", std::to_string(n.shift));
@@ -508,6 +536,7 @@ std::string Emitter::protocol_row() const {
     table("peek_lengths", l_.peek_lengths);
     table("windows", l_.windows);
     table("places", l_.places);
+    if (!l_.exprs.empty()) set.push_back("exprs(" + f + "_exprs)");
     if (p_.pairing) set.push_back("pairing(&" + f + "_pairing)");
     if (extra_ && !extra_->analysis_data.empty()) set.push_back("analysis_data(&" + extra_->analysis_data + ")");
     return named_row("dg_protocol_of(" + c_string(p_.name) + ", " + c_string(p_.abbreviation) + ", " + c_string(f) + ")", set);
@@ -604,7 +633,7 @@ bool needs_extra(const Node& n) {
     return (n.is_leaf() && (n.display == Display::String || n.display == Display::StringZ ||
                             n.display == Display::Time)) ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
-           n.keeps_values;
+           n.keeps_values || n.is_computed();
 }
 
 void Emitter::extra_table() {
@@ -640,6 +669,8 @@ std::string Emitter::extra_row(const Node& n) const {
     if (!n.from_up && slot(n.from) >= 0) add("from_slot", std::to_string(slot(n.from)));
     if (n.from_up) add("from_up", std::to_string(n.from_up));
     if (n.keeps_values) add("keep_values", "");
+    if (n.is_computed())
+        add("value", std::to_string(l_.expr_span.at(&n).first) + ", " + std::to_string(l_.expr_span.at(&n).second));
     return named_row("dg_node_extra()", set);
 }
 
@@ -668,8 +699,20 @@ std::optional<FieldType> typed_field_type(const Node& n) {
     }
 }
 
+// A computed value: 64 bits, signed unless shown in hex or as a name.
+FieldType computed_field_type(const Node& n) {
+    switch (n.display) {
+        case Display::Float: return {"FT_DOUBLE", "BASE_NONE", 0};
+        case Display::Bool: return {"FT_BOOLEAN", "BASE_NONE", 0};
+        case Display::NumberHex: return {"FT_UINT64", "BASE_HEX", 0};
+        case Display::Enum: return {"FT_UINT64", "BASE_HEX|BASE_VAL64_STRING", 0};
+        default: return {"FT_INT64", "BASE_DEC", 0};
+    }
+}
+
 FieldType field_type(const Node& n) {
     if (n.is_container()) return {"FT_NONE", "BASE_NONE", 0};
+    if (n.is_computed()) return computed_field_type(n);
     if (auto typed = typed_field_type(n)) return *typed;
     if (!n.is_numeric()) {
         const char* sep = n.display == Display::Address ? "SEP_COLON"

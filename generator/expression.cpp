@@ -2,6 +2,9 @@
 // A precedence-climbing parser for value="..." expressions (see expression.h).
 #include "expression.h"
 
+#include "model.h"
+
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdlib>
@@ -144,6 +147,7 @@ private:
         if (point) {
             out.op = ExprOp::Float;
             out.real = std::strtod(digits.c_str(), nullptr);
+            if (errno == ERANGE) return fail("number '" + digits + "' is out of range");
         } else {
             out.op = ExprOp::Int;
             unsigned long long v = std::strtoull(digits.c_str(), nullptr, hex ? 16 : 10);
@@ -182,6 +186,108 @@ bool expr_op_needs_integers(ExprOp op) {
     default:
         return false;
     }
+}
+
+namespace {
+
+const char* integer_code(ExprOp op) {
+    switch (op) {
+    case ExprOp::Neg: return "DG_OP_NEG";
+    case ExprOp::Not: return "DG_OP_NOT";
+    case ExprOp::BitNot: return "DG_OP_BITNOT";
+    case ExprOp::Mul: return "DG_OP_MUL";
+    case ExprOp::Div: return "DG_OP_DIV";
+    case ExprOp::Mod: return "DG_OP_MOD";
+    case ExprOp::Add: return "DG_OP_ADD";
+    case ExprOp::Sub: return "DG_OP_SUB";
+    case ExprOp::Shl: return "DG_OP_SHL";
+    case ExprOp::Shr: return "DG_OP_SHR";
+    case ExprOp::Lt: return "DG_OP_LT";
+    case ExprOp::Le: return "DG_OP_LE";
+    case ExprOp::Gt: return "DG_OP_GT";
+    case ExprOp::Ge: return "DG_OP_GE";
+    case ExprOp::Eq: return "DG_OP_EQ";
+    case ExprOp::Ne: return "DG_OP_NE";
+    case ExprOp::BitAnd: return "DG_OP_BITAND";
+    case ExprOp::BitXor: return "DG_OP_BITXOR";
+    case ExprOp::BitOr: return "DG_OP_BITOR";
+    case ExprOp::And: return "DG_OP_AND";
+    default: return "DG_OP_OR";
+    }
+}
+
+// The double variant of an operator that has one (the others need integers).
+std::string float_code(ExprOp op) {
+    const std::string code = integer_code(op);
+    return "DG_OP_F" + code.substr(6);
+}
+
+void compile_into(const Expr& e, bool as_float, std::vector<ExprRow>& out) {
+    ExprRow row;
+    switch (e.op) {
+    case ExprOp::Int:
+        if (as_float) {
+            row.code = "DG_OP_FLOAT";
+            row.real = static_cast<double>(e.integer);
+        } else {
+            row.code = "DG_OP_INT";
+            row.integer = e.integer;
+        }
+        out.push_back(row);
+        return;
+    case ExprOp::Float:
+        row.code = "DG_OP_FLOAT";
+        row.real = e.real;
+        out.push_back(row);
+        return;
+    case ExprOp::Index:
+        out.push_back({"DG_OP_INDEX"});
+        if (as_float) out.push_back({"DG_OP_TO_FLOAT"});
+        return;
+    case ExprOp::Field:
+        row.slot = e.target->slot;
+        if (e.is_float) {
+            row.code = "DG_OP_FIELD_FLOAT";
+        } else if (e.target->display == Display::Int) {
+            row.code = "DG_OP_FIELD_SIGNED";
+            row.bits = e.target->bits;
+        } else {
+            row.code = "DG_OP_FIELD";
+        }
+        out.push_back(row);
+        if (as_float && !e.is_float) out.push_back({"DG_OP_TO_FLOAT"});
+        return;
+    default:
+        break;
+    }
+    // The operands work in double when one of them is a double.
+    bool operands_float = false;
+    for (const Expr& a : e.args) operands_float = operands_float || a.is_float;
+    for (const Expr& a : e.args) compile_into(a, operands_float, out);
+    out.push_back({operands_float ? float_code(e.op) : integer_code(e.op)});
+    // Comparisons and logic give an integer even on doubles.
+    if (as_float && !e.is_float) out.push_back({"DG_OP_TO_FLOAT"});
+}
+
+}  // namespace
+
+std::vector<ExprRow> compile_expression(const Expr& e, bool as_float) {
+    std::vector<ExprRow> out;
+    compile_into(e, as_float, out);
+    return out;
+}
+
+unsigned expression_stack_depth(const std::vector<ExprRow>& rows) {
+    static const std::vector<std::string> operands = {"DG_OP_INT", "DG_OP_FLOAT", "DG_OP_FIELD",
+                                                      "DG_OP_FIELD_SIGNED", "DG_OP_FIELD_FLOAT", "DG_OP_INDEX"};
+    static const std::vector<std::string> unary = {"DG_OP_TO_FLOAT", "DG_OP_NEG", "DG_OP_NOT", "DG_OP_BITNOT",
+                                                   "DG_OP_FNEG", "DG_OP_FNOT"};
+    unsigned depth = 0, deepest = 0;
+    for (const ExprRow& r : rows) {
+        if (std::find(operands.begin(), operands.end(), r.code) != operands.end()) deepest = std::max(deepest, ++depth);
+        else if (std::find(unary.begin(), unary.end(), r.code) == unary.end()) --depth;
+    }
+    return deepest;
 }
 
 }  // namespace dissgen

@@ -39,6 +39,23 @@ struct Expr {
     bool is_float = false;          // derived by the validator: evaluated in double
 };
 
+// One operation of a compiled expression, as the runtime's dg_expr_op
+// (plugin_runtime/dissgen_expr.h) holds it: `code` is its DG_OP_ name.
+struct ExprRow {
+    std::string code;
+    unsigned bits = 0;   // DG_OP_FIELD_SIGNED
+    int slot = -1;       // DG_OP_FIELD*
+    int64_t integer = 0; // DG_OP_INT
+    double real = 0;     // DG_OP_FLOAT
+};
+
+// A checked expression (targets resolved and slotted, types derived) in
+// postfix order; `as_float`: the result is wanted as a double.
+std::vector<ExprRow> compile_expression(const Expr& e, bool as_float);
+
+// The stack depth compile_expression's rows need.
+unsigned expression_stack_depth(const std::vector<ExprRow>& rows);
+
 // Parses `text`; on a mistake returns false and sets `error` to a message
 // that says where ("... at character 7").
 bool parse_expression(const std::string& text, Expr& out, std::string& error);

@@ -25,6 +25,7 @@ struct dg_node_row {
     constexpr dg_node_row &length_field(dg_ref ref) { n.length_kind = DG_LEN_FIELD; n.length_ref = ref; return *this; }
     constexpr dg_node_row &length_rest() { n.length_kind = DG_LEN_REST; return *this; }
     constexpr dg_node_row &length_children() { n.length_kind = DG_LEN_CHILDREN; return *this; }
+    constexpr dg_node_row &length_computed() { n.length_kind = DG_LEN_COMPUTED; return *this; }
     constexpr dg_node_row &shift(guint8 v) { n.shift = v; return *this; }
     constexpr dg_node_row &bits(guint8 v) { n.bits = v; return *this; }
     constexpr dg_node_row &slot(gint16 v) { n.slot = v; return *this; }
@@ -80,6 +81,7 @@ struct dg_extra_row {
     constexpr dg_extra_row &from_slot(gint16 slot) { e.from_slot = slot; return *this; }
     constexpr dg_extra_row &from_up(guint8 levels) { e.from_up = levels; return *this; }
     constexpr dg_extra_row &keep_values() { e.keep_values = 1; return *this; }
+    constexpr dg_extra_row &value(guint16 first, guint16 count) { e.expr_first = first; e.expr_count = count; return *this; }
 };
 
 /* UTF-8 strings, times in nanoseconds, no reassembly. */
@@ -138,7 +140,15 @@ struct dg_protocol_row {
     constexpr dg_protocol_row &places(const dg_place *v) { p.places = v; return *this; }
     constexpr dg_protocol_row &pairing(const dg_pairing *v) { p.pairing = v; return *this; }
     constexpr dg_protocol_row &analysis_data(const void *v) { p.analysis_data = v; return *this; }
+    constexpr dg_protocol_row &exprs(const dg_expr_op *v) { p.exprs = v; return *this; }
 };
+
+/* Operations of computed values: dg_op(CODE) for operators and index, and
+ * the operands that carry a number or read a field. */
+constexpr dg_expr_op dg_op(guint8 code) { return dg_expr_op{code, 0, -1, 0, 0}; }
+constexpr dg_expr_op dg_op_int(gint64 v) { return dg_expr_op{DG_OP_INT, 0, -1, v, 0}; }
+constexpr dg_expr_op dg_op_real(gdouble v) { return dg_expr_op{DG_OP_FLOAT, 0, -1, 0, v}; }
+constexpr dg_expr_op dg_op_field(guint8 code, gint16 slot, guint8 bits) { return dg_expr_op{code, bits, slot, 0, 0}; }
 
 constexpr dg_protocol_row dg_protocol_of(const char *name, const char *short_name, const char *filter) {
     dg_protocol_row r{};

@@ -9,6 +9,7 @@
  */
 #pragma once
 
+#include "dissgen_expr.h"
 #include "dissgen_compat.h"
 #include "dissgen_names.h"
 
@@ -18,7 +19,8 @@ enum dg_length_kind {
     DG_LEN_FIXED = 0,    /* bytes in dg_node.length */
     DG_LEN_FIELD = 1,    /* value of an earlier field, dg_node.length_ref */
     DG_LEN_REST = 2,     /* to the end of the enclosing known-length container */
-    DG_LEN_CHILDREN = 3  /* sum of the children */
+    DG_LEN_CHILDREN = 3, /* sum of the children */
+    DG_LEN_COMPUTED = 4  /* none: a computed value (dg_extra.expr_first/count) */
 };
 /* How a leaf's value is shown; used for summaries and the Info column. */
 enum dg_show {
@@ -97,6 +99,8 @@ typedef struct dg_extra {
     guint8 from_up;
     guint8 keep_values;
 #endif
+    /* value="EXPR": the operations dg_protocol.exprs[expr_first ..] */
+    guint16 expr_first, expr_count;
 } dg_extra;
 
 /* The most entries an offset table may have; longer ones are malformed. */
@@ -282,6 +286,7 @@ typedef struct dg_protocol {
 #else
     const void *analysis_data;
 #endif
+    const dg_expr_op *exprs; /* computed values' operations, NULL when none */
 } dg_protocol;
 
 #ifdef __cplusplus
