@@ -254,8 +254,7 @@ def capture_checks(check, env, path, name, expect_faults=False):
 class TestEcatFigures(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
-        cls.env.install_plugin(ARGS.dissgen, os.path.join(ARGS.source_dir, "rules", "ethercat.xml"))
-        cls.env.assert_plugin_loaded("ecatr")
+        cls.install(os.path.join("rules", "ethercat.xml"), "ecatr")
 
     def test_generated_faults_counted_and_timed(self):
         with self.checks() as check:

@@ -147,8 +147,7 @@ def decode(env, path, two_pass):
 class TestEscCommands(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
-        cls.env.install_plugin(ARGS.dissgen, os.path.join(ARGS.source_dir, "rules", "ethercat.xml"))
-        cls.env.assert_plugin_loaded("ecatr")
+        cls.install(os.path.join("rules", "ethercat.xml"), "ecatr")
 
     def test_every_command_returned_as_the_rules_say(self):
         env = self.env

@@ -389,8 +389,7 @@ class TestLosses(TsharkTestCase, unittest.TestCase):
     def prepare(cls):
         if ARGS.with_corpus and not ARGS.corpus:
             ARGS.corpus = os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus", "ethercat")
-        cls.env.install_plugin(ARGS.dissgen, os.path.join(ARGS.source_dir, "rules", "ethercat.xml"))
-        cls.env.assert_plugin_loaded("ecatr")
+        cls.install(os.path.join("rules", "ethercat.xml"), "ecatr")
         cls.dec = Decoder(cls.env)
         cls.summary = []
 

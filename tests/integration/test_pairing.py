@@ -565,8 +565,7 @@ class TestPairing(TsharkTestCase, unittest.TestCase):
 
     @classmethod
     def prepare(cls):
-        cls.env.install_plugin(ARGS.dissgen, os.path.join(ARGS.source_dir, "rules", "ethercat.xml"))
-        cls.env.assert_plugin_loaded("ecatr")
+        cls.install(os.path.join("rules", "ethercat.xml"), "ecatr")
         cls.corpus_dir = ARGS.corpus or os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus",
                                                      "ethercat")
         files = corpus_captures(cls.corpus_dir)

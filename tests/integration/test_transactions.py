@@ -75,8 +75,7 @@ def decode(env, path, two_pass):
 class TestTransactions(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
-        cls.env.install_plugin(ARGS.dissgen, os.path.join(ARGS.source_dir, "tests", "rules", "transactions.xml"))
-        cls.env.assert_plugin_loaded("txnp")
+        cls.install(os.path.join("tests", "rules", "transactions.xml"), "txnp")
 
     def test_requests_and_responses_paired_by_direction(self):
         env = self.env

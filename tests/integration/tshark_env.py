@@ -297,7 +297,8 @@ class TsharkEnv:
 
 class TsharkTestCase:
     """Mixin for a unittest.TestCase class whose tests share one TsharkEnv (cls.env),
-    set up by the class's own `prepare()` classmethod, if it has one.
+    set up by the class's own `prepare()` classmethod, if it has one (`cls.install(rules,
+    protocol)` puts a plugin in it); cls.args: the options run_unittests parsed.
 
     A test that makes many fine-grained checks collects them with `self.checks()`: each
     prints an ok/FAIL line, and the test fails at the end of the block, listing the
@@ -317,6 +318,12 @@ class TsharkTestCase:
     @classmethod
     def tearDownClass(cls):
         cls.env.cleanup()
+
+    @classmethod
+    def install(cls, rules, protocol, extra_args=()):
+        """Install the plugin of rules (a path in the source tree) into cls.env, check it loads."""
+        cls.env.install_plugin(cls.args.dissgen, os.path.join(cls.args.source_dir, rules), extra_args)
+        cls.env.assert_plugin_loaded(protocol)
 
     @contextlib.contextmanager
     def checks(self):
@@ -348,7 +355,7 @@ def run_unittests(add_arguments=None):
         print("SKIPPED: tshark is not installed")
         return args, 77
     main_module = sys.modules["__main__"]
-    main_module.ARGS = args
+    main_module.ARGS = TsharkTestCase.args = args
     result = unittest.main(module=main_module, argv=[sys.argv[0]] + rest, exit=False, verbosity=2).result
     skipped = [(test, why) for test, why in result.skipped]
     ran = result.testsRun - sum(1 for test, _why in skipped if isinstance(test, unittest.TestCase))
