@@ -25,7 +25,7 @@ std::string build_and_install(const BuildRequest& request, std::string& installe
 // dissgen, and (through links CMake makes) of build/bin/dissgen.
 std::string share_dir(const std::string& argv0);
 
-// The folder holding dissgen_runtime.{h,cpp}: $DISSGEN_RUNTIME_DIR, else
+// The folder holding dissgen_runtime.h and the runtime sources: $DISSGEN_RUNTIME_DIR, else
 // share_dir()/runtime; "" when neither has it.
 std::string find_runtime_dir(const std::string& argv0);
 

@@ -266,7 +266,7 @@ int cmd_install(const std::string& path, const std::string& dir, bool system, co
     }
     std::string runtime = find_runtime_dir(argv0);
     if (runtime.empty()) {
-        std::cerr << "dissgen: cannot find the plugin runtime (dissgen_runtime.cpp); set DISSGEN_RUNTIME_DIR\n";
+        std::cerr << "dissgen: cannot find the plugin runtime (dissgen_runtime.h and its sources); set DISSGEN_RUNTIME_DIR\n";
         return 1;
     }
     BuildRequest req{generate_source(*l.proto, path, bus), plugin_basename(path), target_dir, runtime,

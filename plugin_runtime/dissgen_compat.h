@@ -11,14 +11,10 @@
 /* Reassembly and hand-off. reassemble.h and show_exception.h have no C++ guards;
  * packet-tcp.h includes reassemble.h outside its own, so they come first. */
 #include <epan/exceptions.h>
-#ifdef __cplusplus
 extern "C" {
-#endif
 #include <epan/show_exception.h>
 #include <epan/reassemble.h>
-#ifdef __cplusplus
 }
-#endif
 #include <epan/dissectors/packet-tcp.h>
 #include <wsutil/report_message.h>
 
@@ -93,9 +89,10 @@ extern "C" {
  * - proto_name_already_registered() returns int in 4.0, bool later: only
  *   tested for truth. */
 
-/* The plugin loader's entry points. In C++ a namespace-scope const has
- * internal linkage, so the data symbols are declared extern (inside an
- * extern "C" block) before they are defined.
+/* The plugin loader's entry points, with C linkage: the loader looks them up
+ * by their plain names. In C++ a namespace-scope const has internal linkage,
+ * so the data symbols are declared extern (inside the extern "C" block)
+ * before they are defined.
  *
  * The protocol is registered at the start of the handoff phase, not in the
  * register phase: per-user plugins register before global ones, so only
@@ -103,14 +100,6 @@ extern "C" {
  * are taken (say, by Debian's ethercat.so) step aside instead of making
  * Wireshark abort on a duplicate name. Subtree and field arrays are still
  * open for registration then. */
-#ifdef __cplusplus
-#define DG_BEGIN_C extern "C" {
-#define DG_END_C }
-#else
-#define DG_BEGIN_C
-#define DG_END_C
-#endif
-
 /* 4.4+: tell the loader this plugin is a dissector (shown by tshark -G plugins
  * and Wireshark's About dialog). */
 #ifdef DG_HAVE_PLUGIN_DESCRIBE
@@ -128,7 +117,7 @@ extern "C" {
         register_fn();                                                               \
         handoff_fn();                                                                \
     }                                                                                \
-    DG_BEGIN_C                                                                       \
+    extern "C" {                                                                     \
     WS_DLL_PUBLIC_DEF extern const char plugin_version[];                            \
     WS_DLL_PUBLIC_DEF extern const int plugin_want_major;                            \
     WS_DLL_PUBLIC_DEF extern const int plugin_want_minor;                            \
@@ -144,4 +133,4 @@ extern "C" {
         plug.register_handoff = dg_register_then_handoff;                            \
         proto_register_plugin(&plug);                                                \
     }                                                                                \
-    DG_END_C
+    }

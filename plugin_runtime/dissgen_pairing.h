@@ -108,9 +108,8 @@ typedef struct dg_analysis {
     gboolean (*key_changed)(tvbuff_t *request, tvbuff_t *message);
 } dg_analysis;
 
-#ifdef __cplusplus
+/* C linkage like dissgen_runtime.h's entry points: plain symbol names. */
 extern "C" {
-#endif
 
 /* At registration: the pairing's fields and expert infos, its analysis's,
  * and the per-capture init/cleanup routines. */
@@ -130,6 +129,4 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, 
 void dg_pairing_stats_init(const dg_protocol *p, stats_tree *st);
 void dg_pairing_stats_packet(const dg_protocol *p, stats_tree *st, packet_info *pinfo, const dg_frame_pairing *fp);
 
-#ifdef __cplusplus
 }
-#endif

@@ -57,13 +57,8 @@ typedef struct dg_range {
 typedef struct dg_summary_piece {
     const char *text;
     gint16 slot;
-#ifdef __cplusplus
     guint16 group = 0;
     guint16 node = 0;
-#else
-    guint16 group;
-    guint16 node;
-#endif
 } dg_summary_piece;
 
 /* What few nodes need (direction, repeat="rest", strings, times,
@@ -88,19 +83,12 @@ typedef struct dg_extra {
      * field in from_slot, or (from_slot -1) the start of the from_up-th
      * enclosing container's content. Generated code gives them only for the
      * nodes that use them. */
-#ifdef __cplusplus
     gint16 offsets_slot = -1; /* slot of the repeated offset leaf; -1: not placed by a table */
     gint16 from_slot = -1;
     guint8 from_up = 0;
     guint8 keep_values = 0;   /* an offset leaf: the value of every instance is kept (up to DG_MAX_TABLE) */
-#else
-    gint16 offsets_slot;
-    gint16 from_slot;
-    guint8 from_up;
-    guint8 keep_values;
-#endif
     /* value="EXPR": the operations dg_protocol.exprs[expr_first ..] */
-    guint16 expr_first, expr_count;
+    guint16 expr_first = 0, expr_count = 0;
 } dg_extra;
 
 /* The most entries an offset table may have; longer ones are malformed. */
@@ -169,39 +157,21 @@ typedef struct dg_node {
     /* ifhook: decoded only when the value the dissector table matched
      * (pinfo->match_uint: the port, the ethertype) is in these ranges.
      * Generated code gives them only for nodes that have the attribute. */
-#ifdef __cplusplus
     guint16 hook_first = 0, hook_count = 0;
-#else
-    guint16 hook_first, hook_count;
-#endif
     /* NULL for nodes without string/time/int/float/ipv4 attributes,
      * repeat="rest", direction, dissector or reassembly. */
-#ifdef __cplusplus
     const dg_extra *extra = NULL;
-#else
-    const dg_extra *extra;
-#endif
     /* <when> conditions (dg_protocol.whens), DG_ALT_* flags, and
      * the window (dg_protocol.windows) of a container with 'base'. Generated
      * code gives them only for nodes that use them. */
-#ifdef __cplusplus
     guint16 when_first = 0, when_count = 0;
     guint8 alt = 0;
     gint16 window = -1;
-#else
-    guint16 when_first, when_count;
-    guint8 alt;
-    gint16 window;
-#endif
     /* quiet_size: > 0 when nothing but the node's own items depends on it
      * (no value others read, no summary, key or hand-off) and it cannot be
      * malformed within these many bytes: a walk with no tree and no tap
      * listener steps over it when they are there. */
-#ifdef __cplusplus
     guint32 quiet_size = 0;
-#else
-    guint32 quiet_size;
-#endif
 } dg_node;
 
 /* The expert infos of every protocol, one member per row of
@@ -249,49 +219,29 @@ typedef struct dg_protocol {
     guint32 pdu_offset;
     gint64 pdu_add;
     /* reassembly across frames (NULL when no node reassembles). */
-#ifdef __cplusplus
     reassembly_table *reassembly = NULL;
     const fragment_items *fragments = NULL;
-#else
-    reassembly_table *reassembly;
-    const fragment_items *fragments;
-#endif
     /* tables of <when> conditions, peeks and windows (NULL when unused). */
-#ifdef __cplusplus
     const dg_when *whens = NULL;
     const dg_peek *peeks = NULL;
     const dg_ref *peek_lengths = NULL;
     const dg_window *windows = NULL;
     const dg_place *places = NULL;
-#else
-    const dg_when *whens;
-    const dg_peek *peeks;
-    const dg_ref *peek_lengths;
-    const dg_window *windows;
-    const dg_place *places;
-#endif
     /* request/response pairing, NULL when the rule file has none.
      * Generated code gives it only for protocols that have one. */
-#ifdef __cplusplus
     const dg_pairing *pairing = nullptr;
-#else
-    const dg_pairing *pairing;
-#endif
     /* Data for the pairing's analysis, built from other inputs than the rule
      * file (for the EtherCAT analysis: the ESI catalogue and network design
      * of --esi / --network); only the analysis knows its type. NULL when none;
      * generated code gives it only when there is some. */
-#ifdef __cplusplus
     const void *analysis_data = nullptr;
-#else
-    const void *analysis_data;
-#endif
-    const dg_expr_op *exprs; /* computed values' operations, NULL when none */
+    const dg_expr_op *exprs = nullptr; /* computed values' operations, NULL when none */
 } dg_protocol;
 
-#ifdef __cplusplus
+/* The entry points generated code calls. C linkage: plain symbol
+ * names in every plugin (tests/integration/test_plugin_contents.py reads
+ * them), whatever the compiler's name mangling. */
 extern "C" {
-#endif
 
 /* True when no protocol of the running Wireshark uses this protocol's name,
  * short name or filter name; otherwise reports the clash (report_failure)
@@ -318,6 +268,4 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
 /* Dissects a TCP segment holding whole or partial messages (pdulength). */
 int dg_dissect_stream(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
 
-#ifdef __cplusplus
 }
-#endif

@@ -6,12 +6,9 @@
 
 #include "dissgen_pairing.h"
 
-#ifdef __cplusplus
+/* C linkage: generated code declares it so (extern "C") where its rules name it. */
 extern "C" {
-#endif
 
 extern const dg_analysis dg_ethercat_esc;
 
-#ifdef __cplusplus
 }
-#endif

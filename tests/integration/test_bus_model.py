@@ -36,24 +36,23 @@
    field for them (0x1D09:10, only in a PDO not assigned by default) or its ESI file does not
    know them (0x7777:01); one pass and -2 alike. The same with a design
    (tests/network/small_design.xml: its EL1004 assigned 0x1A10, which small_io.xml does not
-   assign by default), without the corpus too. The EL1252 part is SKIPPED without the ESI file.
-`--only NAME` runs one part alone: identities, network, wkc, stats, eni, pdo, coe (1 to 7).
-Skips (exit 77) when the corpus is absent (parts 6 and 7 run all the same).
+   assign by default), without the corpus too. The EL1252 test is skipped without the ESI file.
+Each part is one test (TestBusModel.test_...; one alone: give its name after the options).
+Without the corpus, parts 1 to 5 are reported skipped and parts 6 and 7 run all the same.
 """
-import argparse
 import os
 import random
 import re
 import struct
 import sys
+import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pcapgen as pg  # noqa: E402
 import pcaprewrite as pr  # noqa: E402
-from tshark_env import Checks, TsharkEnv  # noqa: E402
+from tshark_env import TsharkEnv, TsharkTestCase, corpus_captures, run_unittests  # noqa: E402
 
-SKIP = 77
-check = Checks()
+ARGS = None
 SLAVE = ["ecatr.slave.position", "ecatr.slave.station", "ecatr.slave.vendor", "ecatr.slave.product",
          "ecatr.slave.revision", "ecatr.slave.name"]
 EXPERTS = ["ecatr.expert.network.count", "ecatr.expert.network.model", "ecatr.expert.network.ok"]
@@ -77,18 +76,8 @@ EXPECTED = {
 
 def decode(env, path, fields, two_pass, display_filter=None):
     """[(frame, {field: [values]})] from tshark -T fields (all occurrences)."""
-    args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=;", "-e", "frame.number"]
-    if two_pass:
-        args.append("-2")
-    if display_filter:
-        args += ["-Y", display_filter]
-    for f in fields:
-        args += ["-e", f]
-    rows = []
-    for line in env.tshark(args).stdout.splitlines():
-        cols = line.split("\t") + [""] * len(fields)
-        rows.append((int(cols[0]), {f: [v for v in cols[i + 1].split(";") if v] for i, f in enumerate(fields)}))
-    return rows
+    rows = env.field_rows(path, ["frame.number"] + fields, two_pass, display_filter, aggregator=";")
+    return [(n, {f: [v for v in vs if v] for f, vs in r.items()}) for n, r in rows.items()]
 
 
 def slaves_seen(rows):
@@ -159,7 +148,7 @@ def oracle(cap):
 
 # ----------------------------------------------------------------------------- checks
 
-def identity_checks(env, corpus, files):
+def identity_checks(check, env, corpus, files):
     print("\n== identities per capture (tshark -2)")
     for name in files:
         rows = decode(env, os.path.join(corpus, name), SLAVE, True, "ecatr.slave")
@@ -181,7 +170,7 @@ def identity_checks(env, corpus, files):
                 name, pos, sorted(stations)))
 
 
-def names_checks(env, corpus):
+def names_checks(check, env, corpus):
     print("\n== names from the ESI files (soem-sdinfo-ek1100-el1004)")
     path = os.path.join(corpus, "soem-sdinfo-ek1100-el1004.pcapng")
     rows = decode(env, path, SLAVE, True, "ecatr.slave")
@@ -211,7 +200,7 @@ def design(env, name, slaves):
     return env.add_file(name, ("<network>\n%s</network>\n" % body).encode())
 
 
-def network_checks(dissgen, rules, corpus):
+def network_checks(check, dissgen, rules, corpus):
     print("\n== the network check (soem-sdinfo-ek1100-el1004)")
     path = os.path.join(corpus, "soem-sdinfo-ek1100-el1004.pcapng")
     first_brd, ident = oracle(pr.Capture.read(path))
@@ -225,7 +214,8 @@ def network_checks(dissgen, rules, corpus):
     for case, slaves, want in cases:
         with TsharkEnv() as env:
             env.install_plugin(dissgen, rules, ["--network", design(env, case + ".xml", slaves)])
-            local = env.add_file("soem.pcapng", open(path, "rb").read())
+            with open(path, "rb") as fh:
+                local = env.add_file("soem.pcapng", fh.read())
             results = []
             for two_pass in (False, True):
                 rows = decode(env, local, EXPERTS, two_pass)
@@ -240,7 +230,7 @@ def network_checks(dissgen, rules, corpus):
                     print("   " + line.strip())
 
 
-def wkc_checks(env, corpus, files):
+def wkc_checks(check, env, corpus, files):
     print("\n== expected working counters")
     for name in files:
         path = os.path.join(corpus, name)
@@ -295,7 +285,7 @@ def slave_stats(env, path, two_pass):
     return out
 
 
-def stats_checks(env, corpus):
+def stats_checks(check, env, corpus):
     print("\n== statistics per slave (-z ecatr,tree)")
     for name in ("soem-sdinfo-ek1100-el1004.pcapng", "replay-mailbox-el6910.pcapng", "twincat-scan-boxes.pcapng"):
         path = os.path.join(corpus, name)
@@ -312,7 +302,7 @@ def stats_checks(env, corpus):
               % (name, counts))
 
 
-def eni_checks(dissgen, rules, shared):
+def eni_checks(check, dissgen, rules, shared):
     print("\n== the ENI's expected working counters")
     eni = os.path.join(shared, "eni", "twincat_5_slaves_eni.xml")
     # Its cyclic frame reads 14 bytes at logical 0x01000000 with <Cnt>1</Cnt>.
@@ -348,7 +338,7 @@ def sii_reads(station, vendor, product, revision):
     return steps
 
 
-def pdo_checks(dissgen, source_dir, design=True):
+def pdo_checks(check, dissgen, source_dir, design=True):
     """Process data by name: with a design, of its slaves; without one, of the slaves the
     capture identifies from their SII, with their model's default process data (ESI)."""
     print("\n== process data by name (generated frames, %s)" % ("a design" if design else "the ESI file alone"))
@@ -502,15 +492,12 @@ def coe_frames(config_steps, inputs_before, inputs_after, inputs_middle=None, st
     return frames, lrds
 
 
-def coe_checks(dissgen, source_dir, shared):
+def coe_checks(check, dissgen, source_dir, shared):
     """Process data as the master assigns and maps it over CoE (0x1C13, 0x1Axx), on an EL1252
     of Beckhoff_EL1xxx.xml: its default inputs are 0x1A00, 0x1A01, 0x1A02 (empty) and 0x1A13;
     0x1A14 (SysTime, 0x1D09:10) is one it does not assign by default."""
     print("\n== process data as configured over CoE (generated frames, EL1252)")
     esi = os.path.join(shared, "esi", "Beckhoff_EL1xxx.xml")
-    if not os.path.isfile(esi):
-        print("SKIPPED: the CoE PDO part: no %s" % esi)
-        return False
     ch1, ch2 = "ecatr.pdo.el1252.channel_0.input", "ecatr.pdo.el1252.channel_1.input"
     # The fields of revision 0x00160000's 0x1A13 (0x1D09:AE, AF, B0, B8): older revisions name
     # other objects of 0x1A13 Status1 and LatchPos1 (see `dissgen fields`), hence the _2.
@@ -643,7 +630,7 @@ def coe_checks(dissgen, source_dir, shared):
     return ok
 
 
-def coe_design_checks(dissgen, source_dir):
+def coe_design_checks(check, dissgen, source_dir):
     """With a design (tests/network/small_design.xml, tests/esi_ok/small_io.xml): its EL1004 at
     position 1 ("Inputs left") assigned 0x1A10 (Counter, 0x6100:11, not assigned by default: no
     field) and 0x1A00 by complete access."""
@@ -676,60 +663,80 @@ def coe_design_checks(dissgen, source_dir):
                   "design: the entry named from the ESI file, under the design's slave name%s" % tag)
 
 
-# The parts by the name `--only` gives them (the mutation check runs each alone); those that
-# need the corpus skip without it.
-PARTS = ("identities", "network", "wkc", "stats", "eni", "pdo", "coe")
-CORPUS_PARTS = ("identities", "network", "wkc", "stats", "eni")
+class TestBusModel(TsharkTestCase, unittest.TestCase):
+    """cls.env: the plugin with the EK11xx and EL1xxx ESI files, the corpus captures in its HOME."""
 
+    @classmethod
+    def prepare(cls):
+        cls.shared = os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus")
+        cls.corpus = os.path.join(cls.shared, "ethercat")
+        cls.files = corpus_captures(cls.corpus)
+        cls.rules = os.path.join(ARGS.source_dir, "rules", "ethercat.xml")
+        if cls.files:
+            cls.env.install_plugin(ARGS.dissgen, cls.rules,
+                                   ["--esi", os.path.join(cls.shared, "esi", "Beckhoff_EK11xx.xml"),
+                                    "--esi", os.path.join(cls.shared, "esi", "Beckhoff_EL1xxx.xml")])
+            cls.env.assert_plugin_loaded("ecatr")
+            for f in cls.files:
+                with open(os.path.join(cls.corpus, f), "rb") as fh:
+                    cls.env.add_file(f, fh.read())
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--dissgen", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--only", choices=PARTS, help="run only this part: 1 identities, 2 network, 3 wkc, 4 stats, "
-                                                   "5 eni, 6 pdo, 7 coe")
-    args = ap.parse_args()
-    parts = [args.only] if args.only else list(PARTS)
-    shared = os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus")
-    corpus = os.path.join(shared, "ethercat")
-    files = sorted(f for f in os.listdir(corpus) if f.endswith((".pcap", ".pcapng"))) \
-        if os.path.isdir(corpus) else []
-    rules = os.path.join(args.source_dir, "rules", "ethercat.xml")
-    skipped = [p for p in parts if p in CORPUS_PARTS] if not files else []
-    if files and any(p in ("identities", "wkc", "stats") for p in parts):
-        with TsharkEnv() as env:
-            env.install_plugin(args.dissgen, rules, ["--esi", os.path.join(shared, "esi", "Beckhoff_EK11xx.xml"),
-                                                     "--esi", os.path.join(shared, "esi", "Beckhoff_EL1xxx.xml")])
-            env.assert_plugin_loaded("ecatr")
-            for f in files:
-                env.add_file(f, open(os.path.join(corpus, f), "rb").read())
-            if "identities" in parts:
-                identity_checks(env, env.home, files)
-                names_checks(env, env.home)
-                rows = decode(env, os.path.join(env.home, "soem-sdinfo-ek1100-el1004.pcapng"), EXPERTS, True)
-                check(not any(any(r.values()) for _n, r in rows), "no network experts without a design")
-            if "wkc" in parts:
-                wkc_checks(env, env.home, files)
-            if "stats" in parts:
-                stats_checks(env, env.home)
-    if files and "network" in parts:
-        network_checks(args.dissgen, rules, corpus)
-    if files and "eni" in parts:
-        eni_checks(args.dissgen, rules, shared)
-    if "pdo" in parts:
-        pdo_checks(args.dissgen, args.source_dir)
-        pdo_checks(args.dissgen, args.source_dir, design=False)
-    if "coe" in parts:
-        coe_design_checks(args.dissgen, args.source_dir)
-        coe_checks(args.dissgen, args.source_dir, shared)  # skips its EL1252 part without the ESI file
-    print("\n%d failed" % len(check.failed))
-    if check.failed:
-        return 1
-    if skipped:
-        print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng): parts %s not run" % (corpus, ", ".join(skipped)))
-        return SKIP
-    return 0
+    def need_corpus(self):
+        if not self.files:
+            self.skipTest("no corpus at %s (no *.pcap/*.pcapng)" % self.corpus)
+
+    def test_slave_identities_as_the_corpus_lists_them(self):
+        """Part 1."""
+        self.need_corpus()
+        with self.checks() as check:
+            identity_checks(check, self.env, self.env.home, self.files)
+            names_checks(check, self.env, self.env.home)
+            rows = decode(self.env, os.path.join(self.env.home, "soem-sdinfo-ek1100-el1004.pcapng"), EXPERTS, True)
+            check(not any(any(r.values()) for _n, r in rows), "no network experts without a design")
+
+    def test_network_check_against_four_designs(self):
+        """Part 2."""
+        self.need_corpus()
+        with self.checks() as check:
+            network_checks(check, ARGS.dissgen, self.rules, self.corpus)
+
+    def test_expected_working_counters(self):
+        """Part 3."""
+        self.need_corpus()
+        with self.checks() as check:
+            wkc_checks(check, self.env, self.env.home, self.files)
+
+    def test_per_slave_statistics(self):
+        """Part 4."""
+        self.need_corpus()
+        with self.checks() as check:
+            stats_checks(check, self.env, self.env.home)
+
+    def test_eni_cyclic_commands_expected_wkc(self):
+        """Part 5."""
+        self.need_corpus()
+        with self.checks() as check:
+            eni_checks(check, ARGS.dissgen, self.rules, self.shared)
+
+    def test_process_data_by_name(self):
+        """Part 6 (generated frames)."""
+        with self.checks() as check:
+            pdo_checks(check, ARGS.dissgen, ARGS.source_dir)
+            pdo_checks(check, ARGS.dissgen, ARGS.source_dir, design=False)
+
+    def test_process_data_as_mapped_over_coe_with_a_design(self):
+        """Part 7 (generated frames), with tests/network/small_design.xml."""
+        with self.checks() as check:
+            coe_design_checks(check, ARGS.dissgen, ARGS.source_dir)
+
+    def test_process_data_as_mapped_over_coe_on_an_el1252(self):
+        """Part 7 (generated frames), the EL1252 of the corpus's Beckhoff_EL1xxx.xml."""
+        esi = os.path.join(self.shared, "esi", "Beckhoff_EL1xxx.xml")
+        if not os.path.isfile(esi):
+            self.skipTest("no %s" % esi)
+        with self.checks() as check:
+            coe_checks(check, ARGS.dissgen, ARGS.source_dir, self.shared)
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_unittests()[1])

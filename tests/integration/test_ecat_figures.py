@@ -29,29 +29,28 @@ faults, with real tshark.
 
 The generated capture (pairs of every command, with 1..3 datagrams): returns lost, captured
 twice, without a captured request, out of order, working counters that came back lower and
-unchanged. Without the corpus the generated capture is checked, then the test exits 77
-("SKIPPED: ...").
+unchanged. Without the corpus the generated capture is checked and the corpus test is
+reported skipped.
 
     test_ecat_figures.py --dissgen build/bin/dissgen --source-dir . [--corpus DIR]
 """
-import argparse
 import os
 import struct
 import sys
+import unittest
 from decimal import Decimal
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pcapgen as pg  # noqa: E402
 import pcaprewrite as pr  # noqa: E402
-from tshark_env import Checks, TsharkEnv  # noqa: E402
+from tshark_env import TsharkTestCase, corpus_captures, run_unittests  # noqa: E402
 
-SKIP = 77
 FIELDS = ["frame.number", "ecatr.response_in", "ecatr.no_request", "ecatr.request_in", "ecatr.time", "ecatr.expert.no_response",
           "ecatr.expert.duplicate", "ecatr.expert.wkc_down", "ecatr.expert.wkc", "ecatr.datagram.idx",
           "ecatr.datagram.cmd", "ecatr.datagram.wkc", "ecatr.esc.wkc_added"]
 MASTER = b"\x00\x1b\x21\x3c\x55\x10"
 RETURNED = bytes([MASTER[0] | 0x02]) + MASTER[1:]
-check = Checks()
+ARGS = None
 
 
 # ----------------------------------------------------------------------------- tshark's view
@@ -124,7 +123,7 @@ def down_by_value(rows):
     return sum(1 for r in rows.values() for v in r["ecatr.esc.wkc_added"] if int(v) < 0)
 
 
-def stats_checks(env, path, name, rows):
+def stats_checks(check, env, path, name, rows):
     want, times = figures(rows)
     check(want[("Working counter went down",)] == down_by_value(rows),
           "%s: one ecatr.expert.wkc_down per negative ecatr.esc.wkc_added (%d)" % (name, down_by_value(rows)))
@@ -155,7 +154,7 @@ def nanoseconds(cap, pkt):
     return pkt.ts * 10**9 // units
 
 
-def time_checks(env, path, name, rows_two_pass):
+def time_checks(check, env, path, name, rows_two_pass):
     cap = pr.Capture.read(path)
     ts = [nanoseconds(cap, p) for p in cap.packets]
     for two_pass in (False, True):
@@ -241,41 +240,41 @@ def pcap_ns(frames):
     return b"".join(blob)
 
 
-def capture_checks(env, path, name, expect_faults=False):
+def capture_checks(check, env, path, name, expect_faults=False):
     rows = decode(env, path, True)
     if expect_faults:
         want, _ = figures(rows)
         present = [p for p in [("No response",), ("Duplicates",), ("Responses to requests not captured",),
                                ("Working counter went down",)] if want[p]]
         check(len(present) == 4, "%s: the faults show (%s)" % (name, present))
-    stats_checks(env, path, name, rows)
-    time_checks(env, path, name, rows)
+    stats_checks(check, env, path, name, rows)
+    time_checks(check, env, path, name, rows)
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--dissgen", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--corpus")
-    args = ap.parse_args()
-    corpus = args.corpus or os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus", "ethercat")
-    files = sorted(f for f in os.listdir(corpus) if f.endswith((".pcap", ".pcapng"))) if os.path.isdir(corpus) else []
-    with TsharkEnv() as env:
-        env.install_plugin(args.dissgen, os.path.join(args.source_dir, "rules", "ethercat.xml"))
-        env.assert_plugin_loaded("ecatr")
-        print("== generated frames with faults")
-        capture_checks(env, env.add_file("figures.pcap", pcap_ns(generated())), "generated", expect_faults=True)
-        for f in files:
-            print("== %s" % f)
-            capture_checks(env, env.readable(os.path.join(corpus, f)), f)
-    print("\n%d failed" % len(check.failed))
-    if check.failed:
-        return 1
-    if not files:
-        print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng): the generated capture only" % corpus)
-        return SKIP
-    return 0
+class TestEcatFigures(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("rules", "ethercat.xml"), "ecatr")
+
+    def test_generated_faults_counted_and_timed(self):
+        with self.checks() as check:
+            capture_checks(check, self.env, self.env.add_file("figures.pcap", pcap_ns(generated())), "generated",
+                           expect_faults=True)
+
+    def test_corpus_captures_counted_and_timed(self):
+        corpus = ARGS.corpus or os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus", "ethercat")
+        files = corpus_captures(corpus)
+        if not files:
+            self.skipTest("no corpus at %s (no *.pcap/*.pcapng)" % corpus)
+        with self.checks() as check:
+            for f in files:
+                print("== %s" % f)
+                capture_checks(check, self.env, self.env.readable(os.path.join(corpus, f)), f)
+
+
+def add_arguments(parser):
+    parser.add_argument("--corpus", help="the EtherCAT captures (default ../shared/corpus/ethercat)")
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_unittests(add_arguments)[1])

@@ -21,20 +21,19 @@ offsets   tests/rules/offsets_from.xml: offsets= counted from the container arou
           single byte, the last one ending with the message; no expert info. An offset one
           byte inside the table gives offs.expert.bad_offset and no entry.
 
-    test_edges.py --dissgen build/bin/dissgen --source-dir . [--only handoff|peek|offsets]
+    test_edges.py --dissgen build/bin/dissgen --source-dir . [TestEdges.test_handoff_...|-k peek|-k offsets]
 """
-import argparse
 import os
 import random
 import struct
 import sys
+import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pcapgen  # noqa: E402
-from tshark_env import Checks, TsharkEnv  # noqa: E402
+from tshark_env import TsharkEnv, TsharkTestCase, run_unittests  # noqa: E402
 
-PARTS = ("handoff", "peek", "offsets")
-check = Checks()
+ARGS = None
 
 
 def pcap(payloads, port):
@@ -45,19 +44,12 @@ def pcap(payloads, port):
     return b"".join(out)
 
 
-def fields(env, path, names):
+def fields(check, env, path, names):
     """[{field: [values]}] per packet."""
-    args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=|"]
-    for n in names:
-        args += ["-e", n]
-    p = env.tshark(args)
-    check(not p.stderr.strip(), "%s: tshark wrote nothing to stderr%s" % (
-        os.path.basename(path), ": " + p.stderr.strip()[:300] if p.stderr.strip() else ""))
-    rows = []
-    for line in p.stdout.splitlines():
-        cols = (line.split("\t") + [""] * len(names))[:len(names)]
-        rows.append({n: (v.split("|") if v else []) for n, v in zip(names, cols)})
-    return rows
+    rows, err = env.field_rows(path, ["frame.number"] + names, aggregator="|", with_stderr=True)
+    check(not err.strip(), "%s: tshark wrote nothing to stderr%s" % (
+        os.path.basename(path), ": " + err.strip()[:300] if err.strip() else ""))
+    return list(rows.values())
 
 
 # ----------------------------------------------------------------------------- hand-off
@@ -67,7 +59,7 @@ def inner_frame(payload):
     return b"\x02\x11\x11\x11\x11\x11\x02\x22\x22\x22\x22\x22\x88\xb5" + payload
 
 
-def handoff_checks(dissgen, source_dir):
+def handoff_checks(check, dissgen, source_dir):
     print("\n== hand-off: the other dissector gets the leaf's bytes only")
     rng = random.Random(1)
     cases = []   # (payload, [inner payloads expected], {field: value})
@@ -89,7 +81,7 @@ def handoff_checks(dissgen, source_dir):
         env.install_plugin(dissgen, os.path.join(source_dir, "tests", "rules", "handoff.xml"))
         env.assert_plugin_loaded("hndf")
         path = env.add_file("handoff.pcap", pcap([c[0] for c in cases], 47490))
-        rows = fields(env, path, names)
+        rows = fields(check, env, path, names)
         check(len(rows) == len(cases), "one line per packet (%d)" % len(rows))
         for (payload, bodies, after, what), r in zip(cases, rows):
             want_data = [b.hex() for b in bodies if b]
@@ -149,7 +141,7 @@ def peek_message(order, w, target, low, high):
     return bytes([w, 0x5A]) + value.to_bytes(g, "little" if order == "little" else "big")
 
 
-def peek_checks(dissgen, source_dir):
+def peek_checks(check, dissgen, source_dir):
     print("\n== peek at a bit-group member with a shift, widths 1..%d" % MAX_WIDTH)
     rng = random.Random(2)
     with TsharkEnv() as env:
@@ -171,7 +163,7 @@ def peek_checks(dissgen, source_dir):
             names = []
             for w in range(1, MAX_WIDTH + 1):
                 names += ["%s.w%d.probe" % (abbr, w), "%s.w%d.miss" % (abbr, w), "%s.w%d.target" % (abbr, w)]
-            rows = fields(env, path, names + ["_ws.expert"])
+            rows = fields(check, env, path, names + ["_ws.expert"])
             wrong = {}
             for (w, target, low, high), r in zip(cases, rows):
                 shown = [int(x, 16) for x in r["%s.w%d.target" % (abbr, w)]]
@@ -218,7 +210,7 @@ def offsets_message(kind, entries, gap, first_shift=0):
             + b"".join(bytes([tag]) + body for tag, body in entries)), entries
 
 
-def offsets_checks(dissgen, source_dir):
+def offsets_checks(check, dissgen, source_dir):
     print("\n== offsets= counted from the containers around the node")
     rng = random.Random(3)
     cases = []   # (kind, payload, entries, bad, what)
@@ -240,7 +232,7 @@ def offsets_checks(dissgen, source_dir):
         env.install_plugin(dissgen, os.path.join(source_dir, "tests", "rules", "offsets_from.xml"))
         env.assert_plugin_loaded("offs")
         path = env.add_file("offsets.pcap", pcap([c[1] for c in cases], 47493))
-        rows = fields(env, path, names)
+        rows = fields(check, env, path, names)
         check(len(rows) == len(cases), "one line per packet (%d)" % len(rows))
         for (kind, _payload, entries, bad, what), r in zip(cases, rows):
             prefix = KINDS[kind][0]
@@ -253,22 +245,19 @@ def offsets_checks(dissgen, source_dir):
                 "" if got == want else "\n       got  %s\n       want %s" % (got, want)))
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--dissgen", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--only", choices=PARTS)
-    args = ap.parse_args()
-    parts = [args.only] if args.only else PARTS
-    if "handoff" in parts:
-        handoff_checks(args.dissgen, args.source_dir)
-    if "peek" in parts:
-        peek_checks(args.dissgen, args.source_dir)
-    if "offsets" in parts:
-        offsets_checks(args.dissgen, args.source_dir)
-    print("\n%d failed" % len(check.failed))
-    return 1 if check.failed else 0
+class TestEdges(TsharkTestCase, unittest.TestCase):
+    def test_handoff_gives_the_other_dissector_the_leaf_only(self):
+        with self.checks() as check:
+            handoff_checks(check, ARGS.dissgen, ARGS.source_dir)
+
+    def test_peek_at_shifted_bit_group_members(self):
+        with self.checks() as check:
+            peek_checks(check, ARGS.dissgen, ARGS.source_dir)
+
+    def test_offsets_from_enclosing_containers(self):
+        with self.checks() as check:
+            offsets_checks(check, ARGS.dissgen, ARGS.source_dir)
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_unittests()[1])

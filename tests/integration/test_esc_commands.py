@@ -30,13 +30,13 @@ frame ecatr.response_in (-2) and no expert info.
 
     test_esc_commands.py --dissgen build/bin/dissgen --source-dir .
 """
-import argparse
 import os
 import sys
+import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pcapgen as pg  # noqa: E402
-from tshark_env import Checks, TsharkEnv  # noqa: E402
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 
 NAMES = pg.CMD_NAMES
 WRITES = {2, 5, 8, 11}                  # APWR FPWR BWR LWR
@@ -49,7 +49,7 @@ ESC = ["ecatr.esc.wkc_added", "ecatr.esc.slaves_passed", "ecatr.esc.data_changed
 FIELDS = ["frame.number", "ecatr.request_in", "ecatr.response_in"] + ESC + ["ecatr.expert." + e for e in EXPERTS]
 MASTER = b"\x00\x1b\x21\x3c\x55\x10"
 RETURNED = bytes([MASTER[0] | 0x02]) + MASTER[1:]
-check = Checks()
+ARGS = None
 
 
 def datagram(cmd, idx, adp=0xfffe, ado=0x1000, lad=0x00012340, data=b"\x11\x22\x33\x44", wkc=0):
@@ -144,45 +144,43 @@ def decode(env, path, two_pass):
     return env.field_rows(path, FIELDS, two_pass)
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--dissgen", required=True)
-    ap.add_argument("--source-dir", required=True)
-    args = ap.parse_args()
-    cs = cases()
-    covered = {(c.what, c.cmd) for c in cs}
-    check(all(("clean", cmd) in covered for cmd in NAMES), "every command has its cases (%d pairs)" % len(cs))
-    with TsharkEnv() as env:
-        env.install_plugin(args.dissgen, os.path.join(args.source_dir, "rules", "ethercat.xml"))
-        env.assert_plugin_loaded("ecatr")
-        path = env.add_file("esc-commands.pcap", pg.pcap_bytes(frames_of(cs)))
-        for two_pass in (False, True):
-            tag = " (-2)" if two_pass else ""
-            rows = decode(env, path, two_pass)
-            bad_requests, bad_returns = [], []
-            for k, c in enumerate(cs):
-                sent_no, back_no = 2 * k + 1, 2 * k + 2
-                r = rows[sent_no]
-                want_sent = {f: [] for f in FIELDS[1:]}
-                if two_pass:
-                    want_sent["ecatr.response_in"] = [str(back_no)]
-                if r != want_sent:
-                    bad_requests.append((sent_no, c.what, NAMES[c.cmd], {f: v for f, v in r.items() if v}))
-                want = dict(c.expect, **{"ecatr.request_in": [str(sent_no)], "ecatr.response_in": []})
-                got = rows[back_no]
-                diff = {f: (got[f], want[f]) for f in want if got[f] != want[f]}
-                if diff:
-                    bad_returns.append("%s %s (frame %d): %s" % (NAMES[c.cmd], c.what, back_no, diff))
-            check(not bad_requests, "sent frames%s: paired, no expert info%s" % (
-                tag, ": %s" % bad_requests[:4] if bad_requests else ""))
-            for cmd in sorted(NAMES):
-                mine = [b for b in bad_returns if b.startswith(NAMES[cmd] + " ")]
-                check(not mine, "%s%s: returned frames show what the rules say (%s)%s" % (
-                    NAMES[cmd], tag, ", ".join(c.what for c in cs if c.cmd == cmd),
-                    "".join("\n       " + b for b in mine[:4])))
-    print("\n%d failed" % len(check.failed))
-    return 1 if check.failed else 0
+class TestEscCommands(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("rules", "ethercat.xml"), "ecatr")
+
+    def test_every_command_returned_as_the_rules_say(self):
+        env = self.env
+        with self.checks() as check:
+            cs = cases()
+            covered = {(c.what, c.cmd) for c in cs}
+            check(all(("clean", cmd) in covered for cmd in NAMES), "every command has its cases (%d pairs)" % len(cs))
+            path = env.add_file("esc-commands.pcap", pg.pcap_bytes(frames_of(cs)))
+            for two_pass in (False, True):
+                tag = " (-2)" if two_pass else ""
+                rows = decode(env, path, two_pass)
+                bad_requests, bad_returns = [], []
+                for k, c in enumerate(cs):
+                    sent_no, back_no = 2 * k + 1, 2 * k + 2
+                    r = rows[sent_no]
+                    want_sent = {f: [] for f in FIELDS[1:]}
+                    if two_pass:
+                        want_sent["ecatr.response_in"] = [str(back_no)]
+                    if r != want_sent:
+                        bad_requests.append((sent_no, c.what, NAMES[c.cmd], {f: v for f, v in r.items() if v}))
+                    want = dict(c.expect, **{"ecatr.request_in": [str(sent_no)], "ecatr.response_in": []})
+                    got = rows[back_no]
+                    diff = {f: (got[f], want[f]) for f in want if got[f] != want[f]}
+                    if diff:
+                        bad_returns.append("%s %s (frame %d): %s" % (NAMES[c.cmd], c.what, back_no, diff))
+                check(not bad_requests, "sent frames%s: paired, no expert info%s" % (
+                    tag, ": %s" % bad_requests[:4] if bad_requests else ""))
+                for cmd in sorted(NAMES):
+                    mine = [b for b in bad_returns if b.startswith(NAMES[cmd] + " ")]
+                    check(not mine, "%s%s: returned frames show what the rules say (%s)%s" % (
+                        NAMES[cmd], tag, ", ".join(c.what for c in cs if c.cmd == cmd),
+                        "".join("\n       " + b for b in mine[:4])))
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_unittests()[1])

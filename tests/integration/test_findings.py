@@ -16,19 +16,18 @@ a line `FRAME EXPERT end` marks a loss only the capture's end shows (-2 only).
 line before committing, and explain it.
 """
 
-import argparse
 import collections
 import os
 import re
 import sys
+import unittest
 import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import Checks, TsharkEnv  # noqa: E402
+from tshark_env import Checks, TsharkEnv, TsharkTestCase, corpus_captures, run_unittests  # noqa: E402
 
-SKIP = 77
 PROTOCOLS = {"ethercat": ("rules/ethercat.xml", "ecatr"), "enip": ("rules/enip.xml", "enipr")}
-check = Checks()
+ARGS = None
 
 
 def registered(env, proto):
@@ -42,21 +41,13 @@ def findings(env, path, proto, experts, has_link, two_pass):
     """Counter of (frame, expert), and {frame: [lost requests it names]}."""
     links = [proto + ".no_response_to"] if has_link else []
     fields = ["frame.number"] + links + experts
-    args = ["-r", path, "-Y", proto, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"]
-    if two_pass:
-        args.append("-2")
-    for f in fields:
-        args += ["-e", f]
     found, named = collections.Counter(), {}
-    for line in env.tshark(args).stdout.splitlines():
-        cols = line.split("\t") + [""] * len(fields)
-        frame = int(cols[0])
-        if links and cols[1]:
-            named[frame] = [int(x) for x in cols[1].split(",")]
-        for k, e in enumerate(experts):
-            value = cols[1 + len(links) + k]
-            if value:
-                found[(frame, e)] += len(value.split(","))
+    for frame, r in env.field_rows(path, fields, two_pass, display_filter=proto).items():
+        if links and r[links[0]]:
+            named[frame] = [int(x) for x in r[links[0]]]
+        for e in experts:
+            if r[e]:
+                found[(frame, e)] += len(r[e])
     return found, named
 
 
@@ -124,15 +115,11 @@ def diff_text(want, got):
     return missing, added
 
 
-def run_protocol(env, args, kind, rules, proto):
+def run_protocol(check, env, args, kind, rules, proto):
     corpus = os.path.join(args.corpus, kind)
-    if not os.path.isdir(corpus):
-        return False
     env.install_plugin(args.dissgen, os.path.join(args.source_dir, rules))
     experts, has_link = registered(env, proto)
-    for name in sorted(os.listdir(corpus)):
-        if not name.endswith((".pcap", ".pcapng")):
-            continue
+    for name in corpus_captures(corpus):
         with open(os.path.join(corpus, name), "rb") as fh:
             path = env.add_file(kind + "-" + name, fh.read())
         listed = os.path.join(args.source_dir, "tests", "findings", kind, name + ".findings")
@@ -167,31 +154,34 @@ def run_protocol(env, args, kind, rules, proto):
               "wrong %s, unlinked %s)" % (name, len(proved), sorted(want_lost - end - proved)[:6],
                                           sorted(proved - (want_lost - end))[:6], unlinked[:6]))
         check(named2 == named1, "%s: -2 keeps the links of one pass on the proving frames" % name)
-    return True
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--dissgen", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--corpus")
-    ap.add_argument("--write", action="store_true", help="rewrite the lists (then review them)")
-    args = ap.parse_args()
-    if not args.corpus:
-        args.corpus = os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus")
-    if not os.path.isdir(args.corpus):
-        print("SKIPPED: no corpus at %s" % args.corpus)
-        return SKIP
-    ran = False
-    for kind, (rules, proto) in PROTOCOLS.items():
+class TestFindings(TsharkTestCase, unittest.TestCase):
+    def protocol(self, kind):
+        rules, proto = PROTOCOLS[kind]
+        if not ARGS.corpus:
+            ARGS.corpus = os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus")
+        corpus = os.path.join(ARGS.corpus, kind)
+        if not corpus_captures(corpus):
+            self.skipTest("no corpus at %s (no *.pcap/*.pcapng)" % corpus)
         with TsharkEnv() as env:
-            ran = run_protocol(env, args, kind, rules, proto) or ran
-    if not ran:
-        print("SKIPPED: no captures in %s" % args.corpus)
-        return SKIP
-    print("all checks passed" if not check.failed else "%d checks failed" % len(check.failed))
-    return 1 if check.failed else 0
+            if ARGS.write:
+                run_protocol(Checks(), env, ARGS, kind, rules, proto)
+                return
+            with self.checks() as check:
+                run_protocol(check, env, ARGS, kind, rules, proto)
+
+    def test_ethercat_findings_as_reviewed(self):
+        self.protocol("ethercat")
+
+    def test_enip_findings_as_reviewed(self):
+        self.protocol("enip")
+
+
+def add_arguments(parser):
+    parser.add_argument("--corpus", help="the corpus (default ../shared/corpus)")
+    parser.add_argument("--write", action="store_true", help="rewrite the lists (then review them)")
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_unittests(add_arguments)[1])

@@ -13,7 +13,7 @@ CAP_NET_ADMIN, as the `wireshark` group gives dumpcap). The live decode must equ
 decode of the same frames read from the file, the pairing included (ecatr.request_in,
 what the segment did, the expert infos), but for the round-trip times.
 
-Only traffic inside the namespace the test made. Exit 77 with "SKIPPED: ..." when not
+Only traffic inside the namespace the test made. Skipped (exit 77, "SKIPPED: ...") when not
 root or when network namespaces, veth or capabilities are not available.
 """
 
@@ -23,13 +23,13 @@ import select
 import socket
 import subprocess
 import sys
+import unittest
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import NOBODY, Checks, TsharkEnv  # noqa: E402
+from tshark_env import NOBODY, TsharkTestCase, run_unittests  # noqa: E402
 import pcaprewrite as pr  # noqa: E402
 
-SKIP = 77
 CAPTURES = ["soem-sdinfo-ek1100-el1004.pcapng", "replay-sdo-error.pcapng"]
 STRETCH = 2.0
 FIELDS = ["frame.number", "ecatr.header.length", "ecatr.datagram.cmd", "ecatr.datagram.idx",
@@ -40,7 +40,7 @@ FIELDS = ["frame.number", "ecatr.header.length", "ecatr.datagram.cmd", "ecatr.da
           "ecatr.expert.write_changed", "ecatr.expert.wkc_down", "ecatr.expert.forwarding",
           "ecatr.expert.no_response", "ecatr.no_response_to"]
 LOST_RETURNS = 5   # returns removed from a copy of the first capture: a live capture reports them
-check = Checks()
+ARGS = None
 
 
 def ethercat_frames(path):
@@ -117,10 +117,9 @@ def capture_command(env, ns, stop):
 
 
 def file_decode(env, path):
-    args = ["-r", path, "-Y", "eth.type == 0x88a4", "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"]
-    for f in FIELDS:
-        args += ["-e", f]
-    return [line.split("\t") for line in env.tshark(args).stdout.splitlines()]
+    """The rows of tshark -T fields as tshark -i prints them: a list of columns per frame."""
+    rows = env.field_rows(path, FIELDS, display_filter="eth.type == 0x88a4")
+    return [[str(n)] + [",".join(r[f]) for f in FIELDS[1:]] for n, r in rows.items()]
 
 
 def normalise(rows, numbers):
@@ -163,7 +162,7 @@ def without_returns(src, dst, count):
     return {tags.index(sent) for sent, _back in chosen}
 
 
-def live(env, ns, path, stop, expect_frames):
+def live(check, env, ns, path, stop, expect_frames):
     cmd = capture_command(env, ns, stop)
     p = subprocess.Popen(cmd, env=env.env(), cwd=env.home, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     # Wait until dumpcap listens ("Capturing on 'vb'") before sending.
@@ -189,73 +188,87 @@ def live(env, ns, path, stop, expect_frames):
     return rows
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--dissgen")
-    ap.add_argument("--source-dir")
-    ap.add_argument("--corpus")
-    ap.add_argument("--send", help=argparse.SUPPRESS)
-    ap.add_argument("--iface", help=argparse.SUPPRESS)
-    args = ap.parse_args()
-    if args.send:
-        return send(args.send, args.iface)
+class TestLiveCapture(TsharkTestCase, unittest.TestCase):
+    """cls.ns: the namespace with the veth pair; skipped as a whole when it cannot be made."""
 
-    corpus_dir = args.corpus or os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus", "ethercat")
-    files = [f for f in CAPTURES if os.path.isfile(os.path.join(corpus_dir, f))]
-    if not files:
-        print("SKIPPED: no corpus captures at %s" % corpus_dir)
-        return SKIP
-    if os.geteuid() != 0:
-        print("SKIPPED: making a network namespace and a veth pair needs root")
-        return SKIP
-    try:
-        ns = Namespace().__enter__()
-    except (OSError, RuntimeError) as e:
-        print("SKIPPED: network namespaces or veth pairs are not allowed here (%s)" % e)
-        return SKIP
-    try:
-        with TsharkEnv() as env:
-            env.install_plugin(args.dissgen, os.path.join(args.source_dir, "rules", "ethercat.xml"))
-            env.assert_plugin_loaded("ecatr")
-            probe = subprocess.run(capture_command(env, ns, ["-c", "1", "-a", "duration:1"]), env=env.env(),
-                                   cwd=env.home, capture_output=True, text=True)
+    @classmethod
+    def prepare(cls):
+        corpus_dir = ARGS.corpus or os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus",
+                                                 "ethercat")
+        cls.files = [f for f in CAPTURES if os.path.isfile(os.path.join(corpus_dir, f))]
+        if not cls.files:
+            raise unittest.SkipTest("no corpus captures at %s" % corpus_dir)
+        if os.geteuid() != 0:
+            raise unittest.SkipTest("making a network namespace and a veth pair needs root")
+        try:
+            cls.ns = Namespace().__enter__()
+        except (OSError, RuntimeError) as e:
+            raise unittest.SkipTest("network namespaces or veth pairs are not allowed here (%s)" % e)
+        try:
+            cls.install(os.path.join("rules", "ethercat.xml"), "ecatr")
+            probe = subprocess.run(capture_command(cls.env, cls.ns, ["-c", "1", "-a", "duration:1"]),
+                                   env=cls.env.env(), cwd=cls.env.home, capture_output=True, text=True)
             if "permission" in probe.stderr.lower() or "capabilit" in probe.stderr.lower():
-                print("SKIPPED: an ordinary user with CAP_NET_RAW cannot capture here: %s" % probe.stderr.strip())
-                return SKIP
-            runs = []
-            for name in files:
+                raise unittest.SkipTest("an ordinary user with CAP_NET_RAW cannot capture here: %s"
+                                        % probe.stderr.strip())
+            cls.paths = {}
+            for name in cls.files:
                 with open(os.path.join(corpus_dir, name), "rb") as fh:
-                    runs.append((name, env.add_file(name, fh.read()), None))
-            lossy = "lossy-" + files[0]
-            lost = without_returns(runs[0][1], env.path(lossy), LOST_RETURNS)
-            runs.append((lossy, env.path(lossy), lost))
-            for name, path, lost in runs:
-                cap, frames = ethercat_frames(path)
-                numbers = [k + 1 for k in frames]
-                want = normalise(file_decode(env, path), numbers)
-                check(len(want) == len(frames), "%s: the file holds %d EtherCAT frames" % (name, len(frames)))
-                duration = (cap.seconds(cap.packets[frames[-1]]) - cap.seconds(cap.packets[frames[0]])) * STRETCH
-                for stop in (["-c", str(len(frames))], ["-a", "duration:%d" % (int(duration) + 4)]):
-                    got = live(env, ns, path, stop, len(frames))
-                    got = normalise(got, list(range(1, len(got) + 1)))
-                    diff = [k for k, (a, b) in enumerate(zip(got, want)) if a != b]
-                    paired = sum(1 for r in got if r[FIELDS.index("ecatr.request_in")])
-                    check(not diff and len(got) == len(want),
-                          "%s %s: the live decode equals the file's, pairing included (%d frames, %d paired)%s" % (
-                              name, " ".join(stop), len(got), paired,
-                              "; first difference at EtherCAT frame %d:\n  live %s\n  file %s" % (
-                                  diff[0], got[diff[0]], want[diff[0]]) if diff else ""))
-                    if lost is not None:
-                        k_expert, k_link = FIELDS.index("ecatr.expert.no_response"), FIELDS.index("ecatr.no_response_to")
-                        named = {int(x) for r in got if r[k_expert] for x in r[k_link].split(",") if x}
-                        check(named == lost, "%s %s: live, each lost frame is reported by a later frame "
-                              "naming it (%s, removed returns of %s)" % (name, " ".join(stop), sorted(named),
-                                                                        sorted(lost)))
-    finally:
-        ns.__exit__()
-    print("\n%d failed" % len(check.failed))
-    return 1 if check.failed else 0
+                    cls.paths[name] = cls.env.add_file(name, fh.read())
+        except BaseException:
+            cls.ns.__exit__()     # tearDownClass does not run when setUpClass fails
+            raise
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.ns.__exit__()
+        super().tearDownClass()
+
+    def replay(self, check, name, path, lost):
+        """Replays the capture live twice (-c N, -a duration); the live decode must be the file's."""
+        cap, frames = ethercat_frames(path)
+        numbers = [k + 1 for k in frames]
+        want = normalise(file_decode(self.env, path), numbers)
+        check(len(want) == len(frames), "%s: the file holds %d EtherCAT frames" % (name, len(frames)))
+        duration = (cap.seconds(cap.packets[frames[-1]]) - cap.seconds(cap.packets[frames[0]])) * STRETCH
+        for stop in (["-c", str(len(frames))], ["-a", "duration:%d" % (int(duration) + 4)]):
+            got = live(check, self.env, self.ns, path, stop, len(frames))
+            got = normalise(got, list(range(1, len(got) + 1)))
+            diff = [k for k, (a, b) in enumerate(zip(got, want)) if a != b]
+            paired = sum(1 for r in got if r[FIELDS.index("ecatr.request_in")])
+            check(not diff and len(got) == len(want),
+                  "%s %s: the live decode equals the file's, pairing included (%d frames, %d paired)%s" % (
+                      name, " ".join(stop), len(got), paired,
+                      "; first difference at EtherCAT frame %d:\n  live %s\n  file %s" % (
+                          diff[0], got[diff[0]], want[diff[0]]) if diff else ""))
+            if lost is not None:
+                k_expert, k_link = FIELDS.index("ecatr.expert.no_response"), FIELDS.index("ecatr.no_response_to")
+                named = {int(x) for r in got if r[k_expert] for x in r[k_link].split(",") if x}
+                check(named == lost, "%s %s: live, each lost frame is reported by a later frame "
+                      "naming it (%s, removed returns of %s)" % (name, " ".join(stop), sorted(named),
+                                                                sorted(lost)))
+
+    def test_live_decode_equals_the_files(self):
+        with self.checks() as check:
+            for name in self.files:
+                self.replay(check, name, self.paths[name], None)
+
+    def test_live_losses_named_by_a_later_frame(self):
+        lossy = "lossy-" + self.files[0]
+        lost = without_returns(self.paths[self.files[0]], self.env.path(lossy), LOST_RETURNS)
+        with self.checks() as check:
+            self.replay(check, lossy, self.env.path(lossy), lost)
+
+
+def add_arguments(parser):
+    parser.add_argument("--corpus", help="the EtherCAT captures (default ../shared/corpus/ethercat)")
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    if "--send" in sys.argv:    # this script run by the test inside the namespace: the sender
+        ap = argparse.ArgumentParser()
+        ap.add_argument("--send", required=True)
+        ap.add_argument("--iface", required=True)
+        args = ap.parse_args()
+        sys.exit(send(args.send, args.iface))
+    sys.exit(run_unittests(add_arguments)[1])

@@ -22,19 +22,21 @@ orphans (no no_response, a row in -z ecatr,tree) and nothing is flagged that the
 did not flag.
 
 Without --corpus (or when it is absent), generated captures only: cyclic process data with
-the datagram index reused every cycle, and mailbox polling with several frames in flight.
+the datagram index reused every cycle, and mailbox polling with several frames in flight;
+the corpus test is reported skipped. The corpus alone:
+  test_losses.py --dissgen build/bin/dissgen --source-dir . --with-corpus TestLosses.test_corpus_losses_found_exactly
 """
 
-import argparse
 import os
 import struct
 import sys
+import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import Checks, TsharkEnv  # noqa: E402
+from tshark_env import TsharkTestCase, corpus_captures, run_unittests  # noqa: E402
 import pcaprewrite as pr  # noqa: E402
 
-check = Checks()
+ARGS = None
 MASTER = bytes.fromhex("00a0de000001")
 
 
@@ -163,26 +165,16 @@ class Decoder:
         cap.write(path)
         os.chmod(path, 0o644)
         fields = ["frame.number", "ecatr.no_response_to", "ecatr.no_request"] + self.values + self.experts
-        args = ["-r", path, "-Y", "ecatr", "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"]
-        if two_pass:
-            args.append("-2")
-        for f in fields:
-            args += ["-e", f]
         tag_of = {n + 1: p.tag for n, p in enumerate(cap.packets)}
         rows = {}
-        for line in self.env.tshark(args).stdout.splitlines():
-            cols = line.split("\t") + [""] * len(fields)
-            tag = tag_of[int(cols[0])]
-            row = {"experts": [], "lost": set(), "negative": []}
-            row["lost"] = {tag_of[int(x)] for x in cols[1].split(",") if x}
-            row["no_request"] = bool(cols[2])
-            for k, f in enumerate(self.values):
-                if any(v.startswith("-") for v in cols[3 + k].split(",") if v):
-                    row["negative"].append(f)
-            for k, f in enumerate(self.experts):
-                if cols[3 + len(self.values) + k]:
-                    row["experts"] += [f] * len(cols[3 + len(self.values) + k].split(","))
-            rows[tag] = row
+        for n, r in self.env.field_rows(path, fields, two_pass=two_pass, display_filter="ecatr").items():
+            row = {"experts": [], "negative": []}
+            row["lost"] = {tag_of[int(x)] for x in r["ecatr.no_response_to"] if x}
+            row["no_request"] = bool(r["ecatr.no_request"])
+            row["negative"] = [f for f in self.values if any(v.startswith("-") for v in r[f])]
+            for f in self.experts:
+                row["experts"] += [f] * len(r[f])
+            rows[tag_of[n]] = row
         os.unlink(path)
         return rows
 
@@ -250,7 +242,7 @@ def provable(cap, pairs, lost):
     return out
 
 
-def deletion_checks(dec, name, base, pairs, k, summary):
+def deletion_checks(check, dec, name, base, pairs, k, summary):
     victims = victims_of(pairs, k)
     if not victims:
         print("(%s: too few pairs to delete %d returns)" % (name, k))
@@ -291,7 +283,7 @@ def deletion_checks(dec, name, base, pairs, k, summary):
             name, mode, impossible(after)[:5]))
 
 
-def orphan_checks(env, dec, name, base, pairs):
+def orphan_checks(check, env, dec, name, base, pairs):
     """The capture cut between a request and its return, several times over: the returns
     whose request is gone are orphans, nothing is flagged lost that was not before."""
     order = sorted(pairs)
@@ -330,7 +322,7 @@ def orphan_checks(env, dec, name, base, pairs):
         os.unlink(path)
 
 
-def foreign_return_checks(dec, name, base, pairs):
+def foreign_return_checks(check, dec, name, base, pairs):
     """Another station's return (marked, working counter 1, an index and an address the
     capture does not use) right after a request in the middle of the capture, while that
     request waits: an orphan (ecatr.no_request), paired with nothing, nothing else changed."""
@@ -374,56 +366,74 @@ def tagged(packets):
     return packets
 
 
-def run_capture(env, dec, name, cap, summary, k=10):
+def run_capture(check, env, dec, name, cap, summary, k=10):
     pairs = marked_pairs(cap)
     cap.unchanged = True
     print("\n== %s: %d frames, %d pairs" % (name, len(cap.packets), len(pairs)))
-    deletion_checks(dec, name + " (marked)", cap, pairs, k, summary)
+    deletion_checks(check, dec, name + " (marked)", cap, pairs, k, summary)
     plain = clone(cap)
     unmark(plain, pairs)
     plain.unchanged = True
-    deletion_checks(dec, name + " (unmarked)", plain, pairs, k, summary)
-    orphan_checks(env, dec, name, cap, pairs)
-    foreign_return_checks(dec, name, cap, pairs)
+    deletion_checks(check, dec, name + " (unmarked)", plain, pairs, k, summary)
+    orphan_checks(check, env, dec, name, cap, pairs)
+    foreign_return_checks(check, dec, name, cap, pairs)
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--dissgen", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--corpus", help="../shared/corpus/ethercat: its captures too")
-    ap.add_argument("--with-corpus", action="store_true", help="--corpus at its place beside the source tree")
-    args = ap.parse_args()
-    if args.with_corpus and not args.corpus:
-        args.corpus = os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus", "ethercat")
-    summary = []
-    with TsharkEnv() as env:
-        env.install_plugin(args.dissgen, os.path.join(args.source_dir, "rules", "ethercat.xml"))
-        env.assert_plugin_loaded("ecatr")
-        dec = Decoder(env)
-        for name, packets in (("generated cyclic LRW+FRMW", cyclic_capture()),
-                              ("generated status polling, the same bytes every cycle", status_capture()),
-                              ("generated mailbox polling, two in flight", mailbox_capture())):
-            path = env.path(name.split()[1] + ".pcap")
-            generated(path, packets)
-            cap = pr.Capture.read(path)
-            tagged(cap.packets)
-            run_capture(env, dec, name, cap, summary)
-        if args.corpus:
-            if not os.path.isdir(args.corpus):
-                print("SKIPPED: no corpus at %s (the generated captures passed)" % args.corpus)
-                return 77 if not check.failed else 1
-            for f in sorted(os.listdir(args.corpus)):
-                if f.endswith((".pcap", ".pcapng")):
-                    cap = pr.Capture.read(os.path.join(args.corpus, f))
-                    tagged(cap.packets)
-                    run_capture(env, dec, f, cap, summary)
-    print("\n%-58s %-9s %5s %5s %6s %10s" % ("capture", "mode", "lost", "found", "wrong", "other new"))
-    for row in summary:
-        print("%-58s %-9s %5d %5d %6d %10d" % row)
-    print("\n%d checks failed" % len(check.failed) if check.failed else "\nall checks passed")
-    return 1 if check.failed else 0
+GENERATED = {"cyclic": ("generated cyclic LRW+FRMW", cyclic_capture),
+             "status": ("generated status polling, the same bytes every cycle", status_capture),
+             "mailbox": ("generated mailbox polling, two in flight", mailbox_capture)}
+
+
+class TestLosses(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        if ARGS.with_corpus and not ARGS.corpus:
+            ARGS.corpus = os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus", "ethercat")
+        cls.install(os.path.join("rules", "ethercat.xml"), "ecatr")
+        cls.dec = Decoder(cls.env)
+        cls.summary = []
+
+    @classmethod
+    def tearDownClass(cls):
+        print("\n%-58s %-9s %5s %5s %6s %10s" % ("capture", "mode", "lost", "found", "wrong", "other new"))
+        for row in cls.summary:
+            print("%-58s %-9s %5d %5d %6d %10d" % row)
+        super().tearDownClass()
+
+    def generated(self, kind):
+        name, packets = GENERATED[kind]
+        path = self.env.path(name.split()[1] + ".pcap")
+        generated(path, packets())
+        cap = pr.Capture.read(path)
+        tagged(cap.packets)
+        with self.checks() as check:
+            run_capture(check, self.env, self.dec, name, cap, self.summary)
+
+    def test_cyclic_process_data_losses_found_exactly(self):
+        self.generated("cyclic")
+
+    def test_status_polling_with_the_same_bytes_losses_found_exactly(self):
+        self.generated("status")
+
+    def test_mailbox_polling_two_in_flight_losses_found_exactly(self):
+        self.generated("mailbox")
+
+    def test_corpus_losses_found_exactly(self):
+        if not ARGS.corpus:
+            self.skipTest("no --corpus (or --with-corpus) given: generated captures only")
+        if not os.path.isdir(ARGS.corpus):
+            self.skipTest("no corpus at %s" % ARGS.corpus)
+        with self.checks() as check:
+            for f in corpus_captures(ARGS.corpus):
+                cap = pr.Capture.read(os.path.join(ARGS.corpus, f))
+                tagged(cap.packets)
+                run_capture(check, self.env, self.dec, f, cap, self.summary)
+
+
+def add_arguments(parser):
+    parser.add_argument("--corpus", help="../shared/corpus/ethercat: its captures too")
+    parser.add_argument("--with-corpus", action="store_true", help="--corpus at its place beside the source tree")
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_unittests(add_arguments)[1])

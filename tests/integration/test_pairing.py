@@ -39,22 +39,22 @@ datagrams): it names the whole test instead (pairing_full in tests/mutation/run_
    ecatr.request_in, each waiting request is paired with its own return, and no expert info
    is raised; one pass and -2.
 
-Parts 5 and 6 need no corpus; without it they run all the same, then the test exits 77 with
-"SKIPPED: ..." (parts 1 to 4 need the corpus).
+Parts 5 and 6 need no corpus; without it they run and pass all the same, and the tests of
+parts 1 to 4 are reported skipped ("no corpus at ..."). One part alone:
+test_pairing.py --dissgen ... --source-dir . TestPairing.test_orphan_returns_answer_no_waiting_request
 """
 
-import argparse
 import os
 import struct
 import subprocess
 import sys
+import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import Checks, TsharkEnv  # noqa: E402
+from tshark_env import TsharkTestCase, corpus_captures, run_unittests  # noqa: E402
 import pcapgen  # noqa: E402
 import pcaprewrite as pr  # noqa: E402
 
-SKIP = 77
 EXPERTS = ["no_response", "duplicate", "out_of_order", "changed", "frame_length", "write_changed",
            "wkc_down", "forwarding"]
 # Shown on the returned frame, so known in one pass already.
@@ -64,25 +64,13 @@ FIELDS = ["frame.number", "ecatr.response_in", "ecatr.expert.no_response", "ecat
 WRITES = {2, 5, 8, 11}            # APWR FPWR BWR LWR
 READS = {1, 4, 7, 10}             # APRD FPRD BRD LRD
 ADVANCING = {1, 2, 3, 7, 8, 9, 13}  # auto-increment and broadcast commands
-check = Checks()
+ARGS = None
 
 
 def decode(env, path, two_pass=True, display_filter=None):
-    """{frame number: {field: value}} for every frame, from tshark -T fields."""
-    args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"]
-    if two_pass:
-        args.append("-2")
-    if display_filter:
-        args += ["-Y", display_filter]
-    for f in FIELDS:
-        args += ["-e", f]
-    out = env.tshark(args).stdout
-    rows = {}
-    for line in out.splitlines():
-        cols = line.split("\t")
-        cols += [""] * (len(FIELDS) - len(cols))
-        rows[int(cols[0])] = dict(zip(FIELDS[1:], cols[1:]))
-    return rows
+    """{frame number: {field: its values, comma-separated}} for every frame."""
+    rows = env.field_rows(path, FIELDS, two_pass=two_pass, display_filter=display_filter)
+    return {n: {f: ",".join(v) for f, v in r.items()} for n, r in rows.items()}
 
 
 def with_expert(rows, name):
@@ -124,7 +112,7 @@ def oracle(cap):
 
 # ----------------------------------------------------------------------------- corpus
 
-def corpus_checks(env, corpus_dir, files):
+def corpus_checks(check, env, corpus_dir, files):
     print("\n== real captures: pairs per file (tshark -2)")
     print("%-40s %7s %7s %7s %7s %7s" % ("file", "sent", "back", "paired", "bytes", "lost"))
     print("(sent/back: frames from the master / returned, by their source address; paired: by the plugin;\n"
@@ -166,7 +154,7 @@ def corpus_checks(env, corpus_dir, files):
               "-2 flags (%d), and -2 names the same%s" % (name, len(named), len(lost),
                                                       ": %s" % sorted(named ^ named2 | (named - lost))[:5]
                                                       if not (named <= lost and named == named2) else ""))
-        stats_checks(env, path, name, rows)
+        stats_checks(check, env, path, name, rows)
         filtered = decode(env, path, display_filter="ecatr.request_in || ecatr.expert.no_response")
         diff = [n for n in filtered if filtered[n] != rows[n]]
         check(filtered and not diff, "%s: a display filter keeps the same items (%d frames)%s" % (
@@ -191,7 +179,7 @@ def stats_tree(env, path, two_pass):
     return items
 
 
-def stats_checks(env, path, name, rows):
+def stats_checks(check, env, path, name, rows):
     """The "Requests and responses" rows against the fields and expert infos of the same pass:
     responses and lost requests counted alike, every answered or lost request among the
     requests (a request still in flight when the capture ends is neither)."""
@@ -383,7 +371,7 @@ def make_faults(base_cap, pairs):
     return faults
 
 
-def fault_checks(env, corpus_dir, files):
+def fault_checks(check, env, corpus_dir, files):
     for name in files:
         path = os.path.join(corpus_dir, name)
         base = pr.Capture.read(path)
@@ -436,7 +424,7 @@ def unmarked(cap, returned):
         cap.packets[i].data[6] &= ~0x02
 
 
-def variant_checks(env, corpus_dir, files):
+def variant_checks(check, env, corpus_dir, files):
     """The same pairs and expert infos when the returns come on another interface of the
     capture, or unmarked (pairing must not rely on source addresses alone); unmarked, a frame
     that nobody processed comes back byte for byte as it was sent, and is still its return."""
@@ -492,15 +480,16 @@ def unique_key_frames(n, answer_every=1000, answer_after=40, outlier=None, gap_a
     return frames, pairs
 
 
-def peak_rss_mb(env, args):
+def peak_rss_mb(check, env, args):
     p = subprocess.Popen(env.command(args), env=env.env(), cwd=env.home, stdout=subprocess.DEVNULL,
                          stderr=subprocess.DEVNULL)
     _pid, status, usage = os.wait4(p.pid, 0)
+    p.returncode = os.waitstatus_to_exitcode(status)   # reaped here, not by Popen
     check(status == 0, "tshark %s exited %d" % (" ".join(args), status))
     return usage.ru_maxrss / 1024.0
 
 
-def check_paired(env, path, pairs, what, two_pass):
+def check_paired(check, env, path, pairs, what, two_pass):
     """Every return of `pairs` ({return: request}) and no other frame carries ecatr.request_in."""
     rows = decode(env, path, two_pass=two_pass)
     got = {f: int(r["ecatr.request_in"]) for f, r in rows.items() if r["ecatr.request_in"]}
@@ -508,15 +497,15 @@ def check_paired(env, path, pairs, what, two_pass):
           % (what, " (-2)" if two_pass else "", len(pairs), len(got), sorted(set(got.items()) ^ set(pairs.items()))[:4]))
 
 
-def forgetting_checks(env):
+def forgetting_checks(check, env):
     print("== keys never used again")
     rss = {}
     for n in (8000, 32000):
         frames, pairs = unique_key_frames(n)
         name = "unique-keys-%d.pcap" % n
         path = env.add_file(name, pcapgen.pcap_bytes(frames))
-        check_paired(env, path, pairs, name, two_pass=False)
-        rss[n] = min(peak_rss_mb(env, ["-r", path]) for _ in range(2))
+        check_paired(check, env, path, pairs, name, two_pass=False)
+        rss[n] = min(peak_rss_mb(check, env, ["-r", path]) for _ in range(2))
         print("   %s: peak RSS %.1f MB" % (name, rss[n]))
     growth = rss[32000] - rss[8000]
     check(growth < 25, "peak memory grows by %.1f MB from 8 000 to 32 000 frames (less than 25)" % growth)
@@ -527,7 +516,7 @@ def forgetting_checks(env):
         frames, pairs = unique_key_frames(8000, **kwargs)
         path = env.add_file(name, pcapgen.pcap_bytes(frames))
         for two_pass in (False, True):
-            check_paired(env, path, pairs, what, two_pass)
+            check_paired(check, env, path, pairs, what, two_pass)
 
 
 MASTER = b"\x00\x1b\x21\x00\x00\x01"
@@ -557,7 +546,7 @@ def orphan_frames(waiting):
     return frames, pairs
 
 
-def orphan_checks(env):
+def orphan_checks(check, env):
     print("\n== orphan returns among waiting requests (generated frames)")
     for waiting in (0, 2, 3):
         frames, pairs = orphan_frames(waiting)
@@ -565,49 +554,69 @@ def orphan_checks(env):
         path = env.add_file(name, pcapgen.pcap_bytes(frames))
         for two_pass in (False, True):
             what = "an orphan return while %d requests wait" % waiting
-            check_paired(env, path, pairs, what, two_pass)
+            check_paired(check, env, path, pairs, what, two_pass)
             rows = decode(env, path, two_pass=two_pass)
             experts = {e: sorted(with_expert(rows, e)) for e in EXPERTS if with_expert(rows, e)}
             check(not experts, "%s%s: no expert infos (%s)" % (what, " (-2)" if two_pass else "", experts))
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--dissgen", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--corpus")
-    ap.add_argument("--quick", action="store_true", help="small captures only (see above)")
-    args = ap.parse_args()
-    corpus_dir = args.corpus or os.path.join(os.path.abspath(args.source_dir), "..", "shared", "corpus", "ethercat")
-    files = sorted(f for f in os.listdir(corpus_dir) if f.endswith((".pcap", ".pcapng"))) \
-        if os.path.isdir(corpus_dir) else []
-    if args.quick:
-        files = [f for f in files if os.path.getsize(os.path.join(corpus_dir, f)) < 1 << 20]
-    with TsharkEnv() as env:
-        env.install_plugin(args.dissgen, os.path.join(args.source_dir, "rules", "ethercat.xml"))
-        env.assert_plugin_loaded("ecatr")
-        orphan_checks(env)
-        if not files:
-            forgetting_checks(env)
-            print("\n%d failed" % len(check.failed))
-            if check.failed:
-                return 1
-            print("SKIPPED: no corpus at %s (no *.pcap/*.pcapng): parts 1 to 4 not run" % corpus_dir)
-            return SKIP
-        local = []
+class TestPairing(TsharkTestCase, unittest.TestCase):
+    """Parts 5 and 6 on generated frames; parts 1 to 4 on the corpus (skipped without it)."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("rules", "ethercat.xml"), "ecatr")
+        cls.corpus_dir = ARGS.corpus or os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus",
+                                                     "ethercat")
+        files = corpus_captures(cls.corpus_dir)
+        if ARGS.quick:
+            files = [f for f in files if os.path.getsize(os.path.join(cls.corpus_dir, f)) < 1 << 20]
+        cls.files = []
         for f in files:  # readable by the tshark user
-            with open(os.path.join(corpus_dir, f), "rb") as fh:
-                env.add_file(f, fh.read())
-            local.append(f)
-        corpus_checks(env, env.home, local)
-        faulted = ("soem-sdinfo-ek1100-el1004.pcapng",) if args.quick else (
+            with open(os.path.join(cls.corpus_dir, f), "rb") as fh:
+                cls.env.add_file(f, fh.read())
+            cls.files.append(f)
+        faulted = ("soem-sdinfo-ek1100-el1004.pcapng",) if ARGS.quick else (
             "soem-sdinfo-ek1100-el1004.pcapng", "replay-ek1100-el2828-el2889.pcapng", "twincat-scan-boxes.pcapng")
-        fault_checks(env, env.home, [f for f in faulted if f in local])
-        variant_checks(env, env.home, [f for f in faulted if f in local])
-        forgetting_checks(env)
-    print("\n%d failed" % len(check.failed))
-    return 1 if check.failed else 0
+        cls.faulted = [f for f in faulted if f in cls.files]
+
+    def need_corpus(self):
+        if not self.files:
+            self.skipTest("no corpus at %s (no *.pcap/*.pcapng)" % self.corpus_dir)
+
+    def test_corpus_returns_paired_as_the_bytes_show(self):
+        """Parts 1 and 2."""
+        self.need_corpus()
+        with self.checks() as check:
+            corpus_checks(check, self.env, self.env.home, self.files)
+
+    def test_injected_faults_raise_their_expert_infos_only(self):
+        """Part 3."""
+        self.need_corpus()
+        with self.checks() as check:
+            fault_checks(check, self.env, self.env.home, self.faulted)
+
+    def test_variants_give_the_same_pairs_and_experts(self):
+        """Part 4."""
+        self.need_corpus()
+        with self.checks() as check:
+            variant_checks(check, self.env, self.env.home, self.faulted)
+
+    def test_unused_keys_are_forgotten(self):
+        """Part 5 (generated frames)."""
+        with self.checks() as check:
+            forgetting_checks(check, self.env)
+
+    def test_orphan_returns_answer_no_waiting_request(self):
+        """Part 6 (generated frames)."""
+        with self.checks() as check:
+            orphan_checks(check, self.env)
+
+
+def add_arguments(parser):
+    parser.add_argument("--corpus", help="the EtherCAT captures (default ../shared/corpus/ethercat)")
+    parser.add_argument("--quick", action="store_true", help="small captures only (see above)")
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_unittests(add_arguments)[1])

@@ -14,12 +14,13 @@ reported lost (with -2 on itself, in one pass on the request that proved it). Ne
 import os
 import struct
 import sys
+import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import Checks, TsharkEnv  # noqa: E402
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 import pcapgen  # noqa: E402
 
-check = Checks()
+ARGS = None
 PORT = 47480
 CLIENT, SERVER = b"\x0a\x00\x00\x01", b"\x0a\x00\x00\x02"
 
@@ -65,53 +66,44 @@ def write(path):
 
 
 def decode(env, path, two_pass):
+    """{frame number: {field: its values, comma-separated}}."""
     fields = ["frame.number", "txnp.request_in", "txnp.response_in", "txnp.expert.no_response",
               "txnp.no_response_to", "txnp.time"]
-    args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"] + (["-2"] if two_pass else [])
-    for f in fields:
-        args += ["-e", f]
-    rows = {}
-    for line in env.tshark(args).stdout.splitlines():
-        cols = line.split("\t") + [""] * len(fields)
-        rows[int(cols[0])] = dict(zip(fields[1:], cols[1:]))
-    return rows
+    return {n: {f: ",".join(v) for f, v in r.items()} for n, r in env.field_rows(path, fields, two_pass).items()}
 
 
-def main():
-    import argparse
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--dissgen", required=True)
-    ap.add_argument("--source-dir", required=True)
-    args = ap.parse_args()
-    with TsharkEnv() as env:
-        env.install_plugin(args.dissgen, os.path.join(args.source_dir, "tests", "rules", "transactions.xml"))
-        env.assert_plugin_loaded("txnp")
+class TestTransactions(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "transactions.xml"), "txnp")
+
+    def test_requests_and_responses_paired_by_direction(self):
+        env = self.env
         path = env.path("transactions.pcap")
         write(path)
         os.chmod(path, 0o644)
-        for two_pass in (True, False):
-            mode = "-2" if two_pass else "one pass"
-            rows = decode(env, path, two_pass)
-            got = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
-            check(got == PAIRS, "%s: each response answers its own request, orphans answer nothing "
-                  "(%s)" % (mode, got))
-            if two_pass:
-                back = {int(r["txnp.response_in"]): n for n, r in rows.items() if r["txnp.response_in"]}
-                check(back == PAIRS, "%s: each answered request links its response (%s)" % (mode, back))
-                flagged = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
-                check(flagged == set(LOST), "%s: no_response exactly on the lost request %s (%s)" % (
-                    mode, sorted(LOST), sorted(flagged)))
-            else:
-                flagged = {n: r["txnp.no_response_to"] for n, r in rows.items() if r["txnp.expert.no_response"]}
-                want = {proof: str(lost) for lost, proof in LOST.items()}
-                check(flagged == want, "%s: no_response on the frame that proves the loss, naming it "
-                      "(%s, want %s)" % (mode, flagged, want))
-            times = {n: r["txnp.time"] for n, r in rows.items() if r["txnp.time"]}
-            want = {n: "%.9f" % ((MESSAGES[n - 1][0] - MESSAGES[m - 1][0]) / 1000) for n, m in PAIRS.items()}
-            check(times == want, "%s: round trips are the timestamps' differences (%s)" % (mode, times))
-    print("all checks passed" if not check.failed else "%d checks failed" % len(check.failed))
-    return 1 if check.failed else 0
+        with self.checks() as check:
+            for two_pass in (True, False):
+                mode = "-2" if two_pass else "one pass"
+                rows = decode(env, path, two_pass)
+                got = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
+                check(got == PAIRS, "%s: each response answers its own request, orphans answer nothing "
+                      "(%s)" % (mode, got))
+                if two_pass:
+                    back = {int(r["txnp.response_in"]): n for n, r in rows.items() if r["txnp.response_in"]}
+                    check(back == PAIRS, "%s: each answered request links its response (%s)" % (mode, back))
+                    flagged = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
+                    check(flagged == set(LOST), "%s: no_response exactly on the lost request %s (%s)" % (
+                        mode, sorted(LOST), sorted(flagged)))
+                else:
+                    flagged = {n: r["txnp.no_response_to"] for n, r in rows.items() if r["txnp.expert.no_response"]}
+                    want = {proof: str(lost) for lost, proof in LOST.items()}
+                    check(flagged == want, "%s: no_response on the frame that proves the loss, naming it "
+                          "(%s, want %s)" % (mode, flagged, want))
+                times = {n: r["txnp.time"] for n, r in rows.items() if r["txnp.time"]}
+                want = {n: "%.9f" % ((MESSAGES[n - 1][0] - MESSAGES[m - 1][0]) / 1000) for n, m in PAIRS.items()}
+                check(times == want, "%s: round trips are the timestamps' differences (%s)" % (mode, times))
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run_unittests()[1])

@@ -16,6 +16,7 @@ CLI (for a quick look):  tshark_env.py --dissgen PATH --rules FILE [--protocol e
 """
 
 import argparse
+import contextlib
 import os
 import re
 import shutil
@@ -40,21 +41,29 @@ class TsharkError(RuntimeError):
 
 
 class Checks:
-    """Prints one "ok"/"FAIL" line per check; `failed` lists the failed ones.
+    """Prints one "ok"/"FAIL" line per check; `failed` lists the failed ones, `count` all.
+    A test collects its fine-grained checks in one (TsharkTestCase.checks) and fails at
+    its end, listing them.
 
-        check = Checks()
-        check(a == b, "what a == b means")
-        return 1 if check.failed else 0
+        with self.checks() as check:
+            check(a == b, "what a == b means")
     """
 
     def __init__(self):
         self.failed = []
+        self.count = 0
 
     def __call__(self, cond, what):
-        print(("ok   " if cond else "FAIL ") + what)
+        self.count += 1
+        print(("ok   " if cond else "FAIL ") + what, flush=True)
         if not cond:
             self.failed.append(what)
         return cond
+
+
+def corpus_captures(folder):
+    """The names of the *.pcap and *.pcapng files in folder, sorted ([] when it is absent)."""
+    return sorted(f for f in os.listdir(folder) if f.endswith((".pcap", ".pcapng"))) if os.path.isdir(folder) else []
 
 
 def read_tshark_output(path, xml=False):
@@ -194,17 +203,23 @@ class TsharkEnv:
             cmd = ["setpriv", "--reuid=%d" % NOBODY, "--regid=%d" % NOBODY, "--clear-groups"] + cmd
         return cmd
 
-    def field_rows(self, path, fields, two_pass=False):
+    def field_rows(self, path, fields, two_pass=False, display_filter=None, aggregator=",", with_stderr=False):
         """{frame number: {field: [values]}} of `tshark -T fields` for fields[1:] (fields[0]
-        is frame.number), every occurrence of each field."""
-        args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=,"] + (["-2"] if two_pass else [])
+        is frame.number), every occurrence of each field; with display_filter, of the frames
+        it keeps.  aggregator: what tshark puts between occurrences (one no value holds).
+        with_stderr: (rows, what tshark wrote to stderr)."""
+        args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=" + aggregator]
+        args += ["-2"] if two_pass else []
+        if display_filter:
+            args += ["-Y", display_filter]
         for f in fields:
             args += ["-e", f]
+        p = self.tshark(args)
         rows = {}
-        for line in self.tshark(args).stdout.splitlines():
+        for line in p.stdout.splitlines():
             cols = (line.split("\t") + [""] * len(fields))[:len(fields)]
-            rows[int(cols[0])] = {f: (v.split(",") if v else []) for f, v in zip(fields[1:], cols[1:])}
-        return rows
+            rows[int(cols[0])] = {f: (v.split(aggregator) if v else []) for f, v in zip(fields[1:], cols[1:])}
+        return (rows, p.stderr) if with_stderr else rows
 
     def tshark(self, args, check=True, stdout=None, timeout=1800):
         """Run tshark; return CompletedProcess (text stdout/stderr unless stdout is a file)."""
@@ -282,13 +297,20 @@ class TsharkEnv:
 
 class TsharkTestCase:
     """Mixin for a unittest.TestCase class whose tests share one TsharkEnv (cls.env),
-    set up by the class's own `prepare()` classmethod."""
+    set up by the class's own `prepare()` classmethod, if it has one (`cls.install(rules,
+    protocol)` puts a plugin in it); cls.args: the options run_unittests parsed.
+
+    A test that makes many fine-grained checks collects them with `self.checks()`: each
+    prints an ok/FAIL line, and the test fails at the end of the block, listing the
+    failed ones (and when the block made no check at all).  A test that cannot run here
+    (no corpus, no privileges) calls `self.skipTest("why")`."""
 
     @classmethod
     def setUpClass(cls):
         cls.env = TsharkEnv()
         try:
-            cls.prepare()
+            if hasattr(cls, "prepare"):
+                cls.prepare()
         except BaseException:
             cls.env.cleanup()     # tearDownClass does not run when setUpClass fails
             raise
@@ -297,12 +319,31 @@ class TsharkTestCase:
     def tearDownClass(cls):
         cls.env.cleanup()
 
+    @classmethod
+    def install(cls, rules, protocol, extra_args=()):
+        """Install the plugin of rules (a path in the source tree) into cls.env, check it loads."""
+        cls.env.install_plugin(cls.args.dissgen, os.path.join(cls.args.source_dir, rules), extra_args)
+        cls.env.assert_plugin_loaded(protocol)
+
+    @contextlib.contextmanager
+    def checks(self):
+        print(flush=True)     # the checks' lines start on their own, after unittest's "test_x ... "
+        check = Checks()
+        yield check
+        if check.failed:
+            self.fail("%d of %d checks failed:\n- %s" % (len(check.failed), check.count,
+                                                        "\n- ".join(check.failed)))
+        if not check.count:
+            self.fail("no check was made")
+
 
 def run_unittests(add_arguments=None):
     """The entry point of every tests/integration/test_*.py: parses --dissgen and
-    --source-dir (plus what `add_arguments(parser)` adds), runs the module's
-    unittest cases, and returns the exit status for ctest (77: skipped)."""
-    import argparse
+    --source-dir (plus what `add_arguments(parser)` adds), runs the module's unittest
+    cases (or those named: `TestX.test_y`, `-k pattern`), and returns (args, exit status
+    for ctest): 0 when every test run passed or skipped, 77 when every one skipped
+    ("SKIPPED: <reasons>"), 1 when one failed or when none was run (a selection that
+    matches nothing)."""
     import unittest
     parser = argparse.ArgumentParser()
     parser.add_argument("--dissgen", required=True)
@@ -314,9 +355,23 @@ def run_unittests(add_arguments=None):
         print("SKIPPED: tshark is not installed")
         return args, 77
     main_module = sys.modules["__main__"]
-    main_module.ARGS = args
+    main_module.ARGS = TsharkTestCase.args = args
     result = unittest.main(module=main_module, argv=[sys.argv[0]] + rest, exit=False, verbosity=2).result
-    return args, (0 if result.wasSuccessful() else 1)
+    skipped = [(test, why) for test, why in result.skipped]
+    ran = result.testsRun - sum(1 for test, _why in skipped if isinstance(test, unittest.TestCase))
+    reasons = sorted({why for _test, why in skipped})
+    sys.stdout.flush()
+    if not result.wasSuccessful():
+        return args, 1
+    if ran == 0 and skipped:
+        print("SKIPPED: " + "; ".join(reasons))
+        return args, 77
+    if ran == 0:
+        print("FAIL: no test was run (does the selection name a test?)")
+        return args, 1
+    if skipped:
+        print("(skipped here: %s)" % "; ".join("%s: %s" % (t.id().split(".", 1)[-1], why) for t, why in skipped))
+    return args, 0
 
 
 def main(argv=None):

@@ -24,6 +24,7 @@ Exit status: 0 when every mutant is killed, 1 otherwise, 77 (skip) without tshar
 """
 
 import argparse
+import fnmatch
 import glob
 import os
 import re
@@ -60,8 +61,9 @@ def corpus_differential(src, build):
 # The tests a mutant may name, each short (seconds), each a real test of the suite.
 # Golden files are not among them: they record the emitter's output and a changed
 # output is regenerated on purpose, so a mutant must be killed by behaviour.
-# Every integration script, and every part a script can run alone (--only), has a name
-# here (check_coverage): a bug only one part catches must be able to name that part.
+# Every integration script, and every test of it (a unittest method, chosen by its name
+# "Class.test_name" or by "-k pattern"), is run by a name here (check_coverage): a bug only
+# one test catches must be able to name that test.
 TESTS = {
     "unit": unit("-Golden*"),
     "rules_err": unit("Files/RulesErr.*:Files/RulesOk.*:RuleFolders.*"),
@@ -76,20 +78,20 @@ TESTS = {
     "info_column": integration("test_info_column.py"),
     "layout": integration("test_layout.py"),
     "bus_tables": integration("test_bus_tables.py"),
-    "bus_identities": integration("test_bus_model.py", "--only", "identities"),
-    "bus_network": integration("test_bus_model.py", "--only", "network"),
-    "bus_wkc": integration("test_bus_model.py", "--only", "wkc"),
-    "bus_stats": integration("test_bus_model.py", "--only", "stats"),
-    "bus_eni": integration("test_bus_model.py", "--only", "eni"),
-    "bus_pdo": integration("test_bus_model.py", "--only", "pdo"),
-    "bus_coe": integration("test_bus_model.py", "--only", "coe"),
+    "bus_identities": integration("test_bus_model.py", "TestBusModel.test_slave_identities_as_the_corpus_lists_them"),
+    "bus_network": integration("test_bus_model.py", "TestBusModel.test_network_check_against_four_designs"),
+    "bus_wkc": integration("test_bus_model.py", "TestBusModel.test_expected_working_counters"),
+    "bus_stats": integration("test_bus_model.py", "TestBusModel.test_per_slave_statistics"),
+    "bus_eni": integration("test_bus_model.py", "TestBusModel.test_eni_cyclic_commands_expected_wkc"),
+    "bus_pdo": integration("test_bus_model.py", "TestBusModel.test_process_data_by_name"),
+    "bus_coe": integration("test_bus_model.py", "-k", "test_process_data_as_mapped_over_coe_"),
     "pairing": integration("test_pairing.py", "--quick"),
     "pairing_full": integration("test_pairing.py"),
     "esc_commands": integration("test_esc_commands.py"),
     "ecat_figures": integration("test_ecat_figures.py"),
-    "edges_handoff": integration("test_edges.py", "--only", "handoff"),
-    "edges_peek": integration("test_edges.py", "--only", "peek"),
-    "edges_offsets": integration("test_edges.py", "--only", "offsets"),
+    "edges_handoff": integration("test_edges.py", "TestEdges.test_handoff_gives_the_other_dissector_the_leaf_only"),
+    "edges_peek": integration("test_edges.py", "TestEdges.test_peek_at_shifted_bit_group_members"),
+    "edges_offsets": integration("test_edges.py", "TestEdges.test_offsets_from_enclosing_containers"),
     "malformed_skip": integration("test_malformed_skip.py"),
     "quiet": integration("test_quiet.py"),
     "live_capture": integration("test_live_capture.py"),
@@ -106,10 +108,20 @@ TESTS = {
 }
 
 
+def selected(run, tests):
+    """The tests ("Class.test_name") of a script that its arguments `run` select: those named
+    (Class.test_name), those matching a -k pattern (as unittest matches them), else all."""
+    names = [a for a in run if re.match(r"^[A-Za-z_]\w*\.test_\w+$", a)]
+    patterns = [run[i + 1] for i, a in enumerate(run[:-1]) if a == "-k"]
+    if not names and not patterns:
+        return set(tests)
+    patterns = [p if "*" in p else "*%s*" % p for p in patterns]
+    return {t for t in tests if t in names or any(fnmatch.fnmatchcase("__main__." + t, p) for p in patterns)}
+
+
 def check_coverage(source_dir):
-    """What no TESTS name reaches: integration scripts not named, and parts of a script
-    (its PARTS = (...) tuple, chosen with --only) that no name selects and that no name
-    running the whole script covers."""
+    """What no TESTS name reaches: integration scripts not named, their tests (unittest
+    methods, "Class.test_name") that no name runs, and names that select no test."""
     commands = [c("SRC", "BUILD") for c in TESTS.values()]
     folder = os.path.join(source_dir, "tests", "integration")
     missing = []
@@ -119,10 +131,20 @@ def check_coverage(source_dir):
         if not runs:
             missing.append(script)
             continue
-        m = re.search(r"^PARTS = \(([^)]*)\)", open(path, encoding="utf-8").read(), re.M)
-        for part in re.findall(r'"([^"]+)"', m.group(1)) if m else []:
-            if not any(r[r.index("--only") + 1] == part for r in runs if "--only" in r):
-                missing.append("%s --only %s" % (script, part))
+        tests, cls = [], None
+        for line in open(path, encoding="utf-8"):
+            m = re.match(r"^class (\w+)\(.*unittest\.TestCase", line)
+            cls = m.group(1) if m else (None if re.match(r"^\S", line) else cls)
+            m = re.match(r"^    def (test_\w+)\(", line)
+            if cls and m:
+                tests.append("%s.%s" % (cls, m.group(1)))
+        reached = set()
+        for run in runs:
+            these = selected(run, tests)
+            if tests and not these:
+                missing.append("%s %s (selects no test)" % (script, " ".join(run)))
+            reached |= these
+        missing += ["%s %s" % (script, t) for t in tests if t not in reached]
     return missing
 
 

@@ -103,7 +103,8 @@ for dep in "libwireshark-dev (>= $abi)" "libwireshark-dev (<< $next_abi)" libxml
   check "Depends on $dep" grep -qF "$dep" <<<"$depends"
 done
 for f in /usr/bin/dissgen /usr/share/dissgen/runtime/dissgen_runtime.h \
-         /usr/share/dissgen/runtime/dissgen_runtime.cpp /usr/share/dissgen/runtime/dissgen_compat.h \
+         /usr/share/dissgen/runtime/dissgen_walk.cpp /usr/share/dissgen/runtime/dissgen_state.h \
+         /usr/share/dissgen/runtime/dissgen_compat.h \
          /usr/share/dissgen/runtime/dissgen_rows.h \
          /usr/share/dissgen/runtime/dissgen_pairing.cpp /usr/share/dissgen/runtime/ethercat/ethercat_esc.cpp \
          /usr/share/dissgen/runtime/ethercat/ethercat_bus.cpp \

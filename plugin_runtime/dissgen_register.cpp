@@ -1,0 +1,216 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* What a generated plugin does once, at start-up: check that its names are
+ * free, register the protocol, its fields and expert infos, hook into
+ * dissector tables (and keep its entries the default whatever the plugin
+ * load order), and the statistics tree (tshark -z FILTER,tree, Wireshark's
+ * Statistics menu) that counts what the walk records.
+ *
+ * Each plugin links its own copy of the runtime and holds one protocol, so
+ * the callbacks that get no user pointer find it in this file's globals.
+ * Like the whole runtime: no non-trivial C++ object (Wireshark's exceptions
+ * are longjmps).
+ */
+#include "dissgen_state.h"
+
+#include <epan/stats_tree.h>
+#include <epan/tap.h>
+
+#include <string.h>
+
+int dg_rt::stats_tap = -1;
+
+using namespace dg_rt;
+
+namespace {
+
+/* --- hand-off tables ------------------------------------------------------ */
+
+struct dg_claim {
+    const char *table;
+    guint32 value;
+    dissector_handle_t handle;
+};
+
+GArray *claims; /* of dg_claim: table entries this plugin must own */
+
+/* Runs after every plugin's handoff and before Decode As choices (-d, the
+ * profile's decode_as_entries) are applied: whatever the plugin load order,
+ * our handle becomes the default for our values, and the other registrant
+ * stays selectable in Decode As. */
+void claim_tables(void)
+{
+    for (guint i = 0; claims && i < claims->len; i++) {
+        const dg_claim *c = &g_array_index(claims, dg_claim, i);
+        if (dissector_get_uint_handle(find_dissector_table(c->table), c->value) != c->handle)
+            dissector_add_uint(c->table, c->value, c->handle);
+    }
+}
+
+gboolean table_accepts_integers(const char *table)
+{
+    switch (get_dissector_table_selector_type(table)) {
+    case FT_UINT8: case FT_UINT16: case FT_UINT24: case FT_UINT32: return TRUE;
+    default: return FALSE;
+    }
+}
+
+/* --- statistics: tshark -z FILTER,tree, Statistics menu in Wireshark ---- */
+
+/* The protocol the stats tree callbacks (which get no user pointer) count for. */
+const dg_protocol *stats_protocol;
+
+/* "Command (ecatr.datagram.cmd)": node names must be unique in the tree. */
+const char *stats_node_name(const dg_node *n, const char *what)
+{
+    header_field_info *hfi = n->hf ? proto_registrar_get_nth(*n->hf) : NULL;
+    return g_strdup_printf("%s%s (%s)", n->name, what, hfi ? hfi->abbrev : stats_protocol->filter);
+}
+
+char **stats_node_names;   /* per node: that node's name, or NULL (no statistics) */
+int stats_frames_id;
+
+void stats_init(stats_tree *st)
+{
+    const dg_protocol *p = stats_protocol;
+    guint n_nodes = p->node_count;
+    if (stats_node_names) g_strfreev(stats_node_names);
+    stats_node_names = g_new0(char *, n_nodes + 1);
+    stats_frames_id = stats_tree_create_node(st, "Messages", 0, STAT_DT_INT, FALSE);
+    for (guint i = 0; i < n_nodes; i++) {
+        const dg_node *n = &p->nodes[i];
+        const char *what = NULL;
+        if (is_repeated(n)) what = " per message";
+        else if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM) what = "";
+        if (!what) continue;
+        /* The node itself appears with its first count: no rows of zeros. */
+        stats_node_names[i] = (char *)stats_node_name(n, what);
+    }
+    if (p->pairing) dg_pairing_stats_init(p, st);
+}
+
+tap_packet_status stats_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *, const void *data, tap_flags_t)
+{
+    const dg_tap_data *t = (const dg_tap_data *)data;
+    const dg_protocol *p = stats_protocol;
+    tick_stat_node(st, "Messages", 0, FALSE);
+    char buf[64];
+    for (guint i = 0; i < t->count; i++) {
+        const dg_tap_record *r = &t->records[i];
+        const dg_node *n = &p->nodes[r->node];
+        if (!stats_node_names[r->node]) continue;
+        const char *label = NULL;
+        if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM && !is_repeated(n)) {
+            header_field_info *hfi = proto_registrar_get_nth(*n->hf);
+            label = enum_name(hfi, r->value);
+            if (!label) {
+                /* padded like the tree item: "Unknown (0x07)" for an 8-bit field */
+                g_snprintf(buf, sizeof buf, "Unknown (0x%0*" G_GINT64_MODIFIER "x)", (int)((n->bits + 3) / 4), r->value);
+                label = buf;
+            }
+        } else {
+            g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "u", r->value);
+            label = buf;
+        }
+        int id = tick_stat_node(st, stats_node_names[r->node], 0, TRUE);
+        tick_stat_node(st, label, id, FALSE);
+    }
+    if (p->pairing) dg_pairing_stats_packet(p, st, pinfo, t->pairing);
+    return TAP_PACKET_REDRAW;
+}
+
+void register_stats_tree(const dg_protocol *p)
+{
+    stats_protocol = p;
+    stats_tap = register_tap(p->filter);
+    stats_tree_register_plugin(p->filter, p->filter, p->name, 0, stats_packet, stats_init, NULL);
+}
+
+} // namespace
+
+/* --- registration --------------------------------------------------------- */
+
+gboolean dg_protocol_names_free(const dg_protocol *p)
+{
+    /* The very same protocol from another plugin (a packaged plugin and the
+     * user's own build of the same rules): the first one registered wins, and
+     * this one steps aside without a dialog at every start. */
+    int same = proto_get_id_by_filter_name(p->filter);
+    if (same != -1 && strcmp(proto_get_protocol_name(same), p->name) == 0 &&
+        strcmp(proto_get_protocol_short_name(find_protocol_by_id(same)), p->short_name) == 0) {
+        /* ws_log, not ws_info: that macro would compile the source path into the plugin */
+        ws_log("dissgen", LOG_LEVEL_INFO, "\"%s\" (%s) is already registered by another plugin; this one steps aside",
+               p->name, p->filter);
+        return FALSE;
+    }
+    const char *what = NULL, *value = NULL;
+    if (proto_get_id_by_filter_name(p->filter) != -1) {
+        what = "filter name";
+        value = p->filter;
+    } else if (proto_get_id_by_short_name(p->short_name) != -1) {
+        what = "abbreviation";
+        value = p->short_name;
+    } else if (proto_name_already_registered(p->name)) {
+        what = "name";
+        value = p->name;
+    }
+    if (!what) return TRUE;
+    report_failure("The dissgen plugin for \"%s\" was not loaded: another protocol already has the %s \"%s\". "
+                   "Change it in the rule file (<root %s=...>) and regenerate the plugin.",
+                   p->name, what, value, strcmp(what, "abbreviation") == 0 || strcmp(what, "name") == 0 ? what : "filter");
+    return FALSE;
+}
+
+void dg_name_fields(hf_register_info *hf, const char *const *names, guint count, const char *filter)
+{
+    for (guint i = 0; i < count; i++) hf[i].hfinfo.abbrev = g_strdup_printf("%s.%s", filter, names[i]);
+}
+
+void dg_name_experts(ei_register_info *ei, const char *const *names, guint count, const char *filter)
+{
+    for (guint i = 0; i < count; i++) ei[i].eiinfo.name = g_strdup_printf("%s.%s", filter, names[i]);
+}
+
+void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett, int ett_count,
+                 ei_register_info *ei, int ei_count)
+{
+    *p->proto = proto_register_protocol(p->name, p->short_name, p->filter);
+    proto_register_field_array(*p->proto, hf, hf_count);
+    /* Wireshark keeps a pointer to it: a static array, a name that lives until exit. */
+    static hf_register_info runtime_hf[] = {DG_RUNTIME_FIELDS(DG_HF_ROW)};
+    static const char *const names[] = {DG_RUNTIME_FIELDS(DG_FIELD_NAME)};
+    dg_name_fields(runtime_hf, names, G_N_ELEMENTS(runtime_hf), p->filter);
+    proto_register_field_array(*p->proto, runtime_hf, (int)G_N_ELEMENTS(runtime_hf));
+    proto_register_subtree_array(ett, ett_count);
+    expert_module_t *experts = expert_register_protocol(*p->proto);
+    expert_register_field_array(experts, ei, ei_count);
+    register_dissector(p->filter, p->dissect, *p->proto);
+    register_stats_tree(p);
+    if (p->reassembly) reassembly_table_register(p->reassembly, &addresses_reassembly_table_functions);
+    if (p->pairing) dg_pairing_register(p);
+}
+
+/* Handoff: the protocol's hooks, the dissectors its leaves hand bytes to. */
+void dg_handoff(const dg_protocol *p)
+{
+    if (*p->proto == -1) return; /* not registered: its names were taken */
+    dissector_handle_t handle = find_dissector(p->filter);
+    dissector_handle_t stream = p->dissect_stream ? create_dissector_handle(p->dissect_stream, *p->proto) : NULL;
+    if (!claims) {
+        claims = g_array_new(FALSE, FALSE, sizeof(dg_claim));
+        register_final_registration_routine(claim_tables);
+    }
+    find_handoff_dissectors(p);
+    for (guint i = 0; i < p->hook_count; i++) {
+        const dg_hook *h = &p->hooks[i];
+        if (!find_dissector_table(h->table) || !table_accepts_integers(h->table)) {
+            report_failure("The dissgen plugin for \"%s\" cannot hook into \"%s\": Wireshark has no integer "
+                           "dissector table of that name. The hook is ignored.", p->name, h->table);
+            continue;
+        }
+        dissector_handle_t h_handle = (stream && strcmp(h->table, "tcp.port") == 0) ? stream : handle;
+        dissector_add_uint(h->table, h->value, h_handle);
+        dg_claim c = {h->table, h->value, h_handle};
+        g_array_append_val(claims, c);
+    }
+}
+

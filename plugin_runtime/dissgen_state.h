@@ -1,0 +1,231 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* Inside the runtime: the state of the message being decoded, the helpers
+ * every part of the walk calls for every field (inline here, so that each
+ * source inlines them), and what the runtime's sources call of each other.
+ *
+ *   dissgen_walk.cpp        the table walk: leaves, containers, repeats, located instances
+ *   dissgen_conditions.cpp  references, offset tables, conditions, windows
+ *   dissgen_text.cpp        shown values, summaries, the Info column
+ *   dissgen_handoff.cpp     hand-off to other dissectors, reassembly, stream transports
+ *   dissgen_register.cpp    registration, hand-off tables, statistics
+ *
+ * Wireshark's exceptions are longjmps that skip C++ destructors, so nothing
+ * here owns a non-trivial C++ object; memory comes from pinfo->pool. Names
+ * here are hidden: each plugin links its own copy of the runtime.
+ */
+#pragma once
+
+#include "dissgen_pairing.h"
+#include "dissgen_runtime.h"
+#include "dissgen_text.h"
+#include "dissgen_values.h"
+
+namespace dg_rt __attribute__((visibility("hidden"))) {
+
+/* A slot's value is valid only while dg_state.present[slot] is set: the
+ * flags are cleared per message and per repeated instance, the slots not
+ * (fewer bytes to clear). */
+struct dg_slot {
+    guint64 value;
+    gint offset;
+    gint length;
+    const dg_node *node;
+};
+
+/* One counted thing for the stats tree: an enum leaf's value, or how many
+ * instances a repeated node had in this message. */
+struct dg_tap_record {
+    guint16 node;
+    guint64 value;
+};
+
+struct dg_tap_data {
+    dg_tap_record *records;
+    guint count, capacity;
+    const dg_frame_pairing *pairing; /* what the pairing found, or NULL */
+};
+
+/* Every value of an offset leaf (extra->keep_values) in this
+ * message, in instance order; reset when its repetition starts. */
+struct dg_table {
+    guint64 *values;
+    guint count, capacity;
+    gboolean overflow; /* more than DG_MAX_TABLE instances */
+};
+
+/* Summaries of one repeated node's instances, gathered for the Info column
+ * (in `buf` on the caller's stack until they outgrow it). */
+struct dg_summaries {
+    dg_text text;
+    char buf[256];
+    guint count;
+};
+
+#define DG_MAX_LISTS 80 /* nesting is at most 64 levels (parser.h kMaxNesting) */
+
+struct dg_state {
+    const dg_protocol *p;
+    tvbuff_t *tvb;
+    packet_info *pinfo;
+    dg_slot *slots;
+    guint8 *present;      /* per slot: decoded in this message (instance) */
+    dg_table *tables;     /* offset tables: per slot, allocated at the first offset leaf */
+    gint packet_end;      /* captured bytes */
+    gboolean stopped;     /* a malformed spot was reported: decode nothing more */
+    gboolean want_text;   /* summaries are shown: a visible tree, or columns */
+    gboolean want_info;   /* the Info column is shown (pinfo->cinfo) */
+    gboolean quiet;       /* no tree, no tap listener: step over quiet nodes (dg_node.quiet_size) */
+    dg_text *info;  /* the Info column being built (want_info) */
+    dg_text *text;  /* scratch for one container's summary (want_text) */
+    guint64 group_value;  /* the bit group being decoded */
+    guint32 hook_value;   /* pinfo->match_uint on entry: the hook (or Decode As) value, for ifhook */
+    dg_tap_data *tap;     /* what the stats tree counts; NULL when nobody listens */
+    guint8 direction;     /* DG_DIR_REQUEST/RESPONSE when a port hook matched, else DG_DIR_ANY */
+    /* where each list of siblings being decoded started (the
+     * message, then each open container), for peeks counted from a container */
+    gint list_starts[DG_MAX_LISTS];
+    gint list_ends[DG_MAX_LISTS]; /* and where each ends: a peek reads nothing beyond */
+    guint lists;
+    /* the values of the <pairing> key fields (DG_KEY), in decoding order */
+    guint64 *keys;
+    guint key_count, key_capacity;
+};
+
+/* --- dissgen_walk.cpp ---------------------------------------------------- */
+
+/* Reports a malformed spot at `offset` (clamped into the packet) and stops decoding. */
+void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format, ...)
+    G_GNUC_PRINTF(6, 7);
+
+/* One instance of n (a leaf or a container) at *offset, before end; sink
+ * gathers the Info column text of a repeated node's instances, or NULL. */
+void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
+                      gboolean in_summary, dg_summaries *sink);
+
+/* P.padding (dissgen_names.h): registered with the protocol, added by containers. */
+extern int hf_padding;
+
+/* --- dissgen_conditions.cpp ---------------------------------------------- */
+
+/* The value of a length or count reference, or FALSE (reported) when it is
+ * missing or negative. */
+gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char *what, proto_tree *tree,
+                   gint offset, gint64 *out);
+
+/* The table of the offset leaf in `slot`, allocated on first use. */
+dg_table *table_of(dg_state *st, gint16 slot);
+void table_append(dg_state *st, const dg_node *n, guint64 value);
+/* An offset leaf's repetition starts a new, empty table. */
+void table_reset(dg_state *st, const dg_node *n, gint offset);
+
+/* selected() for a node with a condition, an otherwise or a direction: out of
+ * line, so that the unconditional test below is inlined into the walk. */
+gboolean selected_conditional(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken);
+
+/* A window's children, at addresses: dg_node.window. */
+void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary);
+
+/* --- dissgen_text.cpp ---------------------------------------------------- */
+
+/* The name an enum's value_string, val64_string or range_string gives the value, or NULL. */
+const char *enum_name(const header_field_info *hfi, guint64 value);
+
+/* The summary of container n, in st->text (valid until the next summary). */
+const char *summary_text(const dg_state *st, const dg_node *n);
+
+void info_append(dg_state *st, const char *text, gsize len);
+
+/* Info column text of a repeated node's summarised instances: gathered in
+ * *s while they are decoded (when summaries_begin says so), then added. */
+gboolean summaries_begin(const dg_state *st, const dg_node *n, gboolean in_summary, dg_summaries *s);
+void summaries_end(dg_state *st, const dg_node *n, const dg_summaries *s);
+
+/* --- dissgen_handoff.cpp ------------------------------------------------- */
+
+/* A leaf with dissector= or reassemble-*: its bytes (or, once reassembled,
+ * the whole message) go to the named dissector, or are shown raw. */
+void dissect_handoff(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len);
+
+/* At handoff: the dissectors that dissector= names, the reassembled sources' names. */
+void find_handoff_dissectors(const dg_protocol *p);
+
+/* --- dissgen_register.cpp ------------------------------------------------ */
+
+extern int stats_tap; /* the protocol's tap, -1 before registration */
+
+/* --- inline: run for every field ----------------------------------------- */
+
+static inline void key_append(dg_state *st, guint64 value)
+{
+    if (st->key_count == st->key_capacity) {
+        st->key_capacity = st->key_capacity ? 2 * st->key_capacity : 16;
+        st->keys = (guint64 *)wmem_realloc(st->pinfo->pool, st->keys, st->key_capacity * sizeof(guint64));
+    }
+    st->keys[st->key_count++] = value;
+}
+
+static inline void tap_record(dg_state *st, const dg_node *n, guint64 value)
+{
+    dg_tap_data *t = st->tap;
+    if (t->count == t->capacity) {
+        t->capacity = t->capacity ? 2 * t->capacity : 16;
+        t->records = (dg_tap_record *)wmem_realloc(st->pinfo->pool, t->records, t->capacity * sizeof(dg_tap_record));
+    }
+    t->records[t->count].node = (guint16)(n - st->p->nodes);
+    t->records[t->count].value = value;
+    t->count++;
+}
+
+/* Keeps a decoded leaf's value where later nodes, the stats tree and the
+ * pairing find it. */
+static inline __attribute__((always_inline)) void store(dg_state *st, const dg_node *n, guint64 value, gint offset,
+                                                        gint length)
+{
+    if (st->tap && n->show == DG_SHOW_ENUM) tap_record(st, n, value);
+    if (n->flags & DG_KEY) key_append(st, value);
+    if (n->slot < 0) return;
+    if (n->extra && n->extra->keep_values) table_append(st, n, value);
+    dg_slot *s = &st->slots[n->slot];
+    s->value = value;
+    s->offset = offset;
+    s->length = length;
+    s->node = n;
+    st->present[n->slot] = TRUE;
+}
+
+/* Whether store() uses a leaf's value: a later node reads it (slot) or the
+ * stats tree counts it. Otherwise the walk need not read it from the tvb. */
+static inline gboolean value_wanted(const dg_state *st, const dg_node *n)
+{
+    return n->slot >= 0 || (st->tap && n->show == DG_SHOW_ENUM) || (n->flags & DG_KEY);
+}
+
+/* A new instance: the values of the previous one's subtree are gone. */
+static inline void clear_slots(dg_state *st, const dg_node *n)
+{
+    if (n->slot_count) memset(&st->present[n->slot_first], 0, n->slot_count);
+}
+
+/* Whether n is decoded at `offset`. *chain_taken says whether a member of the
+ * current chain of alternatives (a conditional node and the otherwise nodes
+ * after it) was decoded; an otherwise node is skipped when one was. */
+static inline gboolean selected(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken)
+{
+    if (!n->alt && !n->hook_count && n->if_slot < 0 && !n->when_count && !n->extra) {
+        *chain_taken = FALSE; /* unconditional: ends any chain */
+        return TRUE;
+    }
+    return selected_conditional(st, n, offset, chain_taken);
+}
+
+/* The encoding a non-numeric leaf's item is added with. */
+static inline guint item_encoding(const dg_node *n)
+{
+    switch (n->show) {
+    case DG_SHOW_STRING: case DG_SHOW_STRINGZ: return n->extra ? n->extra->encoding : ENC_UTF_8;
+    case DG_SHOW_IPV4: case DG_SHOW_FLOAT: return encoding_of(n);
+    default: return ENC_NA;
+    }
+}
+
+} // namespace dg_rt

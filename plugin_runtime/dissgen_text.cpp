@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* The texts the walk shows besides items: a leaf's value as its tree item
+ * shows it, container summaries (summary="..." with optional parts), and the
+ * Info column, where a repeated node's summaries are gathered into one entry.
+ *
+ * Summary text is built with the dg_text appends of dissgen_text.h instead
+ * of printf: it runs for every instance of a summarised container. Like the
+ * whole runtime: no non-trivial C++ object (Wireshark's exceptions are
+ * longjmps), memory from pinfo->pool.
+ */
+#include "dissgen_state.h"
+
+#include <float.h>
+#include <string.h>
+
+namespace dg_rt {
+
+void text_grow(dg_text *t, gsize n)
+{
+    gsize cap = MAX(2 * t->cap, t->len + n + 1);
+    char *bigger = (char *)wmem_alloc(t->pool, cap);
+    memcpy(bigger, t->data, t->len + 1);
+    t->data = bigger; /* the old buffer goes with the pool */
+    t->cap = cap;
+}
+
+const char *enum_name(const header_field_info *hfi, guint64 value)
+{
+    if (hfi->display & BASE_RANGE_STRING) return try_rval_to_str((guint32)value, (const range_string *)hfi->strings);
+    if (hfi->display & BASE_VAL64_STRING) return try_val64_to_str(value, (const val64_string *)hfi->strings);
+    return try_val_to_str((guint32)value, (const value_string *)hfi->strings);
+}
+
+} // namespace dg_rt
+
+using namespace dg_rt;
+
+namespace {
+
+/* --- shown values -------------------------------------------------------- */
+
+/* The values of string, stringz, ipv4, int, float and time leaves,
+ * for summaries and the Info column (as the tree item shows them). */
+void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
+{
+    const dg_node *n = s->node;
+    char buf[64];
+    switch (n->show) {
+    case DG_SHOW_STRING:
+    case DG_SHOW_STRINGZ:
+        if (s->length > 0)
+            append_str(out, (const char *)tvb_get_string_enc(st->pinfo->pool, st->tvb, s->offset, s->length,
+                                                             n->extra ? n->extra->encoding : ENC_UTF_8));
+        return;
+    case DG_SHOW_IPV4: {
+        guint32 a = (guint32)s->value;
+        g_snprintf(buf, sizeof buf, "%u.%u.%u.%u", a >> 24, (a >> 16) & 0xff, (a >> 8) & 0xff, a & 0xff);
+        break;
+    }
+    case DG_SHOW_INT: {
+        guint64 v = s->value;
+        if (n->bits > 0 && n->bits < 64 && (v >> (n->bits - 1)) & 1) v |= ~bit_mask(n->bits);
+        g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "d", (gint64)v);
+        break;
+    }
+    case DG_SHOW_FLOAT:
+        if (s->length == 4)
+            g_snprintf(buf, sizeof buf, "%.*g", FLT_DIG, tvb_get_ieee_float(st->tvb, s->offset, encoding_of(n)));
+        else
+            g_snprintf(buf, sizeof buf, "%.*g", DBL_DIG, tvb_get_ieee_double(st->tvb, s->offset, encoding_of(n)));
+        break;
+    case DG_SHOW_TIME: {
+        nstime_t t = time_of(n, s->value);
+        g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "d.%09d seconds", (gint64)t.secs, t.nsecs);
+        break;
+    }
+    default: return;
+    }
+    append_str(out, buf);
+}
+
+/* Appends a leaf's value as its tree item shows it, for summaries. */
+void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s)
+{
+    wmem_allocator_t *pool = st->pinfo->pool;
+    const dg_node *n = s->node;
+    switch (n->show) {
+    case DG_SHOW_HEX:
+        append_hex(out, s->value, (n->bits + 3) / 4);
+        return;
+    case DG_SHOW_BOOL:
+        append_str(out, s->value ? "True" : "False");
+        return;
+    case DG_SHOW_ENUM: {
+        const char *name = enum_name(proto_registrar_get_nth(*n->hf), s->value);
+        if (name) {
+            append_str(out, name);
+        } else {
+            /* As the tree shows it: as many hex digits as the field's bits need. */
+            text_append(out, "Unknown (", 9);
+            append_hex(out, s->value, (n->bits + 3) / 4);
+            text_append(out, ")", 1);
+        }
+        return;
+    }
+    /* An empty byte field (length 0 from a field, or 'rest' with nothing left)
+     * shows nothing: tvb_bytes_to_str_punct() asserts len > 0. */
+    case DG_SHOW_ADDRESS:
+        if (s->length > 0) append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ':'));
+        return;
+    case DG_SHOW_BYTES:
+        if (s->length > 0) append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' '));
+        return;
+    case DG_SHOW_STRING: case DG_SHOW_STRINGZ: case DG_SHOW_IPV4: case DG_SHOW_INT: case DG_SHOW_FLOAT:
+    case DG_SHOW_TIME:
+        append_typed_value(st, out, s);
+        return;
+    default:
+        if (n->flags & DG_NUMERIC)
+            append_dec(out, s->value);
+        else if (s->length > 0)
+            append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' '));
+        return;
+    }
+}
+
+/* --- summaries ----------------------------------------------------------- */
+
+/* Whether every value an optional part shows itself (not those of the parts
+ * inside it) was decoded: a part that is left out then costs no text. */
+gboolean part_decoded(const dg_state *st, guint first, guint count)
+{
+    for (guint i = first; i < first + count; i++) {
+        const dg_summary_piece *piece = &st->p->pieces[i];
+        if (piece->group)
+            i += piece->group;
+        else if (piece->slot >= 0 && !st->present[piece->slot])
+            return FALSE;
+    }
+    return TRUE;
+}
+
+/* Appends the `count` summary pieces from pieces[first] on; FALSE when a
+ * placeholder among them showed nothing (not decoded, or empty), which drops
+ * the optional part {?...} around it. Outside optional parts a value that was
+ * not decoded shows as "-". */
+gboolean append_pieces(const dg_state *st, dg_text *out, guint first, guint count)
+{
+    gboolean complete = TRUE;
+    for (guint i = first; i < first + count; i++) {
+        const dg_summary_piece *piece = &st->p->pieces[i];
+        if (piece->group) {
+            gsize mark = out->len;
+            if (part_decoded(st, i + 1, piece->group) && !append_pieces(st, out, i + 1, piece->group))
+                text_truncate(out, mark); /* a value with empty text */
+            i += piece->group;
+        } else if (piece->slot < 0) {
+            append_str(out, piece->text);
+        } else {
+            const dg_slot *s = &st->slots[piece->slot];
+            gsize before = out->len;
+            if (!st->present[piece->slot]) {
+                text_append(out, "-", 1);
+                complete = FALSE;
+                continue;
+            }
+            if (piece->node) {
+                const dg_node *c = &st->p->nodes[piece->node - 1];
+                append_pieces(st, out, c->summary_first, c->summary_count);
+            } else {
+                append_shown_value(st, out, s);
+            }
+            if (out->len == before) complete = FALSE;
+        }
+    }
+    return complete;
+}
+
+/* The separator before the next item of the Info column, when there is one before it. */
+void info_separate(dg_state *st)
+{
+    if (st->info->len > 0) text_append(st->info, ", ", 2);
+}
+
+} // namespace
+
+namespace dg_rt {
+
+const char *summary_text(const dg_state *st, const dg_node *n)
+{
+    dg_text *out = st->text;
+    text_truncate(out, 0);
+    append_pieces(st, out, n->summary_first, n->summary_count);
+    return out->data;
+}
+
+/* --- the Info column ------------------------------------------------------ */
+
+void info_append(dg_state *st, const char *text, gsize len)
+{
+    info_separate(st);
+    text_append(st->info, text, len);
+}
+
+gboolean summaries_begin(const dg_state *st, const dg_node *n, gboolean in_summary, dg_summaries *s)
+{
+    s->count = 0;
+    if (in_summary || n->summary_count == 0 || !st->want_info) return FALSE;
+    text_init(&s->text, st->pinfo->pool, s->buf, sizeof s->buf);
+    return TRUE;
+}
+
+void summaries_end(dg_state *st, const dg_node *n, const dg_summaries *s)
+{
+    if (s->count > 1) {
+        /* "NAME ×COUNT: SUMMARY, SUMMARY, ..." */
+        info_separate(st);
+        append_str(st->info, n->name);
+        text_append(st->info, " \xc3\x97", 3);
+        append_dec(st->info, s->count);
+        text_append(st->info, ": ", 2);
+        text_append(st->info, s->text.data, s->text.len);
+    } else if (s->count == 1) {
+        info_append(st, s->text.data, s->text.len);
+    }
+}
+
+} // namespace dg_rt

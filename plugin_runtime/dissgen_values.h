@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* The runtime's arithmetic on values: a field's bytes read as a number, bit
+ * masks, value ranges, reference arithmetic, time units.
+ *
+ * None of it depends on the message being decoded, so the unit tests call it
+ * directly (tests/unit/test_runtime.cpp). Static inline: the walk calls
+ * these for every field, and each runtime source inlines them into its loops.
+ */
+#pragma once
+
+#include "dissgen_runtime.h"
+
+namespace dg_rt __attribute__((visibility("hidden"))) {
+
+static inline guint encoding_of(const dg_node *n) { return (n->flags & DG_LITTLE) ? ENC_LITTLE_ENDIAN : ENC_BIG_ENDIAN; }
+
+/* The `length` bytes at offset (1 to 8; more reads 8) as an unsigned number. */
+static inline guint64 read_uint(tvbuff_t *tvb, gint offset, guint length, guint encoding)
+{
+    switch (length) {
+    case 1: return dg_tvb_get_uint8(tvb, offset);
+    case 2: return dg_tvb_get_uint16(tvb, offset, encoding);
+    case 3: return dg_tvb_get_uint24(tvb, offset, encoding);
+    case 4: return dg_tvb_get_uint32(tvb, offset, encoding);
+    case 5: return dg_tvb_get_uint40(tvb, offset, encoding);
+    case 6: return dg_tvb_get_uint48(tvb, offset, encoding);
+    case 7: return dg_tvb_get_uint56(tvb, offset, encoding);
+    default: return dg_tvb_get_uint64(tvb, offset, encoding);
+    }
+}
+
+/* The low `bits` bits set (all 64 from 64 on). */
+static inline guint64 bit_mask(guint bits) { return bits >= 64 ? G_MAXUINT64 : ((G_GUINT64_CONSTANT(1) << bits) - 1); }
+
+/* A bit field's value: `bits` bits from bit `shift` of its group's value. */
+static inline guint64 bit_field(guint64 group, guint shift, guint bits) { return (group >> shift) & bit_mask(bits); }
+
+/* Whether value lies in one of the `count` ranges from p->ranges[first] on. */
+static inline gboolean in_ranges(const dg_protocol *p, guint16 first, guint16 count, guint64 value)
+{
+    for (guint i = 0; i < count; i++) {
+        const dg_range *r = &p->ranges[first + i];
+        if (value >= r->low && value <= r->high) return TRUE;
+    }
+    return FALSE;
+}
+
+/* A referenced field's value with the reference's arithmetic applied. Values
+ * beyond 2^31 are past any packet's end anyway; clamping there keeps even
+ * "* 999999999" (the largest operand the generator accepts) in range. */
+static inline gint64 ref_arith(guint64 value, const dg_ref *ref)
+{
+    gint64 v = value > (G_GUINT64_CONSTANT(1) << 31) ? (G_GINT64_CONSTANT(1) << 31) : (gint64)value;
+    switch (ref->op) {
+    case '+': v += ref->operand; break;
+    case '-': v -= ref->operand; break;
+    case '*': v *= ref->operand; break;
+    default: break;
+    }
+    return v;
+}
+
+/* A time leaf's count of units as an nstime. */
+static inline nstime_t time_of(const dg_node *n, guint64 value)
+{
+    guint64 per_second = n->extra && n->extra->units_per_second ? n->extra->units_per_second : 1000000000u;
+    nstime_t t;
+    t.secs = (time_t)(value / per_second);
+    t.nsecs = (int)((value % per_second) * (1000000000u / per_second));
+    return t;
+}
+
+/* Whether the node is decoded more than once: a count, a repeat flag,
+ * repeat="rest" or an offset table. */
+static inline gboolean is_repeated(const dg_node *n)
+{
+    return n->count.slot >= 0 || n->repeat_slot >= 0 ||
+           (n->extra && (n->extra->repeat_rest || n->extra->offsets_slot >= 0));
+}
+
+} // namespace dg_rt

@@ -1,0 +1,598 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* The table walk behind every dissgen-generated dissector: a message's
+ * nodes in document order, each a leaf (a value, a bit field, a hand-off) or
+ * a container of more, decoded once, repeated (count, repeat flag, rest) or
+ * placed by an offset table.
+ *
+ * Wireshark's exceptions are longjmps that skip C++ destructors, so nothing
+ * here owns a non-trivial C++ object; memory comes from pinfo->pool. Every
+ * read is checked against the bytes left first, so no tvb_ or proto_ call
+ * can throw: malformed packets end in an expert info instead.
+ */
+#include "dissgen_state.h"
+
+#include <epan/proto_data.h>
+#include <epan/tap.h>
+
+#include <string.h>
+
+namespace dg_rt {
+
+void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format, ...)
+{
+    if (offset > st->packet_end) offset = st->packet_end;
+    if (length < 0 || offset + length > st->packet_end) length = st->packet_end - offset;
+    st->stopped = TRUE;
+    if (st->quiet) {
+        /* No tree and no tap listener: nobody reads the text, but the
+         * severity still goes to the Expert column and the capture's highest
+         * severity, as Wireshark does for every expert info. */
+        proto_tree_add_expert(tree, st->pinfo, ei, st->tvb, offset, length);
+        return;
+    }
+    va_list ap;
+    va_start(ap, format);
+    char *text = wmem_strdup_vprintf(st->pinfo->pool, format, ap);
+    va_end(ap);
+    proto_tree_add_expert_format(tree, st->pinfo, ei, st->tvb, offset, length, "%s", text);
+}
+
+int hf_padding = -1;
+
+} // namespace dg_rt
+
+using namespace dg_rt;
+
+namespace {
+
+void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
+                  gboolean in_summary);
+
+/* --- leaves -------------------------------------------------------------- */
+
+/* A numeric leaf's item from its bytes already read (a bit group's
+ * whole value: Wireshark masks and shifts it by the field's bitmask), which
+ * costs Wireshark about a third less than proto_tree_add_item() reading them
+ * again. Unsigned displays only; the others are added from the bytes. */
+proto_item *add_numeric_item(const dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint length,
+                             guint64 raw)
+{
+    switch (n->show) {
+    case DG_SHOW_HEX: case DG_SHOW_DEC: case DG_SHOW_ENUM:
+        return length <= 4 ? proto_tree_add_uint(tree, *n->hf, st->tvb, offset, length, (guint32)raw)
+                           : proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, length, raw);
+    default:
+        return proto_tree_add_item(tree, *n->hf, st->tvb, offset, length, encoding_of(n));
+    }
+}
+
+void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end)
+{
+    if (n->flags & DG_GROUP_FIRST) {
+        if ((gint)n->length > end - *offset) {
+            report(st, tree, &st->p->ei->truncated, *offset, -1, "Truncated: '%s' needs %u bytes, only %d left",
+                   n->name, n->length, end - *offset);
+            return;
+        }
+        st->group_value = read_uint(st->tvb, *offset, n->length, encoding_of(n));
+    }
+    /* No tree (e.g. tshark's summary lines): only values later nodes read are
+     * wanted. proto_tree_add_item() would check the length and return NULL. */
+    if (tree) {
+        proto_item *item = add_numeric_item(st, n, tree, *offset, (gint)n->length, st->group_value);
+        if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+    }
+    if (value_wanted(st, n)) store(st, n, bit_field(st->group_value, n->shift, n->bits), *offset, n->length);
+    if (n->flags & DG_GROUP_LAST) *offset += n->length;
+}
+
+/* Bytes from offset to the first NUL before end, NUL included; one more than
+ * is left when there is none. */
+gint64 stringz_length(const dg_state *st, gint offset, gint end)
+{
+    if (offset >= end) return 1;
+    gint nul = dg_tvb_find_uint8(st->tvb, offset, end - offset, 0);
+    return nul < 0 ? (gint64)(end - offset) + 1 : (gint64)(nul - offset) + 1;
+}
+
+/* A leaf's length in bytes at offset, or -1 when its length field is
+ * missing or negative (reported). */
+gint64 leaf_length(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint end)
+{
+    gint64 length = 0;
+    switch (n->length_kind) {
+    case DG_LEN_FIXED: length = n->length; break;
+    case DG_LEN_FIELD:
+        if (!ref_value(st, &n->length_ref, n, "length", tree, offset, &length)) return -1;
+        break;
+    case DG_LEN_REST: length = end - offset; break;
+    default:
+        /* a stringz without a length runs to its NUL, included. */
+        length = n->show == DG_SHOW_STRINGZ ? stringz_length(st, offset, end) : 0;
+        break;
+    }
+    return length;
+}
+
+/* A leaf longer than the `left` bytes there are: show the bytes that are
+ * there, then say what is missing. */
+void report_short_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint64 length, gint left)
+{
+    /* An IPv4 address or a float has one size only: Wireshark throws on fewer bytes. */
+    gboolean fixed_size = n->show == DG_SHOW_IPV4 || n->show == DG_SHOW_FLOAT;
+    if (!(n->flags & DG_NUMERIC) && !fixed_size && left > 0 && tree) {
+        proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, left, item_encoding(n));
+        if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+    }
+    if (n->show == DG_SHOW_STRINGZ && n->length_kind == DG_LEN_CHILDREN)
+        report(st, tree, &st->p->ei->truncated, offset, left,
+               "Truncated: '%s' has no NUL before the end of its data (%d bytes left)", n->name, left);
+    else if (n->length_kind == DG_LEN_FIELD)
+        report(st, tree, &st->p->ei->past_end, offset, left,
+               "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)", n->name,
+               length, left);
+    else
+        report(st, tree, &st->p->ei->truncated, offset, left,
+               "Truncated: '%s' needs %" G_GINT64_MODIFIER "d bytes, only %d left", n->name, length, left);
+}
+
+/* The `len` bytes of a leaf at offset, all there: its item and its value.
+ * The value is read only when store() uses it, the item added only when
+ * there is a tree. */
+void decode_leaf_value(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len)
+{
+    guint64 value = 0;
+    proto_item *item = NULL;
+    if (n->show == DG_SHOW_TIME) {
+        /* a count of units; the item shows it as seconds. */
+        value = read_uint(st->tvb, offset, (guint)len, encoding_of(n));
+        if (tree) {
+            nstime_t t = time_of(n, value);
+            item = proto_tree_add_time(tree, *n->hf, st->tvb, offset, len, &t);
+        }
+    } else if (n->show == DG_SHOW_IPV4) {
+        if (value_wanted(st, n)) value = read_uint(st->tvb, offset, 4, encoding_of(n));
+        if (tree) item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, encoding_of(n));
+    } else if (n->flags & DG_NUMERIC) {
+        if (tree || value_wanted(st, n)) value = read_uint(st->tvb, offset, (guint)len, encoding_of(n));
+        if (tree) item = add_numeric_item(st, n, tree, offset, len, value);
+    } else if (len > 0 && tree) {
+        item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, item_encoding(n));
+    }
+    if (item && (n->flags & DG_HIDDEN)) proto_item_set_hidden(item);
+    store(st, n, value, offset, len);
+}
+
+void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end)
+{
+    if (n->flags & DG_GROUP) {
+        dissect_bit_field(st, n, tree, offset, end);
+        return;
+    }
+    gint64 length = leaf_length(st, n, tree, *offset, end);
+    if (length < 0) return;
+    gint left = end - *offset;
+    if (length > left) {
+        report_short_leaf(st, n, tree, *offset, length, left);
+        return;
+    }
+    gint len = (gint)length;
+    if (n->extra && (n->extra->dissector || n->extra->reassemble_id >= 0) && len > 0) {
+        dissect_handoff(st, n, tree, *offset, len);
+        store(st, n, 0, *offset, len);
+    } else {
+        decode_leaf_value(st, n, tree, *offset, len);
+    }
+    *offset += len;
+}
+
+/* --- containers ---------------------------------------------------------- */
+
+/* Whether the `length` bytes at offset are captured and all zero. Bytes the
+ * capture did not keep are not known to be zero. */
+gboolean all_zero(const dg_state *st, gint offset, gint length)
+{
+    static const guint8 zeros[64] = {0};
+    if (offset < 0 || length > st->packet_end - offset) return FALSE;
+    while (length > 0) {
+        gint n = MIN(length, (gint)sizeof zeros);
+        if (tvb_memeql(st->tvb, offset, zeros, (size_t)n) != 0) return FALSE;
+        offset += n;
+        length -= n;
+    }
+    return TRUE;
+}
+
+/* A container's length at start: -1 when its children make it; FALSE when
+ * its length field is missing or negative (reported). */
+gboolean container_length(dg_state *st, const dg_node *n, proto_tree *tree, gint start, gint end, gint64 *length)
+{
+    switch (n->length_kind) {
+    case DG_LEN_FIXED: *length = n->length; break;
+    case DG_LEN_FIELD: return ref_value(st, &n->length_ref, n, "length", tree, start, length);
+    case DG_LEN_REST: *length = end - start; break;
+    default: *length = -1; break;
+    }
+    return TRUE;
+}
+
+/* The container's item and subtree (NULL without a tree). Length 0 now, the
+ * real length once the children are decoded: a length of -1 would throw when
+ * the container starts at the end of the packet. */
+proto_tree *open_container(const dg_state *st, const dg_node *n, proto_tree *tree, gint start, proto_item **item)
+{
+    if (!tree) return NULL; /* nothing to add to */
+    if (n->hf) {
+        *item = proto_tree_add_item(tree, *n->hf, st->tvb, start, 0, ENC_NA);
+        return proto_item_add_subtree(*item, *n->ett);
+    }
+    return proto_tree_add_subtree(tree, st->tvb, start, 0, *n->ett, item, n->name);
+}
+
+/* The bytes between the end of a container's fields (at) and the end its
+ * length gives (inner_end): padding when zero, otherwise not decoded. */
+void show_trailing_bytes(dg_state *st, const dg_node *n, proto_tree *subtree, gint start, gint at, gint inner_end,
+                         gint64 length)
+{
+    if (all_zero(st, at, inner_end - at)) {
+        /* Zero bytes up to the length: padding, which senders may add (to
+         * a minimum length, or a length rounded up). Nothing is wrong. */
+        if (subtree) proto_tree_add_item(subtree, hf_padding, st->tvb, at, inner_end - at, ENC_NA);
+    } else {
+        /* The length says more than the fields hold: say so, then skip to the end. */
+        proto_tree_add_expert_format(subtree, st->pinfo, &st->p->ei->unused, st->tvb, at, inner_end - at,
+                                     "'%s' is %" G_GINT64_MODIFIER "d bytes, but its fields end after %d: "
+                                     "%d bytes are not decoded",
+                                     n->name, length, at - start, inner_end - at);
+    }
+}
+
+/* A container that a summary refers to: decoded in this instance. */
+void container_decoded(dg_state *st, const dg_node *n, gint start, gint end)
+{
+    dg_slot *s = &st->slots[n->slot];
+    s->offset = start;
+    s->length = end - start;
+    s->node = n;
+    st->present[n->slot] = TRUE;
+}
+
+/* The container's summary on its item and, outside other summaries, in the
+ * Info column (or in sink, for a repeated node's instances). */
+void show_summary(dg_state *st, const dg_node *n, proto_item *item, gboolean in_summary, dg_summaries *sink)
+{
+    const char *text = summary_text(st, n);
+    gsize text_len = st->text->len;
+    if (item) proto_item_append_text(item, ": %s", text);
+    if (in_summary || !st->want_info) return;
+    if (sink) {
+        if (sink->count++) text_append(&sink->text, ", ", 2);
+        text_append(&sink->text, text, text_len);
+    } else {
+        info_append(st, text, text_len);
+    }
+}
+
+void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
+                       gboolean in_summary, dg_summaries *sink)
+{
+    gint start = *offset;
+    gint64 length = -1;
+    if (!container_length(st, n, tree, start, end, &length)) return;
+    gboolean past_end = length > end - start;
+    gint inner_end = (length >= 0 && !past_end) ? start + (gint)length : end;
+
+    proto_item *item = NULL;
+    proto_tree *subtree = open_container(st, n, tree, start, &item);
+    if (past_end)
+        report(st, subtree, n->length_kind == DG_LEN_FIELD ? &st->p->ei->past_end : &st->p->ei->truncated, start,
+               end - start, "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)",
+               n->name, length, end - start);
+    /* Decode what is there even when the length overruns. */
+    gboolean was_stopped = st->stopped;
+    st->stopped = FALSE;
+    if (n->window >= 0) /* a window: children at addresses, not one after another */
+        dissect_window(st, n, subtree, offset, inner_end, in_summary || n->summary_count > 0);
+    else
+        dissect_list(st, n->first_child, n->child_count, subtree, offset, inner_end,
+                     in_summary || n->summary_count > 0);
+    st->stopped = st->stopped || was_stopped;
+    if (!st->stopped && length >= 0 && *offset < inner_end &&
+        (n->length_kind == DG_LEN_FIXED || n->length_kind == DG_LEN_FIELD)) {
+        show_trailing_bytes(st, n, subtree, start, *offset, inner_end, length);
+    }
+    if (!st->stopped && length >= 0) *offset = inner_end;
+    if (st->stopped && !was_stopped && (n->flags & DG_SKIP_MALFORMED) && length >= 0) {
+        /* malformed="skip": the spot is marked by its expert info; the rest of
+         * this container is left undecoded and decoding goes on after it, as
+         * for a PDU in a tvb of its own. */
+        st->stopped = FALSE;
+        *offset = inner_end;
+    }
+    proto_item_set_len(item, *offset - start);
+    if (n->slot >= 0) container_decoded(st, n, start, *offset);
+    /* The text only when something shows it: the item, or the Info column
+     * (a summarised container inside another one only has its item). */
+    if (n->summary_count > 0 && st->want_text && (item || (!in_summary && st->want_info)))
+        show_summary(st, n, item, in_summary, sink);
+}
+
+/* --- repetition ---------------------------------------------------------- */
+
+/* repeat: another instance while the flag is set; count: exactly N. Every
+ * instance must consume bytes, which bounds the loop by the packet size. */
+void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary)
+{
+    gint64 wanted = -1;
+    if (n->count.slot >= 0 && !ref_value(st, &n->count, n, "count", tree, *offset, &wanted)) return;
+    if (n->extra && n->extra->keep_values) table_reset(st, n, *offset); /* a new table for this repetition */
+    dg_summaries summaries;
+    gboolean collect = summaries_begin(st, n, in_summary, &summaries);
+
+    guint instances = 0;
+    for (gint64 done = 0; wanted < 0 || done < wanted; done++) {
+        if (wanted >= 0 && *offset >= end) {
+            report(st, tree, &st->p->ei->count_short, *offset, 0,
+                   "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after %" G_GINT64_MODIFIER "d",
+                   n->name, wanted, done);
+            st->stopped = FALSE; /* the data simply ended: siblings may still be empty-length */
+            break;
+        }
+        if (n->extra && n->extra->repeat_rest && *offset >= end) break; /* repeat="rest": stop where the data ends */
+        clear_slots(st, n);
+        gint before = *offset;
+        dissect_instance(st, n, tree, offset, end, in_summary, collect ? &summaries : NULL);
+        instances++;
+        if (st->stopped || *offset == before) break;
+        if (n->repeat_slot >= 0) {
+            const dg_slot *flag = &st->slots[n->repeat_slot];
+            if (!st->present[n->repeat_slot] || flag->value == 0) break;
+            if (*offset >= end) {
+                report(st, tree, &st->p->ei->more_no_data, *offset, 0,
+                       "'%s': the repeat flag '%s' says another follows, but no data is left", n->name,
+                       flag->node->name);
+                st->stopped = FALSE;
+                break;
+            }
+        }
+    }
+    if (st->tap) tap_record(st, n, instances);
+    if (collect) summaries_end(st, n, &summaries);
+}
+
+/* Whether entry k of offset table t, placed at base, lies in
+ * [low, end]; otherwise reports it (bad_offset), which ends the node. */
+gboolean entry_ok(dg_state *st, const dg_node *n, proto_tree *tree, const dg_table *t, guint k, gint64 base,
+                  gint64 low, gint end, gint first)
+{
+    gint64 at = base + (gint64)MIN(t->values[k], (guint64)G_MAXINT32);
+    if (at >= low && at <= end) return TRUE;
+    report(st, tree, &st->p->ei->bad_offset, first, 0,
+           "'%s' %u of %u: offset %" G_GINT64_MODIFIER "u (byte %" G_GINT64_MODIFIER "d) is %s; "
+           "the instances lie in bytes %d to %d",
+           n->name, k + 1, t->count, t->values[k], at,
+           at > end ? "past the end" : k == 0 ? "before the bytes left" : "smaller than the one before it", first, end);
+    return FALSE;
+}
+
+/* Where the offsets of a located node count from (from="XPATH"): the first
+ * byte of a field, or the start of an enclosing container's content. FALSE
+ * (reported) when that field is not in this packet. */
+gboolean offsets_base(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint64 *base)
+{
+    const dg_extra *x = n->extra;
+    if (x->from_slot >= 0) {
+        const dg_slot *fs = &st->slots[x->from_slot];
+        if (!st->present[x->from_slot]) {
+            report(st, tree, &st->p->ei->bad_length, offset, 0,
+                   "The offsets of '%s' count from a field that is not in this packet", n->name);
+            return FALSE;
+        }
+        *base = fs->offset;
+    } else if (x->from_up <= st->lists && st->lists - x->from_up < DG_MAX_LISTS) {
+        *base = st->list_starts[st->lists - x->from_up];
+    } else {
+        *base = 0; /* nested deeper than the lists kept: from the message */
+    }
+    return TRUE;
+}
+
+/* offsets="XPATH" from="XPATH". Instance i covers [base +
+ * offset[i], base + offset[i+1]), the last one [base + offset[last], end).
+ * An offset before the bytes not yet decoded, past the end, or smaller than
+ * the one before is reported (bad_offset) and ends the node; the instances
+ * before it are decoded. */
+void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary)
+{
+    const dg_extra *x = n->extra;
+    const dg_slot *ts = &st->slots[x->offsets_slot];
+    if (!st->present[x->offsets_slot]) {
+        report(st, tree, &st->p->ei->bad_length, *offset, 0,
+               "The offsets of '%s' come from a field that is not in this packet", n->name);
+        return;
+    }
+    const dg_table *t = table_of(st, x->offsets_slot);
+    gint64 base;
+    if (!offsets_base(st, n, tree, *offset, &base)) return;
+    if (t->overflow) {
+        report(st, tree, &st->p->ei->bad_offset, ts->offset, ts->length,
+               "The offset table '%s' has more than %u entries; '%s' is not decoded", ts->node->name,
+               (guint)DG_MAX_TABLE, n->name);
+        return;
+    }
+    dg_summaries summaries;
+    gboolean collect = summaries_begin(st, n, in_summary, &summaries);
+    guint instances = 0;
+    gint first = *offset;
+    for (guint i = 0; i < t->count && !st->stopped; i++) {
+        if (i == 0 && !entry_ok(st, n, tree, t, 0, base, first, end, first)) break;
+        gint64 from = base + (gint64)t->values[i]; /* checked: inside [first, end] */
+        gint to = end;
+        if (i + 1 < t->count) {
+            if (!entry_ok(st, n, tree, t, i + 1, base, from, end, first)) break;
+            to = (gint)(base + (gint64)t->values[i + 1]);
+        }
+        gint at = (gint)from;
+        clear_slots(st, n);
+        dissect_instance(st, n, tree, &at, to, in_summary, collect ? &summaries : NULL);
+        instances++;
+        if (!st->stopped) *offset = to;
+    }
+    if (st->tap) tap_record(st, n, instances);
+    if (collect) summaries_end(st, n, &summaries);
+}
+
+/* --- lists of siblings --------------------------------------------------- */
+
+void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
+                  gboolean in_summary)
+{
+    gboolean chain_taken = FALSE; /* a conditional sibling was decoded: its otherwise members are not */
+    if (st->lists < DG_MAX_LISTS) {
+        st->list_starts[st->lists] = *offset;
+        st->list_ends[st->lists] = end;
+    }
+    st->lists++;
+    for (guint16 i = 0; i < count && !st->stopped; i++) {
+        const dg_node *n = &st->p->nodes[st->p->children[first + i]];
+        if (!selected(st, n, *offset, &chain_taken)) continue;
+        if (st->quiet && n->quiet_size && (gint64)n->quiet_size <= (gint64)(end - *offset)) {
+            *offset += (gint)n->quiet_size; /* nobody would see it, and it cannot be malformed */
+            continue;
+        }
+        if (n->extra && n->extra->offsets_slot >= 0)
+            dissect_located(st, n, tree, offset, end, in_summary); /* offset table */
+        else if (is_repeated(n))
+            dissect_repeated(st, n, tree, offset, end, in_summary);
+        else
+            dissect_instance(st, n, tree, offset, end, in_summary, NULL);
+    }
+    st->lists--;
+}
+
+/* --- one message ----------------------------------------------------------- */
+
+/* Request when the port the hook (or Decode As) matched is the
+ * destination port, response when it is only the source port. */
+guint8 direction_of(const packet_info *pinfo)
+{
+    if (pinfo->ptype == PT_NONE) return DG_DIR_ANY;
+    if (pinfo->destport == pinfo->match_uint) return DG_DIR_REQUEST;
+    if (pinfo->srcport == pinfo->match_uint) return DG_DIR_RESPONSE;
+    return DG_DIR_ANY;
+}
+
+/* Key of the per-packet count of messages decoded (p_add_proto_data). */
+#define DG_MESSAGES_KEY 0x6d736773u
+
+/* How many messages of this protocol the packet had before this one (a TCP
+ * segment may hold several); counts this one. */
+guint *count_message(const dg_protocol *p, packet_info *pinfo)
+{
+    guint *messages = (guint *)p_get_proto_data(pinfo->pool, pinfo, *p->proto, DG_MESSAGES_KEY);
+    if (!messages) {
+        messages = wmem_new0(pinfo->pool, guint);
+        p_add_proto_data(pinfo->pool, pinfo, *p->proto, DG_MESSAGES_KEY, messages);
+    }
+    (*messages)++;
+    return messages;
+}
+
+/* The buffers one message's state starts in, on dg_dissect's stack. The
+ * values of one message live there when they fit (most rule files): two
+ * allocations fewer per message. Nothing keeps them after it. */
+enum { stack_slots = 128 };
+struct dg_message_buffers {
+    dg_slot slots[stack_slots];
+    guint8 present[stack_slots];
+    dg_text info_text, scratch_text;
+    char info_buf[256], scratch_buf[256];
+};
+
+void begin_message(dg_state *st, dg_message_buffers *b, const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo,
+                   proto_tree *tree)
+{
+    memset(st, 0, sizeof *st);
+    st->p = p;
+    st->tvb = tvb;
+    st->pinfo = pinfo;
+    if (p->slot_count <= stack_slots) {
+        st->slots = b->slots;
+        st->present = b->present;
+        memset(b->present, 0, p->slot_count);
+    } else {
+        st->slots = wmem_alloc_array(pinfo->pool, dg_slot, p->slot_count);
+        st->present = (guint8 *)wmem_alloc0(pinfo->pool, p->slot_count);
+    }
+    st->packet_end = (gint)tvb_captured_length(tvb);
+    st->hook_value = pinfo->match_uint;
+    st->direction = direction_of(pinfo);
+    /* Summaries are text for the Info column and for container items; build
+     * them only when someone sees them: tshark -T fields and -V have a visible
+     * tree and no columns, summary lines have columns and no tree, and a
+     * filter-only pass (-Y with -w) has neither. */
+    st->want_info = pinfo->cinfo != NULL;
+    st->want_text = st->want_info || (tree != NULL && PTREE_DATA(tree)->visible);
+    /* The Info column and the summary scratch start on the stack. */
+    if (st->want_info) {
+        text_init(&b->info_text, pinfo->pool, b->info_buf, sizeof b->info_buf);
+        st->info = &b->info_text;
+    }
+    if (st->want_text) {
+        text_init(&b->scratch_text, pinfo->pool, b->scratch_buf, sizeof b->scratch_buf);
+        st->text = &b->scratch_text;
+    }
+    if (stats_tap >= 0 && have_tap_listener(stats_tap)) st->tap = wmem_new0(pinfo->pool, dg_tap_data);
+    /* nobody sees items or the text of expert infos without a tree
+     * and without a tap listener (the Expert dialog and -z expert are taps):
+     * quiet nodes are stepped over, expert infos are raised without text
+     * (their severity still reaches the Expert column). */
+    st->quiet = tree == NULL && !tap_listeners_require_dissection();
+}
+
+} // namespace
+
+namespace dg_rt {
+
+void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
+                      gboolean in_summary, dg_summaries *sink)
+{
+    if (n->kind == DG_LEAF)
+        dissect_leaf(st, n, tree, offset, end);
+    else
+        dissect_container(st, n, tree, offset, end, in_summary, sink);
+}
+
+} // namespace dg_rt
+
+int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    col_set_str(pinfo->cinfo, COL_PROTOCOL, p->short_name);
+    /* Several messages in one packet (a TCP segment): each adds its Info text. */
+    guint *messages = count_message(p, pinfo);
+    gboolean first_message = *messages == 1;
+    if (first_message) col_clear(pinfo->cinfo, COL_INFO);
+
+    dg_state st;
+    dg_message_buffers buffers;
+    begin_message(&st, &buffers, p, tvb, pinfo, tree);
+
+    proto_item *root = tree ? proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA) : NULL;
+    proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
+    gint offset = 0;
+    dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
+    proto_item_set_len(root, offset);
+    if (p->pairing) {
+        const dg_frame_pairing *fp =
+            dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, *messages - 1, st.direction);
+        if (st.tap) st.tap->pairing = fp;
+    }
+
+    if (st.tap) tap_queue_packet(stats_tap, pinfo, st.tap);
+    const char *info = st.info && st.info->len > 0 ? st.info->data : p->name;
+    if (first_message)
+        col_add_str(pinfo->cinfo, COL_INFO, info);
+    else
+        col_append_sep_str(pinfo->cinfo, COL_INFO, " | ", info);
+    return offset > 0 ? offset : st.packet_end;
+}

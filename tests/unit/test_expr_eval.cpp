@@ -1,0 +1,171 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Computed values end to end without tshark: a rule file's value="..." is
+// parsed, checked and compiled by the generator, and the rows it would emit
+// are evaluated by the runtime's evaluator (plugin_runtime/dissgen_expr.cpp)
+// with field values given here.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include "dissgen_expr.h"
+#include "expression.h"
+#include "test_support.h"
+
+namespace dissgen::testing {
+namespace {
+
+guint8 code_of(const std::string& name) {
+    static const std::map<std::string, guint8> codes = {
+        {"DG_OP_INT", DG_OP_INT}, {"DG_OP_FLOAT", DG_OP_FLOAT}, {"DG_OP_FIELD", DG_OP_FIELD},
+        {"DG_OP_FIELD_SIGNED", DG_OP_FIELD_SIGNED}, {"DG_OP_FIELD_FLOAT", DG_OP_FIELD_FLOAT},
+        {"DG_OP_INDEX", DG_OP_INDEX}, {"DG_OP_TO_FLOAT", DG_OP_TO_FLOAT}, {"DG_OP_NEG", DG_OP_NEG},
+        {"DG_OP_NOT", DG_OP_NOT}, {"DG_OP_BITNOT", DG_OP_BITNOT}, {"DG_OP_FNEG", DG_OP_FNEG},
+        {"DG_OP_FNOT", DG_OP_FNOT}, {"DG_OP_MUL", DG_OP_MUL}, {"DG_OP_DIV", DG_OP_DIV}, {"DG_OP_MOD", DG_OP_MOD},
+        {"DG_OP_ADD", DG_OP_ADD}, {"DG_OP_SUB", DG_OP_SUB}, {"DG_OP_SHL", DG_OP_SHL}, {"DG_OP_SHR", DG_OP_SHR},
+        {"DG_OP_LT", DG_OP_LT}, {"DG_OP_LE", DG_OP_LE}, {"DG_OP_GT", DG_OP_GT}, {"DG_OP_GE", DG_OP_GE},
+        {"DG_OP_EQ", DG_OP_EQ}, {"DG_OP_NE", DG_OP_NE}, {"DG_OP_BITAND", DG_OP_BITAND},
+        {"DG_OP_BITXOR", DG_OP_BITXOR}, {"DG_OP_BITOR", DG_OP_BITOR}, {"DG_OP_AND", DG_OP_AND},
+        {"DG_OP_OR", DG_OP_OR}, {"DG_OP_FMUL", DG_OP_FMUL}, {"DG_OP_FDIV", DG_OP_FDIV},
+        {"DG_OP_FADD", DG_OP_FADD}, {"DG_OP_FSUB", DG_OP_FSUB}, {"DG_OP_FLT", DG_OP_FLT},
+        {"DG_OP_FLE", DG_OP_FLE}, {"DG_OP_FGT", DG_OP_FGT}, {"DG_OP_FGE", DG_OP_FGE}, {"DG_OP_FEQ", DG_OP_FEQ},
+        {"DG_OP_FNE", DG_OP_FNE}, {"DG_OP_FAND", DG_OP_FAND}, {"DG_OP_FOR", DG_OP_FOR}};
+    auto it = codes.find(name);
+    if (it == codes.end()) ADD_FAILURE() << "no runtime code for " << name;
+    return it == codes.end() ? 0 : it->second;
+}
+
+// Field values by slot; a slot missing from the map was not decoded.
+using Slots = std::map<gint16, guint64>;
+
+gboolean read_slot(const void* context, gint16 slot, guint64* value) {
+    const Slots& slots = *static_cast<const Slots*>(context);
+    auto it = slots.find(slot);
+    if (it == slots.end()) return FALSE;
+    *value = it->second;
+    return TRUE;
+}
+
+// Rule file fields: A (2 bytes), S (1-byte int), C (1 byte); then the value under test.
+struct Evaluated {
+    dg_expr_value v{};
+    std::string error;
+};
+
+Evaluated evaluate(const std::string& expr, const Slots& by_name, guint32 index = 0, const std::string& display = "") {
+    Front f = front_end(rules("  <node name=\"A\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"S\" length=\"1byte\" displaytype=\"int\"/>\n"
+                              "  <node name=\"C\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"F\" value=\"{A} * 0.5\"/>\n"
+                              "  <node name=\"R\" count=\"../node[@name='C']\">\n"
+                              "    <node name=\"V\" value=\"" + expr + "\"" +
+                              (display.empty() ? "" : " displaytype=\"" + display + "\"") + "/>\n"
+                              "  </node>\n"));
+    Evaluated out;
+    if (!f.ok()) {
+        out.error = f.messages();
+        return out;
+    }
+    const Node& v = *f.proto->nodes[4]->children[0];
+    std::vector<dg_expr_op> ops;
+    for (const ExprRow& r : compile_expression(*v.value, v.display == Display::Float))
+        ops.push_back({code_of(r.code), static_cast<guint8>(r.bits), static_cast<gint16>(r.slot), r.integer, r.real});
+    // Slots of the fields by name (A, S, C, F: the evaluator reads them by slot).
+    Slots slots;
+    for (const auto& [name, value] : by_name) {
+        const char* names[] = {"A", "S", "C", "F"};
+        const Node* n = find(*f.proto, names[name]);
+        if (n->slot >= 0) slots[static_cast<gint16>(n->slot)] = value;
+    }
+    out.v = dg_expr_eval(ops.data(), static_cast<guint>(ops.size()), read_slot, &slots, index);
+    return out;
+}
+
+enum { A, S, C, F };
+
+// How a float computed value keeps its value in a slot: the double's bits.
+guint64 bits_of(double d) {
+    guint64 bits;
+    std::memcpy(&bits, &d, sizeof bits);
+    return bits;
+}
+
+const Slots kFields = {{A, 1000}, {S, 0xfe}, {C, 3}, {F, bits_of(500.0)}};
+
+gint64 integer(const std::string& expr, const Slots& fields = kFields, guint32 index = 0) {
+    Evaluated e = evaluate(expr, fields, index);
+    EXPECT_EQ(e.error, "") << expr;
+    EXPECT_TRUE(e.v.defined) << expr;
+    EXPECT_FALSE(e.v.is_float) << expr;
+    return e.v.integer;
+}
+
+double real(const std::string& expr, const Slots& fields = kFields) {
+    Evaluated e = evaluate(expr, fields);
+    EXPECT_EQ(e.error, "") << expr;
+    EXPECT_TRUE(e.v.defined) << expr;
+    EXPECT_TRUE(e.v.is_float) << expr;
+    return e.v.real;
+}
+
+bool undefined(const std::string& expr, const Slots& fields = kFields) {
+    Evaluated e = evaluate(expr, fields);
+    EXPECT_EQ(e.error, "") << expr;
+    return !e.v.defined;
+}
+
+TEST(ComputedEval, IntegerArithmeticAsInC) {
+    EXPECT_EQ(integer("{A} + index + 1", {{A, 40000}, {C, 5}}, 3), 40004);
+    EXPECT_EQ(integer("{S}"), -2);                 // an int field is signed
+    EXPECT_EQ(integer("{C} - 5"), -2);
+    EXPECT_EQ(integer("7 / 2"), 3);
+    EXPECT_EQ(integer("-7 / 2"), -3);             // truncates toward zero
+    EXPECT_EQ(integer("-7 % 3"), -1);
+    EXPECT_EQ(integer("1 << 4 | 3"), 19);
+    EXPECT_EQ(integer("0xff & ~0x0f ^ 1"), 0xf1);
+    EXPECT_EQ(integer("{A} >> 3"), 125);
+    EXPECT_EQ(integer("1 << 64"), 0);
+    EXPECT_EQ(integer("-1 >> 60"), 15);           // the bit pattern shifts
+    EXPECT_EQ(integer("9223372036854775807 + 1"), INT64_MIN);  // wraps
+    EXPECT_EQ(integer("(-9223372036854775807 - 1) / -1"), INT64_MIN);  // wraps, no trap
+    EXPECT_EQ(integer("(-9223372036854775807 - 1) % -1"), 0);
+}
+
+TEST(ComputedEval, ComparisonsAndLogicGiveZeroOrOne) {
+    EXPECT_EQ(integer("{C} == 3"), 1);
+    EXPECT_EQ(integer("{C} != 3"), 0);
+    EXPECT_EQ(integer("{S} < 0"), 1);
+    EXPECT_EQ(integer("{C} <= 2 || {C} >= 3"), 1);
+    EXPECT_EQ(integer("{C} > 2 && 5"), 1);
+    EXPECT_EQ(integer("!{C}"), 0);
+    EXPECT_EQ(integer("!!{C}"), 1);
+    EXPECT_EQ(integer("{F} > 499.5"), 1);  // on reals, still 0 or 1
+}
+
+TEST(ComputedEval, UndefinedWhenAFieldIsMissingOrIntegerDivisionByZero) {
+    EXPECT_TRUE(undefined("{A} / ({C} - 3)"));
+    EXPECT_TRUE(undefined("{A} % 0"));
+    EXPECT_TRUE(undefined("{A} + 1", {{C, 3}}));
+    // the left side decides, as in C
+    EXPECT_EQ(integer("{C} != 3 && {A} / ({C} - 3) > 1"), 0);
+    EXPECT_EQ(integer("{C} == 3 || {A} / 0"), 1);
+    EXPECT_EQ(integer("{C} == 3 || {A} > 1", {{C, 3}}), 1);
+    EXPECT_TRUE(undefined("{C} == 4 || {A} > 1", {{C, 3}}));
+    EXPECT_TRUE(undefined("{A} > 1 || {C} == 3", {{C, 3}}));  // an undefined left decides nothing
+}
+
+TEST(ComputedEval, RealsWhenADecimalTakesPart) {
+    EXPECT_DOUBLE_EQ(real("{S} * 0.1 - 40"), -40.2);
+    EXPECT_DOUBLE_EQ(real("{F} + 1"), 501.0);     // a float computed value read back
+    EXPECT_DOUBLE_EQ(real("({A} + 1) / 2.0"), 500.5);
+    EXPECT_DOUBLE_EQ(real("{A} / 3 * 1.0"), 333.0);  // the integer division comes first
+    EXPECT_DOUBLE_EQ(real("-{F}"), -500.0);
+    EXPECT_TRUE(std::isinf(real("1.0 / 0")));      // IEEE: not undefined
+    Evaluated shown_as_float = evaluate("{C} * 2", {{A, 1}, {C, 3}}, 0, "float");
+    EXPECT_TRUE(shown_as_float.v.is_float);
+    EXPECT_DOUBLE_EQ(shown_as_float.v.real, 6.0);
+}
+
+}  // namespace
+}  // namespace dissgen::testing
