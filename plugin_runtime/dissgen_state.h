@@ -81,6 +81,7 @@ struct dg_state {
     guint32 hook_value;   /* pinfo->match_uint on entry: the hook (or Decode As) value, for ifhook */
     dg_tap_data *tap;     /* what the stats tree counts; NULL when nobody listens */
     guint8 direction;     /* DG_DIR_REQUEST/RESPONSE when a port hook matched, else DG_DIR_ANY */
+    guint32 instance;     /* the instance number of the innermost repeat (computed values' index) */
     /* where each list of siblings being decoded started (the
      * message, then each open container), for peeks counted from a container */
     gint list_starts[DG_MAX_LISTS];

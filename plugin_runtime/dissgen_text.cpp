@@ -79,11 +79,31 @@ void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
     append_str(out, buf);
 }
 
+/* A computed value shown as a signed number or a double: its value is in
+ * the slot, not in the bytes (it has none). */
+void append_computed_value(dg_text *out, const dg_node *n, guint64 value)
+{
+    char buf[64];
+    if (n->show == DG_SHOW_FLOAT) {
+        gdouble d;
+        memcpy(&d, &value, sizeof d);
+        g_snprintf(buf, sizeof buf, "%.*g", DBL_DIG, d);
+    } else {
+        g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "d", (gint64)value);
+    }
+    append_str(out, buf);
+}
+
 /* Appends a leaf's value as its tree item shows it, for summaries. */
 void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s)
 {
     wmem_allocator_t *pool = st->pinfo->pool;
     const dg_node *n = s->node;
+    if (n->length_kind == DG_LEN_COMPUTED && n->show != DG_SHOW_HEX && n->show != DG_SHOW_BOOL &&
+        n->show != DG_SHOW_ENUM) {
+        append_computed_value(out, n, s->value);
+        return;
+    }
     switch (n->show) {
     case DG_SHOW_HEX:
         append_hex(out, s->value, (n->bits + 3) / 4);

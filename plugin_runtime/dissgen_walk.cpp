@@ -163,10 +163,46 @@ void decode_leaf_value(dg_state *st, const dg_node *n, proto_tree *tree, gint of
     store(st, n, value, offset, len);
 }
 
+/* A slot's value for the evaluator of computed values (dissgen_expr.h). */
+gboolean read_slot(const void *context, gint16 slot, guint64 *value)
+{
+    const dg_state *st = (const dg_state *)context;
+    if (slot < 0 || !st->present[slot]) return FALSE;
+    *value = st->slots[slot].value;
+    return TRUE;
+}
+
+/* value="EXPR": a generated item at the current offset, taking no bytes; an
+ * undefined value (a field not decoded, a division by zero) shows nothing. */
+void dissect_computed(dg_state *st, const dg_node *n, proto_tree *tree, gint offset)
+{
+    if (!tree && !value_wanted(st, n)) return;
+    const dg_extra *x = n->extra;
+    dg_expr_value v = dg_expr_eval(&st->p->exprs[x->expr_first], x->expr_count, read_slot, st, st->instance);
+    if (!v.defined) return;
+    guint64 bits = (guint64)v.integer;
+    if (v.is_float) memcpy(&bits, &v.real, sizeof bits);
+    store(st, n, bits, offset, 0);
+    if (!tree || !n->hf) return;
+    proto_item *item;
+    switch (n->show) {
+    case DG_SHOW_FLOAT: item = proto_tree_add_double(tree, *n->hf, st->tvb, offset, 0, v.real); break;
+    case DG_SHOW_BOOL: item = proto_tree_add_boolean(tree, *n->hf, st->tvb, offset, 0, v.integer != 0); break;
+    case DG_SHOW_HEX: case DG_SHOW_ENUM: item = proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, 0, bits); break;
+    default: item = proto_tree_add_int64(tree, *n->hf, st->tvb, offset, 0, v.integer); break;
+    }
+    proto_item_set_generated(item);
+    if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+}
+
 void dissect_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end)
 {
     if (n->flags & DG_GROUP) {
         dissect_bit_field(st, n, tree, offset, end);
+        return;
+    }
+    if (n->length_kind == DG_LEN_COMPUTED) {
+        dissect_computed(st, n, tree, *offset);
         return;
     }
     gint64 length = leaf_length(st, n, tree, *offset, end);
@@ -330,6 +366,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     gboolean collect = summaries_begin(st, n, in_summary, &summaries);
 
     guint instances = 0;
+    const guint32 outer_instance = st->instance;
     for (gint64 done = 0; wanted < 0 || done < wanted; done++) {
         if (wanted >= 0 && *offset >= end) {
             report(st, tree, &st->p->ei->count_short, *offset, 0,
@@ -341,6 +378,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
         if (n->extra && n->extra->repeat_rest && *offset >= end) break; /* repeat="rest": stop where the data ends */
         clear_slots(st, n);
         gint before = *offset;
+        st->instance = instances;
         dissect_instance(st, n, tree, offset, end, in_summary, collect ? &summaries : NULL);
         instances++;
         if (st->stopped || *offset == before) break;
@@ -356,6 +394,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
             }
         }
     }
+    st->instance = outer_instance;
     if (st->tap) tap_record(st, n, instances);
     if (collect) summaries_end(st, n, &summaries);
 }
@@ -423,6 +462,7 @@ void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *off
     dg_summaries summaries;
     gboolean collect = summaries_begin(st, n, in_summary, &summaries);
     guint instances = 0;
+    const guint32 outer_instance = st->instance;
     gint first = *offset;
     for (guint i = 0; i < t->count && !st->stopped; i++) {
         if (i == 0 && !entry_ok(st, n, tree, t, 0, base, first, end, first)) break;
@@ -434,10 +474,12 @@ void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *off
         }
         gint at = (gint)from;
         clear_slots(st, n);
+        st->instance = i;
         dissect_instance(st, n, tree, &at, to, in_summary, collect ? &summaries : NULL);
         instances++;
         if (!st->stopped) *offset = to;
     }
+    st->instance = outer_instance;
     if (st->tap) tap_record(st, n, instances);
     if (collect) summaries_end(st, n, &summaries);
 }

@@ -99,6 +99,7 @@ TESTS = {
                                 "--malformed", "200"),
     "corpus_differential": corpus_differential,
     "transactions": integration("test_transactions.py"),
+    "computed": integration("test_computed.py"),
     "losses": integration("test_losses.py"),
     "losses_corpus": integration("test_losses.py", "--with-corpus"),
     "findings": integration("test_findings.py"),

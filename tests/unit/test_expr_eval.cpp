@@ -53,13 +53,20 @@ struct Evaluated {
     std::string error;
 };
 
+// expr as an XML attribute value.
+std::string escaped(const std::string& expr) {
+    std::string out;
+    for (char c : expr) out += c == '&' ? "&amp;" : c == '<' ? "&lt;" : std::string(1, c);
+    return out;
+}
+
 Evaluated evaluate(const std::string& expr, const Slots& by_name, guint32 index = 0, const std::string& display = "") {
     Front f = front_end(rules("  <node name=\"A\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
                               "  <node name=\"S\" length=\"1byte\" displaytype=\"int\"/>\n"
                               "  <node name=\"C\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
                               "  <node name=\"F\" value=\"{A} * 0.5\"/>\n"
                               "  <node name=\"R\" count=\"../node[@name='C']\">\n"
-                              "    <node name=\"V\" value=\"" + expr + "\"" +
+                              "    <node name=\"V\" value=\"" + escaped(expr) + "\"" +
                               (display.empty() ? "" : " displaytype=\"" + display + "\"") + "/>\n"
                               "  </node>\n"));
     Evaluated out;

@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Computed values (value="...") with real tshark: tests/rules/computed.xml.
+
+Random messages on ethertype 0x88b6 (start, count, a signed raw value, count
+16-bit registers each followed by a flag byte when odd, a tail byte when
+count is odd). Every computed field is
+computed again here from the bytes, with C's rules (integer division
+truncates, 64-bit wrapping), and compared with what tshark shows, in one pass
+and with -2: reals, booleans, hex, enums, signed values, the instance index,
+an undefined value (division by zero: no item), a computed length, a summary.
+Needs no corpus.
+
+    test_computed.py --dissgen build/bin/dissgen --source-dir .
+"""
+
+import os
+import random
+import struct
+import sys
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
+
+ARGS = None
+ETHERTYPE = 0x88B6
+FIELDS = ["frame.number", "calc.temperature", "calc.alarm", "calc.mixed", "calc.kind", "calc.ratio",
+          "calc.negated", "calc.secret", "calc.registers.register", "calc.registers.flags.flag_index", "calc.tail_bytes", "calc.tail",
+          "_ws.col.Info"]
+
+
+def c_div(a, b):
+    q = abs(a) // abs(b)
+    return q if (a >= 0) == (b > 0) else -q
+
+
+def message(rng):
+    start = rng.choice([0, 1, 40000, 65535, rng.randrange(65536)])
+    count = rng.choice([0, 1, 2, 3, rng.randrange(8)])
+    raw = rng.choice([-32768, -1, 0, 900, 901, 32767, rng.randrange(-32768, 32768)])
+    values = [rng.randrange(65536) for _ in range(count)]
+    # each register: its value, then one flag byte when the value is odd
+    body = struct.pack(">HBh", start, count, raw) + b"".join(
+        struct.pack(">H", v) + bytes([0x0F]) * (v & 1) for v in values)
+    body += bytes([0xA5]) * (count & 1)
+    return (start, count, raw, values), body
+
+
+def expected(start, count, raw, values):
+    """What each field shows, as tshark -T fields prints it (None: no item)."""
+    registers = ", ".join("r%d=0x%04x" % (start + i + 1, v) for i, v in enumerate(values))
+    return {
+        "calc.temperature": raw * 0.1 - 40,
+        "calc.alarm": "1" if raw > 900 or count == 0 else "0",
+        "calc.mixed": "0x%016x" % ((((start << 4) | count) & 0xFFFF) ^ 0x5A),
+        "calc.kind": str(count % 3),
+        "calc.ratio": None if count == 2 else str(c_div(start, count - 2)),
+        "calc.negated": str(-start + -1 + (0 if count else 1)),
+        "calc.secret": str(start >> 2),
+        "calc.registers.register": ",".join(str(start + i + 1) for i in range(count)),
+        "calc.registers.flags.flag_index": ",".join("0" for v in values if v & 1),
+        "calc.tail_bytes": str(count & 1),
+        "calc.tail": "a5" if count & 1 else "",
+        # a repeated node's summaries: "Name ×N: ..." from two on; none: the protocol's name
+        "info": "Computed values" if count == 0 else registers if count == 1 else "Registers ×%d: %s" % (
+            count, registers),
+    }
+
+
+class TestComputed(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "computed.xml"), "calc")
+        rng = random.Random(1234)
+        cls.messages = [message(rng) for _ in range(300)]
+        frames = []
+        for _, body in cls.messages:
+            f = b"\x02\0\0\0\0\x02\x02\0\0\0\0\x01" + struct.pack("!H", ETHERTYPE) + body
+            frames.append(f + bytes(max(0, 60 - len(f))))
+        out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
+        for i, f in enumerate(frames):
+            out.append(struct.pack("<IIII", 1_700_000_000 + i, 0, len(f), len(f)) + f)
+        cls.path = cls.env.add_file("computed.pcap", b"".join(out))
+
+    def test_every_value_as_computed_from_the_bytes(self):
+        with self.checks() as check:
+            for two_pass in (False, True):
+                mode = "-2" if two_pass else "one pass"
+                rows = self.env.field_rows(self.path, FIELDS, two_pass, aggregator=",")
+                wrong = {}
+                for n, (fields, _) in enumerate(self.messages, 1):
+                    want = expected(*fields)
+                    got = {f: ",".join(v) for f, v in rows[n].items()}
+                    for f, w in want.items():
+                        g = got["_ws.col.Info"] if f == "info" else got[f]
+                        if f == "calc.temperature":
+                            ok = g != "" and abs(float(g) - w) < 1e-9
+                        else:
+                            ok = g == ("" if w is None else w)
+                        if not ok:
+                            wrong.setdefault(f, []).append((n, g, w))
+                for f in list(expected(0, 0, 0, []).keys()):
+                    check(f not in wrong, "%s: %s as computed from the bytes in all %d messages%s" % (
+                        mode, f, len(self.messages), "" if f not in wrong else " (wrong: %s)" % wrong[f][:3]))
+
+    def test_items_are_generated_and_nondisplay_is_hidden(self):
+        out = self.env.tshark(["-r", self.path, "-V", "-c", "3"]).stdout
+        with self.checks() as check:
+            check("[Temperature: " in out, "a computed value is a generated item: [Temperature: ...]")
+            check("[Register: " in out, "computed values inside a repeat are generated items too")
+            check("Secret" not in out, "a nondisplay computed value is not printed")
+            filtered = self.env.tshark(["-r", self.path, "-Y", "calc.secret >= 0 && calc.ratio == 0",
+                                        "-T", "fields", "-e", "frame.number"]).stdout.split()
+            want = [str(n) for n, (f, _) in enumerate(self.messages, 1)
+                    if f[1] != 2 and c_div(f[0], f[1] - 2) == 0]
+            check(filtered == want, "computed fields filter like any field (%d frames)" % len(want))
+
+
+if __name__ == "__main__":
+    sys.exit(run_unittests()[1])
