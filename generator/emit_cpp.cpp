@@ -2,6 +2,7 @@
 #include "emit_cpp.h"
 
 #include "analyses.h"
+#include "emit_validity.h"
 #include "quiet.h"
 #include "runtime_names.h"
 #include "text_util.h"
@@ -306,7 +307,8 @@ void Emitter::header() {
        << " * GNU General Public License, version 2 or later: so is the plugin.\n"
        << " * SPDX-License-Identifier: GPL-2.0-or-later\n"
        << " */\n"
-       << "#include \"dissgen_runtime.h\"\n" << (extra_ ? extra_->includes : "") << "\n";
+       << "#include \"dissgen_runtime.h\"\n" << (has_validity(p_) ? "#include \"dissgen_validity.h\"\n" : "")
+       << (extra_ ? extra_->includes : "") << "\n";
 }
 
 void Emitter::declarations() {
@@ -485,11 +487,15 @@ void Emitter::protocol_struct() {
     else if (data) o_ << ",\n    NULL";
     if (data) o_ << ",\n    &" << extra_->analysis_data;
     o_ << "\n};\n\n";
+    // valid fields: the entries test them first (dg_valid_*)
+    const bool valid = has_validity(p_);
+    const std::string entry = valid ? "dg_valid_" : "dg_", of = valid ? "_validity" : "_protocol";
+    if (valid) o_ << emit_validity(p_);
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
-       << "    return dg_dissect(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";
+       << "    return " << entry << "dissect(&" << f << of << ", tvb, pinfo, tree);\n}\n\n";
     if (pdu)
         o_ << "static int dissect_" << f << "_stream(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
-           << "    return dg_dissect_stream(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";
+           << "    return " << entry << "dissect_stream(&" << f << of << ", tvb, pinfo, tree);\n}\n\n";
 }
 
 void Emitter::register_functions() {
@@ -531,7 +537,8 @@ void Emitter::register_functions() {
        << "    if (!dg_protocol_names_free(&" << f << "_protocol))\n        return;\n"
        << "    dg_register(&" << f << "_protocol, hf, " << (first ? "0" : "(int)G_N_ELEMENTS(hf)")
        << ", ett, (int)G_N_ELEMENTS(ett), ei, (int)G_N_ELEMENTS(ei));\n}\n\n"
-       << "void proto_reg_handoff_" << f << "(void)\n{\n    dg_handoff(&" << f << "_protocol);\n}\n\n"
+       << "void proto_reg_handoff_" << f << "(void)\n{\n    dg_handoff(&" << f << "_protocol);\n"
+       << (p_.heuristics.empty() ? "" : "    dg_validity_handoff(&" + f + "_validity);\n") << "}\n\n"
        << "DG_DECLARE_PLUGIN(proto_register_" << f << ", proto_reg_handoff_" << f << ")\n";
 }
 

@@ -104,7 +104,8 @@ for dep in "libwireshark-dev (>= $abi)" "libwireshark-dev (<< $next_abi)" libxml
 done
 for f in /usr/bin/dissgen /usr/share/dissgen/runtime/dissgen_runtime.h \
          /usr/share/dissgen/runtime/dissgen_runtime.cpp /usr/share/dissgen/runtime/dissgen_compat.h \
-         /usr/share/dissgen/runtime/dissgen_pairing.cpp /usr/share/dissgen/runtime/ethercat/ethercat_esc.cpp \
+         /usr/share/dissgen/runtime/dissgen_pairing.cpp /usr/share/dissgen/runtime/dissgen_validity.cpp \
+         /usr/share/dissgen/runtime/ethercat/ethercat_esc.cpp \
          /usr/share/dissgen/runtime/ethercat/ethercat_bus.cpp \
          /usr/share/dissgen/rules/ethercat.xml "$packaged_plugin" /usr/share/man/man1/dissgen.1.gz \
          /usr/share/doc/dissgen/copyright; do
