@@ -62,10 +62,9 @@ std::string emit_validity(const Protocol& proto) {
         const size_t hook_first = ranges.size();
         ranges.insert(ranges.end(), hooks.begin(), hooks.end());
         std::ostringstream row;
-        row << "{ " << n->valid_offset << ", " << bytes << ", " << (n->byteorder == ByteOrder::Little ? 1 : 0) << ", "
+        row << "/* " << n->name << ", line " << n->line << " */ { " << n->valid_offset << ", " << bytes << ", " << (n->byteorder == ByteOrder::Little ? 1 : 0) << ", "
             << (n->in_bit_group ? n->shift : 0) << ", " << (n->in_bit_group ? n->bits : 0) << ", " << in_first << ", "
-            << n->valid_list.size() << ", " << (hooked ? hook_first : 0) << ", " << hooks.size()
-            << " }  /* " << n->name << ", line " << n->line << " */";
+            << n->valid_list.size() << ", " << (hooked ? hook_first : 0) << ", " << hooks.size() << " }";
         rows.push_back(row.str());
     }
     if (proto.pdulength && proto.pdulength->target) header = std::max(header, proto.pdu_fixed_len);
