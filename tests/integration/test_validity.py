@@ -144,10 +144,11 @@ class Validity(TsharkTestCase, unittest.TestCase):
 
     def test_the_bad_header_is_no_message_of_the_protocol(self):
         out = self.env.tshark(["-r", self.tcp, "-T", "fields", "-e", "frame.number", "-e", "_ws.col.Protocol",
-                               "-e", "data.len"]).stdout.splitlines()
+                               "-e", "data.len", "-e", "frame.protocols"]).stdout.splitlines()
         rows = {int(r.split("\t")[0]): r.split("\t")[1:] for r in out}
-        self.assertEqual(rows[3], ["TCP", "16"])            # refused: shown as the TCP payload
-        self.assertEqual(rows[9], ["MBL", "11"])            # message 10, then 11 bytes of data
+        # refused (the dissector returned 0): the TCP payload is data, no layer of ours
+        self.assertEqual(rows[3], ["TCP", "16", "eth:ethertype:ip:tcp:data"])
+        self.assertEqual(rows[9], ["MBL", "11", "eth:ethertype:ip:tcp:mbl:data"])  # message 10, then 11 bytes of data
 
     def test_heuristic_finds_the_protocol_on_an_unregistered_udp_port(self):
         expected = [i + 1 for i, (_, valid) in enumerate(self.udp_sent) if valid]
