@@ -28,7 +28,8 @@ std::vector<std::string> split_words(const std::string& s) {
 // The generic runtime's sources, compiled into every plugin; an analysis's
 // own come from the request (BuildRequest::analysis_sources).
 const char* const kRuntimeSources[] = {"dissgen_walk.cpp",    "dissgen_conditions.cpp", "dissgen_text.cpp",
-                                       "dissgen_handoff.cpp", "dissgen_register.cpp",   "dissgen_pairing.cpp"};
+                                       "dissgen_handoff.cpp", "dissgen_register.cpp",   "dissgen_pairing.cpp",
+                                       "dissgen_validity.cpp"};
 
 bool has_runtime(const fs::path& dir) {
     std::error_code ec;
