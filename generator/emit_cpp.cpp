@@ -2,6 +2,7 @@
 #include "emit_cpp.h"
 
 #include "analyses.h"
+#include "emit_validity.h"
 #include "quiet.h"
 #include "runtime_names.h"
 #include "text_util.h"
@@ -355,7 +356,8 @@ void Emitter::header() {
        << " * GNU General Public License, version 2 or later: so is the plugin.\n"
        << " * SPDX-License-Identifier: GPL-2.0-or-later\n"
        << " */\n"
-       << "#include \"dissgen_rows.h\"\n" << (extra_ ? extra_->includes : "") << "\n";
+       << "#include \"dissgen_rows.h\"\n" << (has_validity(p_) ? "#include \"dissgen_validity.h\"\n" : "")
+       << (extra_ ? extra_->includes : "") << "\n";
 }
 
 void Emitter::declarations() {
@@ -502,11 +504,15 @@ void Emitter::protocol_struct() {
            << (analysis ? "&" + analysis->symbol : std::string("NULL")) << " };\n";
     }
     o_ << "\nstatic dg_protocol " << f << "_protocol =\n    " << protocol_row() << ";\n\n";
+    // valid fields: the entries test them first (dg_valid_*)
+    const bool valid = has_validity(p_);
+    const std::string entry = valid ? "dg_valid_" : "dg_", of = valid ? "_validity" : "_protocol";
+    if (valid) o_ << emit_validity(p_);
     o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
-       << "    return dg_dissect(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";
+       << "    return " << entry << "dissect(&" << f << of << ", tvb, pinfo, tree);\n}\n\n";
     if (pdu)
         o_ << "static int dissect_" << f << "_stream(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
-           << "    return dg_dissect_stream(&" << f << "_protocol, tvb, pinfo, tree);\n}\n\n";
+           << "    return " << entry << "dissect_stream(&" << f << of << ", tvb, pinfo, tree);\n}\n\n";
 }
 
 // The protocol's row: its names, entry points and tables; the tables it does not use stay NULL.
@@ -581,7 +587,8 @@ void Emitter::register_functions() {
        << "    if (!dg_protocol_names_free(&" << f << "_protocol))\n        return;\n"
        << "    dg_register(&" << f << "_protocol, hf, " << (first ? "0" : "(int)G_N_ELEMENTS(hf)")
        << ", ett, (int)G_N_ELEMENTS(ett), ei, (int)G_N_ELEMENTS(ei));\n}\n\n"
-       << "void proto_reg_handoff_" << f << "(void)\n{\n    dg_handoff(&" << f << "_protocol);\n}\n\n"
+       << "void proto_reg_handoff_" << f << "(void)\n{\n    dg_handoff(&" << f << "_protocol);\n"
+       << (p_.heuristics.empty() ? "" : "    dg_validity_handoff(&" + f + "_validity);\n") << "}\n\n"
        << "DG_DECLARE_PLUGIN(proto_register_" << f << ", proto_reg_handoff_" << f << ")\n";
 }
 

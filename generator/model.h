@@ -99,6 +99,9 @@ struct Node {
     // table entry, Decode As included) whose value is in this list.
     std::vector<ValueRange> hook_list;
     bool has_hook = false;
+    // valid="LIST": a message is this protocol's only when this field's value is in the list.
+    std::vector<ValueRange> valid_list;
+    bool has_valid = false;
     std::optional<std::string> filter;  // empty string: leave container out of names
     std::string description;
     std::optional<std::string> summary;
@@ -162,6 +165,8 @@ struct Node {
     bool keeps_values = false;              // an offsets table: every instance's value is kept
     unsigned from_up = 0;                   // from an enclosing container: k levels up (0: an earlier field)
     bool is_located() const { return offsets.has_value(); }
+    // derived by the validator: a valid field's byte offset (its bit group's) from the message start
+    uint64_t valid_offset = 0;
 
     bool is_computed() const { return value.has_value(); }
     bool is_container() const { return !children.empty(); }
@@ -176,6 +181,13 @@ struct Node {
     }
     // A leaf of 1-64 bits whose value other fields may refer to.
     bool is_numeric() const;
+};
+
+// <heuristic table="udp" enabled="true|false"/>: found by its valid fields on a heuristic list.
+struct Heuristic {
+    std::string table;
+    bool enabled = true;
+    int line = 0;
 };
 
 struct Hook {
@@ -208,6 +220,7 @@ struct Protocol {
     std::optional<uint64_t> ethertype;
     ByteOrder byteorder = ByteOrder::Big;
     std::vector<Hook> hooks;
+    std::vector<Heuristic> heuristics;
     std::optional<FieldRef> pdulength;
     int64_t pdulengthadd = 0;
     int line = 0;

@@ -42,9 +42,12 @@ const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displa
                                                   // offset tables
                                                   "offsets", "from",
                                                   // computed values
-                                                  "value"};
+                                                  "value",
+                                                  // whose message it is
+                                                  "valid"};
 const std::vector<std::string> kEnumAttributes = {"value", "name"};
 const std::vector<std::string> kHookAttributes = {"table", "value"};
+const std::vector<std::string> kHeuristicAttributes = {"table", "enabled"};
 const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};
 const std::vector<std::string> kPairingAttributes = {"timeout", "analysis"};
 const std::vector<std::string> kKeyAttributes = {"field"};
@@ -257,6 +260,7 @@ private:
     std::unique_ptr<Node> parse_node(xmlNode* el, Node* parent, int depth);
     void parse_enum(xmlNode* el, Node& node);
     void parse_hook(xmlNode* el, Protocol& proto);
+    void parse_heuristic(xmlNode* el, Protocol& proto);
     void parse_text_direction_handoff_attributes(std::map<std::string, std::string>& attrs, int line, Node& node);
     void defer_reassembly_refs(Node& node, xmlNode* el);
     bool parse_enum_range(const std::string& text, EnumItem& item);
@@ -386,8 +390,10 @@ std::unique_ptr<Protocol> Parser::parse_root(xmlNode* root) {
             parse_hook(c, *proto);
         else if (c->type == XML_ELEMENT_NODE && element_name(c) == "pairing")
             parse_pairing(c, *proto);
+        else if (c->type == XML_ELEMENT_NODE && element_name(c) == "heuristic")
+            parse_heuristic(c, *proto);
         else
-            unexpected_child(c, "root", {"node", "hook", "pairing"});
+            unexpected_child(c, "root", {"node", "hook", "pairing", "heuristic"});
     }
     if (proto->pdulength) defer(*proto->pdulength, root, proto->line, "pdulength");
     resolve_all();
@@ -406,6 +412,28 @@ void Parser::parse_hook(xmlNode* el, Protocol& proto) {
         diags_.error(hook.line, "bad hook value '" + attrs["value"] + "': expected a 32-bit number");
     for (xmlNode* c = el->children; c; c = c->next) unexpected_child(c, "hook", {});
     proto.hooks.push_back(hook);
+}
+
+// <heuristic table="udp" enabled="false"/>: one per heuristic list.
+void Parser::parse_heuristic(xmlNode* el, Protocol& proto) {
+    Heuristic h;
+    h.line = line_of(el);
+    auto attrs = attributes(el, kHeuristicAttributes);
+    h.table = trim(attrs["table"]);
+    if (h.table.empty()) diags_.error(h.line, "<heuristic> needs a 'table' attribute (a heuristic list such as udp)");
+    if (attrs.count("enabled")) {
+        const std::string e = trim(attrs["enabled"]);
+        if (e == "true" || e == "false") h.enabled = e == "true";
+        else diags_.error(h.line, "bad enabled '" + attrs["enabled"] + "' on <heuristic>: expected 'true' or 'false'");
+    }
+    for (xmlNode* c = el->children; c; c = c->next) unexpected_child(c, "heuristic", {});
+    for (const Heuristic& other : proto.heuristics)
+        if (!h.table.empty() && other.table == h.table) {
+            diags_.error(h.line, "duplicate <heuristic table=\"" + h.table + "\"> (the first is on line " +
+                                     std::to_string(other.line) + "): one per heuristic list");
+            return;
+        }
+    proto.heuristics.push_back(h);
 }
 
 // Request/response pairing: <pairing timeout="0.1" analysis="ethercat-esc"><key field="XPATH"/>...</pairing>
@@ -495,6 +523,10 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
     if (attrs.count("ifhook")) {
         node->has_hook = true;
         parse_value_list(attrs["ifhook"], node->line, "ifhook", node->hook_list);
+    }
+    if (attrs.count("valid")) {
+        node->has_valid = true;
+        parse_value_list(attrs["valid"], node->line, "valid", node->valid_list);
     }
     parse_length(attrs.count("length") ? attrs["length"] : "", node->line, *node, el);
     if (attrs.count("value")) parse_value(attrs["value"], node->line, *node);
@@ -667,7 +699,7 @@ void Parser::parse_in_list(const std::string& text, int line, Node& node) {
     parse_value_list(text, line, "in", node.in_list);
 }
 
-// "1-9,0x0d,14": numbers and ranges, for 'in' and 'ifhook'.
+// "1-9,0x0d,14": numbers and ranges, for 'in', 'ifhook' and 'valid'.
 bool Parser::parse_value_list(const std::string& text, int line, const std::string& attribute,
                               std::vector<ValueRange>& out) {
     const std::string bad = "bad '" + attribute + "' list '" + text +

@@ -29,6 +29,15 @@ bool is_ancestor_or_self(const Node* ancestor, const Node* n) {
     return false;
 }
 
+// A Wireshark dissector table or heuristic list name: [a-z0-9._]+
+bool is_table_name(const std::string& table) {
+    bool ok = !table.empty();
+    for (char c : table)
+        ok = ok && (std::islower(static_cast<unsigned char>(c)) || std::isdigit(static_cast<unsigned char>(c)) ||
+                    c == '.' || c == '_');
+    return ok;
+}
+
 class Validator {
 public:
     Validator(Protocol& proto, Diagnostics& diags) : proto_(proto), diags_(diags) {}
@@ -48,9 +57,11 @@ private:
     void check_computed(Node& n);
     bool check_expr(Node& n, Expr& e);
     const Node* find_earlier(const Node& n, const std::string& name);
+    void check_validity();  // valid="LIST" fields and <heuristic>
     void check_pairing();
     void check_hook_list(const Node& n);
-    void check_list_fits(int line, const std::vector<ValueRange>& list, const FieldRef& ref);
+    void check_list_fits(int line, const std::vector<ValueRange>& list, const FieldRef& ref,
+                         const char* attribute = "in");
     bool offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const Node* t, uint64_t& offset,
                    const Node*& blocker) const;
     void parse_summary(Node& n);
@@ -97,6 +108,7 @@ void Validator::run() {
         if (n.is_computed()) check_computed(n);
     });
     check_pdulength();
+    check_validity();
     check_pairing();
     runtime_names_ = name_groups_of(proto_);
     assign_filter_names(proto_.nodes, proto_.filter);
@@ -104,8 +116,8 @@ void Validator::run() {
 }
 
 void Validator::check_root() {
-    if (!proto_.ethertype && proto_.hooks.empty())
-        diags_.error(proto_.line, "<root> needs an 'ethertype' or at least one <hook>; "
+    if (!proto_.ethertype && proto_.hooks.empty() && proto_.heuristics.empty())
+        diags_.error(proto_.line, "<root> needs an 'ethertype' or at least one <hook> (or <heuristic>); "
                                   "otherwise nothing is decoded with these rules");
     if (!is_valid_filter_segment(proto_.filter))
         diags_.error(proto_.line,
@@ -114,12 +126,14 @@ void Validator::check_root() {
                          " is not valid: it must match [a-z][a-z0-9_]*" +
                          (proto_.filter_given ? "" : "; set a 'filter' attribute on <root>"));
     for (const Hook& h : proto_.hooks) {
-        bool ok = !h.table.empty();
-        for (char c : h.table)
-            ok = ok && (std::islower(static_cast<unsigned char>(c)) || std::isdigit(static_cast<unsigned char>(c)) ||
-                        c == '.' || c == '_');
-        if (!ok && !h.table.empty())
+        if (!is_table_name(h.table) && !h.table.empty())
             diags_.error(h.line, "bad hook table '" + h.table + "': expected a Wireshark dissector table such as udp.port");
+    }
+    for (const Heuristic& h : proto_.heuristics) {
+        const bool port = h.table.size() > 5 && h.table.compare(h.table.size() - 5, 5, ".port") == 0;
+        if (!h.table.empty() && (!is_table_name(h.table) || port))
+            diags_.error(h.line, "bad heuristic table '" + h.table + "': expected a Wireshark heuristic list such as "
+                                 "udp, tcp or eth" + (port ? " ('" + h.table + "' is a dissector table: use <hook>)" : ""));
     }
     if (proto_.nodes.empty()) diags_.warning(proto_.line, "<root> has no <node>: the protocol decodes nothing");
 }
@@ -372,6 +386,61 @@ void Validator::check_pdulength() {
     mark_slot(const_cast<Node*>(t));
 }
 
+// Why a valid field is not decoded at one place in every message.
+std::string valid_blocker(const Node& blocker, const Node& t) {
+    const std::string where = quote(blocker) + at_line(blocker);
+    const std::string self = &blocker == &t ? "it" : "it is inside " + where + ", which";
+    if (!is_ancestor_or_self(&blocker, &t) || blocker.is_repeated()) return pdulength_blocker(blocker, t);
+    if (blocker.is_window() || blocker.at) return self + " is placed by address in a window";
+    if (blocker.length_kind == LengthKind::Field)
+        return self + " takes its length from a field: a message may end it before";
+    return self + " is decoded only under a condition ('if', <when>, direction or otherwise)";
+}
+
+// valid="LIST": tested before anything is added to the tree, so each such
+// field sits at a fixed offset and is decoded in every message; an 'ifhook'
+// on it or a container only limits the messages it is tested in.
+void Validator::check_validity() {
+    bool unhooked = false;  // a valid field tested in every message, whatever the hook
+    for_each_node(proto_.nodes, [&](Node& n) {
+        if (!n.has_valid) return;
+        if (n.is_computed()) {
+            diags_.error(n.line, "'valid' on computed value " + quote(n) + ": the test reads bytes before anything "
+                                 "is decoded; put 'valid' on the fields it is computed from");
+            return;
+        }
+        if (!n.is_numeric()) {
+            diags_.error(n.line, "'valid' field " + quote(n) + " is not numeric: it must be a leaf of 1-64 bits shown as "
+                                 "numberhex, numberdec, bool, enum or nondisplay");
+            return;
+        }
+        uint64_t offset = 0;
+        const Node* blocker = nullptr;
+        offset_of(proto_.nodes, &n, offset, blocker);
+        bool hooked = false;
+        for (const Node* a = &n; a; a = a->parent) {
+            hooked = hooked || a->has_hook;
+            const bool conditional = a->if_field || !a->whens.empty() || a->otherwise || a->direction != Direction::Any;
+            const bool placed = a->is_window() || a->at || (a != &n && a->length_kind == LengthKind::Field);
+            if (!blocker && (conditional || placed)) blocker = a;
+        }
+        if (blocker) {
+            diags_.error(n.line, "'valid' field " + quote(n) + " must be at a fixed offset from the start of the message, "
+                                 "in every message: " + valid_blocker(*blocker, n));
+            return;
+        }
+        n.valid_offset = offset;
+        unhooked = unhooked || !hooked;
+        FieldRef self;
+        self.target = &n;
+        check_list_fits(n.line, n.valid_list, self, "valid");
+    });
+    if (!proto_.heuristics.empty() && !unhooked)
+        diags_.error(proto_.heuristics.front().line,
+                     "<heuristic> needs a field with 'valid' (outside every 'ifhook' container): the values that "
+                     "tell this protocol's messages from others");
+}
+
 // ifhook values are those of the root's ethertype and hooks (or a Decode As
 // choice); a list that matches none of them is most likely a mistake.
 void Validator::check_hook_list(const Node& n) {
@@ -388,14 +457,15 @@ void Validator::check_hook_list(const Node& n) {
 
 // An 'in' value the field cannot hold never matches: most likely the list
 // was written for a wider field (in="0x100-0x1ff" on a byte).
-void Validator::check_list_fits(int line, const std::vector<ValueRange>& list, const FieldRef& ref) {
+void Validator::check_list_fits(int line, const std::vector<ValueRange>& list, const FieldRef& ref,
+                                const char* attribute) {
     const Node* t = ref.target;
     if (!t || !t->is_numeric() || t->fixed_bits >= 64) return;
     const uint64_t max = (uint64_t{1} << t->fixed_bits) - 1;
     for (const ValueRange& r : list) {
         if (r.high <= max) continue;
         const std::string values = r.low == r.high ? hex(r.low) : hex(r.low) + "-" + hex(r.high);
-        diags_.warning(line, "'in' value " + values + " does not fit the " + std::to_string(t->fixed_bits) +
+        diags_.warning(line, "'" + std::string(attribute) + "' value " + values + " does not fit the " + std::to_string(t->fixed_bits) +
                                  "-bit field " + quote(*t) + at_line(*t) + ": " +
                                  (r.low > max ? "it never matches" : "values above " + hex(max) + " never match"));
     }

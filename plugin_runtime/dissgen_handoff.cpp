@@ -141,9 +141,7 @@ void dg_rt::find_handoff_dissectors(const dg_protocol *p)
 
 /* --- stream transports --------------------------------------------------- */
 
-namespace {
-
-guint message_length(packet_info *, tvbuff_t *tvb, int offset, void *data)
+extern "C" guint dg_message_length(packet_info *, tvbuff_t *tvb, int offset, void *data)
 {
     const dg_protocol *p = (const dg_protocol *)data;
     const dg_node *n = &p->nodes[p->pdu_node];
@@ -155,6 +153,8 @@ guint message_length(packet_info *, tvbuff_t *tvb, int offset, void *data)
     return (guint)CLAMP(total, minimum, (gint64)G_MAXINT32);
 }
 
+namespace {
+
 int dissect_message(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data)
 {
     return dg_dissect((const dg_protocol *)data, tvb, pinfo, tree);
@@ -165,6 +165,6 @@ int dissect_message(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *d
 int dg_dissect_stream(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     const dg_node *n = &p->nodes[p->pdu_node];
-    tcp_dissect_pdus(tvb, pinfo, tree, TRUE, p->pdu_offset + n->length, message_length, dissect_message, (void *)p);
+    tcp_dissect_pdus(tvb, pinfo, tree, TRUE, p->pdu_offset + n->length, dg_message_length, dissect_message, (void *)p);
     return (int)tvb_captured_length(tvb);
 }

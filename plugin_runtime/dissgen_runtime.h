@@ -268,4 +268,8 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
 /* Dissects a TCP segment holding whole or partial messages (pdulength). */
 int dg_dissect_stream(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
 
+/* The length of the message at `offset` from its pdulength field (a
+ * tcp_dissect_pdus get_pdu_len; data: the dg_protocol). */
+guint dg_message_length(packet_info *pinfo, tvbuff_t *tvb, int offset, void *data);
+
 }

@@ -141,6 +141,15 @@ def udp_ethernet_frame(payload, port, src_ip=b"\x0a\x00\x00\x01", dst_ip=b"\x0a\
     return b"\x02\xee\xee\xee\xee\xee\x02\x00\x00\x00\x00\x01" + struct.pack("!H", ETHERTYPE_IPV4) + ip + u
 
 
+def tcp_ethernet_frame(payload, sport, dport, seq, src_ip=b"\x0a\x00\x00\x01", dst_ip=b"\x0a\x00\x00\x02"):
+    """payload in one TCP segment (sequence number `seq`, PSH+ACK, no checksum) in IPv4 in
+    Ethernet II; a flow is the segments of consecutive `seq` (no handshake needed)."""
+    t = struct.pack("!HHIIBBHHH", sport, dport, seq, 1, 5 << 4, 0x18, 65535, 0, 0) + payload
+    ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(t), 0, 0x4000, 64, 6, 0, src_ip, dst_ip)
+    ip = ip[:10] + struct.pack("!H", ip_checksum(ip)) + ip[12:]
+    return b"\x02\xee\xee\xee\xee\xee\x02\x00\x00\x00\x00\x01" + struct.pack("!H", ETHERTYPE_IPV4) + ip + t
+
+
 def encode_frame(f):
     """Return (captured bytes, original length) of an Ethernet frame."""
     payload = f.ecat_payload()
@@ -213,6 +222,14 @@ def pcap_bytes(frames, base_ts=1704067200.0):
             sec, usec = sec + 1, usec - 1000000
         out.append(struct.pack("<IIII", sec, usec, len(data), orig))
         out.append(data)
+    return b"".join(out)
+
+
+def raw_pcap_bytes(frames, base_ts=1704067200.0):
+    """A pcap of Ethernet frames given as bytes, 1 ms apart."""
+    out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
+    for i, data in enumerate(frames):
+        out.append(struct.pack("<IIII", int(base_ts), i * 1000, len(data), len(data)) + data)
     return b"".join(out)
 
 

@@ -7,7 +7,9 @@
 - the message of the Linux EtherNet/IP paper (seeds/002: SendRRData carrying a CIP
   Forward Open) decodes field by field, and Wireshark's enip/cip agree on it;
 - TCP 44818: a message split over three segments is reassembled and decoded once; three
-  messages in one segment are each decoded once; messages straddling segments too;
+  messages in one segment are each decoded once; messages straddling segments too; a
+  corrupted header (unknown command, a huge length) is not EtherNet/IP and starts no
+  reassembly: the messages after it decode;
 - UDP 44818 (ListIdentity request and reply with the CIP Identity item) and UDP 2222
   (class-1 I/O: a bare Common Packet Format, chosen with `ifhook`);
 - differential against Wireshark's own enip/cip dissectors on the real captures of
@@ -104,6 +106,10 @@ def pcap(frames):
 
 
 # --- EtherNet/IP messages ----------------------------------------------------------
+
+# The encapsulation commands Wireshark 4.0's enip knows (rules/enip.xml: valid="...").
+ENIP_COMMANDS = {0x0000, 0x0004, 0x0063, 0x0064, 0x0065, 0x0066, 0x006F, 0x0070, 0x00C8}
+
 
 def encap(command, data=b"", session=0, status=0, context=bytes(8), options=0):
     return struct.pack("<HHII8sI", command, len(data), session, status, context, options) + data
@@ -743,6 +749,17 @@ class Tcp(unittest.TestCase):
         self.assertEqual(rows[3]["enipr.cpf.item.cip.addstat"], "34 12")
         self.assertEqual(differential(ENV.path("straddle.pcap"))["frames_differ"], [])
 
+    def test_a_corrupted_header_starts_no_reassembly(self):
+        # an unknown command declaring 65520 bytes: not EtherNet/IP (valid="..."), so the
+        # messages after it decode (Wireshark 4.0's enip refuses the segment too, yet decodes
+        # none of the later ones: no comparison here)
+        flow = TcpFlow(50004, 44818)
+        frames = [flow.segment(REGISTER), flow.segment(encap(0x1234, bytes(16))[:2] + b"\xf0\xff" + bytes(36)),
+                  flow.segment(GET_ATTR), flow.segment(SEED)]
+        rows = fields(ENV, capture("corrupted.pcap", frames), ["enipr.command", "_ws.col.Protocol"])
+        self.assertEqual([r["enipr.command"] for r in rows], ["0x0065", "", "0x0070", "0x006f"])
+        self.assertEqual(rows[1]["_ws.col.Protocol"], "TCP")
+
 
     def test_sockaddr_item_in_network_byte_order(self):
         p = "enipr.cpf.item.sockaddr."
@@ -904,7 +921,13 @@ class Malformed(unittest.TestCase):
         self.assertEqual(p.stderr.strip(), "")
         rows = [line.split("\t") for line in p.stdout.splitlines()]
         self.assertEqual(len(rows), len(frames))
-        self.assertEqual({r[0] for r in rows}, {"ENIPR"})
+        # on 44818 a message too short for the header's Command and Length, or with a command
+        # Wireshark's enip does not know, is not EtherNet/IP (valid="..."): left to UDP
+        def ours(b):
+            return len(b) >= 4 and struct.unpack("<HH", b[:4])[0] in ENIP_COMMANDS and struct.unpack("<HH", b[:4])[1] <= 65511
+        expected = ["ENIPR" if ours(b) else "UDP" for b in payloads] + ["ENIPR"] * 200 + \
+            ["ENIPR" if ours(b) else "UDP" for b in more]
+        self.assertEqual([r[0] for r in rows], expected)
         verbose = ENV.tshark(["-r", cap, "-V"], check=False)
         self.assertEqual(verbose.returncode, 0, verbose.stderr)
         self.assertNotIn("[Malformed Packet", verbose.stdout, "a Wireshark exception escaped the rules")

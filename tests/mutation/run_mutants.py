@@ -72,6 +72,8 @@ TESTS = {
     "everything": integration("test_everything.py"),
     "malformed": integration("test_malformed.py"),
     "enip": integration("test_enip.py"),
+    "validity": integration("test_validity.py"),
+    "validity_unit": unit("Validity.*"),
     "loading": integration("test_plugin_loading.py"),
     "esi": unit("Esi*:Files/EsiErr.*:Design.*:Eni.*:Files/NetworkErr.*:BusTables.*:ManualBus.*:-*Golden*"),
     "typed_values": integration("test_typed_values.py"),

@@ -106,7 +106,8 @@ for f in /usr/bin/dissgen /usr/share/dissgen/runtime/dissgen_runtime.h \
          /usr/share/dissgen/runtime/dissgen_walk.cpp /usr/share/dissgen/runtime/dissgen_state.h \
          /usr/share/dissgen/runtime/dissgen_compat.h \
          /usr/share/dissgen/runtime/dissgen_rows.h \
-         /usr/share/dissgen/runtime/dissgen_pairing.cpp /usr/share/dissgen/runtime/ethercat/ethercat_esc.cpp \
+         /usr/share/dissgen/runtime/dissgen_pairing.cpp /usr/share/dissgen/runtime/dissgen_validity.cpp \
+         /usr/share/dissgen/runtime/ethercat/ethercat_esc.cpp \
          /usr/share/dissgen/runtime/ethercat/ethercat_bus.cpp \
          /usr/share/dissgen/rules/ethercat.xml "$packaged_plugin" /usr/share/man/man1/dissgen.1.gz \
          /usr/share/doc/dissgen/copyright; do

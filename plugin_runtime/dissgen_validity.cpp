@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* valid="LIST" fields and <heuristic> registration: see dissgen_validity.h. */
+#include "dissgen_validity.h"
+
+#include <string.h>
+
+namespace {
+
+gboolean listed(const dg_range *ranges, guint16 first, guint16 count, guint64 value)
+{
+    for (guint16 i = first; i < first + count; i++)
+        if (value >= ranges[i].low && value <= ranges[i].high) return TRUE;
+    return FALSE;
+}
+
+/* The field's value; its bytes are known to be there. */
+guint64 field_value(const dg_valid_field *f, tvbuff_t *tvb, gint at)
+{
+    guint64 value = 0;
+    for (guint i = 0; i < f->length; i++) {
+        guint8 byte = tvb_get_guint8(tvb, at + (gint)(f->little ? f->length - 1 - i : i));
+        value = (value << 8) | byte;
+    }
+    if (f->bits > 0 && f->bits < 64) value = (value >> f->shift) & ((G_GUINT64_CONSTANT(1) << f->bits) - 1);
+    return value;
+}
+
+/* tcp_dissect_pdus: the length of a message that passes the test; a message
+ * that fails takes the rest of the segment, which is then shown as data,
+ * instead of a length that would hold back the messages after it. */
+guint valid_message_length(packet_info *pinfo, tvbuff_t *tvb, int offset, void *data)
+{
+    const dg_validity *v = (const dg_validity *)data;
+    guint length = dg_message_length(pinfo, tvb, offset, (void *)v->p);
+    gint available = tvb_captured_length_remaining(tvb, offset);
+    if (dg_valid_at(v, tvb, pinfo, offset, MIN(available, (gint)MIN(length, (guint)G_MAXINT32)))) return length;
+    return (guint)MAX(tvb_reported_length_remaining(tvb, offset), (gint)v->header_length);
+}
+
+int dissect_valid_message(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data)
+{
+    const dg_validity *v = (const dg_validity *)data;
+    if (dg_valid_at(v, tvb, pinfo, 0, (gint)tvb_captured_length(tvb))) return dg_dissect(v->p, tvb, pinfo, tree);
+    return call_data_dissector(tvb, pinfo, tree);
+}
+
+} /* namespace */
+
+extern "C" {
+
+gboolean dg_valid_at(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, gint offset, gint available)
+{
+    for (guint16 i = 0; i < v->field_count; i++) {
+        const dg_valid_field *f = &v->fields[i];
+        if (f->hook_count && !listed(v->ranges, f->hook_first, f->hook_count, pinfo->match_uint)) continue;
+        if ((gint64)f->offset + f->length > (gint64)available) return FALSE;
+        if (!listed(v->ranges, f->in_first, f->in_count, field_value(f, tvb, offset + (gint)f->offset))) return FALSE;
+    }
+    return TRUE;
+}
+
+int dg_valid_dissect(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    if (!dg_valid_at(v, tvb, pinfo, 0, (gint)tvb_captured_length(tvb))) return 0;
+    return dg_dissect(v->p, tvb, pinfo, tree);
+}
+
+int dg_valid_dissect_stream(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    gint have = (gint)tvb_captured_length(tvb);
+    /* Too few bytes to tell: only reassembly can bring the rest of the header. */
+    if (have >= (gint)v->header_length ? !dg_valid_at(v, tvb, pinfo, 0, have) : !pinfo->can_desegment) return 0;
+    tcp_dissect_pdus(tvb, pinfo, tree, TRUE, v->header_length, valid_message_length, dissect_valid_message, (void *)v);
+    return have;
+}
+
+gboolean dg_valid_heuristic(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    if (!dg_valid_at(v, tvb, pinfo, 0, (gint)tvb_captured_length(tvb))) return FALSE;
+    if (v->p->pdu_node >= 0 && pinfo->ptype == PT_TCP)
+        dg_valid_dissect_stream(v, tvb, pinfo, tree);
+    else
+        dg_dissect(v->p, tvb, pinfo, tree);
+    return TRUE;
+}
+
+void dg_validity_handoff(const dg_validity *v)
+{
+    if (*v->p->proto == -1) return; /* not registered: its names were taken */
+    for (guint16 i = 0; i < v->heuristic_count; i++) {
+        const dg_heuristic *h = &v->heuristics[i];
+        if (!find_heur_dissector_list(h->list)) {
+            ws_log("dissgen", LOG_LEVEL_WARNING,
+                   "%s: this Wireshark has no heuristic list \"%s\"; the protocol is not looked for there",
+                   v->p->name, h->list);
+            continue;
+        }
+        if (find_heur_dissector_by_unique_short_name(h->short_name)) {
+            ws_log("dissgen", LOG_LEVEL_WARNING, "%s: the heuristic name \"%s\" is taken; this one is not registered",
+                   v->p->name, h->short_name);
+            continue;
+        }
+        heur_dissector_add(h->list, v->heuristic, h->display_name, h->short_name, *v->p->proto,
+                           h->enabled ? HEURISTIC_ENABLE : HEURISTIC_DISABLE);
+    }
+}
+
+} /* extern "C" */
