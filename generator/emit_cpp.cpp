@@ -372,6 +372,10 @@ void Emitter::declarations() {
 }
 
 void Emitter::value_strings() {
+    for (const Node* n : l_.nodes)  // Wireshark writes the label right after the value (char *: Wireshark 4.0)
+        if (n->has_unit_label() && n->display != Display::Float)
+            o_ << "static const unit_name_string " << l_.ident.at(n) << "_unit = { (char *)" << c_string(" " + n->unit)
+               << ", NULL };\n\n";
     for (const Node* n : l_.nodes) {
         if (n->is_container() || n->display != Display::Enum) continue;
         if (n->has_enum_ranges()) {
@@ -559,6 +563,10 @@ void Emitter::register_functions() {
         if (n->is_leaf() && n->display == Display::Enum)
             strings = uses_val64(*n) ? "VALS64(" + vals(*n) + ")" : "VALS(" + vals(*n) + ")";
         if (n->is_leaf() && n->display == Display::Enum && n->has_enum_ranges()) strings = "RVALS(" + rvals(*n) + ")";
+        if (n->has_unit_label() && n->display != Display::Float) {  // floats: the runtime writes it
+            t.display += "|BASE_UNIT_STRING";
+            strings = "(const void *)&" + l_.ident.at(n) + "_unit";
+        }
         o_ << (first ? "" : ",\n") << "        { &" << hf(*n) << ",\n          { " << c_string(n->name) << ", "
            << c_string(n->filter_name) << ", " << t.type << ", " << t.display << ", " << strings << ", "
            << hex(t.mask) << ",\n            " << (n->description.empty() ? "NULL" : c_string(n->description))
@@ -640,7 +648,7 @@ bool needs_extra(const Node& n) {
     return (n.is_leaf() && (n.display == Display::String || n.display == Display::StringZ ||
                             n.display == Display::Time)) ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
-           n.keeps_values || n.is_computed();
+           n.keeps_values || n.is_computed() || n.has_unit_label();
 }
 
 void Emitter::extra_table() {
@@ -660,7 +668,7 @@ std::string Emitter::extra_row(const Node& n) const {
     auto add = [&](const char* setter, const std::string& args) { set.push_back(setter + ("(" + args + ")")); };
     auto slot = [](const std::optional<FieldRef>& r) { return r && r->target ? r->target->slot : -1; };
     if (n.encoding == "ascii") add("encoding", "ENC_ASCII");
-    if (n.unit == "s" || n.unit == "ms" || n.unit == "us")
+    if (n.display == Display::Time && (n.unit == "s" || n.unit == "ms" || n.unit == "us"))
         add("units_per_second", n.unit == "s" ? "1" : n.unit == "ms" ? "1000" : "1000000");
     if (n.repeat_rest) add("repeat_rest", "");
     if (n.direction != Direction::Any)
@@ -676,6 +684,7 @@ std::string Emitter::extra_row(const Node& n) const {
     if (!n.from_up && slot(n.from) >= 0) add("from_slot", std::to_string(slot(n.from)));
     if (n.from_up) add("from_up", std::to_string(n.from_up));
     if (n.keeps_values) add("keep_values", "");
+    if (n.has_unit_label()) add("unit", c_string(" " + n.unit));
     if (n.is_computed())
         add("value", std::to_string(l_.expr_span.at(&n).first) + ", " + std::to_string(l_.expr_span.at(&n).second));
     return named_row("dg_node_extra()", set);

@@ -130,6 +130,8 @@ struct Node {
     bool encoding_given = false;
     std::string unit = "ns";               // time: "ns", "us", "ms" or "s"
     bool unit_given = false;
+    // unit="°C" on a number: the label its item is shown with (not a time's unit)
+    bool has_unit_label() const { return unit_given && display != Display::Time; }
     bool repeat_rest = false;              // repeat="rest": until the enclosing container ends
     Direction direction = Direction::Any;  // direction="request|response"
     std::optional<std::string> dissector;  // dissector="NAME": hand the bytes to that dissector

@@ -770,8 +770,6 @@ void Parser::parse_text_direction_handoff_attributes(std::map<std::string, std::
     if (attrs.count("unit")) {
         node.unit = trim(attrs["unit"]);
         node.unit_given = true;
-        if (node.unit != "ns" && node.unit != "us" && node.unit != "ms" && node.unit != "s")
-            diags_.error(line, "bad unit '" + attrs["unit"] + "': expected 'ns', 'us', 'ms' or 's'");
     }
     if (attrs.count("direction")) {
         const std::string d = trim(attrs["direction"]);

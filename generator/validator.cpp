@@ -70,6 +70,7 @@ private:
     void assign_slots();
     // display types, range enums, repeat="rest", direction, hand-off, reassembly
     void check_display_direction_handoff(Node& n);
+    void check_unit(const Node& n);
     void check_string_display(Node& n);
     void check_enum_ranges(const Node& n);
     void check_handoff(const Node& n);
@@ -106,6 +107,7 @@ void Validator::run() {
         check_layout(n);
         check_offsets(n);
         if (n.is_computed()) check_computed(n);
+        if (n.unit_given) check_unit(n);  // after check_computed, which settles a computed value's display
     });
     check_pdulength();
     check_validity();
@@ -701,14 +703,31 @@ bool Validator::check_expr(Node& n, Expr& e) {
 
 // --- display types, range enums, repeat="rest", direction, hand-off, reassembly ---
 
+// unit="...": a time's unit (ns, us, ms, s), or the label a number is shown
+// with ("°C", "rpm"): numbers in decimal (numberdec, int) or float.
+void Validator::check_unit(const Node& n) {
+    if (n.display == Display::Time) {
+        if (n.unit != "ns" && n.unit != "us" && n.unit != "ms" && n.unit != "s")
+            diags_.error(n.line, "bad unit '" + n.unit + "': expected 'ns', 'us', 'ms' or 's'");
+        return;
+    }
+    if (n.is_container() || (n.display != Display::NumberDec && n.display != Display::Int && n.display != Display::Float)) {
+        diags_.error(n.line, "'unit' applies to time leaves and to numbers shown as numberdec, int or float; " +
+                                 quote(n) + " is shown as " + display_name(n.display));
+        return;
+    }
+    bool printable = !n.unit.empty() && n.unit.size() <= 32;
+    for (unsigned char c : n.unit) printable = printable && c >= 0x20 && c != 0x7f;
+    if (!printable)
+        diags_.error(n.line, "bad unit '" + n.unit + "': a unit label is 1 to 32 printable characters, such as \"rpm\"");
+}
+
 void Validator::check_display_direction_handoff(Node& n) {
     if (n.repeat_rest && n.count)
         diags_.error(n.line, "node " + quote(n) + " has both repeat=\"rest\" and 'count'; use one of them");
     if (n.encoding_given && n.display != Display::String && n.display != Display::StringZ)
         diags_.error(n.line, "'encoding' applies to string and stringz leaves; " + quote(n) + " is shown as " +
                                  display_name(n.display));
-    if (n.unit_given && n.display != Display::Time)
-        diags_.error(n.line, "'unit' applies to time leaves; " + quote(n) + " is shown as " + display_name(n.display));
     if (n.direction != Direction::Any) {
         bool port_hook = false;
         for (const Hook& h : proto_.hooks)

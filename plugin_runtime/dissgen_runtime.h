@@ -87,6 +87,7 @@ typedef struct dg_extra {
     gint16 from_slot = -1;
     guint8 from_up = 0;
     guint8 keep_values = 0;   /* an offset leaf: the value of every instance is kept (up to DG_MAX_TABLE) */
+    const char *unit = nullptr; /* unit="°C" on a number: " °C", written after its value in summaries */
     /* value="EXPR": the operations dg_protocol.exprs[expr_first ..] */
     guint16 expr_first = 0, expr_count = 0;
 } dg_extra;

@@ -94,8 +94,8 @@ void append_computed_value(dg_text *out, const dg_node *n, guint64 value)
     append_str(out, buf);
 }
 
-/* Appends a leaf's value as its tree item shows it, for summaries. */
-void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s)
+/* A leaf's value as its tree item shows it, without a unit label. */
+void append_bare_value(const dg_state *st, dg_text *out, const dg_slot *s)
 {
     wmem_allocator_t *pool = st->pinfo->pool;
     const dg_node *n = s->node;
@@ -142,6 +142,14 @@ void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s)
             append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' '));
         return;
     }
+}
+
+/* Appends a leaf's value as its tree item shows it, for summaries. */
+void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s)
+{
+    append_bare_value(st, out, s);
+    const dg_extra *x = s->node->extra;
+    if (x && x->unit) append_str(out, x->unit);
 }
 
 /* --- summaries ----------------------------------------------------------- */

@@ -139,6 +139,13 @@ void report_short_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint of
 /* The `len` bytes of a leaf at offset, all there: its item and its value.
  * The value is read only when store() uses it, the item added only when
  * there is a tree. */
+/* A float's unit label: Wireshark 4.0 shows BASE_UNIT_STRING on integers
+ * only, so dissgen writes it after a float's value itself. */
+void append_unit(const dg_node *n, proto_item *item)
+{
+    if (n->extra && n->extra->unit) proto_item_append_text(item, "%s", n->extra->unit);
+}
+
 void decode_leaf_value(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len)
 {
     guint64 value = 0;
@@ -158,6 +165,7 @@ void decode_leaf_value(dg_state *st, const dg_node *n, proto_tree *tree, gint of
         if (tree) item = add_numeric_item(st, n, tree, offset, len, value);
     } else if (len > 0 && tree) {
         item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, item_encoding(n));
+        if (n->show == DG_SHOW_FLOAT) append_unit(n, item);
     }
     if (item && (n->flags & DG_HIDDEN)) proto_item_set_hidden(item);
     store(st, n, value, offset, len);
@@ -186,7 +194,10 @@ void dissect_computed(dg_state *st, const dg_node *n, proto_tree *tree, gint off
     if (!tree || !n->hf) return;
     proto_item *item;
     switch (n->show) {
-    case DG_SHOW_FLOAT: item = proto_tree_add_double(tree, *n->hf, st->tvb, offset, 0, v.real); break;
+    case DG_SHOW_FLOAT:
+        item = proto_tree_add_double(tree, *n->hf, st->tvb, offset, 0, v.real);
+        append_unit(n, item);
+        break;
     case DG_SHOW_BOOL: item = proto_tree_add_boolean(tree, *n->hf, st->tvb, offset, 0, v.integer != 0); break;
     case DG_SHOW_HEX: case DG_SHOW_ENUM: item = proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, 0, bits); break;
     default: item = proto_tree_add_int64(tree, *n->hf, st->tvb, offset, 0, v.integer); break;

@@ -16,6 +16,7 @@ Needs no corpus.
 
 import os
 import random
+import re
 import struct
 import sys
 import unittest
@@ -47,6 +48,11 @@ def message(rng):
     return (start, count, raw, values), body
 
 
+def fmt_g(x):
+    """A double as Wireshark shows it: %.15g."""
+    return "%.15g" % x
+
+
 def expected(start, count, raw, values):
     """What each field shows, as tshark -T fields prints it (None: no item)."""
     registers = ", ".join("r%d=0x%04x" % (start + i + 1, v) for i, v in enumerate(values))
@@ -62,9 +68,9 @@ def expected(start, count, raw, values):
         "calc.registers.flags.flag_index": ",".join("0" for v in values if v & 1),
         "calc.tail_bytes": str(count & 1),
         "calc.tail": "a5" if count & 1 else "",
-        # a repeated node's summaries: "Name ×N: ..." from two on; none: the protocol's name
-        "info": "Computed values" if count == 0 else registers if count == 1 else "Registers ×%d: %s" % (
-            count, registers),
+        # the climate's summary, then a repeated node's summaries ("Name ×N: ..." from two on)
+        "info": "%s °C, alarm %s" % (fmt_g(raw * 0.1 - 40), "True" if raw > 900 or count == 0 else "False")
+                + ("" if count == 0 else ", " + registers if count == 1 else ", Registers ×%d: %s" % (count, registers)),
     }
 
 
@@ -108,6 +114,8 @@ class TestComputed(TsharkTestCase, unittest.TestCase):
         out = self.env.tshark(["-r", self.path, "-V", "-c", "3"]).stdout
         with self.checks() as check:
             check("[Temperature: " in out, "a computed value is a generated item: [Temperature: ...]")
+            check(re.search(r"\[Temperature: -?[0-9.]+ °C\]", out) is not None, "a float's unit label follows its value")
+            check(re.search(r"Count: [0-9]+ registers\n", out) is not None, "an integer's unit label follows its value")
             check("[Register: " in out, "computed values inside a repeat are generated items too")
             check("Secret" not in out, "a nondisplay computed value is not printed")
             filtered = self.env.tshark(["-r", self.path, "-Y", "calc.secret >= 0 && calc.ratio == 0",
