@@ -74,16 +74,23 @@ def expected(start, count, raw, values):
     }
 
 
+def ethernet_frame(body):
+    f = b"\x02\0\0\0\0\x02\x02\0\0\0\0\x01" + struct.pack("!H", ETHERTYPE) + body
+    return f + bytes(max(0, 60 - len(f)))
+
+
+def messages(seed, count):
+    """[(fields, message bytes)]: random messages (test_quiet decodes them too)."""
+    rng = random.Random(seed)
+    return [message(rng) for _ in range(count)]
+
+
 class TestComputed(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
         cls.install(os.path.join("tests", "rules", "computed.xml"), "calc")
-        rng = random.Random(1234)
-        cls.messages = [message(rng) for _ in range(300)]
-        frames = []
-        for _, body in cls.messages:
-            f = b"\x02\0\0\0\0\x02\x02\0\0\0\0\x01" + struct.pack("!H", ETHERTYPE) + body
-            frames.append(f + bytes(max(0, 60 - len(f))))
+        cls.messages = messages(1234, 300)
+        frames = [ethernet_frame(body) for _, body in cls.messages]
         out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
         for i, f in enumerate(frames):
             out.append(struct.pack("<IIII", 1_700_000_000 + i, 0, len(f), len(f)) + f)

@@ -243,6 +243,12 @@ def transactions_frames():
             for n, (_ms, direction, transaction, unit) in enumerate(m.MESSAGES, 1)]
 
 
+def computed_frames():
+    """tests/rules/computed.xml: test_computed.py's random messages."""
+    import test_computed as m
+    return [m.ethernet_frame(body) for _, body in m.messages(77, 40)]
+
+
 def quiet_bits_frames():
     """tests/rules/quiet_bits.xml with random values: whole-byte members in the middle of groups."""
     rng = random.Random(5)
@@ -271,6 +277,7 @@ CAPTURES = {
     "tests/rules/offsets_from.xml": offsets_frames,
     "tests/rules/quiet_bits.xml": quiet_bits_frames,
     "tests/rules/transactions.xml": transactions_frames,
+    "tests/rules/computed.xml": computed_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,
