@@ -24,7 +24,6 @@ the clone under those names (STAND_INS), so that their commands run as written.
 Exit status: 0 all worked, 1 something failed, 77 skipped (no git, no tshark, not a git
 checkout, or packages missing that the demo would install).
 """
-import argparse
 import os
 import re
 import shlex
@@ -34,12 +33,13 @@ import subprocess
 import sys
 import tempfile
 import time
+import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from tshark_env import Checks, TsharkEnv, _make_readable  # noqa: E402
+from tshark_env import TsharkEnv, TsharkTestCase, _make_readable, run_unittests  # noqa: E402
 
-SKIP_CODE = 77
+ARGS = None
 DEMO = r"^bash scripts/demo\.sh\b"
 
 # README commands not run here, each with the reason. Everything else in a ```sh block,
@@ -283,28 +283,40 @@ def check_demo(check, status, output, demo_script):
           "the demo's last section shows %d LRW rows (found %d)" % (LRW_ROWS, len(rows)))
 
 
-def main():
-    if len(sys.argv) > 3 and sys.argv[1] == "--as-tshark":
-        return as_tshark(sys.argv[2], sys.argv[3], sys.argv[4:])
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--source-dir", required=True, help="the checkout whose HEAD is cloned")
-    ap.add_argument("--dissgen", help="(unused: the README's commands use the clone's own build)")
-    ap.add_argument("--keep", action="store_true", help="keep the clone and the reader's HOME")
-    args = ap.parse_args()
-    source_dir = os.path.abspath(args.source_dir)
+def keep_option(parser):
+    parser.add_argument("--keep", action="store_true", help="keep the clone and the reader's HOME")
 
-    reason = skip_reason(source_dir)
-    if reason:
-        print("SKIPPED: " + reason)
-        return SKIP_CODE
 
-    check = Checks()
-    broken = []               # (line, README command, why)
-    tmp = tempfile.mkdtemp(prefix="dissgen-readme-")     # mode 700, as .ci/run's mktemp -d
-    os.chmod(tmp, 0o700)
-    reader = TsharkEnv(keep=args.keep, prefix="dissgen-readme-home-")
-    started = time.monotonic()
-    try:
+class TestReadmeCommands(TsharkTestCase, unittest.TestCase):
+    """The demo in a fresh clone, then every README command as its reader would type it
+    (self.env is the reader's HOME, tshark run as the unprivileged user)."""
+
+    def test_the_demo_and_every_readme_command_work_as_shown(self):
+        source_dir = os.path.abspath(ARGS.source_dir)
+        reason = skip_reason(source_dir)
+        if reason:
+            self.skipTest(reason)
+        reader = self.env
+        reader.keep = ARGS.keep
+        broken = []               # (line, README command, why)
+        tmp = tempfile.mkdtemp(prefix="dissgen-readme-")     # mode 700, as .ci/run's mktemp -d
+        os.chmod(tmp, 0o700)
+        started = time.monotonic()
+        try:
+            with self.checks() as check:
+                self.demo_and_commands(check, broken, source_dir, tmp, reader)
+        finally:
+            if ARGS.keep:
+                print("(kept %s)" % tmp)
+            else:
+                shutil.rmtree(tmp, ignore_errors=True)
+            print("\n%.0f s in all" % (time.monotonic() - started))
+            if broken:
+                print("README commands that do not work as shown:")
+                for line, name, why in broken:
+                    print("  README.md:%s: %s: %s" % (line or "-", name, why))
+
+    def demo_and_commands(self, check, broken, source_dir, tmp, reader):
         # --- part 1: the demo in a fresh clone -------------------------------------
         head = git("-C", source_dir, "rev-parse", "HEAD")
         if git("-C", source_dir, "status", "--porcelain", "--untracked-files=no"):
@@ -379,23 +391,12 @@ def main():
             if not check(not problems, "README.md:%d: %s  [%.1f s]" % (line, label, secs)):
                 print("    %s\n    stdout:\n%s\n    stderr:\n%s" % ("; ".join(problems), tail(out), tail(err)))
                 broken.append((line, name, "; ".join(problems)))
-    finally:
-        reader.cleanup()
-        if args.keep:
-            print("(kept %s)" % tmp)
-        else:
-            shutil.rmtree(tmp, ignore_errors=True)
 
-    print("\n%.0f s in all" % (time.monotonic() - started))
-    if broken:
-        print("README commands that do not work as shown:")
-        for line, name, why in broken:
-            print("  README.md:%s: %s: %s" % (line or "-", name, why))
-        return 1
-    if check.failed:
-        return 1
-    print("every README command that can run here works as shown")
-    return 0
+
+def main():
+    if len(sys.argv) > 3 and sys.argv[1] == "--as-tshark":
+        return as_tshark(sys.argv[2], sys.argv[3], sys.argv[4:])
+    return run_unittests(keep_option)[1]
 
 
 if __name__ == "__main__":
