@@ -648,7 +648,7 @@ bool needs_extra(const Node& n) {
     return (n.is_leaf() && (n.display == Display::String || n.display == Display::StringZ ||
                             n.display == Display::Time)) ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
-           n.keeps_values || n.is_computed() || n.has_unit_label();
+           n.keeps_values || n.is_computed() || n.has_unit_label() || n.is_overlay();
 }
 
 void Emitter::extra_table() {
@@ -685,6 +685,7 @@ std::string Emitter::extra_row(const Node& n) const {
     if (n.from_up) add("from_up", std::to_string(n.from_up));
     if (n.keeps_values) add("keep_values", "");
     if (n.has_unit_label()) add("unit", c_string(" " + n.unit));
+    if (slot(n.overlay) >= 0) add("overlay", std::to_string(slot(n.overlay)));
     if (n.is_computed())
         add("value", std::to_string(l_.expr_span.at(&n).first) + ", " + std::to_string(l_.expr_span.at(&n).second));
     return named_row("dg_node_extra()", set);

@@ -167,6 +167,10 @@ struct Node {
     bool keeps_values = false;              // an offsets table: every instance's value is kept
     unsigned from_up = 0;                   // from an enclosing container: k levels up (0: an earlier field)
     bool is_located() const { return offsets.has_value(); }
+    // overlay="XPATH": a container decoded over the bytes of an earlier node
+    // (from its first byte); the walk's position does not move.
+    std::optional<FieldRef> overlay;
+    bool is_overlay() const { return overlay.has_value(); }
     // derived by the validator: a valid field's byte offset (its bit group's) from the message start
     uint64_t valid_offset = 0;
 

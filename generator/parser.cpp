@@ -41,6 +41,8 @@ const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displa
                                                   "malformed",
                                                   // offset tables
                                                   "offsets", "from",
+                                                  // two views of the same bytes
+                                                  "overlay",
                                                   // computed values
                                                   "value",
                                                   // whose message it is
@@ -547,6 +549,7 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
     if (node->base) defer(*node->base, el, node->line, "base");
     if (node->offsets) defer(*node->offsets, el, node->line, "offsets");
     if (node->from) defer(*node->from, el, node->line, "from");
+    if (node->overlay) defer(*node->overlay, el, node->line, "overlay");
     if (node->repeat) defer(*node->repeat, el, node->line, "repeat");
     if (node->count) defer(*node->count, el, node->line, "count");
     if (node->if_field) defer(*node->if_field, el, node->line, "if");
@@ -617,6 +620,7 @@ void Parser::parse_layout_attributes(std::map<std::string, std::string>& attrs, 
     if (attrs.count("base")) node.base = make_ref(attrs["base"], node.line, "base", true);
     if (attrs.count("offsets")) node.offsets = make_ref(attrs["offsets"], node.line, "offsets", false);
     if (attrs.count("from")) node.from = make_ref(attrs["from"], node.line, "from", false);
+    if (attrs.count("overlay")) node.overlay = make_ref(attrs["overlay"], node.line, "overlay", false);
     auto number = [&](const char* name, uint64_t max, std::optional<uint64_t>& out) {
         if (!attrs.count(name)) return;
         uint64_t v = 0;

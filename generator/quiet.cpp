@@ -21,7 +21,8 @@ bool feeds_others(const Node& n, const std::function<bool(const Node&)>& is_key)
 // container, no unused bytes); nullopt otherwise.
 std::optional<uint64_t> infallible_size(const Node& n) {
     // (Hand-offs never get here: they feed another dissector, see feeds_others.)
-    if (n.is_repeated() || n.is_window()) return std::nullopt;
+    // An overlay takes no bytes of the walk: stepping over its size would move it.
+    if (n.is_repeated() || n.is_window() || n.is_overlay()) return std::nullopt;
     if (n.is_computed()) return 0;  // reads fields, raises nothing
     if (n.is_leaf()) {
         if (n.in_bit_group || !n.has_fixed_length() || n.fixed_bits % 8) return std::nullopt;

@@ -80,6 +80,7 @@ private:
     void check_layout(Node& n);
     void check_peek(Node& n, When& w);
     void check_offsets(Node& n);  // offsets="XPATH" from="XPATH"
+    void check_overlay(Node& n);  // overlay="XPATH"
     bool known_before(const Node* t, const Node& n) const;
 
     Protocol& proto_;
@@ -106,6 +107,7 @@ void Validator::run() {
         check_display_direction_handoff(n);
         check_layout(n);
         check_offsets(n);
+        if (n.is_overlay()) check_overlay(n);
         if (n.is_computed()) check_computed(n);
         if (n.unit_given) check_unit(n);  // after check_computed, which settles a computed value's display
     });
@@ -269,6 +271,7 @@ void Validator::close_group(std::vector<Node*>& group, unsigned bits) {
 }
 
 std::optional<uint64_t> Validator::fixed_bytes(const Node& n) const {
+    if (n.is_overlay()) return 0;  // decodes bytes already decoded: the next sibling starts where it would
     if (n.is_repeated() || n.is_conditional()) return std::nullopt;
     if (n.is_computed()) return 0;
     if (n.has_fixed_length()) return n.fixed_bits / 8;
@@ -342,7 +345,7 @@ bool Validator::offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const
                           const Node*& blocker) const {
     for (const auto& c : nodes) {
         if (is_ancestor_or_self(c.get(), t)) {
-            if (!blocker && (c->is_repeated() || c->if_field)) blocker = c.get();
+            if (!blocker && (c->is_repeated() || c->if_field || c->is_overlay())) blocker = c.get();
             return c.get() == t || offset_of(c->children, t, offset, blocker);
         }
         if (c->in_bit_group) {
@@ -363,6 +366,7 @@ std::string pdulength_blocker(const Node& blocker, const Node& t) {
     const std::string self = &blocker == &t ? "it" : "it is inside " + where + ", which";
     if (blocker.is_repeated())
         return encloses ? self + " is repeated" : where + " before it is repeated";
+    if (encloses && blocker.is_overlay()) return self + " is an overlay: its bytes are another node's";
     if (encloses) return self + " has an 'if': a message without it would have no length";
     if (blocker.is_conditional()) return where + " before it is decoded only under a condition";
     return where + " before it has no fixed length";
@@ -392,7 +396,8 @@ void Validator::check_pdulength() {
 std::string valid_blocker(const Node& blocker, const Node& t) {
     const std::string where = quote(blocker) + at_line(blocker);
     const std::string self = &blocker == &t ? "it" : "it is inside " + where + ", which";
-    if (!is_ancestor_or_self(&blocker, &t) || blocker.is_repeated()) return pdulength_blocker(blocker, t);
+    if (!is_ancestor_or_self(&blocker, &t) || blocker.is_repeated() || blocker.is_overlay())
+        return pdulength_blocker(blocker, t);
     if (blocker.is_window() || blocker.at) return self + " is placed by address in a window";
     if (blocker.length_kind == LengthKind::Field)
         return self + " takes its length from a field: a message may end it before";
@@ -994,6 +999,49 @@ void Validator::check_offsets(Node& n) {
     }
 }
 
+// overlay="XPATH": a container decoding the bytes of an earlier leaf or
+// container of the same instance (or outside every repeat), from its first
+// byte. The walk does not move, so the overlay is not placed (window, offset
+// table), repeated or computed.
+void Validator::check_overlay(Node& n) {
+    const std::string what = "'overlay' on " + quote(n);
+    if (n.is_leaf()) {
+        diags_.error(n.line, what + ": an overlay is a container whose children decode the bytes of another node; "
+                                    "put the fields inside it");
+        return;
+    }
+    const char* clash = n.base ? "base" : n.at ? "at" : n.stride ? "stride" : n.instances ? "instances"
+                      : n.offsets ? "offsets" : n.from ? "from" : n.repeat ? "repeat" : n.count ? "count"
+                      : n.repeat_rest ? "repeat" : n.value ? "value" : n.dissector ? "dissector" : nullptr;
+    if (clash) {
+        diags_.error(n.line, what + " cannot have '" + clash + "': an overlay is decoded once, over the bytes of "
+                                    "its target, and does not move the position of the nodes after it");
+        return;
+    }
+    const Node* t = n.overlay->target;
+    if (!t) return;  // the parser already reported the XPath
+    const std::string target = "overlay target " + lines_of(*t);
+    if (t == &n) {
+        diags_.error(n.line, target + " is the overlay itself; select an earlier leaf or container");
+    } else if (is_ancestor_or_self(t, &n)) {
+        diags_.error(n.line, target + " contains " + quote(n) + "; an overlay decodes the bytes of a node decoded "
+                                      "before it, not of its own container");
+    } else if (t->doc_index >= n.doc_index) {
+        diags_.error(n.line, target + " is not decoded before " + quote(n) + "; it must come earlier in the file");
+    } else if (t->is_computed()) {
+        diags_.error(n.line, target + " is a computed value: it has no bytes to decode again");
+    } else {
+        for (const Node* r = t; r; r = r->parent)
+            if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
+                diags_.error(n.line, target + (r == t ? " is repeated" : " is inside repeated node " + lines_of(*r)) +
+                                         ", which does not contain " + quote(n) +
+                                         "; use a node of the same instance or one outside every repeat");
+                return;
+            }
+        mark_slot(const_cast<Node*>(t));
+    }
+}
+
 // Whether the value of t is known when n starts: decoded earlier, in the same
 // repeat instance or outside every repeat.
 bool Validator::known_before(const Node* t, const Node& n) const {
@@ -1032,6 +1080,7 @@ void Validator::check_peek(Node& n, When& w) {
     // Adds the bytes of s (n itself when self) to the offset.
     auto add = [&](const Node& s, bool self) {
         std::string not_known;
+        if (s.is_overlay()) return;  // the walk's position does not move
         if ((!self && s.is_conditional()) || s.is_repeated())
             not_known = lines_of(s) + " is " + (s.is_repeated() ? "repeated" : "conditional");
         else if (s.has_fixed_length())
@@ -1088,9 +1137,11 @@ void Validator::check_peek(Node& n, When& w) {
             return;
         }
         ++up;
-        if (p->is_repeated() || p->is_window()) {
+        if (p->is_repeated() || p->is_window() || p->is_overlay()) {
             diags_.error(w.line, unknown + "container " + lines_of(*p) +
-                                     (p->is_repeated() ? " is repeated" : " is a window"));
+                                     (p->is_repeated() ? " is repeated"
+                                      : p->is_window() ? " is a window"
+                                                       : " is an overlay of another node's bytes"));
             return;
         }
         if (p->length_kind == LengthKind::Children) continue;  // it ends where its children do

@@ -88,6 +88,11 @@ typedef struct dg_extra {
     guint8 from_up = 0;
     guint8 keep_values = 0;   /* an offset leaf: the value of every instance is kept (up to DG_MAX_TABLE) */
     const char *unit = nullptr; /* unit="°C" on a number: " °C", written after its value in summaries */
+    /* overlay="XPATH": this container decodes the bytes of the node in
+     * overlay_slot (a leaf or container decoded before it: its slot keeps
+     * where they are), from their first byte; the walk's position does not
+     * move. -1: not an overlay. */
+    gint16 overlay_slot = -1;
     /* value="EXPR": the operations dg_protocol.exprs[expr_first ..] */
     guint16 expr_first = 0, expr_count = 0;
 } dg_extra;

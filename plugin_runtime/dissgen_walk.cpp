@@ -495,6 +495,21 @@ void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *off
     if (collect) summaries_end(st, n, &summaries);
 }
 
+/* --- overlays ------------------------------------------------------------ */
+
+/* overlay="XPATH": the container decodes the bytes of an earlier node,
+ * from its first byte to its end (its own length, if any, must fit in
+ * them), and leaves the walk's position where it is. Skipped when that node
+ * is not in this message. */
+void dissect_overlay(dg_state *st, const dg_node *n, proto_tree *tree, gboolean in_summary)
+{
+    const gint16 target = n->extra->overlay_slot;
+    if (!st->present[target]) return;
+    const dg_slot *t = &st->slots[target];
+    gint at = t->offset;
+    dissect_container(st, n, tree, &at, t->offset + t->length, in_summary, NULL);
+}
+
 /* --- lists of siblings --------------------------------------------------- */
 
 void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
@@ -513,9 +528,12 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
             *offset += (gint)n->quiet_size; /* nobody would see it, and it cannot be malformed */
             continue;
         }
-        if (n->extra && n->extra->offsets_slot >= 0)
-            dissect_located(st, n, tree, offset, end, in_summary); /* offset table */
-        else if (is_repeated(n))
+        if (n->extra && (n->extra->offsets_slot >= 0 || n->extra->overlay_slot >= 0)) {
+            if (n->extra->overlay_slot >= 0)
+                dissect_overlay(st, n, tree, in_summary); /* the bytes of an earlier node */
+            else
+                dissect_located(st, n, tree, offset, end, in_summary); /* offset table */
+        } else if (is_repeated(n))
             dissect_repeated(st, n, tree, offset, end, in_summary);
         else
             dissect_instance(st, n, tree, offset, end, in_summary, NULL);

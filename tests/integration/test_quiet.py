@@ -265,6 +265,13 @@ def quiet_bits_frames():
     return out
 
 
+def overlays_frames():
+    """tests/rules/overlays.xml: test_overlays.py's messages, well-formed and malformed."""
+    import test_overlays as m
+    rng = random.Random(6)
+    return [m.HEADER + data for _m, data in (m.message(rng) for _ in range(60))]
+
+
 # Rule file (relative to the source folder) -> the captures that exercise it.
 CAPTURES = {
     "tests/rules/widths.xml": widths_frames,
@@ -277,6 +284,7 @@ CAPTURES = {
     "tests/rules/offsets_from.xml": offsets_frames,
     "tests/rules/quiet_bits.xml": quiet_bits_frames,
     "tests/rules/transactions.xml": transactions_frames,
+    "tests/rules/overlays.xml": overlays_frames,
     "tests/rules/computed.xml": computed_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
