@@ -102,6 +102,7 @@ TESTS = {
     "corpus_differential": corpus_differential,
     "transactions": integration("test_transactions.py"),
     "computed": integration("test_computed.py"),
+    "request_context": integration("test_request_context.py"),
     "losses": integration("test_losses.py"),
     "losses_corpus": integration("test_losses.py", "--with-corpus"),
     "findings": integration("test_findings.py"),
