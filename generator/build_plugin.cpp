@@ -29,7 +29,7 @@ std::vector<std::string> split_words(const std::string& s) {
 // own come from the request (BuildRequest::analysis_sources).
 const char* const kRuntimeSources[] = {"dissgen_walk.cpp",    "dissgen_conditions.cpp", "dissgen_text.cpp",
                                        "dissgen_handoff.cpp", "dissgen_register.cpp",   "dissgen_pairing.cpp",
-                                       "dissgen_expr.cpp", "dissgen_validity.cpp"};
+                                       "dissgen_expr.cpp", "dissgen_validity.cpp", "dissgen_request.cpp"};
 
 bool has_runtime(const fs::path& dir) {
     std::error_code ec;

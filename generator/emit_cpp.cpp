@@ -165,7 +165,7 @@ std::string expr_row(const ExprRow& r) {
         std::snprintf(buf, sizeof buf, "%.17g", r.real);
         row = "dg_op_real(" + std::string(buf) + ")";
     }
-    if (r.code.rfind("DG_OP_FIELD", 0) == 0)
+    if (r.code.rfind("DG_OP_FIELD", 0) == 0 || r.code.rfind("DG_OP_REQUEST_FIELD", 0) == 0)
         row = "dg_op_field(" + r.code + ", " + std::to_string(r.slot) + ", " + std::to_string(r.bits) + ")";
     return row;
 }
@@ -301,6 +301,7 @@ private:
     std::string node_row(const Node& n) const;
     std::vector<std::string> summary_rows() const;
     std::string protocol_row() const;
+    void request_context();
     std::string extra_row(const Node& n) const;
     void condition_and_window_tables();
     void protocol_struct();
@@ -506,6 +507,7 @@ void Emitter::protocol_struct() {
                << "extern \"C\" const struct dg_analysis " << analysis->symbol << ";\n";
         o_ << "static const dg_pairing " << f << "_pairing = { " << timeout << ", "
            << (analysis ? "&" + analysis->symbol : std::string("NULL")) << " };\n";
+        if (!p_.request_fields.empty()) request_context();
     }
     o_ << "\nstatic dg_protocol " << f << "_protocol =\n    " << protocol_row() << ";\n\n";
     // valid fields: the entries test them first (dg_valid_*)
@@ -548,8 +550,39 @@ std::string Emitter::protocol_row() const {
     table("places", l_.places);
     if (!l_.exprs.empty()) set.push_back("exprs(" + f + "_exprs)");
     if (p_.pairing) set.push_back("pairing(&" + f + "_pairing)");
+    if (p_.pairing && !p_.request_fields.empty()) set.push_back("request_context(&" + f + "_request_context)");
     if (extra_ && !extra_->analysis_data.empty()) set.push_back("analysis_data(&" + extra_->analysis_data + ")");
     return named_row("dg_protocol_of(" + c_string(p_.name) + ", " + c_string(p_.abbreviation) + ", " + c_string(f) + ")", set);
+}
+
+// request{...}: the key fields where a response reads them before it is
+// decoded (in the walk's order: the document's), and the slots of the fields
+// a request keeps for its responses.
+void Emitter::request_context() {
+    const std::string& f = p_.filter;
+    std::vector<const PairingKey*> keys;
+    for (const PairingKey& k : p_.pairing->keys)
+        if (k.field.target) keys.push_back(&k);
+    std::sort(keys.begin(), keys.end(), [](const PairingKey* a, const PairingKey* b) {
+        return a->field.target->doc_index < b->field.target->doc_index;
+    });
+    std::vector<std::string> key_rows, slot_rows;
+    for (const PairingKey* k : keys) {
+        const Node& n = *k->field.target;
+        key_rows.push_back("/* " + n.name + ", line " + std::to_string(n.line) + " */ { " + std::to_string(k->offset) +
+                           ", " + std::to_string(value_bytes(n)) + ", " +
+                           (n.byteorder == ByteOrder::Little ? "1" : "0") + ", " +
+                           std::to_string(n.in_bit_group ? n.shift : 0) + ", " +
+                           std::to_string(n.in_bit_group ? n.bits : 0) + " }");
+    }
+    for (const Node* n : p_.request_fields)
+        slot_rows.push_back("/* " + n->name + ", line " + std::to_string(n->line) + " */ " + std::to_string(n->slot));
+    o_ << "/* request{...}: the key fields at fixed offsets (offset, bytes, little-endian, shift, bits), and the\n"
+       << " * slots of the fields a request keeps for its responses. */\n"
+       << c_array("static const dg_fixed_field " + f + "_request_keys", key_rows)
+       << c_array("static const gint16 " + f + "_request_slots", slot_rows)
+       << "static const dg_request_context " << f << "_request_context = { " << f << "_request_keys, "
+       << key_rows.size() << ", " << f << "_request_slots, " << slot_rows.size() << " };\n";
 }
 
 void Emitter::register_functions() {

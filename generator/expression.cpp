@@ -115,6 +115,12 @@ private:
             pos_ = end + 1;
             return true;
         }
+        if (s_.compare(pos_, 8, "request{") == 0) {
+            pos_ += 7;  // past "request": the field is read from its brace
+            if (!operand(out)) return false;
+            out.op = ExprOp::RequestField;
+            return true;
+        }
         if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return number(out);
         if (s_.compare(pos_, 5, "index") == 0 &&
             (pos_ + 5 >= s_.size() || !std::isalnum(static_cast<unsigned char>(s_[pos_ + 5])))) {
@@ -245,18 +251,21 @@ void compile_into(const Expr& e, bool as_float, std::vector<ExprRow>& out) {
         if (as_float) out.push_back({"DG_OP_TO_FLOAT"});
         return;
     case ExprOp::Field:
-        row.slot = e.target->slot;
+    case ExprOp::RequestField: {
+        const std::string prefix = e.op == ExprOp::Field ? "DG_OP_FIELD" : "DG_OP_REQUEST_FIELD";
+        row.slot = e.op == ExprOp::Field ? e.target->slot : e.request_index;
         if (e.is_float) {
-            row.code = "DG_OP_FIELD_FLOAT";
+            row.code = prefix + "_FLOAT";
         } else if (e.target->display == Display::Int) {
-            row.code = "DG_OP_FIELD_SIGNED";
+            row.code = prefix + "_SIGNED";
             row.bits = e.target->bits;
         } else {
-            row.code = "DG_OP_FIELD";
+            row.code = prefix;
         }
         out.push_back(row);
         if (as_float && !e.is_float) out.push_back({"DG_OP_TO_FLOAT"});
         return;
+    }
     default:
         break;
     }
@@ -279,7 +288,9 @@ std::vector<ExprRow> compile_expression(const Expr& e, bool as_float) {
 
 unsigned expression_stack_depth(const std::vector<ExprRow>& rows) {
     static const std::vector<std::string> operands = {"DG_OP_INT", "DG_OP_FLOAT", "DG_OP_FIELD",
-                                                      "DG_OP_FIELD_SIGNED", "DG_OP_FIELD_FLOAT", "DG_OP_INDEX"};
+                                                      "DG_OP_FIELD_SIGNED", "DG_OP_FIELD_FLOAT", "DG_OP_INDEX",
+                                                      "DG_OP_REQUEST_FIELD", "DG_OP_REQUEST_FIELD_SIGNED",
+                                                      "DG_OP_REQUEST_FIELD_FLOAT"};
     static const std::vector<std::string> unary = {"DG_OP_TO_FLOAT", "DG_OP_NEG", "DG_OP_NOT", "DG_OP_BITNOT",
                                                    "DG_OP_FNEG", "DG_OP_FNOT"};
     unsigned depth = 0, deepest = 0;

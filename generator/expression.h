@@ -7,7 +7,9 @@
 //
 // Operands: integers (decimal, 0x hex), decimals with a point (1.5),
 // {Name} (the value of an earlier numeric field), index (the instance number
-// of the innermost repeated node, from 0). Operators as in C, with C's
+// of the innermost repeated node, from 0), request{Name} (the value of a
+// field of the paired request message, in a protocol with <pairing>).
+// Operators as in C, with C's
 // precedence: unary - ! ~; * / %; + -; << >>; < <= > >=; == !=; &; ^; |;
 // &&; ||; and parentheses.
 #pragma once
@@ -22,7 +24,7 @@ namespace dissgen {
 struct Node;
 
 enum class ExprOp {
-    Int, Float, Field, Index,                  // operands
+    Int, Float, Field, Index, RequestField,    // operands
     Neg, Not, BitNot,                          // unary
     Mul, Div, Mod, Add, Sub, Shl, Shr,         // binary, arithmetic
     Lt, Le, Gt, Ge, Eq, Ne,                    // binary, comparisons (0 or 1)
@@ -33,8 +35,9 @@ struct Expr {
     ExprOp op = ExprOp::Int;
     int64_t integer = 0;            // Int
     double real = 0;                // Float
-    std::string name;               // Field: the name between the braces
-    Node* target = nullptr;         // Field: resolved by the validator
+    std::string name;               // Field, RequestField: the name between the braces
+    Node* target = nullptr;         // Field, RequestField: resolved by the validator
+    int request_index = -1;         // RequestField: its place among the values a request keeps
     std::vector<Expr> args;         // one (unary) or two (binary) operands
     bool is_float = false;          // derived by the validator: evaluated in double
 };
@@ -43,8 +46,8 @@ struct Expr {
 // (plugin_runtime/dissgen_expr.h) holds it: `code` is its DG_OP_ name.
 struct ExprRow {
     std::string code;
-    unsigned bits = 0;   // DG_OP_FIELD_SIGNED
-    int slot = -1;       // DG_OP_FIELD*
+    unsigned bits = 0;   // DG_OP_FIELD_SIGNED, DG_OP_REQUEST_FIELD_SIGNED
+    int slot = -1;       // DG_OP_FIELD*; DG_OP_REQUEST_FIELD*: the index into the request's kept values
     int64_t integer = 0; // DG_OP_INT
     double real = 0;     // DG_OP_FLOAT
 };

@@ -209,6 +209,9 @@ struct Hook {
 struct PairingKey {
     FieldRef field;
     int line = 0;
+    // derived by the validator when a value reads request{...}: the key
+    // field's byte offset (its bit group's) from the message start
+    uint64_t offset = 0;
 };
 
 struct Pairing {
@@ -237,6 +240,9 @@ struct Protocol {
     // --- derived by the validator ---
     int slot_count = 0;
     unsigned pdu_fixed_len = 0;      // bytes needed to read the pdulength field
+    // the fields of a request that responses read (request{Name}), each once;
+    // a request keeps their values in this order
+    std::vector<const Node*> request_fields;
 };
 
 // Calls fn(node) for every node in document order.

@@ -25,6 +25,8 @@ std::vector<NameGroup> make_groups() {
         {When::Reassembly, "", "the reassembly", "reassembly", {DG_FRAGMENT_FIELDS(DISSGEN_FIELD)}},
         {When::Pairing, "", "the request/response pairing", "pairing",
          {DG_PAIRING_FIELDS(DISSGEN_FIELD) DG_PAIRING_EXPERTS(DISSGEN_EXPERT)}},
+        {When::RequestContext, "", "values read from the paired request", "request context",
+         {DG_REQUEST_CONTEXT_EXPERTS(DISSGEN_EXPERT)}},
         {When::Analysis, DG_ANALYSIS_ETHERCAT_ESC, "the " DG_ANALYSIS_ETHERCAT_ESC " analysis",
          DG_ANALYSIS_ETHERCAT_ESC,
          {DG_ESC_FIELDS(DISSGEN_FIELD) DG_BUS_FIELDS(DISSGEN_FIELD) DG_ESC_EXPERTS(DISSGEN_EXPERT)
@@ -47,6 +49,7 @@ bool applies(const NameGroup& g, const Protocol& proto) {
         case When::Always: return true;
         case When::Reassembly: return reassembles(proto);
         case When::Pairing: return proto.pairing != nullptr;
+        case When::RequestContext: return proto.pairing && !proto.request_fields.empty();
         case When::Analysis: return proto.pairing && proto.pairing->analysis == g.analysis;
     }
     return false;

@@ -27,7 +27,7 @@ struct RuntimeName {
 
 // The names one part of the runtime registers, and for which protocols.
 struct NameGroup {
-    enum class When { Always, Reassembly, Pairing, Analysis };
+    enum class When { Always, Reassembly, Pairing, RequestContext, Analysis };
     When when;
     const char* analysis;  // When::Analysis: the <pairing analysis="..."> it belongs to
     const char* owner;     // in diagnostics: "is reserved for OWNER"

@@ -56,6 +56,9 @@ private:
     void check_pdulength();
     void check_computed(Node& n);
     bool check_expr(Node& n, Expr& e);
+    bool check_request_field(Node& n, Expr& e);
+    void check_request_keys();
+    const Node* fixed_offset_blocker(const Node& n, uint64_t& offset) const;
     const Node* find_earlier(const Node& n, const std::string& name);
     void check_validity();  // valid="LIST" fields and <heuristic>
     void check_pairing();
@@ -114,6 +117,7 @@ void Validator::run() {
     check_pdulength();
     check_validity();
     check_pairing();
+    check_request_keys();
     runtime_names_ = name_groups_of(proto_);
     assign_filter_names(proto_.nodes, proto_.filter);
     assign_slots();
@@ -407,6 +411,21 @@ std::string valid_blocker(const Node& blocker, const Node& t) {
 // valid="LIST": tested before anything is added to the tree, so each such
 // field sits at a fixed offset and is decoded in every message; an 'ifhook'
 // on it or a container only limits the messages it is tested in.
+// What keeps n from being at a fixed offset from the start of every message
+// (a field before it of no fixed length; n or a container of it repeated,
+// conditional, placed in a window or cut short by a length field), or
+// nullptr with `offset` set.
+const Node* Validator::fixed_offset_blocker(const Node& n, uint64_t& offset) const {
+    const Node* blocker = nullptr;
+    offset_of(proto_.nodes, &n, offset, blocker);
+    for (const Node* a = &n; a; a = a->parent) {
+        const bool conditional = a->if_field || !a->whens.empty() || a->otherwise || a->direction != Direction::Any;
+        const bool placed = a->is_window() || a->at || (a != &n && a->length_kind == LengthKind::Field);
+        if (!blocker && (conditional || placed)) blocker = a;
+    }
+    return blocker;
+}
+
 void Validator::check_validity() {
     bool unhooked = false;  // a valid field tested in every message, whatever the hook
     for_each_node(proto_.nodes, [&](Node& n) {
@@ -422,15 +441,9 @@ void Validator::check_validity() {
             return;
         }
         uint64_t offset = 0;
-        const Node* blocker = nullptr;
-        offset_of(proto_.nodes, &n, offset, blocker);
+        const Node* blocker = fixed_offset_blocker(n, offset);
         bool hooked = false;
-        for (const Node* a = &n; a; a = a->parent) {
-            hooked = hooked || a->has_hook;
-            const bool conditional = a->if_field || !a->whens.empty() || a->otherwise || a->direction != Direction::Any;
-            const bool placed = a->is_window() || a->at || (a != &n && a->length_kind == LengthKind::Field);
-            if (!blocker && (conditional || placed)) blocker = a;
-        }
+        for (const Node* a = &n; a; a = a->parent) hooked = hooked || a->has_hook;
         if (blocker) {
             diags_.error(n.line, "'valid' field " + quote(n) + " must be at a fixed offset from the start of the message, "
                                  "in every message: " + valid_blocker(*blocker, n));
@@ -655,6 +668,7 @@ bool Validator::check_expr(Node& n, Expr& e) {
             if (r->is_repeated()) return true;
         diags_.error(n.line, "'index'" + in + ": it is not inside a repeated node, so there is no instance to count");
         return false;
+    case ExprOp::RequestField: return check_request_field(n, e);
     case ExprOp::Field: {
         const Node* t = find_earlier(n, e.name);
         if (!t) {
@@ -704,6 +718,82 @@ bool Validator::check_expr(Node& n, Expr& e) {
                              (e.op >= ExprOp::Lt && e.op <= ExprOp::Ne);
     e.is_float = any_float && !gives_truth;
     return true;
+}
+
+// request{Name}: a field of the paired request. Of the nodes named Name,
+// the first one decoded only in requests (it or a container of it has
+// direction="request"), else the first one in the file. Numeric, outside
+// every repeat (a request keeps one value of it), and in a protocol whose
+// messages are paired.
+bool Validator::check_request_field(Node& n, Expr& e) {
+    const std::string what = "request{" + e.name + "} in the value of " + quote(n);
+    if (!proto_.pairing) {
+        diags_.error(n.line, what + ": the protocol has no <pairing>, so no message has a request to read; add a "
+                                    "<pairing> with the key fields a response repeats from its request");
+        return false;
+    }
+    auto only_in = [](const Node& c, Direction d) {
+        for (const Node* a = &c; a; a = a->parent)
+            if (a->direction == d) return true;
+        return false;
+    };
+    const Node* t = nullptr;
+    for_each_node(proto_.nodes, [&](Node& c) {
+        if (c.name != e.name) return;
+        if (!t || (only_in(c, Direction::Request) && !only_in(*t, Direction::Request))) t = &c;
+    });
+    if (!t) {
+        std::vector<std::string> names;
+        for_each_node(proto_.nodes, [&](Node& c) { names.push_back(c.name); });
+        const std::string near = closest_match(e.name, names);
+        diags_.error(n.line, what + ": no node has that name" +
+                                 (near.empty() ? "" : " (did you mean request{" + near + "}?)"));
+        return false;
+    }
+    if (!t->is_numeric() && !t->is_computed()) {
+        diags_.error(n.line, what + " is " + quote(*t) + at_line(*t) +
+                                 ", which is not numeric: it must be a leaf of 1-64 bits shown as a number, "
+                                 "or a computed value");
+        return false;
+    }
+    for (const Node* r = t; r; r = r->parent)
+        if (r->is_repeated()) {
+            diags_.error(n.line, what + " is inside repeated node " + quote(*r) + at_line(*r) +
+                                     ": a request keeps one value of each field; use a field outside every repeat");
+            return false;
+        }
+    if (only_in(*t, Direction::Response)) {
+        diags_.error(n.line, what + " is " + quote(*t) + at_line(*t) +
+                                 ", which is decoded only in responses (direction=\"response\"): a request never "
+                                 "has it");
+        return false;
+    }
+    e.target = const_cast<Node*>(t);
+    e.is_float = t->display == Display::Float;
+    auto& kept = proto_.request_fields;
+    auto it = std::find(kept.begin(), kept.end(), t);
+    e.request_index = static_cast<int>(it - kept.begin());
+    if (it == kept.end()) kept.push_back(t);
+    mark_slot(e.target);
+    return true;
+}
+
+// With request{...}, a response looks its request up before it is decoded:
+// the key fields must be at fixed offsets from the start of every message.
+void Validator::check_request_keys() {
+    if (!proto_.pairing || proto_.request_fields.empty()) return;
+    for (PairingKey& key : proto_.pairing->keys) {
+        const Node* t = key.field.target;
+        if (!t || !t->is_numeric()) continue;  // reported
+        uint64_t offset = 0;
+        if (const Node* blocker = fixed_offset_blocker(*t, offset)) {
+            diags_.error(key.line, "key field " + quote(*t) + " must be at a fixed offset from the start of the "
+                                   "message, in every message, for request{" + proto_.request_fields.front()->name +
+                                   "}: " + valid_blocker(*blocker, *t));
+            continue;
+        }
+        key.offset = offset;
+    }
 }
 
 // --- display types, range enums, repeat="rest", direction, hand-off, reassembly ---

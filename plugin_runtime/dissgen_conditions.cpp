@@ -21,6 +21,12 @@ gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char
 {
     const dg_slot *s = &st->slots[ref->slot];
     if (!st->present[ref->slot]) {
+        if (st->request_missed) {
+            /* For want of the request (its expert info says so once): not
+             * malformed, but nothing after it can be placed. */
+            st->stopped = TRUE;
+            return FALSE;
+        }
         report(st, tree, &st->p->ei->bad_length, offset, 0, "The %s of '%s' comes from a field that is not in this packet",
                what, n->name);
         return FALSE;

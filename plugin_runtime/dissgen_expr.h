@@ -2,8 +2,9 @@
 /* Computed values (value="..." in the rules): an expression compiled by
  * dissgen into operations in postfix order, evaluated here on a small stack.
  *
- * Pure: no packet, no tree. The walk hands in how to read a slot's value and
- * the current instance index (dissgen_walk's computed leaves).
+ * Pure: no packet, no tree. The walk hands in how to read a slot's value, how
+ * to read a value the paired request kept (request{Name}), and the current
+ * instance index (dissgen_walk's computed leaves).
  *
  * Integers are 64-bit two's complement and wrap; a shift by 64 or more gives
  * 0 (>> shifts the bit pattern, as for unsigned values). A value is
@@ -22,6 +23,9 @@ enum dg_expr_code {
     DG_OP_FIELD,        /* slot's value, unsigned */
     DG_OP_FIELD_SIGNED, /* slot's value, sign-extended from `bits` */
     DG_OP_FIELD_FLOAT,  /* slot's value holds a double's bits (a float computed value) */
+    /* request{Name}: as the three above, `slot` the index of the value the
+     * paired request kept */
+    DG_OP_REQUEST_FIELD, DG_OP_REQUEST_FIELD_SIGNED, DG_OP_REQUEST_FIELD_FLOAT,
     DG_OP_INDEX,        /* the instance number of the innermost repeat */
     DG_OP_TO_FLOAT,     /* the integer on top becomes a double */
     /* unary, on integers (F: on doubles) */
@@ -37,8 +41,8 @@ enum dg_expr_code {
 
 typedef struct dg_expr_op {
     guint8 code;    /* dg_expr_code */
-    guint8 bits;    /* DG_OP_FIELD_SIGNED: the field's width */
-    gint16 slot;    /* DG_OP_FIELD*: where the field's value is kept */
+    guint8 bits;    /* DG_OP_*FIELD_SIGNED: the field's width */
+    gint16 slot;    /* DG_OP_FIELD*: where the field's value is kept; DG_OP_REQUEST_FIELD*: its index */
     gint64 integer; /* DG_OP_INT */
     gdouble real;   /* DG_OP_FLOAT */
 } dg_expr_op;
@@ -56,6 +60,8 @@ typedef struct dg_expr_value {
     gdouble real;
 } dg_expr_value;
 
-/* Evaluates ops[0 .. count); the result's is_float tells which member holds it. */
-dg_expr_value dg_expr_eval(const dg_expr_op *ops, guint count, dg_slot_reader read, const void *context,
-                           guint32 index);
+/* Evaluates ops[0 .. count); the result's is_float tells which member holds
+ * it. read_request reads the request's kept values (DG_OP_REQUEST_FIELD*);
+ * NULL: they are undefined. */
+dg_expr_value dg_expr_eval(const dg_expr_op *ops, guint count, dg_slot_reader read, dg_slot_reader read_request,
+                           const void *context, guint32 index);

@@ -77,6 +77,12 @@
     X(duplicate, "expert.duplicate", PI_SEQUENCE, PI_NOTE, "Duplicate message")                             \
     X(out_of_order, "expert.out_of_order", PI_SEQUENCE, PI_NOTE, "Response out of order")
 
+/* --- A protocol whose values read request{...} (dissgen_request.cpp) ------- */
+
+#define DG_REQUEST_CONTEXT_EXPERTS(X)                                                                      \
+    X(no_request_context, "expert.no_request_context", PI_SEQUENCE, PI_NOTE,                                \
+      "The request of this response is not in the capture: the values read from it are unknown")
+
 /* --- The ethercat-esc analysis: ESC forwarding (ethercat_esc.cpp) ---------- */
 
 #define DG_ANALYSIS_ETHERCAT_ESC "ethercat-esc"

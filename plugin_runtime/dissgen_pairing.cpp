@@ -808,6 +808,7 @@ void dg_pairing_register(const dg_protocol *p)
     expert_module_t *experts = expert_register_protocol(*p->proto);
     expert_register_field_array(experts, ei, (int)G_N_ELEMENTS(ei));
 
+    if (p->request_context) dg_request_register(p, experts);
     if (analysis && analysis->register_info) analysis->register_info(*p->proto, p->filter);
     register_init_routine(capture_init);
     register_cleanup_routine(capture_cleanup);
@@ -829,6 +830,17 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, 
     }
     show(fp, tvb, pinfo, tree);
     return fp;
+}
+
+const dg_transaction *dg_pairing_waiting(const guint64 *keys, guint key_count, const packet_info *pinfo)
+{
+    if (!capture || key_count == 0) return NULL;
+    pair_key probe = {key_count, (guint64 *)keys};
+    const key_entry *e = (const key_entry *)wmem_map_lookup(capture->keys, &probe);
+    if (!e) return NULL;
+    for (const pending *q = e->waiting.head; q; q = q->next)
+        if (!q->done && !given_up(capture, q, pinfo, protocol->pairing->timeout)) return q->txn;
+    return NULL;
 }
 
 void dg_pairing_stats_init(const dg_protocol *, stats_tree *st)

@@ -31,7 +31,16 @@ typedef struct dg_transaction {
     guint64 seq;             /* requests in capture order, from 1 */
     guint32 given_up_in;     /* no response: the frame that proved it (the key
                               * reused, the timeout passed); 0 while not known */
+    const struct dg_request_values *values; /* request{...}: what the request kept, or NULL */
 } dg_transaction;
+
+/* The values of the fields a request keeps for its responses
+ * (dg_request_context.slots, in that order), in wmem_file_scope. */
+typedef struct dg_request_values {
+    guint count;
+    guint64 *values;
+    guint8 *present;         /* per value: the request had the field */
+} dg_request_values;
 
 /* The requests a message proved lost: each was given up while this message
  * was paired (its key reused, or its timeout passed). */
@@ -125,6 +134,14 @@ void dg_pairing_register(const dg_protocol *p);
 const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
                                            const guint64 *keys, guint key_count, gint length, guint message,
                                            guint8 direction);
+
+/* First pass, before a message is decoded: the transaction of the request
+ * with these key values that the message would answer (its key's oldest
+ * request still waiting), or NULL. Changes nothing. */
+const dg_transaction *dg_pairing_waiting(const guint64 *keys, guint key_count, const packet_info *pinfo);
+
+/* At registration (dg_pairing_register): request{...}'s expert info. */
+void dg_request_register(const dg_protocol *p, expert_module_t *experts);
 
 void dg_pairing_stats_init(const dg_protocol *p, stats_tree *st);
 void dg_pairing_stats_packet(const dg_protocol *p, stats_tree *st, packet_info *pinfo, const dg_frame_pairing *fp);

@@ -143,6 +143,7 @@ struct dg_protocol_row {
     constexpr dg_protocol_row &pairing(const dg_pairing *v) { p.pairing = v; return *this; }
     constexpr dg_protocol_row &analysis_data(const void *v) { p.analysis_data = v; return *this; }
     constexpr dg_protocol_row &exprs(const dg_expr_op *v) { p.exprs = v; return *this; }
+    constexpr dg_protocol_row &request_context(const dg_request_context *v) { p.request_context = v; return *this; }
 };
 
 /* Operations of computed values: dg_op(CODE) for operators and index, and

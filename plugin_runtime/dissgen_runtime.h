@@ -201,6 +201,24 @@ typedef struct dg_pairing {
     const struct dg_analysis *analysis; /* NULL, or the protocol analysis the rule file names */
 } dg_pairing;
 
+/* request{Name} in computed values: a response reads fields of its paired
+ * request (dissgen_request.cpp). The key fields sit at fixed offsets, so
+ * that a response finds its request before it is decoded; a request keeps
+ * the values of the fields in `slots`, in that order, for its responses. */
+typedef struct dg_fixed_field {
+    guint32 offset;     /* bytes from the message start (a bit field: its group's) */
+    guint8 length;      /* bytes read */
+    guint8 little;
+    guint8 shift, bits; /* bits > 0: a bit field, `bits` wide, `shift` bits up */
+} dg_fixed_field;
+
+typedef struct dg_request_context {
+    const dg_fixed_field *keys; /* the key fields, in the order the walk decodes them */
+    guint16 key_count;
+    const gint16 *slots;        /* the slots of the fields a request keeps */
+    guint16 kept_count;
+} dg_request_context;
+
 typedef struct dg_protocol {
     const char *name;        /* long name, e.g. "EtherCAT" */
     const char *short_name;  /* Protocol column, e.g. "ECATR" */
@@ -242,6 +260,9 @@ typedef struct dg_protocol {
      * generated code gives it only when there is some. */
     const void *analysis_data = nullptr;
     const dg_expr_op *exprs = nullptr; /* computed values' operations, NULL when none */
+    /* request{...}: NULL when no value reads the paired request. Generated
+     * code gives it only for protocols that use it. */
+    const dg_request_context *request_context = nullptr;
 } dg_protocol;
 
 /* The entry points generated code calls. C linkage: plain symbol

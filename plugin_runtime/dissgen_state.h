@@ -90,6 +90,9 @@ struct dg_state {
     /* the values of the <pairing> key fields (DG_KEY), in decoding order */
     guint64 *keys;
     guint key_count, key_capacity;
+    /* request{...}: what the paired request kept, NULL when it is not known */
+    const dg_request_values *request;
+    mutable gboolean request_missed; /* a value read the request, and it is not known */
 };
 
 /* --- dissgen_walk.cpp ---------------------------------------------------- */
@@ -149,6 +152,16 @@ void dissect_handoff(dg_state *st, const dg_node *n, proto_tree *tree, gint offs
 
 /* At handoff: the dissectors that dissector= names, the reassembled sources' names. */
 void find_handoff_dissectors(const dg_protocol *p);
+
+/* --- dissgen_request.cpp ------------------------------------------------- */
+
+/* Before the walk: the request this message answers, or none (st->request). */
+void request_begin(dg_state *st, guint message);
+/* After the walk and the pairing: a request keeps its values (first pass);
+ * a message that read an unknown request says so. */
+void request_end(dg_state *st, const dg_frame_pairing *fp, proto_tree *tree);
+/* The evaluator's reader of request{...} values (dissgen_expr.h). */
+gboolean read_request(const void *context, gint16 index, guint64 *value);
 
 /* --- dissgen_register.cpp ------------------------------------------------ */
 

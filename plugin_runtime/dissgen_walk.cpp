@@ -186,7 +186,8 @@ void dissect_computed(dg_state *st, const dg_node *n, proto_tree *tree, gint off
 {
     if (!tree && !value_wanted(st, n)) return;
     const dg_extra *x = n->extra;
-    dg_expr_value v = dg_expr_eval(&st->p->exprs[x->expr_first], x->expr_count, read_slot, st, st->instance);
+    dg_expr_value v = dg_expr_eval(&st->p->exprs[x->expr_first], x->expr_count, read_slot, read_request, st,
+                                   st->instance);
     if (!v.defined) return;
     guint64 bits = (guint64)v.integer;
     if (v.is_float) memcpy(&bits, &v.real, sizeof bits);
@@ -651,12 +652,14 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     proto_item *root = tree ? proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA) : NULL;
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
     gint offset = 0;
+    if (p->request_context) request_begin(&st, *messages - 1);
     dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
     proto_item_set_len(root, offset);
     if (p->pairing) {
         const dg_frame_pairing *fp =
             dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, *messages - 1, st.direction);
         if (st.tap) st.tap->pairing = fp;
+        if (p->request_context) request_end(&st, fp, subtree);
     }
 
     if (st.tap) tap_queue_packet(stats_tap, pinfo, st.tap);

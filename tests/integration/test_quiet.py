@@ -249,6 +249,15 @@ def computed_frames():
     return [m.ethernet_frame(body) for _, body in m.messages(77, 40)]
 
 
+def request_context_frames():
+    """tests/rules/request_context.xml: read transactions in flight together, then responses
+    without their requests (test_request_context.py's messages)."""
+    import test_request_context as m
+    txns = m.transactions(47502, 30)
+    paired = [m.frame(d, m.payload(d, txns[k])) for d, k in m.schedule(txns, 1)]
+    return paired + [m.frame("response", m.payload("response", t)) for t in txns[:10]]
+
+
 def quiet_bits_frames():
     """tests/rules/quiet_bits.xml with random values: whole-byte members in the middle of groups."""
     rng = random.Random(5)
@@ -286,6 +295,7 @@ CAPTURES = {
     "tests/rules/transactions.xml": transactions_frames,
     "tests/rules/overlays.xml": overlays_frames,
     "tests/rules/computed.xml": computed_frames,
+    "tests/rules/request_context.xml": request_context_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,

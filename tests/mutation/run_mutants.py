@@ -103,6 +103,7 @@ TESTS = {
     "transactions": integration("test_transactions.py"),
     "computed": integration("test_computed.py"),
     "overlays": integration("test_overlays.py"),
+    "request_context": integration("test_request_context.py"),
     "losses": integration("test_losses.py"),
     "losses_corpus": integration("test_losses.py", "--with-corpus"),
     "findings": integration("test_findings.py"),

@@ -85,7 +85,7 @@ Evaluated evaluate(const std::string& expr, const Slots& by_name, guint32 index 
         const Node* n = find(*f.proto, names[name]);
         if (n->slot >= 0) slots[static_cast<gint16>(n->slot)] = value;
     }
-    out.v = dg_expr_eval(ops.data(), static_cast<guint>(ops.size()), read_slot, &slots, index);
+    out.v = dg_expr_eval(ops.data(), static_cast<guint>(ops.size()), read_slot, nullptr, &slots, index);
     return out;
 }
 

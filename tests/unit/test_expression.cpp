@@ -3,6 +3,7 @@
 // name resolution and typing of expressions.
 #include <gtest/gtest.h>
 
+#include "emit_cpp.h"
 #include "expression.h"
 #include "test_support.h"
 
@@ -16,6 +17,7 @@ std::string prefix(const Expr& e) {
     case ExprOp::Float: return std::to_string(e.real).substr(0, 4);
     case ExprOp::Field: return "{" + e.name + "}";
     case ExprOp::Index: return "#";
+    case ExprOp::RequestField: return "request{" + e.name + "}";
     default: break;
     }
     std::string out = std::string("(") + expr_op_text(e.op);
@@ -78,6 +80,58 @@ const char* const kHead =
     "  <node name=\"Reference\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
     "  <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
     "  <node name=\"Raw\" length=\"2byte\" displaytype=\"int\"/>\n";
+
+TEST(Expression, RequestOperand) {
+    EXPECT_EQ(parsed("request{Reference} + index"), "(+ request{Reference} #)");
+    EXPECT_EQ(parsed("request{A}*{B}"), "(* request{A} {B})");
+    EXPECT_EQ(parsed("request{A"), "error: missing '}' at character 8");
+    EXPECT_EQ(parsed("request{}"), "error: empty field name '{}' at character 8");
+    EXPECT_EQ(parsed("request"), "error: expected a number, {field}, index or '(' but found 'r' at character 1");
+}
+
+// A response reads its request: the first request-only node of the name,
+// one kept value per field however often it is read, the keys' offsets.
+TEST(Computed, RequestFieldsAreKeptOnceAndTheKeysPlaced) {
+    Front f = front_end(
+        "<root name=\"Test\" abbreviation=\"TST\" byteorder=\"big\">\n"
+        "  <hook table=\"udp.port\" value=\"47502\"/>\n"
+        "  <pairing>\n"
+        "    <key field=\"node[@name='Unit']\"/>\n"
+        "    <key field=\"node[@name='Transaction']\"/>\n"
+        "  </pairing>\n"
+        "  <node name=\"Transaction\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+        "  <node name=\"Flags\" length=\"4bit\" displaytype=\"numberhex\"/>\n"
+        "  <node name=\"Unit\" length=\"4bit\" displaytype=\"numberdec\"/>\n"
+        "  <node name=\"Reference\" length=\"2byte\" displaytype=\"int\"/>\n"
+        "  <node name=\"Ask\" direction=\"request\">\n"
+        "    <node name=\"Reference\" filter=\"ref\" length=\"2byte\" displaytype=\"int\"/>\n"
+        "  </node>\n"
+        "  <node name=\"First\" value=\"request{Reference} + 1\" direction=\"response\"/>\n"
+        "  <node name=\"Last\" value=\"request{Reference} + request{Transaction}\" direction=\"response\"/>\n"
+        "</root>\n");
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Node* asked = f.proto->nodes[4]->children[0].get();
+    ASSERT_EQ(f.proto->request_fields.size(), 2u);
+    EXPECT_EQ(f.proto->request_fields[0], asked);  // the request-only one, not the earlier one
+    EXPECT_EQ(f.proto->request_fields[1], f.proto->nodes[0].get());
+    const Node& last = *f.proto->nodes[6];
+    EXPECT_EQ(last.value->args[0].request_index, 0);
+    EXPECT_EQ(last.value->args[1].request_index, 1);
+    EXPECT_GE(asked->slot, 0);
+    EXPECT_EQ(f.proto->pairing->keys[0].offset, 2u);  // Unit: its bit group's offset
+    EXPECT_EQ(f.proto->pairing->keys[1].offset, 0u);
+    const std::vector<ExprRow> rows = compile_expression(*last.value, false);
+    ASSERT_EQ(rows.size(), 3u);
+    EXPECT_EQ(rows[0].code, "DG_OP_REQUEST_FIELD_SIGNED");  // an int field is sign-extended
+    EXPECT_EQ(rows[0].bits, 16u);
+    EXPECT_EQ(rows[1].code, "DG_OP_REQUEST_FIELD");
+    EXPECT_EQ(rows[1].slot, 1);
+    const std::string code = emit_cpp(*f.proto, "rules.xml");
+    // the keys in the walk's order (the document's), each where it sits
+    EXPECT_TRUE(contains(code, "/* Transaction, line 7 */ { 0, 2, 0, 0, 0 },\n    /* Unit, line 9 */ { 2, 1, 0, 0, 4 }")) << code;
+    EXPECT_TRUE(contains(code, "request_context(&tst_request_context)")) << code;
+    EXPECT_TRUE(contains(code, "dg_op_field(DG_OP_REQUEST_FIELD_SIGNED, 0, 16)")) << code;
+}
 
 TEST(Computed, ResolvesTheClosestEarlierFieldAndTypes) {
     Front f = front_end(rules(std::string(kHead) +

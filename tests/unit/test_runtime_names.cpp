@@ -57,6 +57,8 @@ Scaffold scaffold_for(const NameGroup& g) {
                     {"  <node name=\"Data\" length=\"rest\" reassemble-id=\"../node[@name='Id']\" "
                      "reassemble-seq=\"../node[@name='Seq']\" reassemble-more=\"../node[@name='Seq']\"/>"}};
         case When::Pairing: return {{"  <pairing>", key, "  </pairing>", id}, {}};
+        case When::RequestContext:
+            return {{"  <pairing>", key, "  </pairing>", id}, {"  <node name=\"Again\" value=\"request{Id}\"/>"}};
         case When::Analysis:
             return {{"  <pairing analysis=\"" + std::string(g.analysis) + "\">", key, "  </pairing>", id}, {}};
     }

@@ -1,0 +1,122 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* request{Name}: computed values of a response that read fields of its
+ * paired request (dg_request_context in dissgen_runtime.h).
+ *
+ * The pairing links a response to its request only after the response was
+ * decoded; a response that reads its request needs it before. So:
+ *  - a request keeps the values of the fields responses read in its
+ *    transaction (wmem_file_scope), on the first pass, once it is paired;
+ *  - before a message is decoded, on the first pass, its key fields are read
+ *    at their fixed offsets and the request it would answer (its key's oldest
+ *    one still waiting) is looked up; what that request kept (or that there
+ *    is none) is saved for the frame (p_add_proto_data), and later passes
+ *    (tshark -2, the GUI in any order) read only that: every pass decodes
+ *    the message alike.
+ * A message whose values read a request that is not known (not captured, a
+ * request of its own, too short to hold its keys) shows them undefined and
+ * says so once (P.expert.no_request_context).
+ */
+#include "dissgen_state.h"
+
+#include <epan/proto_data.h>
+
+using namespace dg_rt;
+
+namespace {
+
+/* Key of the per-frame request values (p_add_proto_data), plus the message number. */
+const guint32 frame_key = 0x72716378u; /* "rqcx" */
+
+/* Saved for a message that found no request: a frame without it was not
+ * decoded on the first pass. */
+const dg_request_values no_request = {0, NULL, NULL};
+
+expert_field ei_no_request_context = EI_INIT;
+
+/* The key values at their fixed offsets, FALSE when the message is too short. */
+gboolean read_keys(const dg_state *st, guint64 *keys)
+{
+    const dg_request_context *rc = st->p->request_context;
+    for (guint16 i = 0; i < rc->key_count; i++) {
+        const dg_fixed_field *k = &rc->keys[i];
+        if ((gint64)k->offset + k->length > (gint64)st->packet_end) return FALSE;
+        guint64 v = read_uint(st->tvb, (gint)k->offset, k->length, k->little ? ENC_LITTLE_ENDIAN : ENC_BIG_ENDIAN);
+        keys[i] = k->bits ? bit_field(v, k->shift, k->bits) : v;
+    }
+    return TRUE;
+}
+
+/* First pass: what the waiting request of this message's key kept. A message
+ * that goes to the hooked port is a request: it answers nothing. */
+const dg_request_values *find_request(const dg_state *st)
+{
+    if (st->direction == DG_DIR_REQUEST) return NULL;
+    const dg_request_context *rc = st->p->request_context;
+    guint64 *keys = wmem_alloc_array(st->pinfo->pool, guint64, rc->key_count);
+    if (!read_keys(st, keys)) return NULL;
+    const dg_transaction *t = dg_pairing_waiting(keys, rc->key_count, st->pinfo);
+    return t ? t->values : NULL;
+}
+
+/* A request's kept values, from the slots of the message just decoded. */
+const dg_request_values *keep_values(const dg_state *st)
+{
+    const dg_request_context *rc = st->p->request_context;
+    dg_request_values *v = wmem_new(wmem_file_scope(), dg_request_values);
+    v->count = rc->kept_count;
+    v->values = wmem_alloc_array(wmem_file_scope(), guint64, rc->kept_count);
+    v->present = (guint8 *)wmem_alloc0(wmem_file_scope(), rc->kept_count);
+    for (guint16 i = 0; i < rc->kept_count; i++) {
+        const gint16 slot = rc->slots[i];
+        v->present[i] = st->present[slot];
+        v->values[i] = st->present[slot] ? st->slots[slot].value : 0;
+    }
+    return v;
+}
+
+} // namespace
+
+namespace dg_rt {
+
+void request_begin(dg_state *st, guint message)
+{
+    const int proto = *st->p->proto;
+    const dg_request_values *v;
+    if (PINFO_FD_VISITED(st->pinfo)) {
+        v = (const dg_request_values *)p_get_proto_data(wmem_file_scope(), st->pinfo, proto, frame_key + message);
+    } else {
+        v = find_request(st);
+        p_add_proto_data(wmem_file_scope(), st->pinfo, proto, frame_key + message,
+                         (void *)(v ? v : &no_request));
+    }
+    st->request = v && v != &no_request ? v : NULL;
+}
+
+void request_end(dg_state *st, const dg_frame_pairing *fp, proto_tree *tree)
+{
+    if (!PINFO_FD_VISITED(st->pinfo) && fp && fp->role == DG_ROLE_REQUEST && fp->txn && !fp->txn->values)
+        fp->txn->values = keep_values(st);
+    if (st->request_missed) proto_tree_add_expert(tree, st->pinfo, &ei_no_request_context, st->tvb, 0, 0);
+}
+
+gboolean read_request(const void *context, gint16 index, guint64 *value)
+{
+    const dg_state *st = (const dg_state *)context;
+    if (!st->request) {
+        st->request_missed = TRUE;
+        return FALSE;
+    }
+    if (index < 0 || (guint)index >= st->request->count || !st->request->present[index]) return FALSE;
+    *value = st->request->values[index];
+    return TRUE;
+}
+
+} // namespace dg_rt
+
+extern "C" void dg_request_register(const dg_protocol *p, expert_module_t *experts)
+{
+    static ei_register_info ei[] = {DG_REQUEST_CONTEXT_EXPERTS(DG_EI_ROW)};
+    static const char *const names[] = {DG_REQUEST_CONTEXT_EXPERTS(DG_EXPERT_NAME)};
+    dg_name_experts(ei, names, G_N_ELEMENTS(ei), p->filter);
+    expert_register_field_array(experts, ei, (int)G_N_ELEMENTS(ei));
+}

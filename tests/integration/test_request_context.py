@@ -1,0 +1,166 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""request{Name}: a response's values read from its paired request (tests/rules/request_context.xml,
+Modbus/TCP's read functions over UDP port 47502, keys: transaction and unit).
+
+  test_request_context.py --dissgen build/bin/dissgen --source-dir .
+
+Generated captures of read transactions, several in flight at once (different keys, answered
+out of order). Function 3: each register's number is the request's reference plus its index;
+function 1 (one byte per coil): as many coils as the request's quantity, numbered the same way.
+Checked against the bytes in one pass and with -2. The same capture without its requests:
+every response decodes what it can (register values, no numbers, no coils), says so with
+rqc.expert.no_request_context once, and raises no malformed expert. Needs no corpus.
+"""
+
+import os
+import random
+import struct
+import sys
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
+import pcapgen  # noqa: E402
+
+ARGS = None
+PORT = 47502
+CLIENT, SERVER = b"\x0a\x00\x00\x01", b"\x0a\x00\x00\x02"
+FIELDS = ["frame.number", "rqc.transaction", "rqc.registers.values.register.value",
+          "rqc.registers.values.register.number", "rqc.coils.coil.state", "rqc.coils.coil.number",
+          "rqc.coils.coil_count", "rqc.request_in", "rqc.expert.no_request_context", "rqc.expert.bad_length",
+          "_ws.expert.severity"]
+
+
+def transactions(seed, n):
+    """n read transactions: (transaction, unit, function, reference, quantity, values)."""
+    rng = random.Random(seed)
+    out = []
+    for i in range(n):
+        function = rng.choice([1, 3])
+        quantity = rng.choice([1, 2, 5, rng.randrange(1, 40)])
+        reference = rng.choice([0, 1, 65535 - quantity, rng.randrange(65536 - quantity)])
+        values = [rng.randrange(65536 if function == 3 else 2) for _ in range(quantity)]
+        out.append((1 + (i * 7919) % 65535, rng.choice([1, 2]), function, reference, quantity, values))
+    return out
+
+
+def schedule(txns, seed):
+    """Messages in capture order: up to three transactions in flight, answered in any order."""
+    rng = random.Random(seed)
+    order, waiting, pending = [], [], list(range(len(txns)))
+    while pending or waiting:
+        if pending and (len(waiting) < 3 and (not waiting or rng.random() < 0.6)):
+            k = pending.pop(0)
+            order.append(("request", k))
+            waiting.append(k)
+        else:
+            order.append(("response", waiting.pop(rng.randrange(len(waiting)))))
+    return order
+
+
+def payload(direction, txn):
+    transaction, unit, function, reference, quantity, values = txn
+    if direction == "request":
+        pdu = struct.pack(">BHH", function, reference, quantity)
+    elif function == 3:
+        pdu = struct.pack(">BB", function, 2 * quantity) + b"".join(struct.pack(">H", v) for v in values)
+    else:
+        pdu = struct.pack(">BB", function, quantity) + bytes(values)
+    return struct.pack(">HHHB", transaction, 0, 1 + len(pdu), unit) + pdu
+
+
+def frame(direction, data):
+    sport, dport = (40000, PORT) if direction == "request" else (PORT, 40000)
+    src, dst = (CLIENT, SERVER) if direction == "request" else (SERVER, CLIENT)
+    u = struct.pack("!HHHH", sport, dport, 8 + len(data), 0) + data
+    ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src, dst)
+    ip = ip[:10] + struct.pack("!H", pcapgen.ip_checksum(ip)) + ip[12:]
+    return b"\x02\x00\x00\x00\x00\x02\x02\x00\x00\x00\x00\x01\x08\x00" + ip + u
+
+
+def expected(txn, with_request):
+    """What a response shows, as tshark -T fields prints it."""
+    _, _, function, reference, quantity, values = txn
+    numbers = ",".join(str(reference + i) for i in range(quantity)) if with_request else ""
+    if function == 3:
+        return {"rqc.registers.values.register.value": ",".join("0x%04x" % v for v in values),
+                "rqc.registers.values.register.number": numbers,
+                "rqc.coils.coil.state": "", "rqc.coils.coil.number": "", "rqc.coils.coil_count": ""}
+    return {"rqc.registers.values.register.value": "", "rqc.registers.values.register.number": "",
+            "rqc.coils.coil.state": ",".join("0x%02x" % v for v in values) if with_request else "",
+            "rqc.coils.coil.number": numbers, "rqc.coils.coil_count": str(quantity) if with_request else ""}
+
+
+class TestRequestContext(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "request_context.xml"), "rqc")
+        cls.txns = transactions(47502, 120)
+        cls.order = schedule(cls.txns, 1)
+        cls.full = cls.env.add_file("full.pcap", pcapgen.raw_pcap_bytes(
+            [frame(d, payload(d, cls.txns[k])) for d, k in cls.order]))
+        cls.orphans = [k for d, k in cls.order if d == "response"]
+        cls.orphan_path = cls.env.add_file("orphans.pcap", pcapgen.raw_pcap_bytes(
+            [frame("response", payload("response", cls.txns[k])) for k in cls.orphans]))
+
+    def rows(self, path, two_pass):
+        return {n: {f: ",".join(v) for f, v in r.items()}
+                for n, r in self.env.field_rows(path, FIELDS, two_pass).items()}
+
+    def test_numbers_and_counts_come_from_the_request(self):
+        in_flight = max(sum(1 for d, k in self.order[:i] if d == "request") -
+                        sum(1 for d, k in self.order[:i] if d == "response") for i in range(len(self.order)))
+        out_of_order = sum(1 for i, (d, k) in enumerate(self.order) if d == "response" and
+                           any(d2 == "request" and k2 > k for d2, k2 in self.order[:i]) and
+                           any(d2 == "response" and k2 > k for d2, k2 in self.order[:i]))
+        with self.checks() as check:
+            check(in_flight == 3 and out_of_order > 0, "the capture has 3 transactions in flight at once and "
+                  "%d responses after a later one's" % out_of_order)
+            for two_pass in (False, True):
+                mode = "-2" if two_pass else "one pass"
+                rows = self.rows(self.full, two_pass)
+                requests = {k: n for n, (d, k) in enumerate(self.order, 1) if d == "request"}
+                wrong, registers, coils = [], 0, 0
+                for n, (d, k) in enumerate(self.order, 1):
+                    r = rows[n]
+                    if d == "request":
+                        if r["rqc.expert.no_request_context"] or r["rqc.registers.values.register.number"]:
+                            wrong.append((n, "request", r))
+                        continue
+                    want = expected(self.txns[k], True)
+                    got = {f: r[f] for f in want}
+                    if got != want or r["rqc.request_in"] != str(requests[k]) or r["rqc.expert.no_request_context"]:
+                        wrong.append((n, got, want))
+                    registers += len(want["rqc.registers.values.register.number"].split(",")) if self.txns[k][2] == 3 else 0
+                    coils += self.txns[k][4] if self.txns[k][2] == 1 else 0
+                check(not wrong, "%s: %d register numbers and %d coils (count and numbers) of %d responses as "
+                      "their requests say, no expert%s" % (mode, registers, coils, len(self.orphans),
+                                                           "" if not wrong else " (wrong: %s)" % wrong[:2]))
+
+    def test_responses_without_their_requests(self):
+        with self.checks() as check:
+            for two_pass in (False, True):
+                mode = "-2" if two_pass else "one pass"
+                rows = self.rows(self.orphan_path, two_pass)
+                wrong = []
+                for n, k in enumerate(self.orphans, 1):
+                    r = rows[n]
+                    want = expected(self.txns[k], False)
+                    got = {f: r[f] for f in want}
+                    if got != want or r["rqc.expert.no_request_context"] != "1" or r["rqc.expert.bad_length"] \
+                            or r["_ws.expert.severity"] not in ("4194304",):
+                        wrong.append((n, got, want, r["rqc.expert.no_request_context"], r["_ws.expert.severity"]))
+                check(not wrong, "%s: %d responses without their requests: register values kept, no numbers, "
+                      "no coils, one note each and nothing malformed%s" % (
+                          mode, len(self.orphans), "" if not wrong else " (wrong: %s)" % wrong[:2]))
+
+    def test_expert_text(self):
+        out = self.env.tshark(["-r", self.orphan_path, "-V", "-c", "1"]).stdout
+        with self.checks() as check:
+            check("The request of this response is not in the capture" in out,
+                  "the expert info says why the values are missing")
+
+
+if __name__ == "__main__":
+    sys.exit(run_unittests()[1])
