@@ -480,7 +480,8 @@ void Validator::check_hook_list(const Node& n) {
 void Validator::check_list_fits(int line, const std::vector<ValueRange>& list, const FieldRef& ref,
                                 const char* attribute) {
     const Node* t = ref.target;
-    if (!t || !t->is_numeric() || t->fixed_bits >= 64) return;
+    // a computed value is a 64-bit integer, whatever its (zero) width in the message
+    if (!t || !t->is_numeric() || t->is_computed() || t->fixed_bits >= 64) return;
     const uint64_t max = (uint64_t{1} << t->fixed_bits) - 1;
     for (const ValueRange& r : list) {
         if (r.high <= max) continue;

@@ -395,6 +395,19 @@ TEST(Conditions, InValuesMustFitTheFieldTheyTest) {
     EXPECT_EQ(std::count(m.begin(), m.end(), '\n'), 2) << m;
 }
 
+TEST(Conditions, InValuesOnAComputedValueFitItsSixtyFourBits) {
+    // A computed value takes no bytes but is a 64-bit integer: any 'in' value may match it.
+    Front f = front_end(rules("  <node name=\"b\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"v\" value=\"{b} * 3\"/>\n"
+                              "  <node name=\"w\" value=\"{b} == 1\" displaytype=\"nondisplay\"\n"
+                              "        if=\"../node[@name='b']\" in=\"1-9\"/>\n"
+                              "  <node name=\"x\" length=\"1byte\" if=\"../node[@name='v']\" in=\"3,300-765\"/>\n"
+                              "  <node name=\"y\" length=\"1byte\"><when field=\"../node[@name='w']\" in=\"1\"/></node>\n"));
+    const std::string m = f.messages();
+    EXPECT_TRUE(f.ok()) << m;
+    EXPECT_EQ(m, "") << m;
+}
+
 TEST(Displays, Warnings) {
     Front f = front_end(rules("  <node name=\"box\" displaytype=\"numberhex\"><node name=\"x\" length=\"1byte\"/></node>\n"
                               "  <node name=\"plain\" length=\"1byte\" displaytype=\"numberhex\"><enum value=\"1\" name=\"one\"/></node>\n"
