@@ -28,9 +28,13 @@ Every returned frame carries ecatr.request_in of its request and ecatr.esc.* per
 ecatr.esc.data_changed), and exactly the expert infos above (counted per datagram); every sent
 frame ecatr.response_in (-2) and no expert info.
 
+Computed values, checked against the bytes written: the mailbox total length (the header's Length
++ 6) of mailboxes in datagrams, one or two in a frame, and of the mailbox gateway.
+
     test_esc_commands.py --dissgen build/bin/dissgen --source-dir .
 """
 import os
+import struct
 import sys
 import unittest
 
@@ -144,6 +148,39 @@ def decode(env, path, two_pass):
     return env.field_rows(path, FIELDS, two_pass)
 
 
+# --------------------------------------------------------------- computed values
+
+COMPUTED = ["ecatr.datagram.mbx.totallength", "ecatr.datagram.mbx.length", "ecatr.gateway.totallength"]
+
+
+def mailbox(length, mtype=0x6, data_len=None):
+    """A mailbox: the 6-byte header (Length, address, channel/priority, type/counter), then
+    data_len bytes (default: Length)."""
+    n = length if data_len is None else data_len
+    return struct.pack("<HHBB", length, 0x1234, 0, mtype | 0x10) + bytes((i * 7) & 0xFF for i in range(n))
+
+
+def computed_frames():
+    """[(frame, {field: [values]})]: each frame with what the computed fields must show,
+    worked out here from the bytes written."""
+    out = []
+    # Mailboxes written to 0x1000: the header's Length + 6, whatever the datagram's Length.
+    for length, size in ((10, 16), (0, 6), (10, 128), (200, 206), (0x0400, 0x0406)):
+        d = pg.Datagram(cmd=5, idx=7, adp=0x1001, ado=0x1000, data=mailbox(length, data_len=size - 6), wkc=1)
+        out.append((pg.Frame([d]), {"ecatr.datagram.mbx.length": [str(length)],
+                                    "ecatr.datagram.mbx.totallength": [str(length + 6)]}))
+    # Two mailboxes in one frame, each with its own header.
+    ds = [pg.Datagram(cmd=5, idx=8 + k, adp=0x1001 + k, ado=0x1000, data=mailbox(n, data_len=n), wkc=1)
+          for k, n in enumerate((4, 30))]
+    out.append((pg.Frame(ds), {"ecatr.datagram.mbx.length": ["4", "30"],
+                               "ecatr.datagram.mbx.totallength": ["10", "36"]}))
+    # The mailbox gateway (frame type 5): one mailbox right after the frame header.
+    for length in (0, 12, 300):
+        out.append((pg.Frame([], header_type=5, padding=mailbox(length)),
+                    {"ecatr.gateway.totallength": [str(length + 6)]}))
+    return out
+
+
 class TestEscCommands(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
@@ -180,6 +217,31 @@ class TestEscCommands(TsharkTestCase, unittest.TestCase):
                     check(not mine, "%s%s: returned frames show what the rules say (%s)%s" % (
                         NAMES[cmd], tag, ", ".join(c.what for c in cs if c.cmd == cmd),
                         "".join("\n       " + b for b in mine[:4])))
+
+    def test_computed_values_match_the_bytes(self):
+        """Mailbox total lengths (ecatr.datagram.mbx.totallength, ecatr.gateway.totallength),
+        frame by frame."""
+        env = self.env
+        with self.checks() as check:
+            fs = computed_frames()
+            frames, t = [], 1704067200.0
+            for f, _ in fs:
+                f.src_mac, f.ts = MASTER, t
+                frames.append(f)
+                t += 0.001
+            path = env.add_file("computed-values.pcap", pg.pcap_bytes(frames))
+            rows, err = env.field_rows(path, ["frame.number"] + COMPUTED, with_stderr=True)
+            check(not err.strip(), "tshark wrote nothing to stderr%s" % (": " + err.strip()[:300] if err.strip() else ""))
+            bad = []
+            for k, (_, want) in enumerate(fs):
+                got = rows.get(k + 1, {})
+                diff = {n: (got.get(n), want.get(n, [])) for n in COMPUTED if got.get(n) != want.get(n, [])}
+                if diff:
+                    bad.append("frame %d: %s" % (k + 1, diff))
+            check(not bad, "%d frames: the computed values are those of the bytes%s" % (
+                len(fs), "".join("\n       " + b for b in bad[:6])))
+            shown = env.tshark(["-r", path, "-V", "-Y", "frame.number == 1"]).stdout
+            check("[Total length: 16 bytes]" in shown, "the tree shows the value with its unit (16 bytes)")
 
 
 if __name__ == "__main__":
