@@ -91,7 +91,7 @@ std::string emit_validity(const Protocol& proto) {
               << c_string(proto.name + " over " + upper(h.table)) << ", " << (h.enabled ? "TRUE" : "FALSE") << " }";
         }
         o << "\n};\n"
-          << "static gboolean heur_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);\n";
+          << "static dg_heur_result heur_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);\n";
     }
     o << "static const dg_validity " << f << "_validity = {\n"
       << "    &" << f << "_protocol, " << (rows.empty() ? "NULL" : f + "_valid_fields") << ", " << rows.size() << ", "
@@ -99,8 +99,8 @@ std::string emit_validity(const Protocol& proto) {
       << "    " << (proto.heuristics.empty() ? "NULL" : f + "_heuristics") << ", " << proto.heuristics.size() << ", "
       << (proto.heuristics.empty() ? "NULL" : "heur_" + f) << "\n};\n\n";
     if (!proto.heuristics.empty())
-        o << "static gboolean heur_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
-          << "    return dg_valid_heuristic(&" << f << "_validity, tvb, pinfo, tree);\n}\n\n";
+        o << "static dg_heur_result heur_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
+          << "    return dg_valid_heuristic(&" << f << "_validity, tvb, pinfo, tree) != 0;\n}\n\n";
     return o.str();
 }
 

@@ -17,6 +17,10 @@ extern "C" {
 }
 #include <epan/dissectors/packet-tcp.h>
 #include <wsutil/report_message.h>
+/* unit_name_string (unit="..." labels): packet.h includes it up to 4.2 only. */
+#include <epan/unit_strings.h>
+
+#include <utility>
 
 /* True when the headers compiled against are Wireshark MAJOR.MINOR or later.
  * ws_version.h belongs to the headers, so a plugin's plugin_want_major/minor
@@ -55,6 +59,9 @@ extern "C" {
 #define dg_tvb_get_uint56 tvb_get_guint56
 #define dg_tvb_get_uint64 tvb_get_guint64
 #endif
+
+/* What a heuristic dissector returns: gboolean up to 4.2, bool from 4.4 on. */
+typedef decltype(std::declval<heur_dissector_t>()(nullptr, nullptr, nullptr, nullptr)) dg_heur_result;
 
 /* 4.4 renamed tvb_find_guint8 too (stringz leaves look for their NUL). */
 #if DG_WS_AT_LEAST(4, 4)

@@ -18,7 +18,7 @@ guint64 field_value(const dg_valid_field *f, tvbuff_t *tvb, gint at)
 {
     guint64 value = 0;
     for (guint i = 0; i < f->length; i++) {
-        guint8 byte = tvb_get_guint8(tvb, at + (gint)(f->little ? f->length - 1 - i : i));
+        guint8 byte = dg_tvb_get_uint8(tvb, at + (gint)(f->little ? f->length - 1 - i : i));
         value = (value << 8) | byte;
     }
     if (f->bits > 0 && f->bits < 64) value = (value >> f->shift) & ((G_GUINT64_CONSTANT(1) << f->bits) - 1);
