@@ -286,19 +286,4 @@ std::vector<ExprRow> compile_expression(const Expr& e, bool as_float) {
     return out;
 }
 
-unsigned expression_stack_depth(const std::vector<ExprRow>& rows) {
-    static const std::vector<std::string> operands = {"DG_OP_INT", "DG_OP_FLOAT", "DG_OP_FIELD",
-                                                      "DG_OP_FIELD_SIGNED", "DG_OP_FIELD_FLOAT", "DG_OP_INDEX",
-                                                      "DG_OP_REQUEST_FIELD", "DG_OP_REQUEST_FIELD_SIGNED",
-                                                      "DG_OP_REQUEST_FIELD_FLOAT"};
-    static const std::vector<std::string> unary = {"DG_OP_TO_FLOAT", "DG_OP_NEG", "DG_OP_NOT", "DG_OP_BITNOT",
-                                                   "DG_OP_FNEG", "DG_OP_FNOT"};
-    unsigned depth = 0, deepest = 0;
-    for (const ExprRow& r : rows) {
-        if (std::find(operands.begin(), operands.end(), r.code) != operands.end()) deepest = std::max(deepest, ++depth);
-        else if (std::find(unary.begin(), unary.end(), r.code) == unary.end()) --depth;
-    }
-    return deepest;
-}
-
 }  // namespace dissgen

@@ -56,9 +56,6 @@ struct ExprRow {
 // postfix order; `as_float`: the result is wanted as a double.
 std::vector<ExprRow> compile_expression(const Expr& e, bool as_float);
 
-// The stack depth compile_expression's rows need.
-unsigned expression_stack_depth(const std::vector<ExprRow>& rows);
-
 // Parses `text`; on a mistake returns false and sets `error` to a message
 // that says where ("... at character 7").
 bool parse_expression(const std::string& text, Expr& out, std::string& error);

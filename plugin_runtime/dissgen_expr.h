@@ -47,7 +47,9 @@ typedef struct dg_expr_op {
     gdouble real;   /* DG_OP_FLOAT */
 } dg_expr_op;
 
-/* The deepest stack an expression may need; dissgen refuses deeper ones. */
+/* The deepest stack an expression may need. The parser's nesting limit
+ * (64 levels: each pending operand is one) keeps every accepted expression
+ * within it (tests/unit/test_expr_eval.cpp); a deeper one would be undefined. */
 #define DG_EXPR_STACK 64
 
 /* A slot's value, or FALSE when the field was not decoded in this message. */

@@ -122,6 +122,20 @@ bool undefined(const std::string& expr, const Slots& fields = kFields) {
     return !e.v.defined;
 }
 
+TEST(ComputedEval, TheDeepestExpressionTheParserTakesFitsTheStack) {
+    // Each operator of rising precedence and each parenthesis leaves an operand waiting.
+    const std::string ladder = "1 || 1 && 1 | 1 ^ 1 & 1 == 1 < 1 << 1 + 1 * (";
+    std::string deepest;
+    for (int i = 0; i < 5; ++i) deepest += ladder;
+    const std::string inner = "1 || 1 && 1 | 1 ^ 1 & 1 == 1 < 1 << 1 + 1";
+    Evaluated e = evaluate(deepest + inner + ")))))", kFields);
+    ASSERT_EQ(e.error, "");
+    EXPECT_TRUE(e.v.defined);
+    EXPECT_EQ(e.v.integer, 1);
+    // one operand more waiting: refused by the parser, not left to the evaluator
+    EXPECT_NE(evaluate(deepest + inner + " * 1)))))", kFields).error, "");
+}
+
 TEST(ComputedEval, IntegerArithmeticAsInC) {
     EXPECT_EQ(integer("{A} + index + 1", {{A, 40000}, {C, 5}}, 3), 40004);
     EXPECT_EQ(integer("{S}"), -2);                 // an int field is signed
