@@ -7,11 +7,14 @@
 //   dissgen install FILE.xml [--dir DIR | --system]
 //                                          generate, build and install the plugin
 //   dissgen esi PATH...                    list the device catalogue of ESI files
+//   dissgen report CAPTURE -o FILE.html    timing report of an EtherCAT capture
 // check, generate, fields and install take --esi PATH (repeatable),
 // --network FILE and --compact: the catalogue and the designed network are
 // embedded into the plugin.
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -24,6 +27,9 @@
 #include "ethercat/esi_reader.h"
 #include "ethercat/network_reader.h"
 #include "parser.h"
+#include "report/capture_stream.h"
+#include "report/report_html.h"
+#include "report/timing_model.h"
 #include "validator.h"
 #include "wireshark_env.h"
 #include "xml_input.h"
@@ -41,8 +47,9 @@ const char kUsage[] =
     "       dissgen fields FILE.xml\n"
     "       dissgen install FILE.xml [--dir DIR | --system]\n"
     "       dissgen esi PATH...\n"
+    "       dissgen report CAPTURE -o FILE.html [--rules FILE.xml]\n"
     "       dissgen --help | --version\n"
-    "  check, generate, fields and install also take [--esi PATH]... [--network FILE] [--compact]\n"
+    "  check, generate, fields, install and report also take [--esi PATH]... [--network FILE] [--compact]\n"
     "\n"
     "commands:\n"
     "  check     validate the rule file; diagnostics as FILE:LINE: error: MESSAGE\n"
@@ -53,9 +60,13 @@ const char kUsage[] =
     "            plugin (dissgen_STEM.so), per user by default\n"
     "  esi       list the devices of ESI files (a file or a folder of *.xml), one line\n"
     "            per revision: 0xVENDOR 0xPRODUCT 0xREVISION NAME, sorted\n"
+    "  report    decode an EtherCAT capture with the installed plugin (with --esi or --network:\n"
+    "            with a plugin built from the rules and those for this run) and write one\n"
+    "            self-contained HTML page: cycles, periods, jitter, round trips, lost frames,\n"
+    "            working-counter errors, the slaves' AL states, the network check\n"
     "\n"
     "options:\n"
-    "  -o DIR          generate: the folder to write into\n"
+    "  -o DIR          generate: the folder to write into; report: the HTML file\n"
     "  --dir DIR       install: into DIR instead of the per-user plugin folder\n"
     "  --system        install: into Wireshark's global plugin folder (needed when\n"
     "                  Wireshark runs as root: it ignores per-user plugins)\n"
@@ -63,6 +74,8 @@ const char kUsage[] =
     "  --network FILE  embed the designed network: a design (<network><slave type=\"EK1100\"/>..)\n"
     "                  or an ENI file; registers a field per PDO entry of its slaves\n"
     "  --compact       embed only the device models the network uses\n"
+    "  --rules FILE    report: the rules of the plugin built for --esi/--network\n"
+    "                  (default: the shipped ethercat.xml)\n"
     "  -h, --help      print this help and exit\n"
     "  --version       print dissgen's version and exit\n";
 
@@ -282,6 +295,97 @@ int cmd_install(const std::string& path, const std::string& dir, bool system, co
     return 0;
 }
 
+// A plugin of `rules` with the catalogue/network of `bus`, built into a new
+// folder that tshark then uses as its HOME: the plugin sits in that HOME's
+// per-user plugin folder, where it takes over from a packaged one as usual,
+// and no plugin the user installed gets in its way. "" on failure.
+std::string build_report_plugin(const std::string& rules, BusInput& bus, const std::string& argv0) {
+    Diagnostics diags;
+    Loaded l = load(rules, diags);
+    print(diags, rules);
+    if (!l.ok || !load_bus(bus)) return "";
+    auto headers = headers_version();
+    std::string runtime = find_runtime_dir(argv0);
+    if (!headers || runtime.empty()) {
+        std::cerr << "dissgen: report: building a plugin for --esi/--network needs libwireshark-dev and the runtime\n";
+        return "";
+    }
+    const char* tmp_env = std::getenv("TMPDIR");
+    std::string tmpl = std::string(tmp_env && *tmp_env ? tmp_env : "/tmp") + "/dissgen-report-XXXXXX";
+    std::vector<char> buf(tmpl.begin(), tmpl.end());
+    buf.push_back('\0');
+    if (!mkdtemp(buf.data())) {
+        std::cerr << "dissgen: report: cannot create a temporary folder\n";
+        return "";
+    }
+    std::string root = buf.data();
+    BuildRequest req{generate_source(*l.proto, rules, bus), plugin_basename(rules), user_plugin_dir(*headers, root), runtime,
+                     analysis_runtime_sources(*l.proto)};
+    std::string installed, error = build_and_install(req, installed);
+    if (!error.empty()) {
+        std::cerr << "dissgen: report: " << error << "\n";
+        std::error_code ec;
+        fs::remove_all(root, ec);
+        return "";
+    }
+    return root;
+}
+
+int cmd_report(const std::string& capture, const std::string& out_path, std::string rules, BusInput& bus,
+               const std::string& argv0) {
+    CaptureStream stream;
+    if (const char* t = std::getenv("DISSGEN_TSHARK"); t && *t) stream.tshark = t;
+    std::string plugin_root;
+    if (bus.given()) {
+        // Wireshark run as root reads no plugin folder but its own.
+        if (geteuid() == 0) {
+            std::cerr << "dissgen: report: --esi/--network build a plugin for this run, into a per-user plugin "
+                         "folder, which Wireshark run as root does not read: run the report as a normal user, or "
+                         "install the plugin with them (dissgen install --system ...) and run the report without\n";
+            return 1;
+        }
+        if (rules.empty()) rules = (fs::path(share_dir(argv0)) / "rules" / "ethercat.xml").string();
+        plugin_root = build_report_plugin(rules, bus, argv0);
+        if (plugin_root.empty()) return 1;
+        stream.environment.push_back({"HOME", plugin_root});
+    }
+    struct Cleanup {
+        std::string d;
+        ~Cleanup() {
+            std::error_code ec;
+            if (!d.empty()) fs::remove_all(d, ec);
+        }
+    } cleanup{plugin_root};
+
+    std::vector<std::string> fields = TimingModelBuilder::timing_fields(known_fields(stream));
+    if (std::find(fields.begin(), fields.end(), "ecatr.time") == fields.end()) {
+        std::cerr << "dissgen: report: " << stream.tshark << " has no EtherCAT plugin of dissgen (no field ecatr.time): "
+                     "install it first, e.g. dissgen install rules/ethercat.xml\n";
+        return 1;
+    }
+    stream.fields = fields;
+    TimingModel model;
+    model.capture = capture;
+    TimingModelBuilder builder(fields, model);
+    std::string error = read_capture(stream, capture, [&](const FieldRow& row) { builder.add(row); });
+    if (!error.empty()) {
+        std::cerr << "dissgen: report: " << error << "\n";
+        return 1;
+    }
+    std::ofstream out(out_path, std::ios::binary);
+    if (!out) {
+        std::cerr << "dissgen: report: cannot write " << out_path << "\n";
+        return 1;
+    }
+    error = write_report_html(model, DISSGEN_VERSION, out);
+    if (!error.empty()) {
+        std::cerr << "dissgen: report: " << error << "\n";
+        return 1;
+    }
+    std::cout << "wrote " << out_path << ": " << model.frames << " frames, " << model.cycles.size() << " cycles\n";
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -295,15 +399,16 @@ int main(int argc, char** argv) {
         return 0;
     }
     const std::string command = args[0];
-    std::string out_dir, dir;
+    std::string out_dir, dir, rules;
     std::vector<std::string> files;
     bool system = false;
     BusInput bus;
     for (size_t i = 1; i < args.size(); ++i) {
         const std::string& a = args[i];
-        if ((a == "-o" || a == "--dir" || a == "--esi" || a == "--network") && i + 1 < args.size()) {
+        if ((a == "-o" || a == "--dir" || a == "--esi" || a == "--network" || a == "--rules") && i + 1 < args.size()) {
             const std::string& v = args[++i];
             if (a == "-o") out_dir = v;
+            else if (a == "--rules") rules = v;
             else if (a == "--dir") dir = v;
             else if (a == "--esi") bus.esi.push_back(v);
             else if (!bus.network_file.empty()) {
@@ -327,6 +432,17 @@ int main(int argc, char** argv) {
             return 2;
         }
         return cmd_esi(files);
+    }
+    if (command == "report") {
+        if (files.size() != 1 || out_dir.empty()) {
+            std::cerr << "dissgen: report takes one capture and -o FILE.html\n" << kUsage;
+            return 2;
+        }
+        return cmd_report(files[0], out_dir, rules, bus, argv[0]);
+    }
+    if (!rules.empty()) {
+        std::cerr << "dissgen: --rules is an option of report\n";
+        return 2;
     }
     if (files.size() > 1) {
         std::cerr << "dissgen: one rule file at a time ('" << files[1] << "' is extra)\n";

@@ -65,9 +65,9 @@ std::optional<std::string> tshark_version() {
     return major_minor(out);
 }
 
-std::string user_plugin_dir(const std::string& version) {
-    const char* home = std::getenv("HOME");
-    return std::string(home ? home : ".") + "/.local/lib/wireshark/plugins/" + version + "/epan";
+std::string user_plugin_dir(const std::string& version, const std::string& home) {
+    const char* env = std::getenv("HOME");
+    return (home.empty() ? std::string(env ? env : ".") : home) + "/.local/lib/wireshark/plugins/" + version + "/epan";
 }
 
 std::optional<std::string> system_plugin_dir() {

@@ -19,8 +19,8 @@ std::optional<std::string> headers_version();
 // "4.0" from `tshark --version` (the Wireshark that will load the plugin).
 std::optional<std::string> tshark_version();
 
-// ~/.local/lib/wireshark/plugins/X.Y/epan
-std::string user_plugin_dir(const std::string& major_minor);
+// HOME/.local/lib/wireshark/plugins/X.Y/epan (HOME: $HOME when empty)
+std::string user_plugin_dir(const std::string& major_minor, const std::string& home = "");
 
 // `pkg-config --variable=plugindir wireshark`/epan
 std::optional<std::string> system_plugin_dir();

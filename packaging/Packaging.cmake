@@ -159,6 +159,8 @@ set(wireshark_bound "${libwireshark_package} (>= ${ws_lower}), ${libwireshark_pa
 # headers of the same minor release (wireshark.pc requires glib-2.0.pc, which
 # libwireshark-dev does not pull in).
 set(install_needs "libwireshark-dev (>= ${ws_lower}), libwireshark-dev (<< ${ws_upper}), libglib2.0-dev, g++ | c++-compiler, pkg-config")
+# `dissgen report` embeds Debian's dygraphs into its pages.
+string(APPEND install_needs ", libjs-dygraphs")
 
 find_program(DPKG_SHLIBDEPS_PROGRAM dpkg-shlibdeps)   # dpkg-dev
 find_program(FILE_PROGRAM file)                     # CPack needs it for shlibdeps

@@ -4,7 +4,7 @@
 # are missing. Uses sudo when not root.
 set -euo pipefail
 packages=(cmake g++ make pkg-config libwireshark-dev tshark libglib2.0-dev libxml2-dev
-          libgtest-dev python3 util-linux clang libclang-rt-14-dev)
+          libgtest-dev python3 util-linux clang libclang-rt-14-dev libjs-dygraphs chromium)
 missing=()
 for p in "${packages[@]}"; do
   # (No `| grep -q`: under pipefail its early exit could fail the query and

@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The report's model of an EtherCAT capture's timing, built from the fields
+// the plugin shows (ecatr.cycle*, ecatr.time, the losses and working-counter
+// experts, the slaves' AL status): what `dissgen report` draws, and the same
+// figures as `tshark -z ecatr,cycles`.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "capture_stream.h"
+
+namespace dissgen {
+
+// A point in a time series: seconds since the capture's first frame, a value in ns.
+struct TimedValue {
+    double t;
+    int64_t ns;
+};
+
+// min/median/p99/max (nearest rank) of a set of ns values; zero when empty.
+struct Spread {
+    size_t count = 0;
+    int64_t min = 0, median = 0, p99 = 0, max = 0;
+    double mean = 0, stddev = 0;  // population standard deviation
+};
+Spread spread_of(std::vector<int64_t> values);
+
+struct Cycle {
+    unsigned number = 0;
+    std::string signature;          // "LRW 0x00010000 + FRMW 0x0910"
+    uint64_t frames = 0;            // sent frames of the cycle
+    uint64_t lost = 0;              // of them, without a return
+    uint64_t wkc_errors = 0;        // returns whose working counter was not the expected one
+    std::vector<TimedValue> period, jitter, round_trip;
+};
+
+struct Event {
+    double t;
+    uint32_t frame;
+    unsigned cycle;  // 0: not a cycle's frame
+};
+
+// AL state of one slave over time, from its AL status reads.
+struct SlaveTimeline {
+    std::string name;                                 // the model's name from the ESI ("EL2004"), or ""
+    std::vector<std::pair<double, unsigned>> states;  // (t, AL state), when it changed
+};
+
+struct TimingModel {
+    std::string capture;
+    uint64_t frames = 0;
+    double duration = 0;            // seconds, first to last frame
+    std::map<unsigned, Cycle> cycles;
+    std::vector<TimedValue> round_trip;  // every return, cycle or not
+    std::vector<Event> lost, wkc_errors;
+    std::map<unsigned, SlaveTimeline> slaves;  // by position
+    std::vector<std::string> network;          // the network check's findings, in order
+    bool has_cycle_fields = false;             // the plugin shows ecatr.cycle
+};
+
+// Builds the model row by row from a capture read with timing_fields().
+class TimingModelBuilder {
+public:
+    // The fields to ask tshark for, among `known` (those the installed tshark has).
+    static std::vector<std::string> timing_fields(const std::vector<std::string>& known);
+
+    TimingModelBuilder(const std::vector<std::string>& fields, TimingModel& model);
+    void add(const FieldRow& row);
+
+private:
+    int column(const char* field) const;
+    std::string_view value(const FieldRow& row, int column) const;
+    void add_cycle_frame(const FieldRow& row, uint32_t frame, double t, unsigned cycle);
+    void add_return(const FieldRow& row, double t);
+    void add_slave_states(const FieldRow& row, double t);
+
+    TimingModel& model_;
+    std::unordered_map<std::string, int> columns_;
+    std::unordered_map<uint32_t, unsigned> cycle_of_frame_;  // sent frames of a cycle
+    int64_t first_s_ = -1, first_ns_ = 0;
+};
+
+// "0.001000250" or "-0.000000125" (seconds, as tshark prints relative times) -> ns.
+bool parse_seconds_ns(std::string_view text, int64_t& ns);
+
+// EtherCAT's command names (APRD, ..., FRMW); "cmd 0xNN" for others.
+std::string ethercat_command_name(unsigned cmd);
+
+// "INIT", "PREOP", "BOOT", "SAFEOP", "OP", with " +ERR" when the error bit is set.
+std::string al_state_name(unsigned status);
+
+}  // namespace dissgen

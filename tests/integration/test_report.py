@@ -1,0 +1,319 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""`dissgen report`: the timing report shows the plugin's numbers, and a browser draws it.
+
+  test_report.py --dissgen build/bin/dissgen --source-dir . [--corpus DIR] [--screenshots DIR]
+
+For a generated capture (two tasks, 1 ms and 10 ms, with known jitter, a lost return and a
+mailbox exchange) and for every capture of the corpus, `dissgen report` is run as the tshark
+user with the plugin installed per user, and:
+
+- its cycle table equals the figures computed here from the same capture's fields
+  (ecatr.cycle, ecatr.cycle.period, ecatr.cycle.jitter, ecatr.time, ecatr.request_in,
+  ecatr.no_response_to, ecatr.expert.wkc): frames, period min/median/p99/max (nearest rank),
+  jitter standard deviation, round trip min/median/p99/max, lost, working-counter errors;
+- the same table equals `tshark -z ecatr,cycles` where the plugin has that statistic;
+- the page embeds everything it needs (no http:, no src= outside the page) and Debian's
+  chromium, headless, draws a canvas in every chart; its screenshot is written to
+  --screenshots (default: the system's temporary folder) and must not be blank.
+Bad input: a capture that is not there, or tshark without the plugin, gives one clear
+message and exit status 1.
+"""
+
+import html.parser
+import math
+import os
+import re
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+import zlib
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from tshark_env import NOBODY, TsharkTestCase, corpus_captures, run_unittests  # noqa: E402
+import pcaprewrite as pr  # noqa: E402
+from test_losses import MASTER, ecat_frame, generated, returned  # noqa: E402
+
+ARGS = None
+FIELDS = ["frame.number", "frame.time_epoch", "ecatr.cycle", "ecatr.cycle.period", "ecatr.cycle.jitter",
+          "ecatr.time", "ecatr.request_in", "ecatr.no_response_to", "ecatr.expert.wkc"]
+
+
+# ----------------------------------------------------------------------------- a capture with known timing
+
+def two_task_capture():
+    """A 1 ms task (LRW + FRMW of the reference clock) with a jitter of -3..+3 us in a fixed
+    pattern, a 10 ms task (LRW of another image), one lost return, and a mailbox exchange."""
+    packets, t0 = [], 1_700_000_000 * 10**9
+    jitter = [0, 3_000, -2_000, 1_000, -3_000, 2_000]
+    for n in range(600):
+        t = t0 + n * 1_000_000 + jitter[n % len(jitter)]
+        dgs = [(12, 0x10, 0x0000, 0x0001, bytes([n & 0xFF, 0, 0, 0]), 0), (14, 0x10, 0x1001, 0x0910, b"\0" * 8, 0)]
+        packets.append(pr.Packet(ecat_frame(MASTER, dgs), t))
+        if n != 300:
+            packets.append(pr.Packet(returned(MASTER, dgs, 3), t + 40_000 + (n % 7) * 1_000))
+        if n % 10 == 5:
+            slow = [(12, 0x20, 0x0000, 0x0002, b"\0" * 16, 0)]
+            packets.append(pr.Packet(ecat_frame(MASTER, slow), t + 200_000))
+            packets.append(pr.Packet(returned(MASTER, slow, 2), t + 260_000))
+        if n in (100, 101):
+            mbx = [(5, 0x30 + n - 100, 0x1002, 0x1000, b"\x0a\x00" + b"\0" * 126, 0)]
+            packets.append(pr.Packet(ecat_frame(MASTER, mbx), t + 500_000))
+            packets.append(pr.Packet(returned(MASTER, mbx, 1), t + 560_000))
+    packets.sort(key=lambda p: p.ts)
+    return packets
+
+
+# ----------------------------------------------------------------------------- what the report says
+
+class TableReader(html.parser.HTMLParser):
+    """The rows of <table id="cycles">, each a list of cell texts."""
+
+    def __init__(self, table_id):
+        super().__init__()
+        self.table_id, self.inside, self.rows, self.cell = table_id, False, [], None
+
+    def handle_starttag(self, tag, attrs):
+        if tag == "table" and dict(attrs).get("id") == self.table_id:
+            self.inside = True
+        elif self.inside and tag == "tr":
+            self.rows.append([])
+        elif self.inside and tag == "td":
+            self.cell = ""
+
+    def handle_endtag(self, tag):
+        if tag == "table":
+            self.inside = False
+        elif tag == "td" and self.cell is not None:
+            self.rows[-1].append(self.cell.strip())
+            self.cell = None
+
+    def handle_data(self, data):
+        if self.cell is not None:
+            self.cell += data
+
+
+def report_table(page):
+    reader = TableReader("cycles")
+    reader.feed(page)
+    return {int(r[0]): r for r in reader.rows if r}
+
+
+def ns(text):
+    """'-0.000001250' (seconds) -> -1250."""
+    neg = text.startswith("-")
+    whole, _, frac = text.lstrip("-").partition(".")
+    v = int(whole) * 10**9 + int((frac + "000000000")[:9])
+    return -v if neg else v
+
+
+def nearest_rank(values, p):
+    s = sorted(values)
+    return s[max(0, math.ceil(p / 100 * len(s)) - 1)]
+
+
+def us(v):
+    return "%.3f" % (v / 1000)
+
+
+def expected_table(rows):
+    """The cycle table computed from the fields, as the report prints it."""
+    cycles, cycle_of = {}, {}
+    for frame, r in sorted(rows.items()):
+        if r["ecatr.cycle"]:
+            c = cycles.setdefault(int(r["ecatr.cycle"][0]), {"frames": 0, "period": [], "jitter": [], "rtt": [],
+                                                              "lost": 0, "wkc": 0})
+            c["frames"] += 1
+            cycle_of[frame] = c
+            c["period"] += [ns(v) for v in r["ecatr.cycle.period"]]
+            c["jitter"] += [ns(v) for v in r["ecatr.cycle.jitter"]]
+        for lost in r["ecatr.no_response_to"]:
+            if int(lost) in cycle_of:
+                cycle_of[int(lost)]["lost"] += 1
+        if r["ecatr.time"] and r["ecatr.request_in"] and int(r["ecatr.request_in"][0]) in cycle_of:
+            c = cycle_of[int(r["ecatr.request_in"][0])]
+            c["rtt"].append(ns(r["ecatr.time"][0]))
+            c["wkc"] += len(r["ecatr.expert.wkc"])
+    table = {}
+    for number, c in cycles.items():
+        def spread(v):
+            return [us(min(v)), us(nearest_rank(v, 50)), us(nearest_rank(v, 99)), us(max(v))] if v else ["0.000"] * 4
+        mean = sum(c["jitter"]) / len(c["jitter"]) if c["jitter"] else 0
+        sd = math.sqrt(sum((j - mean) ** 2 for j in c["jitter"]) / len(c["jitter"])) if c["jitter"] else 0
+        p = spread(c["period"])
+        table[number] = [str(number), None, str(c["frames"]), p[1]] + p + ["%.3f" % (sd / 1000)] + \
+            spread(c["rtt"]) + [str(c["lost"]), str(c["wkc"])]
+    return table
+
+
+def png_pixels(path):
+    """(width, height, set of distinct RGB colours) of an 8-bit RGB/RGBA PNG (stdlib only)."""
+    with open(path, "rb") as fh:
+        blob = fh.read()
+    assert blob[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    pos, idat, width = 8, b"", 0
+    while pos < len(blob):
+        length, kind = struct.unpack(">I4s", blob[pos:pos + 8])
+        data = blob[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, colour = struct.unpack(">IIBB", data[:10])
+            assert depth == 8 and colour in (2, 6), "PNG not 8-bit RGB(A)"
+            bpp = 3 if colour == 2 else 4
+        elif kind == b"IDAT":
+            idat += data
+        pos += 12 + length
+    raw, stride, colours, prev = zlib.decompress(idat), width * bpp, set(), bytearray(width * bpp)
+    for y in range(height):
+        kind, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - bpp] if i >= bpp else 0
+            b, c = prev[i], prev[i - bpp] if i >= bpp else 0
+            if kind == 1:
+                line[i] = (line[i] + a) & 0xFF
+            elif kind == 2:
+                line[i] = (line[i] + b) & 0xFF
+            elif kind == 3:
+                line[i] = (line[i] + (a + b) // 2) & 0xFF
+            elif kind == 4:
+                pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 0xFF
+        if y % 8 == 0:
+            colours.update(bytes(line[i:i + 3]) for i in range(0, stride, bpp * 8))
+        prev = line
+    return width, height, colours
+
+
+# ----------------------------------------------------------------------------- the tests
+
+class TestReport(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        cls.install("rules/ethercat.xml", "ecatr")
+        # dissgen runs tshark itself: it must run as the tshark user, from a place that user can read.
+        cls.dissgen = cls.env.path("dissgen")
+        shutil.copyfile(ARGS.dissgen, cls.dissgen)
+        os.chmod(cls.dissgen, 0o755)
+        cls.out = cls.env.path("reports")    # the tshark user writes the reports here
+        os.makedirs(cls.out)
+        if cls.env.as_nobody:
+            os.chown(cls.out, NOBODY, NOBODY)
+        cls.capture = cls.env.path("two-tasks.pcap")
+        generated(cls.capture, two_task_capture())
+        os.chmod(cls.capture, 0o644)
+
+    def report(self, capture, name, check=True):
+        out = os.path.join(self.out, name + ".html")
+        cmd = [self.dissgen, "report", capture, "-o", out]
+        if self.env.as_nobody:
+            cmd = ["setpriv", "--reuid=%d" % NOBODY, "--regid=%d" % NOBODY, "--clear-groups"] + cmd
+        started = time.monotonic()
+        p = subprocess.run(cmd, env=self.env.env(), cwd=self.env.home, capture_output=True, text=True, timeout=1800)
+        took = time.monotonic() - started
+        if check and p.returncode != 0:
+            self.fail("dissgen report %s: exit %d\n%s%s" % (name, p.returncode, p.stdout, p.stderr))
+        page = open(out, encoding="utf-8").read() if p.returncode == 0 else ""
+        return p, page, took
+
+    def stats_tree(self, capture):
+        """{cycle: [cells]} from `tshark -z ecatr,cycles`, or None when the plugin lacks it."""
+        p = self.env.tshark(["-r", capture, "-q", "-z", "ecatr,cycles"], check=False)
+        if p.returncode != 0:
+            return None
+        return p.stdout
+
+    def table_checks(self, check, capture, name):
+        p, page, took = self.report(capture, name)
+        table = report_table(page)
+        rows = self.env.field_rows(capture, FIELDS, aggregator="\x1f")
+        expected = expected_table(rows)
+        check(sorted(table) == sorted(expected), "%s: the report lists cycles %s, the fields %s"
+              % (name, sorted(table), sorted(expected)))
+        for number, want in expected.items():
+            got = table.get(number)
+            if got is None:
+                continue
+            same = [g == w for g, w in zip(got, want) if w is not None]
+            check(all(same) and len(got) == len(want), "%s cycle %d: report %s == fields %s"
+                  % (name, number, got, [w for w in want]))
+        print("   %s: %.1f s, %d cycles" % (name, took, len(table)))
+        return table, page
+
+    def test_generated_two_tasks(self):
+        with self.checks() as check:
+            table, page = self.table_checks(check, self.capture, "two-tasks")
+            check(len(table) == 2, "two tasks, two cycles (got %d)" % len(table))
+            if len(table) == 2:
+                fast, slow = table[1], table[2]
+                check(fast[1].startswith("LRW") and "FRMW" in fast[1], "cycle 1 signature: %s" % fast[1])
+                check(fast[3] == "1000.000" and slow[3] == "10000.000",
+                      "nominal periods 1 ms and 10 ms (got %s, %s)" % (fast[3], slow[3]))
+                check(fast[13] == "1", "the lost return is counted in cycle 1 (got %s)" % fast[13])
+                check(fast[4] == "995.000" and fast[7] == "1005.000",
+                      "period min/max from the injected jitter of -3..+3 us (got %s/%s)" % (fast[4], fast[7]))
+            check("http:" not in page and "https:" not in page and not re.search(r'src="(?!data:)', page),
+                  "the page loads nothing from outside")
+
+    def test_browser_draws_every_chart(self):
+        chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+        if not chromium:
+            self.skipTest("chromium is not installed (Debian package chromium)")
+        _p, page, _took = self.report(self.capture, "browser")
+        charts = re.findall(r'<div class="chart[^"]*" id="([^"]+)"', page)
+        profile = tempfile.mkdtemp(prefix="dissgen-chromium-")
+        shots = ARGS.screenshots or tempfile.gettempdir()
+        os.makedirs(shots, exist_ok=True)
+        shot = os.path.join(shots, "dissgen-report.png")
+        base = [chromium, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+                "--user-data-dir=" + profile, "--window-size=1400,2400", "--virtual-time-budget=5000"]
+        url = "file://" + os.path.join(self.out, "browser.html")
+        try:
+            dom = subprocess.run(base + ["--dump-dom", url], capture_output=True, text=True, timeout=180).stdout
+            subprocess.run(base + ["--screenshot=" + shot, url], capture_output=True, timeout=180)
+        finally:
+            shutil.rmtree(profile, ignore_errors=True)
+        with self.checks() as check:
+            check(len(charts) >= 4, "the page has charts (%d)" % len(charts))
+            for chart in charts:
+                m = re.search(r'id="%s"(.*?)(?=<div class="chart|<h2|</body)' % re.escape(chart), dom, re.S)
+                check(m is not None and "<canvas" in m.group(1), "chromium drew chart %s" % chart)
+            check(os.path.exists(shot), "screenshot written: %s" % shot)
+            if os.path.exists(shot):
+                width, height, colours = png_pixels(shot)
+                check(width == 1400 and len(colours) > 20,
+                      "the screenshot (%dx%d) shows a drawing (%d colours)" % (width, height, len(colours)))
+
+    def test_bad_input_is_one_clear_message(self):
+        p, _page, _took = self.report(self.env.path("absent.pcap"), "absent", check=False)
+        with self.checks() as check:
+            check(p.returncode == 1 and "absent.pcap" in p.stderr and "Traceback" not in p.stderr,
+                  "a missing capture: exit 1 and its name (%d: %s)" % (p.returncode, p.stderr.strip()))
+            bare = dict(self.env.env(), HOME=tempfile.mkdtemp(prefix="dissgen-noplugin-"))
+            os.chmod(bare["HOME"], 0o755)
+            cmd = [self.dissgen, "report", self.capture, "-o", os.path.join(bare["HOME"], "r.html")]
+            if self.env.as_nobody:
+                cmd = ["setpriv", "--reuid=%d" % NOBODY, "--regid=%d" % NOBODY, "--clear-groups"] + cmd
+            q = subprocess.run(cmd, env=bare, capture_output=True, text=True, timeout=300)
+            shutil.rmtree(bare["HOME"], ignore_errors=True)
+            check(q.returncode == 1 and "dissgen install" in q.stderr,
+                  "tshark without the plugin: exit 1, says how to install it (%d: %s)" % (q.returncode, q.stderr.strip()))
+
+    def test_corpus_reports_match_the_fields(self):
+        corpus = ARGS.corpus or os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus", "ethercat")
+        files = corpus_captures(corpus)
+        if not files:
+            self.skipTest("no corpus at %s (no *.pcap/*.pcapng)" % corpus)
+        with self.checks() as check:
+            for f in files:
+                self.table_checks(check, self.env.readable(os.path.join(corpus, f)), f)
+
+
+if __name__ == "__main__":
+    def options(parser):
+        parser.add_argument("--corpus", help="the EtherCAT captures (default ../shared/corpus/ethercat)")
+        parser.add_argument("--screenshots", help="where the browser's screenshot goes")
+    ARGS, status = run_unittests(options)
+    sys.exit(status)

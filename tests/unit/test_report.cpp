@@ -1,0 +1,171 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// dissgen report's model: tshark's text parsed exactly, figures by nearest
+// rank, rows folded into cycles, returns, losses and slave states.
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "report/report_html.h"
+#include "report/timing_model.h"
+
+using namespace dissgen;
+
+namespace {
+
+TEST(ReportParse, RelativeTimesToTheNanosecond) {
+    int64_t ns = 0;
+    ASSERT_TRUE(parse_seconds_ns("0.001000250", ns));
+    EXPECT_EQ(ns, 1000250);
+    ASSERT_TRUE(parse_seconds_ns("-0.000003000", ns));
+    EXPECT_EQ(ns, -3000);
+    ASSERT_TRUE(parse_seconds_ns("0.089000000", ns));  // a leading 0 is not octal
+    EXPECT_EQ(ns, 89000000);
+    ASSERT_TRUE(parse_seconds_ns("2.5", ns));
+    EXPECT_EQ(ns, 2500000000);
+    ASSERT_TRUE(parse_seconds_ns("12", ns));
+    EXPECT_EQ(ns, 12000000000);
+    EXPECT_FALSE(parse_seconds_ns("", ns));
+    EXPECT_FALSE(parse_seconds_ns("0.00x", ns));
+    EXPECT_FALSE(parse_seconds_ns("--1.0", ns));
+}
+
+TEST(ReportParse, NamesOfCommandsAndStates) {
+    EXPECT_EQ(ethercat_command_name(12), "LRW");
+    EXPECT_EQ(ethercat_command_name(14), "FRMW");
+    EXPECT_EQ(ethercat_command_name(0), "NOP");
+    EXPECT_EQ(ethercat_command_name(15), "cmd 0x0f");
+    EXPECT_EQ(al_state_name(0x0008), "OP");
+    EXPECT_EQ(al_state_name(0x0014), "SAFEOP");  // the error bit is not the state
+    EXPECT_EQ(al_state_name(0x0003), "BOOT");
+    EXPECT_EQ(al_state_name(0x0005), "0x5");
+}
+
+TEST(ReportSpread, NearestRankAndPopulationDeviation) {
+    std::vector<int64_t> v;
+    for (int64_t i = 1; i <= 200; ++i) v.push_back(i);
+    Spread s = spread_of(v);
+    EXPECT_EQ(s.count, 200u);
+    EXPECT_EQ(s.min, 1);
+    EXPECT_EQ(s.median, 100);  // rank ceil(0.5 * 200) = 100
+    EXPECT_EQ(s.p99, 198);     // rank ceil(0.99 * 200) = 198
+    EXPECT_EQ(s.max, 200);
+    Spread one = spread_of({7});
+    EXPECT_EQ(one.median, 7);
+    EXPECT_EQ(one.p99, 7);
+    EXPECT_DOUBLE_EQ(one.stddev, 0);
+    Spread pair = spread_of({-3, 3});
+    EXPECT_EQ(pair.median, -3);
+    EXPECT_DOUBLE_EQ(pair.stddev, 3);
+    EXPECT_EQ(spread_of({}).count, 0u);
+}
+
+// Rows as tshark writes them for TimingModelBuilder::timing_fields().
+struct Rows {
+    std::vector<std::string> fields = TimingModelBuilder::timing_fields(
+        {"frame.number", "frame.time_epoch", "ecatr.cycle", "ecatr.cycle.period", "ecatr.cycle.jitter",
+         "ecatr.datagram.cmd", "ecatr.datagram.ado", "ecatr.datagram.lad", "ecatr.time", "ecatr.request_in",
+         "ecatr.no_response_to", "ecatr.expert.wkc", "ecatr.slave.position", "ecatr.slave.name",
+         "ecatr.datagram.reg.alstatus.status"});
+    std::vector<std::vector<std::string>> text;
+    void add(std::initializer_list<std::pair<const char*, std::string>> values) {
+        std::vector<std::string> row(fields.size());
+        for (auto& [name, value] : values)
+            for (size_t i = 0; i < fields.size(); ++i)
+                if (fields[i] == name) row[i] = value;
+        text.push_back(row);
+    }
+    void feed(TimingModel& m) {
+        TimingModelBuilder b(fields, m);
+        for (auto& r : text) {
+            FieldRow row(r.begin(), r.end());
+            b.add(row);
+        }
+    }
+};
+
+TEST(ReportModel, CyclesReturnsLossesAndStates) {
+    const std::string sep(1, kValueSeparator);
+    Rows r;
+    EXPECT_EQ(r.fields.size(), 15u);  // only the fields tshark knows are asked for
+    r.add({{"frame.number", "1"}, {"frame.time_epoch", "100.000000000"}, {"ecatr.cycle", "1"},
+           {"ecatr.datagram.cmd", "0x0c" + sep + "0x0e"}, {"ecatr.datagram.ado", "0x0910"},
+           {"ecatr.datagram.lad", "0x00010000"}});
+    r.add({{"frame.number", "2"}, {"frame.time_epoch", "100.000050000"}, {"ecatr.time", "0.000050000"},
+           {"ecatr.request_in", "1"}, {"ecatr.expert.wkc", "1"}});
+    r.add({{"frame.number", "3"}, {"frame.time_epoch", "100.001002000"}, {"ecatr.cycle", "1"},
+           {"ecatr.cycle.period", "0.001002000"}, {"ecatr.cycle.jitter", "0.000002000"}});
+    r.add({{"frame.number", "4"}, {"frame.time_epoch", "100.200000000"}, {"ecatr.no_response_to", "3"},
+           {"ecatr.request_in", "9"}, {"ecatr.slave.position", "0" + sep + "1"},
+           {"ecatr.slave.name", "EK1100" + sep + "EL1004"},
+           {"ecatr.datagram.reg.alstatus.status", "0x0002" + sep + "0x0008"}});
+    r.add({{"frame.number", "5"}, {"frame.time_epoch", "100.300000000"}, {"ecatr.request_in", "9"},
+           {"ecatr.slave.position", "1"}, {"ecatr.datagram.reg.alstatus.status", "0x0008"}});
+    TimingModel m;
+    r.feed(m);
+    EXPECT_EQ(m.frames, 5u);
+    EXPECT_NEAR(m.duration, 0.3, 1e-9);
+    ASSERT_EQ(m.cycles.size(), 1u);
+    const Cycle& c = m.cycles.at(1);
+    EXPECT_EQ(c.signature, "LRW 0x00010000 + FRMW 0x0910");
+    EXPECT_EQ(c.frames, 2u);
+    ASSERT_EQ(c.period.size(), 1u);
+    EXPECT_EQ(c.period[0].ns, 1002000);
+    EXPECT_EQ(c.jitter[0].ns, 2000);
+    ASSERT_EQ(c.round_trip.size(), 1u);
+    EXPECT_EQ(c.round_trip[0].ns, 50000);
+    EXPECT_EQ(c.wkc_errors, 1u);
+    EXPECT_EQ(c.lost, 1u);
+    ASSERT_EQ(m.lost.size(), 1u);
+    EXPECT_EQ(m.lost[0].frame, 3u);
+    EXPECT_EQ(m.lost[0].cycle, 1u);
+    ASSERT_EQ(m.slaves.size(), 2u);
+    EXPECT_EQ(m.slaves.at(0).name, "EK1100");
+    EXPECT_EQ(m.slaves.at(1).name, "EL1004");
+    ASSERT_EQ(m.slaves.at(1).states.size(), 1u);  // OP twice: one state, no change
+    EXPECT_EQ(m.slaves.at(1).states[0].second, 8u);
+}
+
+TEST(ReportModel, StatusesNotMatchingTheSlavesAreNotGuessed) {
+    const std::string sep(1, kValueSeparator);
+    Rows r;
+    r.add({{"frame.number", "1"}, {"frame.time_epoch", "1.0"}, {"ecatr.request_in", "0"},
+           {"ecatr.slave.position", "4"}, {"ecatr.datagram.reg.alstatus.status", "0x0002" + sep + "0x0004"}});
+    TimingModel m;
+    r.feed(m);
+    EXPECT_TRUE(m.slaves.empty());
+}
+
+TEST(ReportChart, LongSeriesKeepEveryExtreme) {
+    std::vector<TimedValue> series;
+    for (int i = 0; i < 100000; ++i) series.push_back({i * 0.001, 1000000 + (i == 77777 ? 5000000 : i % 7)});
+    std::string json = series_json(series, 100);
+    size_t points = 0;
+    for (size_t at = json.find("],["); at != std::string::npos; at = json.find("],[", at + 1)) ++points;
+    EXPECT_LE(points, 101u);
+    EXPECT_NE(json.find("6000.000]"), std::string::npos) << "the spike's maximum is drawn";
+    std::string short_json = series_json({{0.5, 1500}, {1.0, -250}}, 100);
+    EXPECT_EQ(short_json, "[[0.500000,[1.500,1.500,1.500]],[1.000000,[-0.250,-0.250,-0.250]]]");
+}
+
+TEST(ReportPage, SelfContainedAndEscaped) {
+    TimingModel m;
+    m.capture = "/x/<evil>.pcap";
+    m.has_cycle_fields = true;
+    Cycle& c = m.cycles[1];
+    c.number = 1;
+    c.signature = "LRW 0x1 + </script>";
+    c.frames = 3;
+    c.period = {{0.001, 1000000}, {0.002, 1000000}};
+    std::ostringstream out;
+    std::string error = write_report_html(m, "test", out);
+    if (error.find("dygraphs") != std::string::npos) GTEST_SKIP() << error;
+    ASSERT_EQ(error, "");
+    std::string page = out.str();
+    EXPECT_EQ(page.find("<evil>"), std::string::npos);
+    EXPECT_NE(page.find("&lt;evil&gt;.pcap"), std::string::npos);
+    EXPECT_NE(page.find("\\u003c/script>"), std::string::npos) << "no </script> inside the data";
+    EXPECT_NE(page.find("<td>1000.000</td>"), std::string::npos);
+    EXPECT_EQ(page.find("src=\"http"), std::string::npos);
+}
+
+}  // namespace
