@@ -689,7 +689,44 @@ bus_frame *new_frame(const bus_model *m, guint count, const events *ev)
     return f;
 }
 
-void show_slave(const bus_model *m, const addressed *a, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+/* Someone may read the slave's fields: a visible tree (the details pane, -V,
+ * -T fields), or a filter or column naming one. */
+gboolean slave_fields_wanted(proto_tree *tree)
+{
+    const int *hfs[] = {&hf_position, &hf_station, &hf_alias, &hf_vendor, &hf_product, &hf_revision, &hf_serial,
+                        &hf_name};
+    for (const int *hf : hfs)
+        if (proto_field_is_referenced(tree, *hf)) return TRUE;
+    return FALSE;
+}
+
+/* "Slave 2: EL1004 'Door switches', station 0x1002": the design's name when it has its own. */
+void slave_label(dg_label *label, const bus_model *m, guint position, gint32 device, gboolean has_station,
+                 guint16 station)
+{
+    const dg_bus *b = m->design;
+    dg_label_str(label, "Slave ");
+    dg_label_int(label, position, FALSE);
+    if (device >= 0) {
+        dg_label_str(label, ": ");
+        dg_label_str(label, b->devices[device].type);
+    }
+    const char *designed = b && b->slaves && position < b->slave_count ? b->slaves[position].name : NULL;
+    if (designed && *designed && (device < 0 || strcmp(designed, b->devices[device].type) != 0)) {
+        dg_label_str(label, " '");
+        dg_label_str(label, designed);
+        dg_label_str(label, "'");
+    }
+    if (has_station) {
+        char hex[8];
+        g_snprintf(hex, sizeof hex, "0x%04x", station);
+        dg_label_str(label, ", station ");
+        dg_label_str(label, hex);
+    }
+}
+
+void show_slave(const bus_model *m, const addressed *a, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
+                gboolean details)
 {
     gint32 position = a->position;
     if (position < 0 && a->by_station && PINFO_FD_VISITED(pinfo)) position = station_position(m, a->station);
@@ -698,30 +735,30 @@ void show_slave(const bus_model *m, const addressed *a, tvbuff_t *tvb, packet_in
     const slave_state *s = m->slaves[position];
     const dg_bus *b = m->design;
     gint32 device = learned_device(b, s);
-    dg_label label = {"", 0}; /* "Slave at position 1: EL1004" */
-    dg_label_str(&label, "Slave at position ");
-    dg_label_int(&label, position, FALSE);
-    if (device >= 0) {
-        dg_label_str(&label, ": ");
-        dg_label_str(&label, b->devices[device].name);
-    }
+    gboolean has_station = a->by_station || (s && s->station_known);
+    guint16 station = a->by_station ? a->station : s ? s->station : 0;
+    dg_label label = {"", 0};
+    slave_label(&label, m, (guint)position, device, has_station, station);
     proto_item *item = proto_tree_add_none_format(tree, hf_slave, tvb, offset, length, "%s", label.text);
     proto_item_set_generated(item);
+    /* The details: printed with the preference, else added hidden (filterable,
+     * not printed), as Wireshark's TCP analysis adds its flags. */
+    gboolean hidden = !details;
+    if (!slave_fields_wanted(tree)) return;
     proto_tree *sub = proto_item_add_subtree(item, ett_slave);
-    proto_item_set_generated(proto_tree_add_uint(sub, hf_position, tvb, offset, length, (guint32)position));
-    if (a->by_station || (s && s->station_known))
-        proto_item_set_generated(
-            proto_tree_add_uint(sub, hf_station, tvb, offset, length, a->by_station ? a->station : s->station));
+    auto add = [hidden](proto_item *it) {
+        proto_item_set_generated(it);
+        if (hidden) proto_item_set_hidden(it);
+    };
+    add(proto_tree_add_uint(sub, hf_position, tvb, offset, length, (guint32)position));
+    if (has_station) add(proto_tree_add_uint(sub, hf_station, tvb, offset, length, station));
     if (!s) return;
-    if (s->alias_known)
-        proto_item_set_generated(proto_tree_add_uint(sub, hf_alias, tvb, offset, length, s->alias));
+    if (s->alias_known) add(proto_tree_add_uint(sub, hf_alias, tvb, offset, length, s->alias));
     const int *hfs[] = {&hf_vendor, &hf_product, &hf_revision, &hf_serial};
     const guint words[] = {W_VENDOR, W_PRODUCT, W_REVISION, W_SERIAL};
     for (guint i = 0; i < G_N_ELEMENTS(words); i++)
-        if (words_known(s, words[i]))
-            proto_item_set_generated(proto_tree_add_uint(sub, *hfs[i], tvb, offset, length, word32(s, words[i])));
-    if (device >= 0)
-        proto_item_set_generated(proto_tree_add_string(sub, hf_name, tvb, offset, length, b->devices[device].type));
+        if (words_known(s, words[i])) add(proto_tree_add_uint(sub, *hfs[i], tvb, offset, length, word32(s, words[i])));
+    if (device >= 0) add(proto_tree_add_string(sub, hf_name, tvb, offset, length, b->devices[device].type));
 }
 
 /* Up to 64 bits of the process image, least significant bit first. */
@@ -1113,14 +1150,14 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const data
     return f;
 }
 
-void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, gboolean details)
 {
     if (!f) return;
     /* Items only into a tree (without one, e.g. summary lines, the labels
      * would be built for nobody); the expert infos below always. */
     for (guint i = 0; tree && i < f->count; i++) {
         const addressed *a = &f->d[i];
-        show_slave(f->model, a, tvb, pinfo, tree);
+        show_slave(f->model, a, tvb, pinfo, tree, details);
         if (a->logical) show_process_data(f->model, &a->dgram, f->returned, pinfo->num, tvb, tree);
         if (a->expected_wkc >= 0)
             proto_item_set_generated(proto_tree_add_uint(tree, hf_wkc_expected, tvb, wkc_offset(&a->dgram),

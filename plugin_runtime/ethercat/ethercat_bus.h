@@ -47,8 +47,10 @@ bus_frame *bus_sent(bus_model *m, tvbuff_t *tvb, packet_info *pinfo);
  * datagrams as read_frame() read them. */
 bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
                         packet_info *pinfo);
-/* Every pass: the slave items and the network-check expert infos. */
-void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+/* Every pass: the slave items and the network-check expert infos. A line per
+ * datagram names its slave; `details` (the preference) prints the slave's
+ * fields under it, else they are added hidden when a filter names them. */
+void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, gboolean details);
 void bus_register(int proto, const char *filter);
 /* Statistics (tshark -z ecatr,tree): per slave position, from returned frames. */
 void bus_stats_init(stats_tree *st, int parent);

@@ -31,6 +31,7 @@
 #include "dissgen_label.h"
 
 #include <epan/expert.h>
+#include <epan/prefs.h>
 
 #include <string.h>
 
@@ -305,25 +306,41 @@ void show_datagram_experts(const compared *c, guint i, tvbuff_t *tvb, packet_inf
                                      i + 1, cmd, c->advance, c->majority);
 }
 
-gboolean is_shown(proto_tree *tree)
+/* "Show slave and ESC details on every datagram" (the preference): off, a
+ * datagram's comparison is printed only when something is unusual. */
+gboolean show_details = FALSE;
+
+/* Someone may read the comparison: a visible tree (the details pane, -V,
+ * -T fields), or a filter or column naming one of its fields. */
+gboolean comparison_wanted(proto_tree *tree)
 {
-    /* proto_field_is_referenced: a visible tree, or a filter or column naming the field */
-    return tree && (proto_field_is_referenced(tree, hf_esc) || proto_field_is_referenced(tree, hf_datagram) ||
-                    proto_field_is_referenced(tree, hf_wkc_added) ||
-                    proto_field_is_referenced(tree, hf_slaves_passed) ||
-                    proto_field_is_referenced(tree, hf_data_changed));
+    const int *hfs[] = {&hf_esc, &hf_datagram, &hf_wkc_added, &hf_slaves_passed, &hf_data_changed};
+    for (const int *hf : hfs)
+        if (proto_field_is_referenced(tree, *hf)) return TRUE;
+    return FALSE;
+}
+
+/* What an expert info of show_datagram_experts() says: worth printing. */
+gboolean unusual(const compared *c)
+{
+    return c->changed || (is_write(c->sent.cmd) && c->data_changed) || wkc_added(c) < 0 || c->forwarding;
 }
 
 void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     const result *r = (const result *)data;
-    /* Items only for whoever looks at them (e.g. not for tshark -T fields of other fields),
-     * expert infos always. */
-    gboolean items = is_shown(tree);
+    /* Printed: every datagram with the preference, else the unusual ones. The
+     * others are added hidden (filterable, not printed) for whoever may read
+     * them. Expert infos always. */
+    gboolean any_unusual = r->length_changed;
+    for (guint i = 0; i < r->count && !any_unusual; i++) any_unusual = unusual(&r->d[i]);
+    gboolean wanted = tree && comparison_wanted(tree);
+    gboolean printed = tree && (show_details || any_unusual);
     proto_tree *sub = tree;
-    if (items) {
+    if (printed || wanted) {
         proto_item *item = proto_tree_add_item(tree, hf_esc, tvb, 0, 0, ENC_NA);
         proto_item_set_generated(item);
+        if (!printed) proto_item_set_hidden(item);
         sub = proto_item_add_subtree(item, ett_esc);
     }
     if (r->length_changed)
@@ -333,10 +350,15 @@ void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *t
                                      r->sent_length, r->sent_count, r->back_length, r->back_count);
     for (guint i = 0; i < r->count; i++) {
         const compared *c = &r->d[i];
-        proto_tree *dg = items ? show_datagram_items(c, i, tvb, sub) : sub;
+        gboolean shown = printed && (show_details || unusual(c));
+        proto_tree *dg = sub;
+        if (shown || wanted) {
+            dg = show_datagram_items(c, i, tvb, sub);
+            if (!shown) proto_item_set_hidden(proto_tree_get_parent(dg));
+        }
         show_datagram_experts(c, i, tvb, pinfo, dg);
     }
-    bus_show(r->bus, tvb, pinfo, tree);
+    bus_show(r->bus, tvb, pinfo, tree, show_details);
 }
 
 /* A frame as sent (or returned without its request): only the slaves. */
@@ -347,7 +369,7 @@ void *esc_sent(void *capture, tvbuff_t *tvb, packet_info *pinfo)
 
 void esc_show_sent(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
-    bus_show((const bus_frame *)data, tvb, pinfo, tree);
+    bus_show((const bus_frame *)data, tvb, pinfo, tree, show_details);
 }
 
 /* --- statistics ---------------------------------------------------------- */
@@ -389,6 +411,12 @@ void esc_register(int proto, const char *filter)
     static const char *const ei_names[] = {DG_ESC_EXPERTS(DG_EXPERT_NAME)};
     dg_name_experts(ei, ei_names, G_N_ELEMENTS(ei), filter);
     expert_register_field_array(expert_register_protocol(proto), ei, (int)G_N_ELEMENTS(ei));
+    module_t *prefs = prefs_register_protocol(proto, NULL);
+    prefs_register_bool_preference(prefs, "show_details", "Show slave and ESC details on every datagram",
+                                   "Print every datagram's slave (position, station, identity) and its comparison "
+                                   "with the frame as sent. Off: one line names the slave, the comparison is "
+                                   "printed where something is unusual, and every field stays filterable.",
+                                   &show_details);
     bus_register(proto, filter);
 }
 

@@ -694,6 +694,21 @@ class TestBusModel(TsharkTestCase, unittest.TestCase):
             rows = decode(self.env, os.path.join(self.env.home, "soem-sdinfo-ek1100-el1004.pcapng"), EXPERTS, True)
             check(not any(any(r.values()) for _n, r in rows), "no network experts without a design")
 
+    def test_one_line_per_slave_details_filterable(self):
+        """-V names a datagram's slave on one line ("Slave 1: EL1004, station 0x1002"); its fields
+        are printed under it only with the preference, and filterable either way."""
+        self.need_corpus()
+        path = os.path.join(self.env.home, "soem-sdinfo-ek1100-el1004.pcapng")
+        with self.checks() as check:
+            for prefs in ([], ["-o", "ecatr.show_details:TRUE"]):
+                text = self.env.tshark(["-r", path, "-2", "-V", "-Y", "frame.number == 97"] + prefs).stdout
+                check("[Slave 1: EL1004, station 0x1002]" in text, "%s: the slave on one line" % (prefs or "default"))
+                check(("[Position: 1]" in text and "[Product code: 0x03ec3052]" in text) == bool(prefs),
+                      "%s: its fields %s" % (prefs or "default", "printed" if prefs else "not printed"))
+            rows = self.env.field_rows(path, ["frame.number"], two_pass=True,
+                                       display_filter='ecatr.slave.name == "EL1004" && ecatr.slave.station == 0x1002')
+            check(97 in rows, "a filter on the slave's fields finds frame 97 (%d frames)" % len(rows))
+
     def test_network_check_against_four_designs(self):
         """Part 2."""
         self.need_corpus()

@@ -34,6 +34,7 @@ Computed values, checked against the bytes written: the mailbox total length (th
     test_esc_commands.py --dissgen build/bin/dissgen --source-dir .
 """
 import os
+import re
 import struct
 import sys
 import unittest
@@ -217,6 +218,30 @@ class TestEscCommands(TsharkTestCase, unittest.TestCase):
                     check(not mine, "%s%s: returned frames show what the rules say (%s)%s" % (
                         NAMES[cmd], tag, ", ".join(c.what for c in cs if c.cmd == cmd),
                         "".join("\n       " + b for b in mine[:4])))
+
+    def test_comparison_printed_only_where_unusual(self):
+        """-V prints a return's comparison (ecatr.esc) only when one of its datagrams raises an
+        expert info, every one with the preference "Show slave and ESC details on every
+        datagram"; the fields are filterable on every return either way."""
+        env = self.env
+        with self.checks() as check:
+            cs = cases()
+            path = env.add_file("esc-printed.pcap", pg.pcap_bytes(frames_of(cs)))
+            unusual = {2 * k + 2 for k, c in enumerate(cs)
+                       if any(v for f, v in c.expect.items() if f.startswith("ecatr.expert."))}
+            for prefs, tag in (([], "default"), (["-o", "ecatr.show_details:TRUE"], "show_details")):
+                text = env.tshark(["-r", path, "-V"] + prefs).stdout
+                frames = {int(m.group(1)): m.group(0) for m in re.finditer(r"(?ms)^Frame (\d+):.*?(?=^Frame |\Z)", text)}
+                printed = {n for n, t in frames.items() if "Out and back (ESC forwarding)" in t}
+                returns = {2 * k + 2 for k in range(len(cs))}
+                want = returns if prefs else unusual
+                check(printed == want, "%s: the comparison is printed on %d returns (%s), want %d: %s" % (
+                    tag, len(printed), "every one" if prefs else "the unusual ones", len(want),
+                    sorted(printed ^ want)[:8]))
+            # Filterable all the same: a filter finds the comparison on every return.
+            rows = env.field_rows(path, ["frame.number"], display_filter="ecatr.esc.wkc_added")
+            check(set(rows) == {2 * k + 2 for k in range(len(cs))},
+                  "-Y ecatr.esc.wkc_added keeps every return (%d of %d)" % (len(rows), len(cs)))
 
     def test_computed_values_match_the_bytes(self):
         """Mailbox total lengths (ecatr.datagram.mbx.totallength, ecatr.gateway.totallength),

@@ -85,6 +85,7 @@ TESTS = {
     "bus_wkc": integration("test_bus_model.py", "TestBusModel.test_expected_working_counters"),
     "bus_stats": integration("test_bus_model.py", "TestBusModel.test_per_slave_statistics"),
     "bus_eni": integration("test_bus_model.py", "TestBusModel.test_eni_cyclic_commands_expected_wkc"),
+    "bus_slave_line": integration("test_bus_model.py", "TestBusModel.test_one_line_per_slave_details_filterable"),
     "bus_pdo": integration("test_bus_model.py", "TestBusModel.test_process_data_by_name"),
     "bus_coe": integration("test_bus_model.py", "-k", "test_process_data_as_mapped_over_coe_"),
     "pairing": integration("test_pairing.py", "--quick"),
