@@ -7,6 +7,9 @@
         register, mailbox and process-data datagrams, as Wireshark's plugin decodes them too)
     python3 bench/bench.py --corpus ../shared/corpus/ethercat --same-depth   (the rules without
         their <pairing> block: what Wireshark's plugin decodes, and nothing more)
+    python3 bench/bench.py --scale 100 --esi ../shared/corpus/esi --configs ours,wireshark,floor
+        (hours of traffic: a real capture repeated 100 times, each copy's timestamps shifted
+        past the previous one's, so every frame pairs as in the original; peak memory per frame)
 
 Expects build/bin/dissgen (build it first: bash scripts/build.sh); builds nothing
 itself. In one run it
@@ -179,6 +182,32 @@ def merge_corpus(folder, copies, out):
         raise BenchError("--corpus needs mergecap (Debian package wireshark-common)")
     p = subprocess.run(["mergecap", "-a", "-F", "pcap", "-w", out] + files * max(1, copies),
                        capture_output=True, text=True)
+    if p.returncode != 0:
+        raise BenchError("mergecap failed:\n" + p.stderr[-2000:])
+
+
+def scale_capture(base, copies, work, out):
+    """`copies` copies of `base` one after the other (editcap -t shifts each copy past the
+    previous one's last frame, mergecap -a appends), as the classic pcap `out`."""
+    for tool in ("editcap", "mergecap", "capinfos"):
+        if shutil.which(tool) is None:
+            raise BenchError("--scale needs %s (Debian package wireshark-common)" % tool)
+    p = subprocess.run(["capinfos", "-T", "-r", "-a", "-e", "-S", base], capture_output=True, text=True)
+    cols = p.stdout.strip().split("\t") if p.returncode == 0 else []
+    if len(cols) < 3:
+        raise BenchError("capinfos cannot read %s: %s" % (base, p.stderr.strip()))
+    span = float(cols[2]) - float(cols[1]) + 0.001
+    pieces = []
+    for k in range(copies):
+        piece = os.path.join(work, "scale-%d.pcap" % k)
+        p = subprocess.run(["editcap", "-F", "pcap", "-t", "%.6f" % (k * span), base, piece],
+                           capture_output=True, text=True)
+        if p.returncode != 0:
+            raise BenchError("editcap failed: " + p.stderr[-2000:])
+        pieces.append(piece)
+    p = subprocess.run(["mergecap", "-a", "-F", "pcap", "-w", out] + pieces, capture_output=True, text=True)
+    for piece in pieces:
+        os.unlink(piece)
     if p.returncode != 0:
         raise BenchError("mergecap failed:\n" + p.stderr[-2000:])
 
@@ -438,6 +467,18 @@ def report(info, decode, startup, install, runs, instr=None):
             verdict.append("%s CPU %.2fx %s (net %s; the floor alone is %.2fx), RSS %.3fx (%+.1f MB) %s" % (
                 mode, c, "ok" if c <= 0.8 else "MISSED", "n/a" if n != n else "%.2fx" % n, f, m, dm,
                 "ok" if m <= 1.0 else ("equal within noise" if m <= 1.005 else "MISSED")))
+        frames = cap["frames"]
+        if frames > 0:
+            per_frame = []
+            for mode, per in decode.items():
+                ours = med(per["ours"], "rss_kb") * 1024
+                line = "%s ours %.0f" % (mode, ours / frames)
+                for k in ("wireshark", "floor"):
+                    if k in per:
+                        line += ", %s %.0f (ours %+.0f)" % (k, med(per[k], "rss_kb") * 1024 / frames,
+                                                            (ours - med(per[k], "rss_kb") * 1024) / frames)
+                per_frame.append(line)
+            out.append("Peak RSS per frame (bytes, %d frames): %s" % (frames, "; ".join(per_frame)))
         if startup and "ours" in startup:
             o = med(startup["ours"], "cpu") / med(startup["none"], "cpu") - 1
             verdict.append("start-up %+.1f%% %s" % (100 * o, "ok" if o <= 0.05 else "MISSED"))
@@ -465,6 +506,13 @@ def main(argv=None):
                          "register and mailbox datagrams) concatenated with mergecap into one pcap")
     ap.add_argument("--corpus-copies", type=int, default=1, metavar="N",
                     help="with --corpus: concatenate the captures N times (a longer run; default 1)")
+    ap.add_argument("--scale", type=int, default=0, metavar="N",
+                    help="decode --scale-base repeated N times, timestamps shifted (hours of traffic)")
+    ap.add_argument("--scale-base", metavar="FILE",
+                    default=os.path.join(ROOT, "..", "shared", "corpus", "ethercat", "twincat-akd-nc-mode.pcapng"),
+                    help="the capture --scale repeats (default the corpus' twincat-akd-nc-mode.pcapng)")
+    ap.add_argument("--esi", action="append", default=[], metavar="PATH",
+                    help="install our plugin with this ESI catalogue (repeatable)")
     ap.add_argument("--modes", default=",".join(MODES), help="of %s (default all)" % ",".join(MODES))
     ap.add_argument("--configs", default=",".join(CONFIGS), help="of %s (default all)" % ",".join(CONFIGS))
     ap.add_argument("--startup-runs", type=int, default=20, help="default 20; 0 skips start-up timing")
@@ -504,7 +552,16 @@ def main(argv=None):
         info["tshark"] = tv[0].split("(Wireshark) ")[-1].split(" ")[0] if tv else "?"
 
         # Inputs.
-        if a.corpus:
+        if a.scale > 0:
+            if not os.path.isfile(a.scale_base):
+                raise BenchError("--scale: no capture at %s (give --scale-base)" % a.scale_base)
+            capture = os.path.join(work, "bench.pcap")
+            log("repeating %s %d times ..." % (os.path.basename(a.scale_base), a.scale))
+            scale_capture(a.scale_base, a.scale, work, capture)
+            info["capture"] = {"frames": count_pcap_records(capture), "datagrams": 0,
+                               "commands": [], "datagrams_per_frame": [0, 0], "data_len": [0, 0, 0],
+                               "encap": {}, "scaled": os.path.abspath(a.scale_base), "copies": a.scale}
+        elif a.corpus:
             capture = os.path.join(work, "bench.pcap")
             merge_corpus(a.corpus, a.corpus_copies, capture)
             info["capture"] = {"frames": count_pcap_records(capture), "datagrams": 0,
@@ -542,7 +599,9 @@ def main(argv=None):
         log("installing the plugins ...")
         ours = TsharkEnv(prefix="dissgen-bench-ours-")
         cleanup.append(ours)
-        ours.install_plugin(a.dissgen, a.rules)
+        ours.install_plugin(a.dissgen, a.rules, [arg for p in a.esi for arg in ("--esi", p)])
+        if a.esi:
+            info["rules"] += " with --esi " + " --esi ".join(a.esi)
         ours.assert_plugin_loaded("ecatr")
         envs.update(ours=ours, wireshark=ours, floor=ours)
         if "lua" in configs:
