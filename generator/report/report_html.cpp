@@ -103,20 +103,21 @@ std::string slaves_json(const TimingModel& m) {
     return out + "]";
 }
 
+// One figure per cell; times in µs with 3 decimals (exact: they are whole ns).
 void cycle_table(const TimingModel& m, std::ostream& out) {
     out << "<table id=\"cycles\"><thead><tr><th>Cycle</th><th>Signature</th><th>Frames</th>"
            "<th>Nominal period (µs)</th><th>Period min</th><th>median</th><th>p99</th><th>max</th>"
            "<th>Jitter std dev (µs)</th><th>Round trip min</th><th>median</th><th>p99</th><th>max</th>"
-           "<th>Lost</th><th>WKC errors</th></tr></thead><tbody>\n";
+           "<th>Returned</th><th>Lost</th><th>WKC errors</th></tr></thead><tbody>\n";
     for (const auto& [number, c] : m.cycles) {
         Spread period = spread_of(values_of(c.period)), jitter = spread_of(values_of(c.jitter)),
                rtt = spread_of(values_of(c.round_trip));
         out << "<tr data-cycle=\"" << number << "\"><td>" << number << "</td><td>" << escape_html(c.signature)
-            << "</td><td>" << c.frames << "</td><td>" << us(period.median) << "</td><td>" << us(period.min)
-            << "</td><td>" << us(period.median) << "</td><td>" << us(period.p99) << "</td><td>" << us(period.max)
-            << "</td><td>" << num(jitter.stddev / 1000.0) << "</td><td>" << us(rtt.min) << "</td><td>"
-            << us(rtt.median) << "</td><td>" << us(rtt.p99) << "</td><td>" << us(rtt.max) << "</td><td>" << c.lost
-            << "</td><td>" << c.wkc_errors << "</td></tr>\n";
+            << "</td><td>" << c.frames << "</td><td>" << us(c.nominal) << "</td>";
+        for (int64_t v : {period.min, period.median, period.p99, period.max}) out << "<td>" << us(v) << "</td>";
+        out << "<td>" << num(jitter.stddev / 1000.0) << "</td>";
+        for (int64_t v : {rtt.min, rtt.median, rtt.p99, rtt.max}) out << "<td>" << us(v) << "</td>";
+        out << "<td>" << c.returned << "</td><td>" << c.lost() << "</td><td>" << c.wkc_errors << "</td></tr>\n";
     }
     out << "</tbody></table>\n";
 }

@@ -13,7 +13,8 @@ namespace {
 const char* const kTimingFields[] = {
     "frame.number",          "frame.time_epoch",        "ecatr.cycle",
     "ecatr.cycle.period",    "ecatr.cycle.jitter",      "ecatr.datagram.cmd",
-    "ecatr.datagram.ado",    "ecatr.datagram.lad",      "ecatr.time",
+    "ecatr.datagram.adp",    "ecatr.datagram.ado",      "ecatr.datagram.lad",
+    "ecatr.datagram.len",    "ecatr.datagram.wkc",      "ecatr.esc.wkc_added",     "ecatr.time",
     "ecatr.request_in",      "ecatr.no_response_to",    "ecatr.expert.wkc",
     "ecatr.slave.position",  "ecatr.slave.name",        "ecatr.datagram.reg.alstatus.status",
     "ecatr.expert.network.ok", "ecatr.expert.network.count", "ecatr.expert.network.model",
@@ -45,9 +46,9 @@ bool parse_epoch(std::string_view text, int64_t& s, int64_t& ns) {
     return true;
 }
 
-// The nearest-rank percentile of sorted values (p in 0..100).
-int64_t nearest_rank(const std::vector<int64_t>& sorted, double p) {
-    size_t rank = static_cast<size_t>(std::ceil(p / 100.0 * static_cast<double>(sorted.size())));
+// The nearest-rank percentile of sorted values (p in 1..100), in integers: ceil(p n / 100).
+int64_t nearest_rank(const std::vector<int64_t>& sorted, unsigned p) {
+    size_t rank = (p * sorted.size() + 99) / 100;
     return sorted[rank == 0 ? 0 : rank - 1];
 }
 
@@ -60,7 +61,7 @@ Spread spread_of(std::vector<int64_t> values) {
     std::sort(values.begin(), values.end());
     s.min = values.front();
     s.max = values.back();
-    s.median = nearest_rank(values, 50);
+    s.median = values[(values.size() - 1) / 2];  // the lower median
     s.p99 = nearest_rank(values, 99);
     double sum = 0, squares = 0;
     for (int64_t v : values) sum += static_cast<double>(v);
@@ -78,6 +79,18 @@ bool parse_seconds_ns(std::string_view text, int64_t& ns) {
     ns = s * 1000000000 + frac;
     if (negative) ns = -ns;
     return true;
+}
+
+uint64_t Cycle::lost() const {
+    // Frames after the latest frame answered may still be in flight.
+    uint32_t latest = 0;
+    for (uint32_t f : answered) latest = std::max(latest, f);
+    std::vector<uint32_t> done(answered);
+    std::sort(done.begin(), done.end());
+    uint64_t lost = 0;
+    for (uint32_t f : sent)
+        if (f < latest && !std::binary_search(done.begin(), done.end(), f)) lost++;
+    return lost;
 }
 
 std::string ethercat_command_name(unsigned cmd) {
@@ -149,7 +162,6 @@ void TimingModelBuilder::add(const FieldRow& row) {
         auto it = cycle_of_frame_.find(static_cast<uint32_t>(f));
         unsigned c = it == cycle_of_frame_.end() ? 0 : it->second;
         model_.lost.push_back({t, static_cast<uint32_t>(f), c});
-        if (c) model_.cycles[c].lost++;
     }
     add_slave_states(row, t);
     const char* network[] = {"ecatr.expert.network.ok", "ecatr.expert.network.count", "ecatr.expert.network.model"};
@@ -163,31 +175,53 @@ void TimingModelBuilder::add(const FieldRow& row) {
     }
 }
 
+// The frame's datagrams in the words of -z ecatr,cycles:
+// "LRW 0x00010000 (4 bytes), FRMW 0x1001:0x0910 (8 bytes)".
+std::string TimingModelBuilder::signature_text(const FieldRow& row) const {
+    std::string signature;
+    auto cmds = split_values(value(row, column("ecatr.datagram.cmd")));
+    auto adps = split_values(value(row, column("ecatr.datagram.adp")));
+    auto ados = split_values(value(row, column("ecatr.datagram.ado")));
+    auto lads = split_values(value(row, column("ecatr.datagram.lad")));
+    auto lens = split_values(value(row, column("ecatr.datagram.len")));
+    size_t next_address = 0, next_lad = 0;
+    for (size_t i = 0; i < cmds.size(); ++i) {
+        uint64_t cmd = 0, a = 0, b = 0, len = 0;
+        parse_uint(cmds[i], cmd);
+        char one[96];
+        if (cmd >= 10 && cmd <= 12) {
+            if (next_lad < lads.size()) parse_uint(lads[next_lad++], a);
+            std::snprintf(one, sizeof one, "%s 0x%08llx", ethercat_command_name(static_cast<unsigned>(cmd)).c_str(),
+                          static_cast<unsigned long long>(a));
+        } else {
+            if (next_address < adps.size()) parse_uint(adps[next_address], a);
+            if (next_address < ados.size()) parse_uint(ados[next_address], b);
+            next_address++;
+            std::snprintf(one, sizeof one, "%s 0x%04llx:0x%04llx",
+                          ethercat_command_name(static_cast<unsigned>(cmd)).c_str(),
+                          static_cast<unsigned long long>(a), static_cast<unsigned long long>(b));
+        }
+        if (i < lens.size()) parse_uint(lens[i], len);
+        if (!signature.empty()) signature += ", ";
+        signature += std::string(one) + " (" + std::to_string(len) + " bytes)";
+    }
+    return signature;
+}
+
 void TimingModelBuilder::add_cycle_frame(const FieldRow& row, uint32_t frame, double t, unsigned number) {
     Cycle& c = model_.cycles[number];
     if (c.frames++ == 0) {
         c.number = number;
-        // The signature, from the first frame: commands with their addresses.
-        auto cmds = split_values(value(row, column("ecatr.datagram.cmd")));
-        auto ados = split_values(value(row, column("ecatr.datagram.ado")));
-        auto lads = split_values(value(row, column("ecatr.datagram.lad")));
-        size_t next_ado = 0, next_lad = 0;
-        for (std::string_view cmd_text : cmds) {
-            uint64_t cmd = 0;
-            parse_uint(cmd_text, cmd);
-            bool logical = cmd >= 10 && cmd <= 12;
-            std::string address;
-            if (logical && next_lad < lads.size()) address = std::string(lads[next_lad++]);
-            else if (!logical && next_ado < ados.size()) address = std::string(ados[next_ado++]);
-            if (!c.signature.empty()) c.signature += " + ";
-            c.signature += ethercat_command_name(static_cast<unsigned>(cmd));
-            if (!address.empty()) c.signature += " " + address;
-        }
+        c.signature = signature_text(row);
     }
+    c.sent.push_back(frame);
     cycle_of_frame_[frame] = number;
-    int64_t ns = 0;
-    if (parse_seconds_ns(value(row, column("ecatr.cycle.period")), ns)) c.period.push_back({t, ns});
-    if (parse_seconds_ns(value(row, column("ecatr.cycle.jitter")), ns)) c.jitter.push_back({t, ns});
+    int64_t period = 0, jitter = 0;
+    if (parse_seconds_ns(value(row, column("ecatr.cycle.period")), period)) c.period.push_back({t, period});
+    if (parse_seconds_ns(value(row, column("ecatr.cycle.jitter")), jitter)) {
+        c.jitter.push_back({t, jitter});
+        c.nominal = period - jitter;
+    }
 }
 
 void TimingModelBuilder::add_return(const FieldRow& row, double t) {
@@ -198,12 +232,37 @@ void TimingModelBuilder::add_return(const FieldRow& row, double t) {
     parse_uint(value(row, column("ecatr.request_in")), request);
     auto it = cycle_of_frame_.find(static_cast<uint32_t>(request));
     unsigned c = it == cycle_of_frame_.end() ? 0 : it->second;
-    if (c) model_.cycles[c].round_trip.push_back({t, rtt});
+    if (c) {
+        Cycle& cyc = model_.cycles[c];
+        // As the statistics clamp it: round trips within 0 .. 2^32-1 ns.
+        cyc.round_trip.push_back({t, std::clamp<int64_t>(rtt, 0, 0xffffffffLL)});
+        cyc.returned++;
+        cyc.answered.push_back(static_cast<uint32_t>(request));
+        count_wkc_error(cyc, row);
+    }
     if (!value(row, column("ecatr.expert.wkc")).empty()) {
         size_t errors = split_values(value(row, column("ecatr.expert.wkc"))).size();
         for (size_t i = 0; i < errors; ++i) model_.wkc_errors.push_back({t, static_cast<uint32_t>(request), c});
-        if (c) model_.cycles[c].wkc_errors += errors;
     }
+}
+
+// A return of the cycle is an error when a datagram's counter was not raised on
+// the way round, or came back below the highest that datagram returned before.
+void TimingModelBuilder::count_wkc_error(Cycle& c, const FieldRow& row) {
+    auto back = split_values(value(row, column("ecatr.datagram.wkc")));
+    auto added = split_values(value(row, column("ecatr.esc.wkc_added")));
+    bool error = false;
+    if (c.wkc_high.empty()) c.wkc_high.assign(back.size(), -1);
+    for (size_t i = 0; i < back.size() && i < added.size() && i < c.wkc_high.size(); ++i) {
+        uint64_t wkc = 0;
+        int64_t plus = 0;
+        if (!parse_uint(back[i], wkc)) continue;
+        std::string a(added[i]);
+        plus = std::strtoll(a.c_str(), nullptr, 10);
+        if (plus <= 0 || static_cast<int64_t>(wkc) < c.wkc_high[i]) error = true;
+        c.wkc_high[i] = std::max<int64_t>(c.wkc_high[i], static_cast<int64_t>(wkc));
+    }
+    if (error) c.wkc_errors++;
 }
 
 // A return's AL status reads, paired with the slaves they address when the

@@ -21,7 +21,8 @@ struct TimedValue {
     int64_t ns;
 };
 
-// min/median/p99/max (nearest rank) of a set of ns values; zero when empty.
+// min/median/p99/max of a set of ns values (the lower median, the nearest-rank
+// 99th percentile, as tshark -z ecatr,cycles); zero when empty.
 struct Spread {
     size_t count = 0;
     int64_t min = 0, median = 0, p99 = 0, max = 0;
@@ -29,13 +30,22 @@ struct Spread {
 };
 Spread spread_of(std::vector<int64_t> values);
 
+// One cycle, as `tshark -z ecatr,cycles` counts it (docs/manual.md, "Cycles").
 struct Cycle {
     unsigned number = 0;
-    std::string signature;          // "LRW 0x00010000 + FRMW 0x0910"
+    std::string signature;          // "LRW 0x00010000 (4 bytes), FRMW 0x1001:0x0910 (8 bytes)"
     uint64_t frames = 0;            // sent frames of the cycle
-    uint64_t lost = 0;              // of them, without a return
-    uint64_t wkc_errors = 0;        // returns whose working counter was not the expected one
+    uint64_t returned = 0;          // of them, those that came back
+    uint64_t wkc_errors = 0;        // returns with a datagram whose counter was not raised, or below
+                                    // the highest that datagram of the cycle returned before
+    int64_t nominal = 0;            // the last frame's nominal period (its period minus its jitter)
     std::vector<TimedValue> period, jitter, round_trip;
+    std::vector<uint32_t> sent;     // its frames, in order
+    std::vector<uint32_t> answered; // those that came back, in the order their returns came
+    std::vector<int64_t> wkc_high;  // per datagram, the highest working counter returned so far
+    // Lost: not answered while a later frame of the cycle was (those still in
+    // flight at the end are not lost).
+    uint64_t lost() const;
 };
 
 struct Event {
@@ -56,7 +66,7 @@ struct TimingModel {
     double duration = 0;            // seconds, first to last frame
     std::map<unsigned, Cycle> cycles;
     std::vector<TimedValue> round_trip;  // every return, cycle or not
-    std::vector<Event> lost, wkc_errors;
+    std::vector<Event> lost, wkc_errors;  // ecatr.no_response_to, ecatr.expert.wkc
     std::map<unsigned, SlaveTimeline> slaves;  // by position
     std::vector<std::string> network;          // the network check's findings, in order
     bool has_cycle_fields = false;             // the plugin shows ecatr.cycle
@@ -75,7 +85,9 @@ private:
     int column(const char* field) const;
     std::string_view value(const FieldRow& row, int column) const;
     void add_cycle_frame(const FieldRow& row, uint32_t frame, double t, unsigned cycle);
+    std::string signature_text(const FieldRow& row) const;
     void add_return(const FieldRow& row, double t);
+    void count_wkc_error(Cycle& c, const FieldRow& row);
     void add_slave_states(const FieldRow& row, double t);
 
     TimingModel& model_;

@@ -40,7 +40,7 @@ from test_losses import MASTER, ecat_frame, generated, returned  # noqa: E402
 
 ARGS = None
 FIELDS = ["frame.number", "frame.time_epoch", "ecatr.cycle", "ecatr.cycle.period", "ecatr.cycle.jitter",
-          "ecatr.time", "ecatr.request_in", "ecatr.no_response_to", "ecatr.expert.wkc"]
+          "ecatr.time", "ecatr.request_in", "ecatr.datagram.wkc", "ecatr.esc.wkc_added"]
 
 
 # ----------------------------------------------------------------------------- a capture with known timing
@@ -111,43 +111,86 @@ def ns(text):
     return -v if neg else v
 
 
-def nearest_rank(values, p):
-    s = sorted(values)
-    return s[max(0, math.ceil(p / 100 * len(s)) - 1)]
+def quantiles(values):
+    """min, lower median, nearest-rank p99, max."""
+    v = sorted(values)
+    return [v[0], v[(len(v) - 1) // 2], v[(99 * len(v) + 99) // 100 - 1], v[-1]] if v else [0, 0, 0, 0]
 
 
 def us(v):
     return "%.3f" % (v / 1000)
 
 
-def expected_table(rows):
-    """The cycle table computed from the fields, as the report prints it."""
+def cycle_figures(rows):
+    """{cycle: figures} computed from the fields, by the rules of docs/manual.md ("Cycles"):
+    frames, nominal (the last frame's period minus its jitter), period and round-trip
+    quantiles, jitter standard deviation (population, ns), returned, lost (unanswered before
+    the latest answered), working-counter errors (a datagram not raised, or below the highest
+    that datagram returned before)."""
     cycles, cycle_of = {}, {}
     for frame, r in sorted(rows.items()):
         if r["ecatr.cycle"]:
-            c = cycles.setdefault(int(r["ecatr.cycle"][0]), {"frames": 0, "period": [], "jitter": [], "rtt": [],
-                                                              "lost": 0, "wkc": 0})
-            c["frames"] += 1
+            c = cycles.setdefault(int(r["ecatr.cycle"][0]), {"sent": [], "period": [], "jitter": [], "rtt": [],
+                                                              "answered": [], "wkc": 0, "high": None})
+            c["sent"].append(frame)
             cycle_of[frame] = c
             c["period"] += [ns(v) for v in r["ecatr.cycle.period"]]
             c["jitter"] += [ns(v) for v in r["ecatr.cycle.jitter"]]
-        for lost in r["ecatr.no_response_to"]:
-            if int(lost) in cycle_of:
-                cycle_of[int(lost)]["lost"] += 1
+            if r["ecatr.cycle.jitter"]:
+                c["nominal"] = ns(r["ecatr.cycle.period"][0]) - ns(r["ecatr.cycle.jitter"][0])
         if r["ecatr.time"] and r["ecatr.request_in"] and int(r["ecatr.request_in"][0]) in cycle_of:
             c = cycle_of[int(r["ecatr.request_in"][0])]
-            c["rtt"].append(ns(r["ecatr.time"][0]))
-            c["wkc"] += len(r["ecatr.expert.wkc"])
-    table = {}
+            c["rtt"].append(min(max(ns(r["ecatr.time"][0]), 0), 2**32 - 1))
+            c["answered"].append(int(r["ecatr.request_in"][0]))
+            back, added = r["ecatr.datagram.wkc"], r["ecatr.esc.wkc_added"]
+            if c["high"] is None:
+                c["high"] = [-1] * len(back)
+            error = False
+            for i in range(min(len(back), len(added), len(c["high"]))):
+                if int(added[i]) <= 0 or int(back[i], 0) < c["high"][i]:
+                    error = True
+                c["high"][i] = max(c["high"][i], int(back[i], 0))
+            c["wkc"] += error
+    out = {}
     for number, c in cycles.items():
-        def spread(v):
-            return [us(min(v)), us(nearest_rank(v, 50)), us(nearest_rank(v, 99)), us(max(v))] if v else ["0.000"] * 4
-        mean = sum(c["jitter"]) / len(c["jitter"]) if c["jitter"] else 0
-        sd = math.sqrt(sum((j - mean) ** 2 for j in c["jitter"]) / len(c["jitter"])) if c["jitter"] else 0
-        p = spread(c["period"])
-        table[number] = [str(number), None, str(c["frames"]), p[1]] + p + ["%.3f" % (sd / 1000)] + \
-            spread(c["rtt"]) + [str(c["lost"]), str(c["wkc"])]
-    return table
+        latest = max(c["answered"], default=0)
+        j = c["jitter"]
+        mean = sum(j) / len(j) if j else 0
+        out[number] = {"frames": len(c["sent"]), "nominal": c.get("nominal", 0), "period": quantiles(c["period"]),
+                       "jitter_sd": math.sqrt(sum((x - mean) ** 2 for x in j) / len(j)) if j else 0.0,
+                       "rtt": quantiles(c["rtt"]), "returned": len(c["rtt"]), "wkc": c["wkc"],
+                       "lost": sum(1 for f in c["sent"] if f < latest and f not in set(c["answered"]))}
+    return out
+
+
+def as_table_row(number, f):
+    """The cells of the report's cycle table for figures f (signature not compared)."""
+    return [str(number), None, str(f["frames"]), us(f["nominal"])] + [us(v) for v in f["period"]] + \
+        [None] + [us(v) for v in f["rtt"]] + [str(f["returned"]), str(f["lost"]), str(f["wkc"])]
+
+
+def stats_cycles(text):
+    """{cycle: figures} from `tshark -z ecatr,cycles`."""
+    out, current = {}, None
+    for line in text.splitlines():
+        m = re.match(r"Cycle (\d+): (.*)$", line)
+        if m:
+            current = out.setdefault(int(m.group(1)), {"signature": m.group(2)})
+            continue
+        if current is None:
+            continue
+        m = re.match(r"\s+(period|round trip) min/median/p99/max \(ns\): (\d+) (\d+) (\d+) (\d+)", line)
+        if m:
+            current["period" if m.group(1) == "period" else "rtt"] = [int(x) for x in m.groups()[1:]]
+        elif re.match(r"\s+(period|round trip): none", line):
+            current["period" if "period" in line else "rtt"] = [0, 0, 0, 0]
+        for key, label in (("frames", "frames"), ("nominal", "nominal period \\(ns\\)"),
+                           ("returned", "frames returned"), ("lost", "frames lost"),
+                           ("wkc", "working counter errors"), ("jitter_sd", "jitter std dev \\(ns\\)")):
+            m = re.match(r"\s+%s: ([\d.]+)$" % label, line)
+            if m:
+                current[key] = float(m.group(1)) if key == "jitter_sd" else int(m.group(1))
+    return out
 
 
 def png_pixels(path):
@@ -218,28 +261,29 @@ class TestReport(TsharkTestCase, unittest.TestCase):
         page = open(out, encoding="utf-8").read() if p.returncode == 0 else ""
         return p, page, took
 
-    def stats_tree(self, capture):
-        """{cycle: [cells]} from `tshark -z ecatr,cycles`, or None when the plugin lacks it."""
-        p = self.env.tshark(["-r", capture, "-q", "-z", "ecatr,cycles"], check=False)
-        if p.returncode != 0:
-            return None
-        return p.stdout
-
     def table_checks(self, check, capture, name):
+        """The report's cycle table against the fields' figures and -z ecatr,cycles."""
         p, page, took = self.report(capture, name)
         table = report_table(page)
-        rows = self.env.field_rows(capture, FIELDS, aggregator="\x1f")
-        expected = expected_table(rows)
-        check(sorted(table) == sorted(expected), "%s: the report lists cycles %s, the fields %s"
-              % (name, sorted(table), sorted(expected)))
-        for number, want in expected.items():
-            got = table.get(number)
+        figures = cycle_figures(self.env.field_rows(capture, FIELDS, aggregator="\x1f"))
+        stats = stats_cycles(self.env.tshark(["-r", capture, "-q", "-z", "ecatr,cycles"]).stdout)
+        check(sorted(table) == sorted(figures) == sorted(stats), "%s: cycles in the report %s, the fields %s, "
+              "-z ecatr,cycles %s" % (name, sorted(table), sorted(figures), sorted(stats)))
+        for number, f in figures.items():
+            got, want = table.get(number), as_table_row(number, f)
             if got is None:
                 continue
-            same = [g == w for g, w in zip(got, want) if w is not None]
-            check(all(same) and len(got) == len(want), "%s cycle %d: report %s == fields %s"
-                  % (name, number, got, [w for w in want]))
-        print("   %s: %.1f s, %d cycles" % (name, took, len(table)))
+            same = len(got) == len(want) and all(w is None or g == w for g, w in zip(got, want))
+            check(same, "%s cycle %d: report %s == fields %s" % (name, number, got, want))
+            check(abs(float(got[8]) * 1000 - f["jitter_sd"]) < 1, "%s cycle %d: jitter std dev %s us, fields %.1f ns"
+                  % (name, number, got[8], f["jitter_sd"]))
+            z = stats.get(number, {})
+            keys = ("frames", "nominal", "period", "rtt", "returned", "lost", "wkc")
+            check(all(z.get(k) == f[k] for k in keys) and abs(z.get("jitter_sd", -9) - f["jitter_sd"]) < 0.1 and
+                  got[1] == z.get("signature"), "%s cycle %d: -z ecatr,cycles %s == fields %s" % (
+                      name, number, {k: z.get(k) for k in keys + ("jitter_sd", "signature")},
+                      dict({k: f[k] for k in keys + ("jitter_sd",)}, signature=got[1])))
+        print("   %s: report in %.1f s, %d cycles" % (name, took, len(table)))
         return table, page
 
     def test_generated_two_tasks(self):
@@ -248,10 +292,11 @@ class TestReport(TsharkTestCase, unittest.TestCase):
             check(len(table) == 2, "two tasks, two cycles (got %d)" % len(table))
             if len(table) == 2:
                 fast, slow = table[1], table[2]
-                check(fast[1].startswith("LRW") and "FRMW" in fast[1], "cycle 1 signature: %s" % fast[1])
+                check(fast[1] == "LRW 0x00010000 (4 bytes), FRMW 0x1001:0x0910 (8 bytes)",
+                      "cycle 1 signature: %s" % fast[1])
                 check(fast[3] == "1000.000" and slow[3] == "10000.000",
                       "nominal periods 1 ms and 10 ms (got %s, %s)" % (fast[3], slow[3]))
-                check(fast[13] == "1", "the lost return is counted in cycle 1 (got %s)" % fast[13])
+                check(fast[14] == "1", "the lost return is counted in cycle 1 (got %s)" % fast[14])
                 check(fast[4] == "995.000" and fast[7] == "1005.000",
                       "period min/max from the injected jitter of -3..+3 us (got %s/%s)" % (fast[4], fast[7]))
             check("http:" not in page and "https:" not in page and not re.search(r'src="(?!data:)', page),

@@ -46,13 +46,17 @@ TEST(ReportSpread, NearestRankAndPopulationDeviation) {
     Spread s = spread_of(v);
     EXPECT_EQ(s.count, 200u);
     EXPECT_EQ(s.min, 1);
-    EXPECT_EQ(s.median, 100);  // rank ceil(0.5 * 200) = 100
+    EXPECT_EQ(s.median, 100);  // the lower of the two middle values
     EXPECT_EQ(s.p99, 198);     // rank ceil(0.99 * 200) = 198
     EXPECT_EQ(s.max, 200);
     Spread one = spread_of({7});
     EXPECT_EQ(one.median, 7);
     EXPECT_EQ(one.p99, 7);
     EXPECT_DOUBLE_EQ(one.stddev, 0);
+    EXPECT_EQ(spread_of({1, 2, 3}).median, 2);
+    std::vector<int64_t> hundred;
+    for (int64_t i = 1; i <= 100; ++i) hundred.push_back(i);
+    EXPECT_EQ(spread_of(hundred).p99, 99);  // rank 99, not 100 (0.99 * 100 is not exact in binary)
     Spread pair = spread_of({-3, 3});
     EXPECT_EQ(pair.median, -3);
     EXPECT_DOUBLE_EQ(pair.stddev, 3);
@@ -63,7 +67,8 @@ TEST(ReportSpread, NearestRankAndPopulationDeviation) {
 struct Rows {
     std::vector<std::string> fields = TimingModelBuilder::timing_fields(
         {"frame.number", "frame.time_epoch", "ecatr.cycle", "ecatr.cycle.period", "ecatr.cycle.jitter",
-         "ecatr.datagram.cmd", "ecatr.datagram.ado", "ecatr.datagram.lad", "ecatr.time", "ecatr.request_in",
+         "ecatr.datagram.cmd", "ecatr.datagram.adp", "ecatr.datagram.ado", "ecatr.datagram.lad",
+         "ecatr.datagram.len", "ecatr.datagram.wkc", "ecatr.esc.wkc_added", "ecatr.time", "ecatr.request_in",
          "ecatr.no_response_to", "ecatr.expert.wkc", "ecatr.slave.position", "ecatr.slave.name",
          "ecatr.datagram.reg.alstatus.status"});
     std::vector<std::vector<std::string>> text;
@@ -86,12 +91,14 @@ struct Rows {
 TEST(ReportModel, CyclesReturnsLossesAndStates) {
     const std::string sep(1, kValueSeparator);
     Rows r;
-    EXPECT_EQ(r.fields.size(), 15u);  // only the fields tshark knows are asked for
+    EXPECT_EQ(r.fields.size(), 19u);  // only the fields tshark knows are asked for
     r.add({{"frame.number", "1"}, {"frame.time_epoch", "100.000000000"}, {"ecatr.cycle", "1"},
-           {"ecatr.datagram.cmd", "0x0c" + sep + "0x0e"}, {"ecatr.datagram.ado", "0x0910"},
-           {"ecatr.datagram.lad", "0x00010000"}});
+           {"ecatr.datagram.cmd", "0x0c" + sep + "0x0e"}, {"ecatr.datagram.adp", "0x1001"},
+           {"ecatr.datagram.ado", "0x0910"}, {"ecatr.datagram.lad", "0x00010000"},
+           {"ecatr.datagram.len", "4" + sep + "8"}});
     r.add({{"frame.number", "2"}, {"frame.time_epoch", "100.000050000"}, {"ecatr.time", "0.000050000"},
-           {"ecatr.request_in", "1"}, {"ecatr.expert.wkc", "1"}});
+           {"ecatr.request_in", "1"}, {"ecatr.expert.wkc", "1"}, {"ecatr.datagram.wkc", "3" + sep + "1"},
+           {"ecatr.esc.wkc_added", "3" + sep + "0"}});
     r.add({{"frame.number", "3"}, {"frame.time_epoch", "100.001002000"}, {"ecatr.cycle", "1"},
            {"ecatr.cycle.period", "0.001002000"}, {"ecatr.cycle.jitter", "0.000002000"}});
     r.add({{"frame.number", "4"}, {"frame.time_epoch", "100.200000000"}, {"ecatr.no_response_to", "3"},
@@ -106,15 +113,17 @@ TEST(ReportModel, CyclesReturnsLossesAndStates) {
     EXPECT_NEAR(m.duration, 0.3, 1e-9);
     ASSERT_EQ(m.cycles.size(), 1u);
     const Cycle& c = m.cycles.at(1);
-    EXPECT_EQ(c.signature, "LRW 0x00010000 + FRMW 0x0910");
+    EXPECT_EQ(c.signature, "LRW 0x00010000 (4 bytes), FRMW 0x1001:0x0910 (8 bytes)");
     EXPECT_EQ(c.frames, 2u);
     ASSERT_EQ(c.period.size(), 1u);
     EXPECT_EQ(c.period[0].ns, 1002000);
     EXPECT_EQ(c.jitter[0].ns, 2000);
     ASSERT_EQ(c.round_trip.size(), 1u);
     EXPECT_EQ(c.round_trip[0].ns, 50000);
-    EXPECT_EQ(c.wkc_errors, 1u);
-    EXPECT_EQ(c.lost, 1u);
+    EXPECT_EQ(c.wkc_errors, 1u);  // the FRMW's counter was not raised
+    EXPECT_EQ(c.nominal, 1000000);
+    EXPECT_EQ(c.returned, 1u);
+    EXPECT_EQ(c.lost(), 0u);  // frame 3 may still be in flight: no later frame came back
     ASSERT_EQ(m.lost.size(), 1u);
     EXPECT_EQ(m.lost[0].frame, 3u);
     EXPECT_EQ(m.lost[0].cycle, 1u);
@@ -123,6 +132,15 @@ TEST(ReportModel, CyclesReturnsLossesAndStates) {
     EXPECT_EQ(m.slaves.at(1).name, "EL1004");
     ASSERT_EQ(m.slaves.at(1).states.size(), 1u);  // OP twice: one state, no change
     EXPECT_EQ(m.slaves.at(1).states[0].second, 8u);
+}
+
+TEST(ReportModel, LostAreUnansweredBeforeTheLatestAnswered) {
+    Cycle c;
+    c.sent = {10, 20, 30, 40, 50};
+    c.answered = {10, 40, 20};  // 30 lost; 50 in flight
+    EXPECT_EQ(c.lost(), 1u);
+    c.answered = {};
+    EXPECT_EQ(c.lost(), 0u);
 }
 
 TEST(ReportModel, StatusesNotMatchingTheSlavesAreNotGuessed) {
