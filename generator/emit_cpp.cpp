@@ -560,9 +560,9 @@ std::string Emitter::protocol_row() const {
 // a request keeps for its responses.
 void Emitter::request_context() {
     const std::string& f = p_.filter;
-    std::vector<const PairingKey*> keys;
+    std::vector<const PairingKey*> keys;  // none: the keys the walk decoded, read when needed
     for (const PairingKey& k : p_.pairing->keys)
-        if (k.field.target) keys.push_back(&k);
+        if (k.field.target && !p_.pairing->keys_decoded) keys.push_back(&k);
     std::sort(keys.begin(), keys.end(), [](const PairingKey* a, const PairingKey* b) {
         return a->field.target->doc_index < b->field.target->doc_index;
     });
@@ -577,8 +577,12 @@ void Emitter::request_context() {
     }
     for (const Node* n : p_.request_fields)
         slot_rows.push_back("/* " + n->name + ", line " + std::to_string(n->line) + " */ " + std::to_string(n->slot));
-    o_ << "/* request{...}: the key fields at fixed offsets (offset, bytes, little-endian, shift, bits), and the\n"
-       << " * slots of the fields a request keeps for its responses. */\n"
+    o_ << (p_.pairing->keys_decoded
+               ? "/* request{...}: no key fields at fixed offsets (a response looks its request up with the key\n"
+                 " * values decoded before its first request{...}), and the slots of the fields a request keeps\n"
+                 " * for its responses. */\n"
+               : "/* request{...}: the key fields at fixed offsets (offset, bytes, little-endian, shift, bits), and the\n"
+                 " * slots of the fields a request keeps for its responses. */\n")
        << c_array("static const dg_fixed_field " + f + "_request_keys", key_rows)
        << c_array("static const gint16 " + f + "_request_slots", slot_rows)
        << "static const dg_request_context " << f << "_request_context = { " << f << "_request_keys, "

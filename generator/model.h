@@ -210,7 +210,8 @@ struct PairingKey {
     FieldRef field;
     int line = 0;
     // derived by the validator when a value reads request{...}: the key
-    // field's byte offset (its bit group's) from the message start
+    // field's byte offset (its bit group's) from the message start, when
+    // every key field has one (Pairing::keys_decoded false)
     uint64_t offset = 0;
 };
 
@@ -218,6 +219,10 @@ struct Pairing {
     int line = 0;
     std::vector<PairingKey> keys;
     double timeout = 1.0;   // seconds a request waits for its response
+    // derived by the validator when a value reads request{...}: some key
+    // field is not at a fixed offset, so a response looks its request up
+    // with the key values the walk decoded before its first request{...}
+    bool keys_decoded = false;
     std::string analysis;   // "" or the name of a protocol analysis (analyses.h)
 };
 
@@ -243,6 +248,8 @@ struct Protocol {
     // the fields of a request that responses read (request{Name}), each once;
     // a request keeps their values in this order
     std::vector<const Node*> request_fields;
+    // the first node (document order) whose value reads request{...}
+    const Node* first_request_reader = nullptr;
 };
 
 // Calls fn(node) for every node in document order.

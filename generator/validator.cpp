@@ -771,6 +771,8 @@ bool Validator::check_request_field(Node& n, Expr& e) {
     }
     e.target = const_cast<Node*>(t);
     e.is_float = t->display == Display::Float;
+    if (!proto_.first_request_reader || n.doc_index < proto_.first_request_reader->doc_index)
+        proto_.first_request_reader = &n;
     auto& kept = proto_.request_fields;
     auto it = std::find(kept.begin(), kept.end(), t);
     e.request_index = static_cast<int>(it - kept.begin());
@@ -779,21 +781,37 @@ bool Validator::check_request_field(Node& n, Expr& e) {
     return true;
 }
 
-// With request{...}, a response looks its request up before it is decoded:
-// the key fields must be at fixed offsets from the start of every message.
+// With request{...}, a response looks its request up by its key values.
+// When every key field is at a fixed offset from the start of every message,
+// it reads them before it is decoded. Otherwise it takes the values the walk
+// decoded when a value first reads the request: every key field must then
+// come before the first node whose value reads request{...}.
 void Validator::check_request_keys() {
     if (!proto_.pairing || proto_.request_fields.empty()) return;
-    for (PairingKey& key : proto_.pairing->keys) {
+    Pairing& pairing = *proto_.pairing;
+    for (PairingKey& key : pairing.keys) {
         const Node* t = key.field.target;
         if (!t || !t->is_numeric()) continue;  // reported
         uint64_t offset = 0;
-        if (const Node* blocker = fixed_offset_blocker(*t, offset)) {
-            diags_.error(key.line, "key field " + quote(*t) + " must be at a fixed offset from the start of the "
-                                   "message, in every message, for request{" + proto_.request_fields.front()->name +
-                                   "}: " + valid_blocker(*blocker, *t));
-            continue;
-        }
+        if (fixed_offset_blocker(*t, offset)) pairing.keys_decoded = true;
         key.offset = offset;
+    }
+    if (!pairing.keys_decoded) return;
+    const Node* reader = proto_.first_request_reader;
+    const Node* moving = nullptr;  // the first key field not at a fixed offset
+    for (const PairingKey& key : pairing.keys) {
+        uint64_t offset = 0;
+        const Node* t = key.field.target;
+        if (!moving && t && t->is_numeric() && fixed_offset_blocker(*t, offset)) moving = t;
+    }
+    for (const PairingKey& key : pairing.keys) {
+        const Node* t = key.field.target;
+        if (!t || !t->is_numeric() || !reader || t->doc_index < reader->doc_index) continue;
+        diags_.error(key.line, "key field " + quote(*t) + at_line(*t) + " is decoded after " + quote(*reader) +
+                                   at_line(*reader) + ", which reads request{...}: key field " + quote(*moving) +
+                                   " is not at a fixed offset, so a response looks its request up with the key "
+                                   "values decoded before its first request{...}; move every key field before " +
+                                   quote(*reader));
     }
 }
 

@@ -6,12 +6,16 @@
  * decoded; a response that reads its request needs it before. So:
  *  - a request keeps the values of the fields responses read in its
  *    transaction (wmem_file_scope), on the first pass, once it is paired;
- *  - before a message is decoded, on the first pass, its key fields are read
- *    at their fixed offsets and the request it would answer (its key's oldest
- *    one still waiting) is looked up; what that request kept (or that there
- *    is none) is saved for the frame (p_add_proto_data), and later passes
- *    (tshark -2, the GUI in any order) read only that: every pass decodes
- *    the message alike.
+ *  - on the first pass, before the message is decoded, its key fields are
+ *    read at their fixed offsets; or, when they are not at fixed offsets,
+ *    the walk's key values (DG_KEY) are taken when a value first reads the
+ *    request (the validator puts every key field before such values), or at
+ *    the end of the walk when none did. The request it would answer (its
+ *    key's oldest one still waiting) is looked up, always before the message
+ *    itself is paired; what that request kept (or that there is none) is
+ *    saved for the frame (p_add_proto_data), and later passes (tshark -2,
+ *    the GUI in any order) read only that: every pass decodes the message
+ *    alike.
  * A message whose values read a request that is not known (not captured, a
  * request of its own, too short to hold its keys) shows them undefined and
  * says so once (P.expert.no_request_context).
@@ -58,6 +62,23 @@ const dg_request_values *find_request(const dg_state *st)
     return t ? t->values : NULL;
 }
 
+/* Saves what the first pass found for the message, for every later pass. */
+void save(const dg_state *st, const dg_request_values *v)
+{
+    p_add_proto_data(wmem_file_scope(), st->pinfo, *st->p->proto, frame_key + st->message,
+                     (void *)(v ? v : &no_request));
+}
+
+/* First pass, keys from the walk: the waiting request of the keys decoded so
+ * far (none decoded: the message is not paired, and answers nothing). */
+void find_from_walk(const dg_state *st)
+{
+    st->request_pending = FALSE;
+    const dg_transaction *t = st->key_count ? dg_pairing_waiting(st->keys, st->key_count, st->pinfo) : NULL;
+    st->request = t ? t->values : NULL;
+    save(st, st->request);
+}
+
 /* A request's kept values, from the slots of the message just decoded. */
 const dg_request_values *keep_values(const dg_state *st)
 {
@@ -80,16 +101,24 @@ namespace dg_rt {
 
 void request_begin(dg_state *st, guint message)
 {
-    const int proto = *st->p->proto;
+    st->message = message;
     const dg_request_values *v;
     if (PINFO_FD_VISITED(st->pinfo)) {
-        v = (const dg_request_values *)p_get_proto_data(wmem_file_scope(), st->pinfo, proto, frame_key + message);
+        v = (const dg_request_values *)p_get_proto_data(wmem_file_scope(), st->pinfo, *st->p->proto,
+                                                        frame_key + message);
+    } else if (st->p->request_context->key_count == 0 && st->direction != DG_DIR_REQUEST) {
+        st->request_pending = TRUE; /* find_from_walk(), once the keys are decoded */
+        v = NULL;
     } else {
         v = find_request(st);
-        p_add_proto_data(wmem_file_scope(), st->pinfo, proto, frame_key + message,
-                         (void *)(v ? v : &no_request));
+        save(st, v);
     }
     st->request = v && v != &no_request ? v : NULL;
+}
+
+void request_walked(dg_state *st)
+{
+    find_from_walk(st);
 }
 
 void request_end(dg_state *st, const dg_frame_pairing *fp, proto_tree *tree)
@@ -102,6 +131,7 @@ void request_end(dg_state *st, const dg_frame_pairing *fp, proto_tree *tree)
 gboolean read_request(const void *context, gint16 index, guint64 *value)
 {
     const dg_state *st = (const dg_state *)context;
+    if (st->request_pending) find_from_walk(st);
     if (!st->request) {
         st->request_missed = TRUE;
         return FALSE;

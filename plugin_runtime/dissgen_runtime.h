@@ -202,9 +202,11 @@ typedef struct dg_pairing {
 } dg_pairing;
 
 /* request{Name} in computed values: a response reads fields of its paired
- * request (dissgen_request.cpp). The key fields sit at fixed offsets, so
- * that a response finds its request before it is decoded; a request keeps
- * the values of the fields in `slots`, in that order, for its responses. */
+ * request (dissgen_request.cpp). When the key fields sit at fixed offsets
+ * (`keys`), a response finds its request before it is decoded; otherwise
+ * (`key_count` 0) it finds it with the key values the walk has decoded when
+ * a value first reads the request. A request keeps the values of the fields
+ * in `slots`, in that order, for its responses. */
 typedef struct dg_fixed_field {
     guint32 offset;     /* bytes from the message start (a bit field: its group's) */
     guint8 length;      /* bytes read */
@@ -213,8 +215,8 @@ typedef struct dg_fixed_field {
 } dg_fixed_field;
 
 typedef struct dg_request_context {
-    const dg_fixed_field *keys; /* the key fields, in the order the walk decodes them */
-    guint16 key_count;
+    const dg_fixed_field *keys; /* the key fields, in the order the walk decodes them; */
+    guint16 key_count;          /* 0: the keys the walk decoded (DG_KEY), read when needed */
     const gint16 *slots;        /* the slots of the fields a request keeps */
     guint16 kept_count;
 } dg_request_context;

@@ -91,8 +91,12 @@ struct dg_state {
     guint64 *keys;
     guint key_count, key_capacity;
     /* request{...}: what the paired request kept, NULL when it is not known */
-    const dg_request_values *request;
+    mutable const dg_request_values *request;
     mutable gboolean request_missed; /* a value read the request, and it is not known */
+    /* keys from the walk (dg_request_context.key_count 0), first pass: the
+     * request is looked up when a value first reads it, with the keys decoded so far */
+    mutable gboolean request_pending;
+    guint message;                   /* the message's number within the frame */
 };
 
 /* --- dissgen_walk.cpp ---------------------------------------------------- */
@@ -155,8 +159,13 @@ void find_handoff_dissectors(const dg_protocol *p);
 
 /* --- dissgen_request.cpp ------------------------------------------------- */
 
-/* Before the walk: the request this message answers, or none (st->request). */
+/* Before the walk: the request this message answers, or none (st->request);
+ * with keys from the walk, on the first pass, it is looked up later. */
 void request_begin(dg_state *st, guint message);
+/* After the walk, before the pairing (first pass, keys from the walk): a
+ * message that read no request value looks its request up now, so that later
+ * passes, which may decode more of it, read the same. */
+void request_walked(dg_state *st);
 /* After the walk and the pairing: a request keeps its values (first pass);
  * a message that read an unknown request says so. */
 void request_end(dg_state *st, const dg_frame_pairing *fp, proto_tree *tree);

@@ -656,6 +656,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
     proto_item_set_len(root, offset);
     if (p->pairing) {
+        if (st.request_pending) request_walked(&st);
         const dg_frame_pairing *fp =
             dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, *messages - 1, st.direction);
         if (st.tap) st.tap->pairing = fp;

@@ -37,7 +37,7 @@ import time
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import SANITIZE, TsharkEnv, run_unittests  # noqa: E402
+from tshark_env import SANITIZE, TsharkEnv, TsharkTestCase, run_unittests  # noqa: E402
 
 ARGS = None
 ENV = None       # our plugins installed (ENIPR + EtherCAT)
@@ -119,8 +119,8 @@ def cpf(*items):
     return struct.pack("<H", len(items)) + b"".join(struct.pack("<HH", t, len(d)) + d for t, d in items)
 
 
-def send_data(command, items, session, timeout=0):
-    return encap(command, struct.pack("<IH", 0, timeout) + cpf(*items), session=session)
+def send_data(command, items, session, timeout=0, context=bytes(8)):
+    return encap(command, struct.pack("<IH", 0, timeout) + cpf(*items), session=session, context=context)
 
 
 def cip_request(service, path, data=b""):
@@ -151,9 +151,9 @@ FORWARD_OPEN_REPLY = send_data(0x6F, [(0x0000, b""),
 IO_FRAME = cpf((0x8002, struct.pack("<II", 0x004B0603, 4166875)), (0x00B1, bytes.fromhex("a587e80f0300")))
 
 
-def unconnected(cip, session=0x11020100):
+def unconnected(cip, session=0x11020100, context=bytes(8)):
     """SendRRData: a Null Address item and an Unconnected Data item holding cip."""
-    return send_data(0x6F, [(0x0000, b""), (0x00B2, cip)], session=session, timeout=32)
+    return send_data(0x6F, [(0x0000, b""), (0x00B2, cip)], session=session, timeout=32, context=context)
 
 
 CONNECTION_MANAGER = bytes.fromhex("20062401")       # class 6, instance 1
@@ -183,10 +183,12 @@ def multiple_service(services, reply=False, status=0):
 UCS_ODD = unconnected(unconnected_send(cip_request(0x10, bytes.fromhex("200124013005"), b"\x07")))
 # Get Attributes All (Identity 1): 6 bytes, no pad; routed over two hops.
 UCS_EVEN = unconnected(unconnected_send(cip_request(0x01, bytes.fromhex("20012401")),
-                                        route=bytes.fromhex("01000203"), tick=0x1A, timeout_ticks=10))
+                                        route=bytes.fromhex("01000203"), tick=0x1A, timeout_ticks=10),
+                       context=b"\x01" + bytes(7))
 # ... and to 10.1.1.5 behind the front port: an extended link address (its size, then ASCII).
 UCS_EXTENDED = unconnected(unconnected_send(cip_request(0x01, bytes.fromhex("20012401")),
-                                            route=bytes.fromhex("0100") + b"\x12\x0810.1.1.5"))
+                                            route=bytes.fromhex("0100") + b"\x12\x0810.1.1.5"),
+                           context=b"\x02" + bytes(7))
 # 0x52 to a tag (ANSI symbol segment): Logix's Read Tag Fragmented, no Unconnected Send.
 READ_TAG_FRAGMENTED = unconnected(cip_request(0x52, b"\x91\x04TAG1", struct.pack("<HI", 1, 0)))
 MSP_SERVICES = [cip_request(0x0E, bytes.fromhex("200124013001")),                      # Identity 1, attribute 1
@@ -574,14 +576,18 @@ def count_embedded(s, theirs, ours):
 def differential(capture_path):
     """Per-frame comparison of one capture; returns a summary dict."""
     theirs = [wireshark_messages(p) for p in pdml_packets(BARE, capture_path)]
-    ours, experts = [], 0
+    ours, experts, pairing = [], 0, dict.fromkeys(PAIRING_EXPERTS, 0)
     for p in pdml_packets(ENV, capture_path):
         ours.append(our_messages(p))
-        experts += sum(1 for _, kind, name, _ in p if kind == "field" and name.startswith("enipr.expert."))
+        for _, kind, name, _ in p:
+            if kind == "field" and name in pairing:
+                pairing[name] += 1
+            elif kind == "field" and name.startswith("enipr.expert."):
+                experts += 1
     if len(theirs) != len(ours):
         raise AssertionError("%s: %d frames for Wireshark, %d with the rules" % (capture_path, len(theirs), len(ours)))
     s = {"frames": len(ours), "enip_frames": 0, "messages_ws": 0, "messages_ours": 0,
-         "fields": 0, "agree": 0, "frames_differ": [], "experts": experts,
+         "fields": 0, "agree": 0, "frames_differ": [], "experts": experts, "pairing": pairing,
          "msp_sc": 0, "msp_sc_agree": 0, "msp_class": 0, "msp_class_agree": 0}
     for number_, (t, o) in enumerate(zip(theirs, ours), 1):
         if not t and not o:
@@ -893,11 +899,20 @@ class Services(unittest.TestCase):
         self.assertEqual([rows[1][n] for n in names],
                          ["0x0a", "0x01", "0x1e", "", "", "", "", "", "2", "6,12", "0x0e,0x03", "0x00,0x05",
                           "01 00", "", ""])
-        # An error reply carries no services: nothing to decode, nothing to report.
-        self.assertEqual([rows[2][n] for n in names], ["0x0a", "0x01", "0x08"] + [""] * 12)
+        # An error reply carries no services: nothing to decode, nothing malformed to report; its
+        # request (the same sender context) was answered by the first reply, so it says that it
+        # cannot read what its request named.
+        self.assertEqual([rows[2][n] for n in names], ["0x0a", "0x01", "0x08"] + [""] * 11 + [NO_REQUEST_NOTE])
         s = differential(ENV.path("msp.pcap"))
         self.assertEqual(s["frames_differ"], [])
         self.assertEqual(s["fields"], s["agree"])
+
+
+NO_REQUEST_NOTE = ("Expert Info (Note/Sequence): The request of this response is not in the capture: the values "
+                   "read from it are unknown")
+# The pairing's expert infos (requests and replies across frames), apart from the malformed ones.
+PAIRING_EXPERTS = ("enipr.expert.no_request_context", "enipr.expert.no_response", "enipr.expert.duplicate",
+                   "enipr.expert.out_of_order")
 
 
 class Malformed(unittest.TestCase):
@@ -963,6 +978,11 @@ class MspFaults(unittest.TestCase):
         rows = fields(ENV, out, ["frame.number", "enipr.cpf.item.cip.msp_reply.reply.service", "_ws.expert.message"],
                       extra=no_seq)
         self.assertEqual(len(rows), 5)
+        # every copy is a reply whose request is not in the capture: one note each, besides
+        for r in rows:
+            messages = r["_ws.expert.message"].split(",") if r["_ws.expert.message"] else []
+            self.assertIn(NO_REQUEST_NOTE[len("Expert Info (Note/Sequence): "):], messages, r)
+            r["_ws.expert.message"] = ",".join(m for m in messages if not m.startswith("The request of this"))
         expert = [n + 1 for n, r in enumerate(rows) if r["_ws.expert.message"]]
         self.assertEqual(expert, [2, 4], rows)
         flagged = ENV.tshark(["-r", out, "-Y", "enipr.expert.bad_offset", "-T", "fields", "-e", "frame.number"] +
@@ -983,15 +1003,11 @@ class Corpus(unittest.TestCase):
     """Wireshark's enip/cip (no dissgen plugin) against the rules (default), on real captures."""
 
     def test_real_captures_agree_with_wireshark(self):
-        corpus = corpus_dir()
-        files = sorted(f for f in os.listdir(corpus) if f.endswith((".pcap", ".pcapng"))) \
-            if os.path.isdir(corpus) else []
-        if not files:
-            self.skipTest("no EtherNet/IP corpus at %s" % corpus)
+        corpus, files = corpus_files(self)
         start = time.time()
         total = {"enip_frames": 0, "messages_ws": 0, "messages_ours": 0, "fields": 0, "agree": 0, "differ": 0,
                  "experts": 0, "msp_sc": 0, "msp_sc_agree": 0, "msp_class": 0, "msp_class_agree": 0}
-        problems = []
+        problems, pairing = [], dict.fromkeys(PAIRING_EXPERTS, 0)
         print("\n%-40s %7s %8s %9s %9s %9s" % ("capture", "frames", "msgs ws", "msgs ours", "fields",
                                                 "agreeing"), file=sys.stderr)
         for f in files:
@@ -1005,6 +1021,8 @@ class Corpus(unittest.TestCase):
                                                    if s["frames_differ"] else ""), file=sys.stderr)
             for number_, diffs in s["frames_differ"]:
                 problems.append("%s frame %d: %s" % (f, number_, "; ".join(diffs)))
+            for k in pairing:
+                pairing[k] += s["pairing"][k]
         print("%-40s %7d %8d %9d %9d %9d  (%.1f s)" % ("total", total["enip_frames"], total["messages_ws"],
                                                       total["messages_ours"], total["fields"], total["agree"],
                                                       time.time() - start), file=sys.stderr)
@@ -1016,12 +1034,166 @@ class Corpus(unittest.TestCase):
         if "cip-multiple-2.pcap" in files:  # 11 replies in one Multiple Service Packet
             self.assertGreaterEqual(total["msp_sc"], 11)
         self.assertEqual((total["msp_sc_agree"], total["msp_class_agree"]), (total["msp_sc"], total["msp_class"]))
-        # Real traffic is well-formed: none of our expert infos fires on it.
+        # Real traffic is well-formed: none of our expert infos fires on it, apart from the
+        # pairing's notes: replies whose request is not in the capture (it began before), and
+        # replies that came back after a later request's (pipelined requests, and the requests of
+        # concurrent sessions and connections: the pairing's order is capture-wide). No request
+        # is given up and no message is a duplicate.
+        print("pairing notes: %s" % ", ".join("%s %d" % (k.split(".")[-1], v) for k, v in pairing.items()),
+              file=sys.stderr)
         self.assertEqual(total["experts"], 0)
+        self.assertEqual((pairing["enipr.expert.no_response"], pairing["enipr.expert.duplicate"]), (0, 0))
+
+
+# Identity object values of CIP replies: Wireshark's cip.id.* field and ours, in the replies
+# to Get Attributes All, Get Attribute Single and Get Attribute List (decoded by the request's
+# path: request{...} and the pairing).
+IDENTITY_FIELDS = (("cip.id.vendor_id", "vendor"), ("cip.id.device_type", "devtype"),
+                   ("cip.id.product_code", "prodcode"), ("cip.id.major_rev", "revision.major"),
+                   ("cip.id.minor_rev", "revision.minor"), ("cip.id.status", "status"),
+                   ("cip.id.serial_number", "serial"), ("cip.id.product_name", "name"))
+OUR_IDENTITY = ("enipr.cpf.item.cip.id.", "enipr.cpf.item.cip.id_attr.", "enipr.cpf.item.cip.id_list.attr.value.")
+
+
+def identity_values(capture_path):
+    """Per capture and Identity field: Wireshark's values outside Multiple Service Packet
+    replies, ours equal to them, different, missing; ours in all; Wireshark's inside Multiple
+    Service Packet replies (their requests are items of an offset table, which a request does
+    not keep: left raw); the differences."""
+    theirs_names = [t for t, _ in IDENTITY_FIELDS]
+    ours_names = [prefix + o for _, o in IDENTITY_FIELDS for prefix in OUR_IDENTITY]
+    theirs = fields(BARE, capture_path, ["frame.number", "cip.service"] + theirs_names)
+    ours = fields(ENV, capture_path, ["frame.number"] + ours_names, extra=["-2"])
+
+    def norm(v):
+        try:
+            return int(v, 0)
+        except ValueError:
+            return v
+    per_field = {t: dict(wireshark=0, equal=0, different=0, missing=0, ours=0, in_msp=0) for t in theirs_names}
+    diffs = []
+    for t, o in zip(theirs, ours):
+        msp = "0x8a" in t["cip.service"].split(",")
+        for their_name, our_name in IDENTITY_FIELDS:
+            a = [norm(v) for v in t[their_name].split(",") if v]
+            b = [norm(v) for prefix in OUR_IDENTITY for v in o[prefix + our_name].split(",") if v]
+            c = per_field[their_name]
+            c["ours"] += len(b)
+            if msp:
+                c["in_msp"] += len(a)
+                continue
+            c["wireshark"] += len(a)
+            same = sum(1 for x, y in zip(a, b) if x == y)
+            c["equal"] += same
+            c["different"] += min(len(a), len(b)) - same
+            c["missing"] += max(0, len(a) - len(b))
+            if same != len(a) or len(a) != len(b):
+                diffs.append("frame %s %s: %s, ours %s" % (t["frame.number"], their_name, a, b))
+    total = {k: sum(c[k] for c in per_field.values()) for k in next(iter(per_field.values()))}
+    return total, per_field, diffs
+
+
+class IdentityReplies(TsharkTestCase, unittest.TestCase):
+    """CIP replies carry no path: ours decode the Identity object's attributes by the
+    request's class and attribute (request{...}), value for value as Wireshark's cip does."""
+
+    def test_identity_values_agree_with_wireshark(self):
+        corpus, files = corpus_files(self)
+        grand = 0
+        with self.checks() as check:
+            for f in files:
+                total, per_field, diffs = identity_values(ENV.readable(os.path.join(corpus, f)))
+                grand += total["wireshark"]
+                if not total["wireshark"] and not total["ours"] and not total["in_msp"]:
+                    continue
+                print("%s: Wireshark's cip.id values %d: ours equal %d, different %d, missing %d; %d more in "
+                      "Multiple Service Packet replies, left raw (%s)" % (
+                          f, total["wireshark"], total["equal"], total["different"], total["missing"],
+                          total["in_msp"], ", ".join("%s %d/%d%s" % (
+                              n.split(".")[-1], c["equal"], c["wireshark"], "+%d" % c["in_msp"] if c["in_msp"] else "")
+                              for n, c in per_field.items() if c["wireshark"] or c["in_msp"])), file=sys.stderr)
+                check(total["ours"] == total["equal"], "%s: ours decode no Identity value Wireshark does not" % f)
+                check(not diffs, "%s: every Identity value as Wireshark's cip.id.* (%s)"
+                      % (f, "; ".join(diffs[:5]) or "%d values" % total["wireshark"]))
+            # EIP-RebootorRestart.pcap has Get Attributes All and Get Attribute List replies
+            if "EIP-RebootorRestart.pcap" in files:
+                check(grand > 0, "the corpus has Identity values to compare")
+
+
+def connected(seq, cip, connection, session=0x11020100):
+    """SendUnitData: a Connected Address item and a Connected Data item (sequence count, cip)."""
+    return send_data(0x70, [(0x00A1, struct.pack("<I", connection)), (0x00B1, struct.pack("<H", seq) + cip)],
+                     session=session)
+
+
+IDENTITY = bytes.fromhex("20012401")
+IDENTITY_ALL = struct.pack("<HHHBBHIB", 1, 0x0C, 58, 4, 3, 0x0030, 0x00524D8E, 11) + b"1756-ENBT/A"
+
+
+class PipelinedReplies(TsharkTestCase, unittest.TestCase):
+    """Connected requests of one session in flight at once, answered in another order: each reply
+    finds its request by the session and the CIP sequence count (a key after the CPF headers) and
+    is decoded by the class, instance and attribute that request named."""
+
+    def test_replies_decoded_by_their_own_request(self):
+        ot, to = 0x80FE0028, 0x00A1B2C3      # the connection's ids, one per direction
+        requests = {100: cip_request(0x01, IDENTITY),                                     # Get Attributes All
+                    101: cip_request(0x0E, IDENTITY + bytes.fromhex("3007")),             # product name
+                    102: cip_request(0x03, IDENTITY, struct.pack("<HHH", 2, 1, 6)),       # vendor, serial
+                    103: cip_request(0x01, bytes.fromhex("20022401"))}                    # Message Router
+        replies = {101: cip_response(0x0E, data=b"\x0b1756-ENBT/A"),
+                   103: cip_response(0x01, data=struct.pack("<HHH", 1, 0x0001, 2)),
+                   100: cip_response(0x01, data=IDENTITY_ALL),
+                   102: cip_response(0x03, data=struct.pack("<HHHHHHI", 2, 1, 0, 0x0001, 6, 0, 0x00524D8E))}
+        out, back = TcpFlow(50040, 44818), TcpFlow(44818, 50040, src=(10, 1, 1, 164), dst=(10, 1, 1, 167))
+        # a second apart (the pairing's timeout is 5 s): 100, 101 sent; 101 answered; 102 sent; 100
+        # answered; 103 sent and answered; 102 answered
+        order = [(out, 100, ot, requests), (out, 101, ot, requests), (back, 101, to, replies),
+                 (out, 102, ot, requests), (back, 100, to, replies), (out, 103, ot, requests),
+                 (back, 103, to, replies), (back, 102, to, replies)]
+        frames = [flow.segment(connected(k, messages[k], conn)) for flow, k, conn, messages in order]
+        # and a Get Attribute Single through an Unconnected Send (SendRRData: paired by sender context)
+        frames.append(out.segment(unconnected(unconnected_send(cip_request(0x0E, IDENTITY + b"\x30\x03")),
+                                              context=b"routed!!")))
+        frames.append(back.segment(unconnected(cip_response(0x0E, data=struct.pack("<H", 58)), context=b"routed!!")))
+        # a reply whose request is not in the capture: decoded as far as it goes, and said so
+        frames.append(back.segment(connected(7, cip_response(0x01, data=IDENTITY_ALL), to)))
+        cap = capture("pipelined.pcap", frames)
+        c = "enipr.cpf.item.cip."
+        names = ["enipr.request_in", c + "identity_request", c + "requested_attribute", c + "id.vendor",
+                 c + "id.devtype", c + "id.prodcode", c + "id.revision.major", c + "id.revision.minor",
+                 c + "id.status", c + "id.serial", c + "id.name", c + "id_attr.name", c + "id_attr.prodcode",
+                 c + "id_list.attr.id", c + "id_list.attr.value.vendor", c + "id_list.attr.value.serial",
+                 "enipr.expert.no_request_context"]
+        all_ = ["0x0001", "0x000c", "58", "4", "3", "0x0030", "0x00524d8e", "1756-ENBT/A"]
+        want = {3: ["2", "1", "7"] + [""] * 8 + ["1756-ENBT/A"] + [""] * 5,
+                5: ["1", "1", ""] + all_ + [""] * 6,
+                7: ["6", "0"] + [""] * 15,
+                8: ["4", "1", ""] + [""] * 10 + ["1,6", "0x0001", "0x00524d8e", ""],
+                10: ["9", "1", "3"] + [""] * 9 + ["58"] + [""] * 4,
+                11: ["", "", ""] + [""] * 13 + ["1"]}
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = fields(ENV, cap, names, extra=["-2"] if two_pass else [])
+                for frame, values in want.items():
+                    got = [rows[frame - 1][n] for n in names]
+                    check(got == values, "%s: frame %d as its request says: %s" % (
+                        "-2" if two_pass else "one pass", frame,
+                        "ok" if got == values else "%s, want %s" % (got, values)))
 
 
 def corpus_dir():
     return ARGS.corpus or os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus", "enip")
+
+
+def corpus_files(test):
+    """The corpus folder and its captures; skips `test` when there are none."""
+    corpus = corpus_dir()
+    files = sorted(f for f in os.listdir(corpus) if f.endswith((".pcap", ".pcapng"))) \
+        if os.path.isdir(corpus) else []
+    if not files:
+        test.skipTest("no EtherNet/IP corpus at %s" % corpus)
+    return corpus, files
 
 
 def setUpModule():

@@ -258,6 +258,16 @@ def request_context_frames():
     return paired + [m.frame("response", m.payload("response", t)) for t in txns[:10]]
 
 
+def request_context_decoded_keys_frames():
+    """tests/rules/request_context_decoded_keys.xml: the same, each message behind a client name
+    of its own length, so that the keys are not at fixed offsets."""
+    import test_request_context as m
+    txns = m.transactions(47503, 30)
+    paired = [m.frame(d, m.payload(d, txns[k], m.client_name(k))) for d, k in m.schedule(txns, 2)]
+    return paired + [m.frame("response", m.payload("response", t, m.client_name(k)))
+                     for k, t in enumerate(txns[:10])]
+
+
 def quiet_bits_frames():
     """tests/rules/quiet_bits.xml with random values: whole-byte members in the middle of groups."""
     rng = random.Random(5)
@@ -296,6 +306,7 @@ CAPTURES = {
     "tests/rules/overlays.xml": overlays_frames,
     "tests/rules/computed.xml": computed_frames,
     "tests/rules/request_context.xml": request_context_frames,
+    "tests/rules/request_context_decoded_keys.xml": request_context_decoded_keys_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,

@@ -59,7 +59,13 @@ def schedule(txns, seed):
     return order
 
 
-def payload(direction, txn):
+def payload(direction, txn, client=None):
+    """The message; with `client`, behind its length-prefixed name (request_context_decoded_keys.xml)."""
+    head = b"" if client is None else bytes([len(client)]) + client
+    return head + modbus(direction, txn)
+
+
+def modbus(direction, txn):
     transaction, unit, function, reference, quantity, values = txn
     if direction == "request":
         pdu = struct.pack(">BHH", function, reference, quantity)
@@ -92,17 +98,26 @@ def expected(txn, with_request):
             "rqc.coils.coil.number": numbers, "rqc.coils.coil_count": str(quantity) if with_request else ""}
 
 
+def client_name(k):
+    """A client name of 0-12 bytes, different from one transaction to the next."""
+    return b"station-%d" % k if k % 3 else b"plc%d" % (k % 7) if k % 2 else b""
+
+
 class TestRequestContext(TsharkTestCase, unittest.TestCase):
+    RULES = "request_context.xml"
+    CLIENT = None  # the name in front of each message: None, or k -> bytes
+
     @classmethod
     def prepare(cls):
-        cls.install(os.path.join("tests", "rules", "request_context.xml"), "rqc")
+        cls.install(os.path.join("tests", "rules", cls.RULES), "rqc")
         cls.txns = transactions(47502, 120)
         cls.order = schedule(cls.txns, 1)
+        name = (lambda k: None) if cls.CLIENT is None else cls.CLIENT
         cls.full = cls.env.add_file("full.pcap", pcapgen.raw_pcap_bytes(
-            [frame(d, payload(d, cls.txns[k])) for d, k in cls.order]))
+            [frame(d, payload(d, cls.txns[k], name(k))) for d, k in cls.order]))
         cls.orphans = [k for d, k in cls.order if d == "response"]
         cls.orphan_path = cls.env.add_file("orphans.pcap", pcapgen.raw_pcap_bytes(
-            [frame("response", payload("response", cls.txns[k])) for k in cls.orphans]))
+            [frame("response", payload("response", cls.txns[k], name(k))) for k in cls.orphans]))
 
     def rows(self, path, two_pass):
         return {n: {f: ",".join(v) for f, v in r.items()}
@@ -160,6 +175,14 @@ class TestRequestContext(TsharkTestCase, unittest.TestCase):
         with self.checks() as check:
             check("The request of this response is not in the capture" in out,
                   "the expert info says why the values are missing")
+
+
+class TestRequestContextDecodedKeys(TestRequestContext):
+    """The same transactions behind a client name of any length (request_context_decoded_keys.xml):
+    the keys are not at fixed offsets, and a response finds its request with the key values it
+    decoded before its first request{...}."""
+    RULES = "request_context_decoded_keys.xml"
+    CLIENT = staticmethod(client_name)
 
 
 if __name__ == "__main__":
