@@ -26,6 +26,7 @@
 #include "dissgen_pairing.h"
 
 
+#include <epan/conversation.h>
 #include <epan/proto_data.h>
 #include <epan/expert.h>
 
@@ -87,7 +88,13 @@ struct capture_state {
     guint waiting;               /* requests not yet answered nor given up */
     guint guessed;               /* of them, taken for requests for want of a better idea */
     guint64 requests;            /* the last request's seq */
-    guint64 answered_max;        /* the highest seq answered so far */
+    guint64 answered_max;        /* the highest seq answered so far, in any order scope */
+    /* Per order scope, the highest seq answered so far. A server answers a
+     * connection's requests in order, not those of other connections: the
+     * out-of-order note and overtaken requests go by the request's TCP or
+     * UDP conversation, or (scope 0) by the whole capture for a protocol
+     * right over a link layer, such as EtherCAT over Ethernet. */
+    wmem_array_t *scope_answered;
     guint32 last_frame;          /* the last message paired (its frame) */
     void *analysis;              /* the analysis's capture-wide state */
     nstime_t clock;              /* what forgetting goes by (forget_clock) */
@@ -152,9 +159,31 @@ capture_state *current_capture(void)
     if (!capture) {
         capture = wmem_new0(wmem_file_scope(), capture_state);
         capture->keys = wmem_map_new(wmem_file_scope(), key_hash, key_equal);
+        capture->scope_answered = wmem_array_sized_new(wmem_file_scope(), sizeof(guint64), 4);
+        guint64 none = 0;
+        wmem_array_append_one(capture->scope_answered, none);
         if (analysis && analysis->capture_new) capture->analysis = analysis->capture_new(protocol);
     }
     return capture;
+}
+
+/* The order scope of a request sent in this packet (capture_state.scope_answered). */
+guint32 order_scope_of(capture_state *c, packet_info *pinfo)
+{
+    if (pinfo->ptype != PT_TCP && pinfo->ptype != PT_UDP) return 0;
+    conversation_t *conv = find_or_create_conversation(pinfo);
+    guint32 scope = GPOINTER_TO_UINT(conversation_get_proto_data(conv, *protocol->proto));
+    if (scope) return scope;
+    scope = wmem_array_get_count(c->scope_answered);
+    guint64 none = 0;
+    wmem_array_append_one(c->scope_answered, none);
+    conversation_add_proto_data(conv, *protocol->proto, GUINT_TO_POINTER(scope));
+    return scope;
+}
+
+guint64 *answered_in(const capture_state *c, const dg_transaction *t)
+{
+    return (guint64 *)wmem_array_index(c->scope_answered, t->order_scope);
 }
 
 key_entry *entry_for(capture_state *c, const guint64 *keys, guint key_count)
@@ -280,7 +309,7 @@ const guint64 max_overtaken = 16;
 
 gboolean given_up(const capture_state *c, const pending *q, const packet_info *pinfo, double timeout)
 {
-    if (c->answered_max > q->txn->seq + max_overtaken) return TRUE;
+    if (*answered_in(c, q->txn) > q->txn->seq + max_overtaken) return TRUE;
     nstime_t age;
     nstime_delta(&age, &pinfo->abs_ts, &q->txn->request_time);
     return nstime_to_sec(&age) > timeout;
@@ -424,7 +453,8 @@ void forget_requests(capture_state *c)
     while (c->sent.head) {
         pending *q = c->sent.head;
         if (!q->done) {
-            if (c->answered_max <= q->txn->seq + max_overtaken && !timed_out(c, &q->txn->request_time)) return;
+            if (*answered_in(c, q->txn) <= q->txn->seq + max_overtaken && !timed_out(c, &q->txn->request_time))
+                return;
             give_up(c, q);
         }
         drop_head(&c->sent, FALSE);
@@ -547,7 +577,9 @@ dg_frame_pairing *response_to(capture_state *c, dg_transaction *t, const guint8 
     t->response_frame = pinfo->num;
     nstime_delta(&t->round_trip, &pinfo->abs_ts, &t->request_time);
     fp->txn = t;
-    fp->out_of_order = t->seq < c->answered_max;
+    guint64 *answered = answered_in(c, t);
+    fp->out_of_order = t->seq < *answered;
+    if (t->seq > *answered) *answered = t->seq;
     if (t->seq > c->answered_max) c->answered_max = t->seq;
     if (analysis && analysis->compare && request_bytes) {
         tvbuff_t *request = tvb_new_real_data(request_bytes, request_length, (gint)request_length);
@@ -583,6 +615,7 @@ dg_frame_pairing *adopt_orphan(capture_state *c, key_entry *e, tvbuff_t *tvb, pa
     t->request_frame = e->last_frame;
     t->request_time = e->last_time;
     t->seq = ++c->requests;
+    t->order_scope = order_scope_of(c, pinfo);
     dg_frame_pairing *request = e->last_record;
     request->role = DG_ROLE_REQUEST;
     request->txn = t;
@@ -604,6 +637,7 @@ dg_frame_pairing *new_request(capture_state *c, key_entry *e, tvbuff_t *tvb, pac
     t->request_frame = pinfo->num;
     t->request_time = pinfo->abs_ts;
     t->seq = ++c->requests;
+    t->order_scope = order_scope_of(c, pinfo);
     fp->role = DG_ROLE_REQUEST;
     fp->txn = t;
     if (!nstime_is_zero(&e->last_request_time) && nstime_cmp(&pinfo->abs_ts, &e->last_request_time) > 0)
@@ -701,7 +735,7 @@ gboolean known_lost(const dg_transaction *t)
 {
     if (t->given_up_in) return TRUE;
     if (!capture) return FALSE;
-    if (capture->answered_max > t->seq) return TRUE;
+    if (*answered_in(capture, t) > t->seq) return TRUE;
     nstime_t waited;
     nstime_delta(&waited, &capture->previous_time, &t->request_time);
     return nstime_to_sec(&waited) > protocol->pairing->timeout;

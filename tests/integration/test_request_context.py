@@ -76,8 +76,8 @@ def modbus(direction, txn):
     return struct.pack(">HHHB", transaction, 0, 1 + len(pdu), unit) + pdu
 
 
-def frame(direction, data):
-    sport, dport = (40000, PORT) if direction == "request" else (PORT, 40000)
+def frame(direction, data, client_port=40000):
+    sport, dport = (client_port, PORT) if direction == "request" else (PORT, client_port)
     src, dst = (CLIENT, SERVER) if direction == "request" else (SERVER, CLIENT)
     u = struct.pack("!HHHH", sport, dport, 8 + len(data), 0) + data
     ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src, dst)
@@ -152,6 +152,28 @@ class TestRequestContext(TsharkTestCase, unittest.TestCase):
                 check(not wrong, "%s: %d register numbers and %d coils (count and numbers) of %d responses as "
                       "their requests say, no expert%s" % (mode, registers, coils, len(self.orphans),
                                                            "" if not wrong else " (wrong: %s)" % wrong[:2]))
+
+    def test_connections_are_ordered_apart(self):
+        """A server answers each connection in order, not the capture's connections among
+        themselves: a request from one client port answered after 30 transactions of another
+        is paired, neither lost nor out of order."""
+        if self.CLIENT is not None:
+            self.skipTest("the plain rule file shows it")
+        slow, quick = self.txns[0], self.txns[1:31]
+        frames = [frame("request", payload("request", slow), 40001)]
+        for t in quick:
+            frames += [frame("request", payload("request", t)), frame("response", payload("response", t))]
+        frames.append(frame("response", payload("response", slow), 40001))
+        path = self.env.add_file("two-connections.pcap", pcapgen.raw_pcap_bytes(frames))
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = self.env.field_rows(path, ["frame.number", "rqc.request_in", "rqc.expert.no_response",
+                                                  "rqc.expert.out_of_order"], two_pass)
+                last = rows[len(frames)]
+                check(last["rqc.request_in"] == ["1"], "%s: the slow connection's response pairs with frame 1 (%s)"
+                      % ("-2" if two_pass else "one pass", last["rqc.request_in"]))
+                flagged = [n for n, r in rows.items() if r["rqc.expert.no_response"] or r["rqc.expert.out_of_order"]]
+                check(not flagged, "%s: nothing lost or out of order (%s)" % ("-2" if two_pass else "one pass", flagged))
 
     def test_responses_without_their_requests(self):
         with self.checks() as check:
