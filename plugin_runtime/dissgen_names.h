@@ -98,6 +98,15 @@
     X(data_changed, "esc.data_changed", FT_BOOLEAN, BASE_NONE, NULL, "Data changed",                        \
       "The data came back different from what was sent")
 
+/* ethercat_cycles.cpp: a sent frame of a cycle (manual, "Cycles"). */
+#define DG_CYCLE_FIELDS(X)                                                                                 \
+    X(cycle, "cycle", FT_UINT16, BASE_DEC, NULL, "Cycle",                                                   \
+      "The cycle this sent frame belongs to: 1, 2, ... in order of first appearance")                      \
+    X(period, "cycle.period", FT_RELATIVE_TIME, BASE_NONE, NULL, "Cycle period",                            \
+      "Time since the cycle's previous frame sent")                                                       \
+    X(jitter, "cycle.jitter", FT_RELATIVE_TIME, BASE_NONE, NULL, "Cycle jitter",                            \
+      "The period minus the cycle's nominal period (the median of its periods so far)")
+
 #define DG_ESC_EXPERTS(X)                                                                                  \
     X(changed, "expert.changed", PI_PROTOCOL, PI_ERROR,                                                     \
       "Returned datagram's command, index, length or address changed")                                    \

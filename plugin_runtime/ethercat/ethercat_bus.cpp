@@ -22,6 +22,7 @@
  * frame where the capture showed them, so every pass shows the same ones.
  */
 #include "ethercat_bus.h"
+#include "ethercat_cycles.h"
 #include "dissgen_label.h"
 
 #include <epan/expert.h>
@@ -150,11 +151,13 @@ struct bus_model {
 
 struct bus_frame {
     const bus_model *model;
-    gboolean returned;   /* inputs are shown from returned frames, outputs from frames as sent */
-    guint count;
     addressed *d;
-    guint event_count;
     bus_event *events;
+    guint32 cycle_period, cycle_nominal; /* a sent frame's cycle_mark (ethercat_cycles.cpp), */
+    guint16 cycle;                       /* laid out with the counts in what was padding */
+    guint16 count;       /* datagrams: at most max_datagrams */
+    guint16 event_count;
+    guint8 returned;     /* inputs are shown from returned frames, outputs from frames as sent */
 };
 
 namespace {
@@ -680,10 +683,10 @@ bus_frame *new_frame(const bus_model *m, guint count, const events *ev)
     /* One allocation for the frame and its datagrams. */
     bus_frame *f = (bus_frame *)wmem_alloc0(wmem_file_scope(), sizeof(bus_frame) + count * sizeof(addressed));
     f->model = m;
-    f->count = count;
+    f->count = (guint16)count;
     f->d = (addressed *)(f + 1);
     if (ev && ev->count) {
-        f->event_count = ev->count;
+        f->event_count = (guint16)MIN(ev->count, G_MAXUINT16);
         f->events = (bus_event *)wmem_memdup(wmem_file_scope(), ev->list, ev->count * sizeof(bus_event));
     }
     return f;
@@ -1081,6 +1084,19 @@ bus_frame *bus_sent(bus_model *m, tvbuff_t *tvb, packet_info *)
     bus_frame *f = new_frame(m, n, NULL);
     for (guint i = 0; i < n; i++) f->d[i] = address_of(m, &d[i]);
     return f;
+}
+
+void bus_set_cycle(bus_frame *f, const cycle_mark *c)
+{
+    f->cycle = c->cycle;
+    f->cycle_period = c->period_ns;
+    f->cycle_nominal = c->nominal_ns;
+}
+
+cycle_mark bus_cycle(const bus_frame *f)
+{
+    cycle_mark c = {f->cycle, f->cycle_period, f->cycle_nominal};
+    return c;
 }
 
 bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,

@@ -47,6 +47,10 @@ bus_frame *bus_sent(bus_model *m, tvbuff_t *tvb, packet_info *pinfo);
  * datagrams as read_frame() read them. */
 bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
                         packet_info *pinfo);
+/* A sent frame's cycle (ethercat_cycles.h), kept with its slaves. */
+struct cycle_mark;
+void bus_set_cycle(bus_frame *f, const cycle_mark *c);
+cycle_mark bus_cycle(const bus_frame *f);
 /* Every pass: the slave items and the network-check expert infos. */
 void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
 void bus_register(int proto, const char *filter);

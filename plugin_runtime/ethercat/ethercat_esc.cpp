@@ -28,6 +28,7 @@
  */
 #include "ethercat_esc.h"
 #include "ethercat_bus.h"
+#include "ethercat_cycles.h"
 #include "dissgen_label.h"
 
 #include <epan/expert.h>
@@ -68,6 +69,7 @@ struct capture_hints {
     gboolean marking_seen; /* a slave set the locally administered bit: the capture shows direction */
     guint8 master[6];      /* the (unmarked) source of the frames answered so far */
     bus_model *bus;        /* the slaves the capture shows (ethercat_bus.cpp) */
+    cycle_model *cycles;   /* the cycles it finds (ethercat_cycles.cpp) */
 };
 
 int hf_esc = -1, hf_datagram = -1, hf_wkc_added = -1, hf_slaves_passed = -1, hf_data_changed = -1;
@@ -139,6 +141,7 @@ void *esc_capture_new(const dg_protocol *p)
 {
     capture_hints *h = wmem_new0(wmem_file_scope(), capture_hints);
     h->bus = bus_new(static_cast<const dg_bus *>(p->analysis_data));
+    h->cycles = cycles_new();
     return h;
 }
 
@@ -220,7 +223,7 @@ gboolean esc_key_changed(tvbuff_t *request, tvbuff_t *message)
 }
 
 
-void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, packet_info *pinfo)
+void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, const dg_transaction *txn, packet_info *pinfo)
 {
     datagram sent[max_datagrams], back[max_datagrams];
     guint sent_length, back_length;
@@ -238,7 +241,9 @@ void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, packet_i
     r->length_changed = sent_length != back_length || sent_count != back_count;
     for (guint i = 0; i < r->count; i++) compare_datagram(&r->d[i], &sent[i], &back[i], request, response);
     check_forwarding(r);
-    r->bus = bus_returned(((capture_hints *)capture)->bus, request, response, sent, back, r->count, pinfo);
+    capture_hints *h = (capture_hints *)capture;
+    r->bus = bus_returned(h->bus, request, response, sent, back, r->count, pinfo);
+    if (!r->length_changed) cycles_returned(h->cycles, sent, back, r->count, txn, pinfo);
     return r;
 }
 
@@ -339,15 +344,25 @@ void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *t
     bus_show(r->bus, tvb, pinfo, tree);
 }
 
-/* A frame as sent (or returned without its request): only the slaves. */
+/* A frame as sent: its slaves and its cycle. */
 void *esc_sent(void *capture, tvbuff_t *tvb, packet_info *pinfo)
 {
-    return bus_sent(((capture_hints *)capture)->bus, tvb, pinfo);
+    capture_hints *h = (capture_hints *)capture;
+    bus_frame *f = bus_sent(h->bus, tvb, pinfo);
+    datagram d[max_datagrams];
+    guint header_length;
+    guint n = read_frame(tvb, &header_length, d, max_datagrams);
+    cycle_mark c = cycles_sent(h->cycles, d, n, pinfo);
+    if (c.cycle) bus_set_cycle(f, &c);
+    return f;
 }
 
 void esc_show_sent(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
-    bus_show((const bus_frame *)data, tvb, pinfo, tree);
+    const bus_frame *f = (const bus_frame *)data;
+    cycle_mark c = bus_cycle(f);
+    cycles_show(&c, tvb, pinfo, tree);
+    bus_show(f, tvb, pinfo, tree);
 }
 
 /* --- statistics ---------------------------------------------------------- */
@@ -390,6 +405,7 @@ void esc_register(int proto, const char *filter)
     dg_name_experts(ei, ei_names, G_N_ELEMENTS(ei), filter);
     expert_register_field_array(expert_register_protocol(proto), ei, (int)G_N_ELEMENTS(ei));
     bus_register(proto, filter);
+    cycles_register(proto, filter);
 }
 
 } /* namespace */

@@ -1,0 +1,503 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* The cycles of an EtherCAT capture (see ethercat_cycles.h and the manual,
+ * "Cycles"), decided on the first pass from what came before each frame:
+ *
+ *  - A frame's signature is the command, address (ADP and ADO, or the
+ *    logical address) and data length of each of its datagrams, in order.
+ *  - A signature that transfers a mailbox or does what only a start-up
+ *    does is never a cycle: a non-logical datagram addressing ESC memory at
+ *    0x1000 or above (the mailboxes), the SyncManager 0/1 status bytes
+ *    (0x0805, 0x080D, which masters poll for mail), the SII interface
+ *    (0x0500-0x050F) or the DC port receive times (0x0900-0x090F, latched
+ *    to measure the topology).
+ *  - A period is the time from a frame sent to the next one sent with its
+ *    signature. It is regular when it is above 0, the previous frame came
+ *    back before this one was sent (not a retry after a timeout) and this
+ *    frame is not a poll: sent less than one round trip after that return
+ *    (a master sending the same frame again as soon as it is back, as while
+ *    waiting for a state or an EEPROM read).
+ *  - A signature becomes a cycle with its first window of `window` (8)
+ *    regular periods in a row, all within half of their median either way
+ *    (and that median below 2^32 ns): the frame that completes the window is
+ *    the cycle's first marked frame. From then on every frame sent with that
+ *    signature is in the cycle, whatever its period.
+ *  - A marked frame's period is the time since the signature's previous
+ *    frame; its nominal period the median (the lower of the two middle
+ *    values for an even count) of the cycle's periods so far: the window's
+ *    and those of every marked frame up to this one; its jitter the period
+ *    minus the nominal period.
+ *
+ * Memory: each sent frame's mark (10 bytes) lives in its bus_frame; the
+ * model keeps per cycle its periods (4 bytes each, in two heaps for the
+ * running median) and the round trips of its returned frames (4 bytes each),
+ * for `-z ecatr,cycles`.
+ */
+#include "ethercat_cycles.h"
+
+#include <epan/stat_tap_ui.h>
+#include <epan/tap.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+namespace dg_ecat {
+
+namespace {
+
+const guint window = 8;
+const guint ring = 16; /* the last frames of a cycle whose return may still come */
+
+struct sig_datagram {
+    guint8 cmd;
+    guint16 adp, ado, length;
+};
+
+/* A growing array of 32-bit values in wmem_file_scope. */
+struct u32_vec {
+    guint32 *v;
+    guint n, cap;
+    void push(guint32 x)
+    {
+        if (n == cap) {
+            cap = cap ? 2 * cap : 16;
+            v = (guint32 *)wmem_realloc(wmem_file_scope(), v, cap * sizeof(guint32));
+        }
+        v[n++] = x;
+    }
+};
+
+/* A binary heap over u32_vec: max-heap when `max`, else min-heap. */
+gboolean before(guint32 a, guint32 b, gboolean max) { return max ? a > b : a < b; }
+
+void heap_push(u32_vec *h, guint32 x, gboolean max)
+{
+    h->push(x);
+    for (guint i = h->n - 1; i > 0;) {
+        guint p = (i - 1) / 2;
+        if (!before(h->v[i], h->v[p], max)) break;
+        guint32 t = h->v[i];
+        h->v[i] = h->v[p];
+        h->v[p] = t;
+        i = p;
+    }
+}
+
+guint32 heap_pop(u32_vec *h, gboolean max)
+{
+    guint32 top = h->v[0];
+    h->v[0] = h->v[--h->n];
+    for (guint i = 0;;) {
+        guint l = 2 * i + 1, r = l + 1, best = i;
+        if (l < h->n && before(h->v[l], h->v[best], max)) best = l;
+        if (r < h->n && before(h->v[r], h->v[best], max)) best = r;
+        if (best == i) break;
+        guint32 t = h->v[i];
+        h->v[i] = h->v[best];
+        h->v[best] = t;
+        i = best;
+    }
+    return top;
+}
+
+struct cycle {
+    guint16 number;
+    guint count;             /* datagrams of its signature */
+    const sig_datagram *sig;
+    u32_vec low, high;       /* its periods: low a max-heap holding the lower half (one more when odd) */
+    guint32 window_periods[window]; /* the qualifying window's: not carried by a marked frame */
+    guint frames;            /* marked frames */
+    guint32 first_frame;     /* the first marked frame */
+    double jitter_sum, jitter_squares;
+    u32_vec rtts;            /* round trips of the marked frames answered, ns */
+    guint answered;
+    guint32 recent[ring];    /* the last marked frames sent, oldest overwritten */
+    guint32 latest_answered; /* the latest marked frame answered */
+    guint unanswered_tail;   /* marked frames sent after it */
+    guint wkc_errors;
+    guint16 *wkc_high;       /* per datagram, the highest working counter returned */
+    cycle *next;
+};
+
+struct signature {
+    guint32 hash;
+    guint count;
+    sig_datagram *d;
+    gboolean eligible;
+    guint32 last_sent_frame;
+    nstime_t last_sent;
+    guint32 last_answered_frame; /* the last of its frames answered, and when */
+    nstime_t last_return;
+    nstime_t last_rtt;
+    guint64 recent[window];      /* its last regular periods, a ring */
+    guint regular;               /* how many in a row (up to window) */
+    guint next_slot;
+    cycle *cyc;
+};
+
+} /* namespace */
+
+struct cycle_model {
+    wmem_map_t *signatures;      /* signature -> itself */
+    cycle *first, *last;
+    guint16 cycles;
+    wmem_map_t *long_periods;    /* frame -> gint64 *, periods of 2^32 ns or more */
+};
+
+namespace {
+
+cycle_model *current; /* the open capture's, for -z ecatr,cycles and long periods */
+
+guint sig_hash(gconstpointer p) { return ((const signature *)p)->hash; }
+
+gboolean sig_equal(gconstpointer a, gconstpointer b)
+{
+    const signature *x = (const signature *)a, *y = (const signature *)b;
+    if (x->hash != y->hash || x->count != y->count) return FALSE;
+    for (guint i = 0; i < x->count; i++)
+        if (x->d[i].cmd != y->d[i].cmd || x->d[i].adp != y->d[i].adp || x->d[i].ado != y->d[i].ado ||
+            x->d[i].length != y->d[i].length)
+            return FALSE;
+    return TRUE;
+}
+
+gboolean overlaps(guint from, guint length, guint lo, guint hi) { return from <= hi && from + length > lo; }
+
+/* Mailbox transfers and SII reads: never cyclic process data. */
+gboolean mailbox_or_sii(const sig_datagram *d)
+{
+    if (d->cmd == 0 || (d->cmd >= 10 && d->cmd <= 12)) return FALSE; /* NOP, LRD/LWR/LRW */
+    guint ado = d->ado, len = d->length;
+    return ado + len > 0x1000 || overlaps(ado, len, 0x0805, 0x0805) || overlaps(ado, len, 0x080D, 0x080D) ||
+           overlaps(ado, len, 0x0500, 0x050F) || overlaps(ado, len, 0x0900, 0x090F);
+}
+
+signature *signature_of(cycle_model *m, const datagram *d, guint n)
+{
+    sig_datagram probe_d[max_datagrams];
+    guint32 h = 2166136261u ^ n;
+    for (guint i = 0; i < n; i++) {
+        probe_d[i].cmd = d[i].cmd;
+        probe_d[i].adp = d[i].adp;
+        probe_d[i].ado = d[i].ado;
+        probe_d[i].length = d[i].length;
+        h = (h ^ d[i].cmd) * 16777619u;
+        h = (h ^ ((guint32)d[i].adp | (guint32)d[i].ado << 16)) * 16777619u;
+        h = (h ^ d[i].length) * 16777619u;
+    }
+    signature probe = {};
+    probe.hash = h;
+    probe.count = n;
+    probe.d = probe_d;
+    signature *s = (signature *)wmem_map_lookup(m->signatures, &probe);
+    if (s) return s;
+    s = wmem_new0(wmem_file_scope(), signature);
+    s->hash = h;
+    s->count = n;
+    s->d = (sig_datagram *)wmem_memdup(wmem_file_scope(), probe_d, n * sizeof(sig_datagram));
+    s->eligible = n > 0;
+    for (guint i = 0; i < n; i++)
+        if (mailbox_or_sii(&s->d[i])) s->eligible = FALSE;
+    wmem_map_insert(m->signatures, s, s);
+    return s;
+}
+
+gint64 ns_of(const nstime_t *t) { return (gint64)t->secs * 1000000000 + t->nsecs; }
+
+/* The median of the regular periods in the window, when all of them lie
+ * within half of it either way; 0 otherwise. */
+guint64 window_median(const signature *s)
+{
+    guint64 v[window];
+    memcpy(v, s->recent, sizeof v);
+    for (guint i = 1; i < window; i++)
+        for (guint j = i; j > 0 && v[j - 1] > v[j]; j--) {
+            guint64 t = v[j];
+            v[j] = v[j - 1];
+            v[j - 1] = t;
+        }
+    guint64 median = v[(window - 1) / 2];
+    if (median == 0 || median > G_MAXUINT32) return 0;
+    if (2 * v[0] < median || 2 * v[window - 1] > 3 * median) return 0;
+    return median;
+}
+
+void add_period(cycle *c, guint32 p)
+{
+    /* low holds the lower half, its top the (lower) median */
+    if (c->low.n == 0 || p <= c->low.v[0])
+        heap_push(&c->low, p, TRUE);
+    else
+        heap_push(&c->high, p, FALSE);
+    if (c->low.n > c->high.n + 1)
+        heap_push(&c->high, heap_pop(&c->low, TRUE), FALSE);
+    else if (c->high.n > c->low.n)
+        heap_push(&c->low, heap_pop(&c->high, FALSE), TRUE);
+}
+
+cycle *new_cycle(cycle_model *m, signature *s, guint32 frame)
+{
+    cycle *c = wmem_new0(wmem_file_scope(), cycle);
+    c->number = ++m->cycles;
+    c->count = s->count;
+    c->sig = s->d;
+    c->first_frame = frame;
+    c->wkc_high = wmem_alloc0_array(wmem_file_scope(), guint16, s->count ? s->count : 1);
+    if (m->last)
+        m->last->next = c;
+    else
+        m->first = c;
+    m->last = c;
+    /* the window's periods, oldest first; the last is the marking frame's own */
+    for (guint i = 0; i + 1 < window; i++) {
+        guint32 p = (guint32)s->recent[(s->next_slot + i) % window];
+        c->window_periods[i] = p;
+        add_period(c, p);
+    }
+    return c;
+}
+
+void capture_cleanup(void) { current = NULL; }
+
+} /* namespace */
+
+cycle_model *cycles_new(void)
+{
+    cycle_model *m = wmem_new0(wmem_file_scope(), cycle_model);
+    m->signatures = wmem_map_new(wmem_file_scope(), sig_hash, sig_equal);
+    current = m;
+    return m;
+}
+
+cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_info *pinfo)
+{
+    cycle_mark mark = {0, 0, 0};
+    signature *s = signature_of(m, d, n);
+    if (!s->eligible) return mark;
+    guint32 previous = s->last_sent_frame;
+    nstime_t previous_time = s->last_sent;
+    s->last_sent_frame = pinfo->num;
+    s->last_sent = pinfo->abs_ts;
+    if (!previous) return mark;
+    gint64 period = ns_of(&pinfo->abs_ts) - ns_of(&previous_time);
+    if (!s->cyc) {
+        gboolean answered = s->last_answered_frame == previous;
+        gboolean poll = answered && ns_of(&pinfo->abs_ts) - ns_of(&s->last_return) < ns_of(&s->last_rtt);
+        if (period <= 0 || !answered || poll) {
+            s->regular = 0;
+            return mark;
+        }
+        s->recent[s->next_slot] = (guint64)period;
+        s->next_slot = (s->next_slot + 1) % window;
+        if (s->regular < window) s->regular++;
+        if (s->regular < window || !window_median(s)) return mark;
+        s->cyc = new_cycle(m, s, pinfo->num);
+    }
+    cycle *c = s->cyc;
+    guint32 stored = period < 0 ? 0 : period >= (gint64)G_MAXUINT32 ? G_MAXUINT32 : (guint32)period;
+    if (stored == G_MAXUINT32) {
+        if (!m->long_periods) m->long_periods = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+        gint64 *exact = wmem_new(wmem_file_scope(), gint64);
+        *exact = period;
+        wmem_map_insert(m->long_periods, GUINT_TO_POINTER(pinfo->num), exact);
+    }
+    add_period(c, stored);
+    mark.cycle = c->number;
+    mark.period_ns = stored;
+    mark.nominal_ns = c->low.v[0];
+    double jitter = (double)(period - (gint64)mark.nominal_ns);
+    c->frames++;
+    c->jitter_sum += jitter;
+    c->jitter_squares += jitter * jitter;
+    c->recent[c->frames % ring] = pinfo->num;
+    c->unanswered_tail++;
+    return mark;
+}
+
+void cycles_returned(cycle_model *m, const datagram *s, const datagram *b, guint n, const dg_transaction *txn,
+                     const packet_info *pinfo)
+{
+    if (!txn) return;
+    signature *sig = signature_of(m, s, n);
+    if (!sig->eligible) return;
+    if (txn->request_frame >= sig->last_answered_frame) {
+        sig->last_answered_frame = txn->request_frame;
+        sig->last_return = pinfo->abs_ts;
+        sig->last_rtt = txn->round_trip;
+    }
+    cycle *c = sig->cyc;
+    if (!c || txn->request_frame < c->first_frame) return;
+    gint64 rtt = ns_of(&txn->round_trip);
+    c->rtts.push(rtt < 0 ? 0 : rtt > (gint64)G_MAXUINT32 ? G_MAXUINT32 : (guint32)rtt);
+    c->answered++;
+    if (txn->request_frame > c->latest_answered) {
+        c->latest_answered = txn->request_frame;
+        guint tail = 0;
+        for (guint i = 0; i < ring && i < c->frames; i++)
+            if (c->recent[i] > txn->request_frame) tail++;
+        c->unanswered_tail = tail;
+    }
+    gboolean error = FALSE;
+    for (guint i = 0; i < n && i < c->count; i++) {
+        if (b[i].wkc <= s[i].wkc || b[i].wkc < c->wkc_high[i]) error = TRUE;
+        if (b[i].wkc > c->wkc_high[i]) c->wkc_high[i] = b[i].wkc;
+    }
+    if (error) c->wkc_errors++;
+}
+
+/* --- items -------------------------------------------------------------- */
+
+namespace {
+
+int hf_cycle = -1, hf_period = -1, hf_jitter = -1;
+
+nstime_t nstime_of(gint64 ns)
+{
+    nstime_t t;
+    t.secs = (time_t)(ns / 1000000000);
+    t.nsecs = (int)(ns % 1000000000);
+    return t;
+}
+
+gint64 period_of(const cycle_mark *c, guint32 frame)
+{
+    if (c->period_ns != G_MAXUINT32 || !current || !current->long_periods) return c->period_ns;
+    const gint64 *exact = (const gint64 *)wmem_map_lookup(current->long_periods, GUINT_TO_POINTER(frame));
+    return exact ? *exact : c->period_ns;
+}
+
+} /* namespace */
+
+void cycles_show(const cycle_mark *c, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    if (!tree || !c->cycle) return;
+    proto_item *it = proto_tree_add_uint(tree, hf_cycle, tvb, 0, 0, c->cycle);
+    proto_item_set_generated(it);
+    gint64 period = period_of(c, pinfo->num);
+    nstime_t t = nstime_of(period);
+    it = proto_tree_add_time(tree, hf_period, tvb, 0, 0, &t);
+    proto_item_set_generated(it);
+    t = nstime_of(period - (gint64)c->nominal_ns);
+    it = proto_tree_add_time(tree, hf_jitter, tvb, 0, 0, &t);
+    proto_item_set_generated(it);
+}
+
+/* --- -z ecatr,cycles ------------------------------------------------------ */
+
+namespace {
+
+int compare_u32(const void *a, const void *b)
+{
+    guint32 x = *(const guint32 *)a, y = *(const guint32 *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The lower median and the nearest-rank 99th percentile of a sorted array. */
+guint32 median_of(const guint32 *v, guint n) { return n ? v[(n - 1) / 2] : 0; }
+guint32 p99_of(const guint32 *v, guint n) { return n ? v[(99 * (guint64)n + 99) / 100 - 1] : 0; }
+
+const char *cycles_filter = "ecatr";
+
+void print_signature(const cycle *c)
+{
+    for (guint i = 0; i < c->count; i++) {
+        const sig_datagram *d = &c->sig[i];
+        if (i) printf(", ");
+        if (d->cmd >= 10 && d->cmd <= 12)
+            printf("%s 0x%08x", command_name(d->cmd), (guint32)d->ado << 16 | d->adp);
+        else
+            printf("%s 0x%04x:0x%04x", command_name(d->cmd), d->adp, d->ado);
+        printf(" (%u bytes)", d->length);
+    }
+}
+
+void print_figures(const char *what, guint32 *v, guint n)
+{
+    qsort(v, n, sizeof *v, compare_u32);
+    if (!n) {
+        printf("  %s: none\n", what);
+        return;
+    }
+    printf("  %s min/median/p99/max (ns): %u %u %u %u\n", what, v[0], median_of(v, n), p99_of(v, n), v[n - 1]);
+}
+
+/* At the end of the capture, from the capture's state (complete by then). */
+void cycles_draw(void *)
+{
+    printf("===================================================================\n");
+    printf("EtherCAT cycles (%s)\n", cycles_filter);
+    guint shown = 0;
+    for (const cycle *c = current ? current->first : NULL; c; c = c->next, shown++) {
+        printf("Cycle %u: ", c->number);
+        print_signature(c);
+        printf("\n  frames: %u\n", c->frames);
+        printf("  nominal period (ns): %u\n", c->low.n ? c->low.v[0] : 0);
+        /* the marked frames' periods: the heaps less the window's */
+        guint total = c->low.n + c->high.n;
+        guint32 *all = g_new(guint32, total + 1);
+        memcpy(all, c->low.v, c->low.n * sizeof(guint32));
+        if (c->high.n) memcpy(all + c->low.n, c->high.v, c->high.n * sizeof(guint32));
+        qsort(all, total, sizeof *all, compare_u32);
+        guint32 win[window];
+        memcpy(win, c->window_periods, sizeof win);
+        qsort(win, window - 1, sizeof *win, compare_u32);
+        guint32 *marked = g_new(guint32, total + 1);
+        guint n = 0, w = 0;
+        for (guint i = 0; i < total; i++) {
+            if (w < window - 1 && all[i] == win[w]) {
+                w++;
+                continue;
+            }
+            marked[n++] = all[i];
+        }
+        print_figures("period", marked, n);
+        double mean = c->frames ? c->jitter_sum / c->frames : 0;
+        double var = c->frames ? c->jitter_squares / c->frames - mean * mean : 0;
+        printf("  jitter std dev (ns): %.1f\n", var > 0 ? sqrt(var) : 0.0);
+        guint32 *rtts = g_new(guint32, c->rtts.n + 1);
+        if (c->rtts.n) memcpy(rtts, c->rtts.v, c->rtts.n * sizeof(guint32));
+        print_figures("round trip", rtts, c->rtts.n);
+        printf("  frames returned: %u\n", c->answered);
+        printf("  frames lost: %u\n", c->frames - c->answered - MIN(c->unanswered_tail, c->frames - c->answered));
+        printf("  working counter errors: %u\n", c->wkc_errors);
+        g_free(all);
+        g_free(marked);
+        g_free(rtts);
+    }
+    if (!shown) printf("No cycles\n");
+    printf("===================================================================\n");
+}
+
+tap_packet_status cycles_packet(void *, packet_info *, epan_dissect_t *, const void *, tap_flags_t)
+{
+    return TAP_PACKET_DONT_REDRAW;
+}
+
+void cycles_cli_init(const char *, void *)
+{
+    /* Listens to the frame tap (every frame) only so that the draw runs at the end. */
+    GString *error = register_tap_listener("frame", &cycles_filter, NULL, TL_REQUIRES_NOTHING, NULL, cycles_packet,
+                                           cycles_draw, NULL);
+    if (error) {
+        fprintf(stderr, "%s,cycles: %s\n", cycles_filter, error->str);
+        g_string_free(error, TRUE);
+    }
+}
+
+} /* namespace */
+
+void cycles_register(int proto, const char *filter)
+{
+    static hf_register_info hf[] = {DG_CYCLE_FIELDS(DG_HF_ROW)};
+    static const char *const names[] = {DG_CYCLE_FIELDS(DG_FIELD_NAME)};
+    dg_name_fields(hf, names, G_N_ELEMENTS(hf), filter);
+    proto_register_field_array(proto, hf, (int)G_N_ELEMENTS(hf));
+    register_cleanup_routine(capture_cleanup);
+    cycles_filter = filter;
+    static stat_tap_ui ui = {REGISTER_STAT_GROUP_GENERIC, NULL, NULL, cycles_cli_init, 0, NULL};
+    ui.cli_string = g_strdup_printf("%s,cycles", filter);
+    register_stat_tap_ui(&ui, NULL);
+}
+
+} /* namespace dg_ecat */

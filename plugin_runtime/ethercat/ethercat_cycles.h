@@ -1,0 +1,34 @@
+/* The cycles of an EtherCAT capture: sent frames whose datagram signature
+ * (commands, addresses, lengths) repeats at regular periods, e.g. LRW +
+ * FRMW 0x0910 every millisecond. ethercat_esc.cpp calls it for every frame
+ * sent and every frame returned on the first pass; each sent frame of a
+ * cycle keeps its mark (cycle number, period, nominal period) in its
+ * bus_frame. The rules: ethercat_cycles.cpp and the manual, "Cycles".
+ * C++ only, inside the runtime. */
+#pragma once
+
+#include "ethercat_bus.h"
+
+namespace dg_ecat {
+
+/* What a sent frame of a cycle shows; cycle 0: not in a cycle. */
+struct cycle_mark {
+    guint16 cycle;        /* 1, 2, ... in order of first appearance */
+    guint32 period_ns;    /* since the cycle's previous frame; G_MAXUINT32: see the model's long periods */
+    guint32 nominal_ns;   /* the cycle's median period so far */
+};
+
+struct cycle_model;   /* capture-wide, wmem_file_scope */
+
+cycle_model *cycles_new(void);
+/* First pass, a frame as sent: its n datagrams. */
+cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_info *pinfo);
+/* First pass, a returned frame answering `txn`: s and b its first n datagrams
+ * as sent and as returned. */
+void cycles_returned(cycle_model *m, const datagram *s, const datagram *b, guint n, const dg_transaction *txn,
+                     const packet_info *pinfo);
+/* Every pass: the cycle items of a sent frame. */
+void cycles_show(const cycle_mark *c, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+void cycles_register(int proto, const char *filter);
+
+} /* namespace dg_ecat */
