@@ -27,6 +27,7 @@
 
 #include <epan/expert.h>
 
+#include <math.h>
 #include <string.h>
 
 namespace dg_ecat {
@@ -153,8 +154,13 @@ struct bus_frame {
     const bus_model *model;
     addressed *d;
     bus_event *events;
-    guint32 cycle_period, cycle_nominal; /* a sent frame's cycle_mark (ethercat_cycles.cpp), */
-    guint16 cycle;                       /* laid out with the counts in what was padding */
+    union {                              /* ethercat_cycles.cpp's, laid out with the counts */
+        struct {                         /* in what was padding: */
+            guint32 period, nominal;     /* a sent frame's cycle_mark */
+        } cycle_times;
+        double dc_drift;                 /* a returned frame's DC drift (NAN: none) */
+    } timing;
+    guint16 cycle;
     guint16 count;       /* datagrams: at most max_datagrams */
     guint16 event_count;
     guint8 returned;     /* inputs are shown from returned frames, outputs from frames as sent */
@@ -1089,15 +1095,23 @@ bus_frame *bus_sent(bus_model *m, tvbuff_t *tvb, packet_info *)
 void bus_set_cycle(bus_frame *f, const cycle_mark *c)
 {
     f->cycle = c->cycle;
-    f->cycle_period = c->period_ns;
-    f->cycle_nominal = c->nominal_ns;
+    f->timing.cycle_times.period = c->period_ns;
+    f->timing.cycle_times.nominal = c->nominal_ns;
 }
 
 cycle_mark bus_cycle(const bus_frame *f)
 {
-    cycle_mark c = {f->cycle, f->cycle_period, f->cycle_nominal};
+    cycle_mark c = {0, 0, 0};
+    if (f->returned) return c;
+    c.cycle = f->cycle;
+    c.period_ns = f->timing.cycle_times.period;
+    c.nominal_ns = f->timing.cycle_times.nominal;
     return c;
 }
+
+void bus_set_dc_drift(bus_frame *f, double drift) { f->timing.dc_drift = drift; }
+
+double bus_dc_drift(const bus_frame *f) { return f->returned ? f->timing.dc_drift : NAN; }
 
 bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
                         packet_info *pinfo)
@@ -1121,6 +1135,7 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const data
     }
     bus_frame *f = new_frame(m, n, &ev);
     f->returned = TRUE;
+    f->timing.dc_drift = NAN;
     for (guint i = 0; i < n; i++) {
         f->d[i] = address_of(m, &s[i]);
         f->d[i].stats = flags[i];

@@ -51,6 +51,9 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const data
 struct cycle_mark;
 void bus_set_cycle(bus_frame *f, const cycle_mark *c);
 cycle_mark bus_cycle(const bus_frame *f);
+/* A returned frame's distributed-clock drift (ethercat_cycles.h), NAN when none. */
+void bus_set_dc_drift(bus_frame *f, double drift);
+double bus_dc_drift(const bus_frame *f);
 /* Every pass: the slave items and the network-check expert infos. */
 void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
 void bus_register(int proto, const char *filter);

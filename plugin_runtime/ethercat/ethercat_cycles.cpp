@@ -138,11 +138,19 @@ struct signature {
 
 } /* namespace */
 
+/* The first system time of each width returned in the capture, and when. */
+struct dc_reference {
+    gboolean known;
+    guint64 systime;
+    gint64 at;   /* capture time, ns */
+};
+
 struct cycle_model {
     wmem_map_t *signatures;      /* signature -> itself */
     cycle *first, *last;
     guint16 cycles;
     wmem_map_t *long_periods;    /* frame -> gint64 *, periods of 2^32 ns or more */
+    dc_reference dc32, dc64;
 };
 
 namespace {
@@ -346,11 +354,61 @@ void cycles_returned(cycle_model *m, const datagram *s, const datagram *b, guint
     if (error) c->wkc_errors++;
 }
 
+/* --- distributed clocks ---------------------------------------------------- */
+
+gboolean dc_datagram(const datagram *s, const datagram *b)
+{
+    return (s->cmd == 13 || s->cmd == 14) && s->ado == 0x0910 && (s->length == 4 || s->length == 8) &&
+           b->cmd == s->cmd && b->ado == s->ado && b->length == s->length && b->wkc > s->wkc;
+}
+
+namespace {
+
+guint64 systime_of(tvbuff_t *tvb, const datagram *b)
+{
+    return b->length == 8 ? tvb_get_letoh64(tvb, data_offset(b)) : tvb_get_letohl(tvb, data_offset(b));
+}
+
+} /* namespace */
+
+/* The drift is the DC time elapsed since the reference less the capture time
+ * elapsed, per second of capture time. A 32-bit system time wraps every
+ * 4.29 s: it is unwrapped to the value nearest the reference plus the
+ * capture time elapsed. */
+double dc_returned(cycle_model *m, const datagram *s, const datagram *b, guint n, tvbuff_t *back,
+                   const packet_info *pinfo)
+{
+    guint i = 0;
+    while (i < n && !dc_datagram(&s[i], &b[i])) i++;
+    if (i == n || (guint)data_offset(&b[i]) + b[i].length > tvb_captured_length(back)) return NAN;
+    guint64 raw = systime_of(back, &b[i]);
+    gint64 at = ns_of(&pinfo->abs_ts);
+    dc_reference *ref = b[i].length == 8 ? &m->dc64 : &m->dc32;
+    if (!ref->known) {
+        ref->known = TRUE;
+        ref->systime = raw;
+        ref->at = at;
+        return NAN;
+    }
+    gint64 elapsed = at - ref->at;
+    if (elapsed <= 0) return NAN;
+    gint64 dc_elapsed;
+    if (b[i].length == 8) {
+        dc_elapsed = (gint64)(raw - ref->systime);
+    } else {
+        /* the wrap count that puts the value nearest the capture's clock */
+        gint64 low = (gint64)((raw - ref->systime) & 0xFFFFFFFFu);
+        gint64 wraps = (elapsed - low + ((gint64)1 << 31)) >> 32;
+        dc_elapsed = low + (wraps << 32);
+    }
+    return (double)(dc_elapsed - elapsed) * 1e9 / (double)elapsed;
+}
+
 /* --- items -------------------------------------------------------------- */
 
 namespace {
 
-int hf_cycle = -1, hf_period = -1, hf_jitter = -1;
+int hf_cycle = -1, hf_period = -1, hf_jitter = -1, hf_systime = -1, hf_drift = -1;
 
 nstime_t nstime_of(gint64 ns)
 {
@@ -368,6 +426,16 @@ gint64 period_of(const cycle_mark *c, guint32 frame)
 }
 
 } /* namespace */
+
+void dc_show(const datagram *b, double drift, tvbuff_t *tvb, proto_tree *tree)
+{
+    if (!tree) return;
+    proto_item *it = proto_tree_add_uint64(tree, hf_systime, tvb, data_offset(b), b->length, systime_of(tvb, b));
+    proto_item_set_generated(it);
+    if (isnan(drift)) return;
+    it = proto_tree_add_double(tree, hf_drift, tvb, data_offset(b), b->length, drift);
+    proto_item_set_generated(it);
+}
 
 void cycles_show(const cycle_mark *c, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
@@ -489,8 +557,8 @@ void cycles_cli_init(const char *, void *)
 
 void cycles_register(int proto, const char *filter)
 {
-    static hf_register_info hf[] = {DG_CYCLE_FIELDS(DG_HF_ROW)};
-    static const char *const names[] = {DG_CYCLE_FIELDS(DG_FIELD_NAME)};
+    static hf_register_info hf[] = {DG_CYCLE_FIELDS(DG_HF_ROW) DG_DC_FIELDS(DG_HF_ROW)};
+    static const char *const names[] = {DG_CYCLE_FIELDS(DG_FIELD_NAME) DG_DC_FIELDS(DG_FIELD_NAME)};
     dg_name_fields(hf, names, G_N_ELEMENTS(hf), filter);
     proto_register_field_array(proto, hf, (int)G_N_ELEMENTS(hf));
     register_cleanup_routine(capture_cleanup);

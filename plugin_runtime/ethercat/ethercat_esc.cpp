@@ -244,6 +244,7 @@ void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, const dg
     capture_hints *h = (capture_hints *)capture;
     r->bus = bus_returned(h->bus, request, response, sent, back, r->count, pinfo);
     if (!r->length_changed) cycles_returned(h->cycles, sent, back, r->count, txn, pinfo);
+    bus_set_dc_drift(r->bus, dc_returned(h->cycles, sent, back, r->count, response, pinfo));
     return r;
 }
 
@@ -336,10 +337,15 @@ void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *t
                                      "Frame length changed: sent with %u bytes of datagrams (%u datagrams), came "
                                      "back with %u (%u datagrams)",
                                      r->sent_length, r->sent_count, r->back_length, r->back_count);
+    gboolean dc_shown = !tree;
     for (guint i = 0; i < r->count; i++) {
         const compared *c = &r->d[i];
         proto_tree *dg = items ? show_datagram_items(c, i, tvb, sub) : sub;
         show_datagram_experts(c, i, tvb, pinfo, dg);
+        if (!dc_shown && dc_datagram(&c->sent, &c->back)) {
+            dc_show(&c->back, bus_dc_drift(r->bus), tvb, tree);
+            dc_shown = TRUE;
+        }
     }
     bus_show(r->bus, tvb, pinfo, tree);
 }
