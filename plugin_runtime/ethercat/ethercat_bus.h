@@ -39,9 +39,9 @@ struct bus_model;   /* capture-wide, wmem_file_scope */
 struct bus_frame;   /* one frame's slaves and network-check findings, wmem_file_scope */
 
 bus_model *bus_new(const dg_bus *design);
-/* First pass. A frame as sent (a request, or one whose response is not paired):
- * which slave each datagram addresses. */
-bus_frame *bus_sent(bus_model *m, tvbuff_t *tvb, packet_info *pinfo);
+/* First pass. A frame as sent (a request, or one whose response is not paired),
+ * its n datagrams as read_frame() read them: which slave each one addresses. */
+bus_frame *bus_sent(bus_model *m, const datagram *d, guint n);
 /* First pass. A returned frame with the frame as sent: what it teaches about
  * the bus, and which slave each datagram addresses. s and b are their first n
  * datagrams as read_frame() read them. */

@@ -35,6 +35,7 @@
 #include "ethercat_cycles.h"
 
 #include <epan/stat_tap_ui.h>
+#include <epan/stats_tree.h>
 #include <epan/tap.h>
 
 #include <math.h>
@@ -151,6 +152,13 @@ struct cycle_model {
     guint16 cycles;
     wmem_map_t *long_periods;    /* frame -> gint64 *, periods of 2^32 ns or more */
     dc_reference dc32, dc64;
+    guint32 last_frame;          /* the last frame the first pass brought here */
+    /* the last frames sent and their signatures, so that most returns find
+     * theirs without hashing their datagrams again */
+    struct {
+        guint32 frame;
+        signature *sig;
+    } recent_sent[ring];
 };
 
 namespace {
@@ -281,7 +289,10 @@ cycle_model *cycles_new(void)
 cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_info *pinfo)
 {
     cycle_mark mark = {0, 0, 0};
+    m->last_frame = pinfo->num;
     signature *s = signature_of(m, d, n);
+    m->recent_sent[pinfo->num % ring].frame = pinfo->num;
+    m->recent_sent[pinfo->num % ring].sig = s;
     if (!s->eligible) return mark;
     guint32 previous = s->last_sent_frame;
     nstime_t previous_time = s->last_sent;
@@ -326,8 +337,12 @@ cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_
 void cycles_returned(cycle_model *m, const datagram *s, const datagram *b, guint n, const dg_transaction *txn,
                      const packet_info *pinfo)
 {
+    m->last_frame = pinfo->num;
     if (!txn) return;
-    signature *sig = signature_of(m, s, n);
+    guint slot = txn->request_frame % ring;
+    signature *sig = m->recent_sent[slot].frame == txn->request_frame && m->recent_sent[slot].sig->count == n
+                         ? m->recent_sent[slot].sig
+                         : signature_of(m, s, n);
     if (!sig->eligible) return;
     if (txn->request_frame >= sig->last_answered_frame) {
         sig->last_answered_frame = txn->request_frame;
@@ -451,7 +466,7 @@ void cycles_show(const cycle_mark *c, tvbuff_t *tvb, packet_info *pinfo, proto_t
     proto_item_set_generated(it);
 }
 
-/* --- -z ecatr,cycles ------------------------------------------------------ */
+/* --- -z ecatr,cycles and the statistics tree ----------------------------- */
 
 namespace {
 
@@ -461,33 +476,90 @@ int compare_u32(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* The lower median and the nearest-rank 99th percentile of a sorted array. */
-guint32 median_of(const guint32 *v, guint n) { return n ? v[(n - 1) / 2] : 0; }
-guint32 p99_of(const guint32 *v, guint n) { return n ? v[(99 * (guint64)n + 99) / 100 - 1] : 0; }
+/* Minimum, lower median, nearest-rank 99th percentile and maximum. */
+struct quantiles {
+    guint n;
+    guint32 min, median, p99, max;
+};
+
+quantiles quantiles_of(guint32 *v, guint n)
+{
+    quantiles q = {n, 0, 0, 0, 0};
+    if (!n) return q;
+    qsort(v, n, sizeof *v, compare_u32);
+    q.min = v[0];
+    q.median = v[(n - 1) / 2];
+    q.p99 = v[(99 * (guint64)n + 99) / 100 - 1];
+    q.max = v[n - 1];
+    return q;
+}
+
+/* A cycle's whole-capture figures, from the capture's state. */
+struct figures {
+    guint32 nominal;
+    quantiles period, rtt;
+    double jitter_sd;
+    guint lost;
+};
+
+figures figures_of(const cycle *c)
+{
+    figures f = {};
+    f.nominal = c->low.n ? c->low.v[0] : 0;
+    /* the marked frames' periods: the cycle's less the window's */
+    guint total = c->low.n + c->high.n;
+    guint32 *all = g_new(guint32, total + 1);
+    memcpy(all, c->low.v, c->low.n * sizeof(guint32));
+    if (c->high.n) memcpy(all + c->low.n, c->high.v, c->high.n * sizeof(guint32));
+    qsort(all, total, sizeof *all, compare_u32);
+    guint32 win[window];
+    memcpy(win, c->window_periods, sizeof win);
+    qsort(win, window - 1, sizeof *win, compare_u32);
+    guint n = 0, w = 0;
+    for (guint i = 0; i < total; i++) {
+        if (w < window - 1 && all[i] == win[w])
+            w++;
+        else
+            all[n++] = all[i];
+    }
+    f.period = quantiles_of(all, n);
+    g_free(all);
+    double mean = c->frames ? c->jitter_sum / c->frames : 0;
+    double var = c->frames ? c->jitter_squares / c->frames - mean * mean : 0;
+    f.jitter_sd = var > 0 ? sqrt(var) : 0.0;
+    guint32 *rtts = g_new(guint32, c->rtts.n + 1);
+    if (c->rtts.n) memcpy(rtts, c->rtts.v, c->rtts.n * sizeof(guint32));
+    f.rtt = quantiles_of(rtts, c->rtts.n);
+    g_free(rtts);
+    guint unanswered = c->frames - c->answered;
+    f.lost = unanswered - MIN(c->unanswered_tail, unanswered);
+    return f;
+}
+
+/* "LRW 0x00010000 (4 bytes), FRMW 0x1001:0x0910 (8 bytes)" */
+char *signature_text(const cycle *c)
+{
+    GString *t = g_string_new("");
+    for (guint i = 0; i < c->count; i++) {
+        const sig_datagram *d = &c->sig[i];
+        if (i) g_string_append(t, ", ");
+        if (d->cmd >= 10 && d->cmd <= 12)
+            g_string_append_printf(t, "%s 0x%08x", command_name(d->cmd), (guint32)d->ado << 16 | d->adp);
+        else
+            g_string_append_printf(t, "%s 0x%04x:0x%04x", command_name(d->cmd), d->adp, d->ado);
+        g_string_append_printf(t, " (%u bytes)", d->length);
+    }
+    return g_string_free(t, FALSE);
+}
 
 const char *cycles_filter = "ecatr";
 
-void print_signature(const cycle *c)
+void print_quantiles(const char *what, const quantiles *q)
 {
-    for (guint i = 0; i < c->count; i++) {
-        const sig_datagram *d = &c->sig[i];
-        if (i) printf(", ");
-        if (d->cmd >= 10 && d->cmd <= 12)
-            printf("%s 0x%08x", command_name(d->cmd), (guint32)d->ado << 16 | d->adp);
-        else
-            printf("%s 0x%04x:0x%04x", command_name(d->cmd), d->adp, d->ado);
-        printf(" (%u bytes)", d->length);
-    }
-}
-
-void print_figures(const char *what, guint32 *v, guint n)
-{
-    qsort(v, n, sizeof *v, compare_u32);
-    if (!n) {
+    if (!q->n)
         printf("  %s: none\n", what);
-        return;
-    }
-    printf("  %s min/median/p99/max (ns): %u %u %u %u\n", what, v[0], median_of(v, n), p99_of(v, n), v[n - 1]);
+    else
+        printf("  %s min/median/p99/max (ns): %u %u %u %u\n", what, q->min, q->median, q->p99, q->max);
 }
 
 /* At the end of the capture, from the capture's state (complete by then). */
@@ -495,45 +567,21 @@ void cycles_draw(void *)
 {
     printf("===================================================================\n");
     printf("EtherCAT cycles (%s)\n", cycles_filter);
-    guint shown = 0;
-    for (const cycle *c = current ? current->first : NULL; c; c = c->next, shown++) {
-        printf("Cycle %u: ", c->number);
-        print_signature(c);
-        printf("\n  frames: %u\n", c->frames);
-        printf("  nominal period (ns): %u\n", c->low.n ? c->low.v[0] : 0);
-        /* the marked frames' periods: the heaps less the window's */
-        guint total = c->low.n + c->high.n;
-        guint32 *all = g_new(guint32, total + 1);
-        memcpy(all, c->low.v, c->low.n * sizeof(guint32));
-        if (c->high.n) memcpy(all + c->low.n, c->high.v, c->high.n * sizeof(guint32));
-        qsort(all, total, sizeof *all, compare_u32);
-        guint32 win[window];
-        memcpy(win, c->window_periods, sizeof win);
-        qsort(win, window - 1, sizeof *win, compare_u32);
-        guint32 *marked = g_new(guint32, total + 1);
-        guint n = 0, w = 0;
-        for (guint i = 0; i < total; i++) {
-            if (w < window - 1 && all[i] == win[w]) {
-                w++;
-                continue;
-            }
-            marked[n++] = all[i];
-        }
-        print_figures("period", marked, n);
-        double mean = c->frames ? c->jitter_sum / c->frames : 0;
-        double var = c->frames ? c->jitter_squares / c->frames - mean * mean : 0;
-        printf("  jitter std dev (ns): %.1f\n", var > 0 ? sqrt(var) : 0.0);
-        guint32 *rtts = g_new(guint32, c->rtts.n + 1);
-        if (c->rtts.n) memcpy(rtts, c->rtts.v, c->rtts.n * sizeof(guint32));
-        print_figures("round trip", rtts, c->rtts.n);
+    if (!current || !current->first) printf("No cycles\n");
+    for (const cycle *c = current ? current->first : NULL; c; c = c->next) {
+        figures f = figures_of(c);
+        char *sig = signature_text(c);
+        printf("Cycle %u: %s\n", c->number, sig);
+        g_free(sig);
+        printf("  frames: %u\n", c->frames);
+        printf("  nominal period (ns): %u\n", f.nominal);
+        print_quantiles("period", &f.period);
+        printf("  jitter std dev (ns): %.1f\n", f.jitter_sd);
+        print_quantiles("round trip", &f.rtt);
         printf("  frames returned: %u\n", c->answered);
-        printf("  frames lost: %u\n", c->frames - c->answered - MIN(c->unanswered_tail, c->frames - c->answered));
+        printf("  frames lost: %u\n", f.lost);
         printf("  working counter errors: %u\n", c->wkc_errors);
-        g_free(all);
-        g_free(marked);
-        g_free(rtts);
     }
-    if (!shown) printf("No cycles\n");
     printf("===================================================================\n");
 }
 
@@ -553,6 +601,64 @@ void cycles_cli_init(const char *, void *)
     }
 }
 
+/* The statistics tree (Wireshark's Statistics menu): the same figures, set
+ * once the capture's state is complete, which it is when a frame is tapped
+ * that the first pass has gone beyond (the GUI taps a capture once it is
+ * read, tshark -2 in its second pass). In one pass tshark taps each frame as
+ * the first pass reaches it: the tree stays empty; -z ecatr,cycles is the
+ * way there. */
+gboolean st_filled;
+
+void st_init(stats_tree *) { st_filled = FALSE; }
+
+void st_set(stats_tree *st, const char *name, int parent, guint64 value)
+{
+    stats_tree_create_node(st, name, parent, STAT_DT_INT, FALSE);
+    set_stat_node(st, name, parent, FALSE, (gint)MIN(value, (guint64)G_MAXINT));
+}
+
+void st_quantiles(stats_tree *st, guint cycle, const char *what, const quantiles *q, int parent)
+{
+    const char *const names[] = {"min", "median", "p99", "max"};
+    const guint32 values[] = {q->min, q->median, q->p99, q->max};
+    for (guint i = 0; q->n && i < 4; i++) {
+        char *name = g_strdup_printf("Cycle %u %s %s (ns)", cycle, what, names[i]);
+        st_set(st, name, parent, values[i]);
+        g_free(name);
+    }
+}
+
+tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *, const void *, tap_flags_t)
+{
+    if (st_filled || !current || pinfo->num >= current->last_frame) return TAP_PACKET_DONT_REDRAW;
+    st_filled = TRUE;
+    for (const cycle *c = current->first; c; c = c->next) {
+        figures f = figures_of(c);
+        char *sig = signature_text(c);
+        char *name = g_strdup_printf("Cycle %u: %s", c->number, sig);
+        int id = stats_tree_create_node(st, name, 0, STAT_DT_INT, TRUE);
+        set_stat_node(st, name, 0, FALSE, (gint)c->frames);
+        g_free(name);
+        g_free(sig);
+        char label[96];
+#define ST_ROW(text, value)                                                  \
+    do {                                                                     \
+        g_snprintf(label, sizeof label, "Cycle %u " text, c->number);        \
+        st_set(st, label, id, value);                                        \
+    } while (0)
+        ST_ROW("frames", c->frames);
+        ST_ROW("nominal period (ns)", f.nominal);
+        st_quantiles(st, c->number, "period", &f.period, id);
+        ST_ROW("jitter std dev (ns)", (guint64)(f.jitter_sd + 0.5));
+        st_quantiles(st, c->number, "round trip", &f.rtt, id);
+        ST_ROW("frames returned", c->answered);
+        ST_ROW("frames lost", f.lost);
+        ST_ROW("working counter errors", c->wkc_errors);
+#undef ST_ROW
+    }
+    return TAP_PACKET_REDRAW;
+}
+
 } /* namespace */
 
 void cycles_register(int proto, const char *filter)
@@ -566,6 +672,10 @@ void cycles_register(int proto, const char *filter)
     static stat_tap_ui ui = {REGISTER_STAT_GROUP_GENERIC, NULL, NULL, cycles_cli_init, 0, NULL};
     ui.cli_string = g_strdup_printf("%s,cycles", filter);
     register_stat_tap_ui(&ui, NULL);
+    /* Statistics > "EtherCAT cycles" in Wireshark (tshark -2 -z ecatr.cycles,tree) */
+    stats_tree_register_plugin("frame", g_strdup_printf("%s.cycles", filter),
+                               g_strdup_printf("%s cycles", proto_get_protocol_short_name(find_protocol_by_id(proto))),
+                               0, st_packet, st_init, NULL);
 }
 
 } /* namespace dg_ecat */

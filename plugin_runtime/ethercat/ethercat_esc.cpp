@@ -354,10 +354,10 @@ void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *t
 void *esc_sent(void *capture, tvbuff_t *tvb, packet_info *pinfo)
 {
     capture_hints *h = (capture_hints *)capture;
-    bus_frame *f = bus_sent(h->bus, tvb, pinfo);
     datagram d[max_datagrams];
     guint header_length;
     guint n = read_frame(tvb, &header_length, d, max_datagrams);
+    bus_frame *f = bus_sent(h->bus, d, n);
     cycle_mark c = cycles_sent(h->cycles, d, n, pinfo);
     if (c.cycle) bus_set_cycle(f, &c);
     return f;
