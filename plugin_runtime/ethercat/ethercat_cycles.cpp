@@ -22,7 +22,7 @@
  *    the cycle's first marked frame. From then on every frame sent with that
  *    signature is in the cycle, whatever its period.
  *  - A marked frame's period is the time since the signature's previous
- *    frame; its nominal period the median (the lower of the two middle
+ *    frame (0 if the timestamps went backwards); its nominal period the median (the lower of the two middle
  *    values for an even count) of the cycle's periods so far: the window's
  *    and those of every marked frame up to this one; its jitter the period
  *    minus the nominal period.
@@ -325,7 +325,8 @@ cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_
     mark.cycle = c->number;
     mark.period_ns = stored;
     mark.nominal_ns = c->low.v[0];
-    double jitter = (double)(period - (gint64)mark.nominal_ns);
+    gint64 shown = stored == G_MAXUINT32 ? period : stored; /* what cycles_show() shows */
+    double jitter = (double)(shown - (gint64)mark.nominal_ns);
     c->frames++;
     c->jitter_sum += jitter;
     c->jitter_squares += jitter * jitter;
@@ -357,7 +358,7 @@ void cycles_returned(cycle_model *m, const datagram *s, const datagram *b, guint
     if (txn->request_frame > c->latest_answered) {
         c->latest_answered = txn->request_frame;
         guint tail = 0;
-        for (guint i = 0; i < ring && i < c->frames; i++)
+        for (guint i = 0; i < ring; i++) /* unused slots hold 0 */
             if (c->recent[i] > txn->request_frame) tail++;
         c->unanswered_tail = tail;
     }
@@ -442,9 +443,23 @@ gint64 period_of(const cycle_mark *c, guint32 frame)
 
 } /* namespace */
 
+namespace {
+
+/* proto_field_is_referenced: a visible tree, or a filter, column or -e naming
+ * the field; tshark -T fields of other fields skips the items. */
+gboolean any_referenced(proto_tree *tree, const int *hf, guint n)
+{
+    for (guint i = 0; i < n; i++)
+        if (proto_field_is_referenced(tree, hf[i])) return TRUE;
+    return FALSE;
+}
+
+} /* namespace */
+
 void dc_show(const datagram *b, double drift, tvbuff_t *tvb, proto_tree *tree)
 {
-    if (!tree) return;
+    const int dc_fields[] = {hf_systime, hf_drift};
+    if (!tree || !any_referenced(tree, dc_fields, G_N_ELEMENTS(dc_fields))) return;
     proto_item *it = proto_tree_add_uint64(tree, hf_systime, tvb, data_offset(b), b->length, systime_of(tvb, b));
     proto_item_set_generated(it);
     if (isnan(drift)) return;
@@ -454,7 +469,8 @@ void dc_show(const datagram *b, double drift, tvbuff_t *tvb, proto_tree *tree)
 
 void cycles_show(const cycle_mark *c, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
-    if (!tree || !c->cycle) return;
+    const int cycle_fields[] = {hf_cycle, hf_period, hf_jitter};
+    if (!tree || !c->cycle || !any_referenced(tree, cycle_fields, G_N_ELEMENTS(cycle_fields))) return;
     proto_item *it = proto_tree_add_uint(tree, hf_cycle, tvb, 0, 0, c->cycle);
     proto_item_set_generated(it);
     gint64 period = period_of(c, pinfo->num);

@@ -203,6 +203,7 @@ class Reference:
                  "frames": [], "rtts": [], "answered": set(), "wkc_high": [0] * len(sig), "wkc_errors": 0}
             s["cycle"] = c
             self.cycles.append(c)
+        period = max(0, period)   # timestamps that went backwards: 0
         c["periods"].append(period)
         nominal = lower_median(c["periods"])
         self.marks[num] = (c["number"], period, period - nominal)
@@ -218,7 +219,7 @@ class Reference:
         c = s["cycle"]
         if c is None or req < c["first"]:
             return
-        c["rtts"].append(rtt)
+        c["rtts"].append(max(0, rtt))
         c["answered"].add(req)
         error = False
         for i, (a, b) in enumerate(zip(sent_dgs, back_dgs)):
