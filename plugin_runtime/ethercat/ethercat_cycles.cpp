@@ -382,7 +382,8 @@ namespace {
 
 guint64 systime_of(tvbuff_t *tvb, const datagram *b)
 {
-    return b->length == 8 ? tvb_get_letoh64(tvb, data_offset(b)) : tvb_get_letohl(tvb, data_offset(b));
+    return b->length == 8 ? dg_tvb_get_uint64(tvb, data_offset(b), ENC_LITTLE_ENDIAN)
+                           : dg_tvb_get_uint32(tvb, data_offset(b), ENC_LITTLE_ENDIAN);
 }
 
 } /* namespace */
