@@ -7,7 +7,7 @@ const std::vector<Analysis>& analyses() {
     static const std::vector<Analysis> list = {
         // What an EtherCAT slave controller does to a frame, and the bus model
         // (plugin_runtime/ethercat/).
-        {"ethercat-esc", "dg_ethercat_esc", {"ethercat/ethercat_esc.cpp", "ethercat/ethercat_bus.cpp"}},
+        {"ethercat-esc", "dg_ethercat_esc", {"ethercat/ethercat_esc.cpp", "ethercat/ethercat_bus.cpp", "ethercat/ethercat_cycles.cpp"}},
     };
     return list;
 }

@@ -98,6 +98,23 @@
     X(data_changed, "esc.data_changed", FT_BOOLEAN, BASE_NONE, NULL, "Data changed",                        \
       "The data came back different from what was sent")
 
+/* ethercat_cycles.cpp: a sent frame of a cycle (manual, "Cycles"). */
+#define DG_CYCLE_FIELDS(X)                                                                                 \
+    X(cycle, "cycle", FT_UINT16, BASE_DEC, NULL, "Cycle",                                                   \
+      "The cycle this sent frame belongs to: 1, 2, ... in order of first appearance")                      \
+    X(period, "cycle.period", FT_RELATIVE_TIME, BASE_NONE, NULL, "Cycle period",                            \
+      "Time since the cycle's previous frame sent")                                                       \
+    X(jitter, "cycle.jitter", FT_RELATIVE_TIME, BASE_NONE, NULL, "Cycle jitter",                            \
+      "The period minus the cycle's nominal period (the median of its periods so far)")
+
+/* ethercat_cycles.cpp: the reference clock's system time in a returned frame. */
+#define DG_DC_FIELDS(X)                                                                                    \
+    X(systime, "dc.systime", FT_UINT64, BASE_DEC, NULL, "DC system time (ns)",                              \
+      "The reference clock's system time as the returned FRMW/ARMW of 0x0910 carries it (32 or 64 bits)")  \
+    X(drift, "dc.drift", FT_DOUBLE, BASE_NONE, NULL, "DC drift (ns/s)",                                     \
+      "DC time elapsed minus capture time elapsed since the capture's first system time, per second "      \
+      "of capture time (ppb); positive: the reference clock runs faster than the capture's")
+
 #define DG_ESC_EXPERTS(X)                                                                                  \
     X(changed, "expert.changed", PI_PROTOCOL, PI_ERROR,                                                     \
       "Returned datagram's command, index, length or address changed")                                    \

@@ -583,7 +583,7 @@ dg_frame_pairing *response_to(capture_state *c, dg_transaction *t, const guint8 
     if (t->seq > c->answered_max) c->answered_max = t->seq;
     if (analysis && analysis->compare && request_bytes) {
         tvbuff_t *request = tvb_new_real_data(request_bytes, request_length, (gint)request_length);
-        fp->analysis = analysis->compare(c->analysis, request, tvb, pinfo);
+        fp->analysis = analysis->compare(c->analysis, request, tvb, t, pinfo);
         tvb_free(request);
     }
     return fp;

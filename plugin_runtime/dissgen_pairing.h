@@ -91,8 +91,10 @@ typedef struct dg_analysis {
      * be a request. */
     gboolean (*is_returned)(void *capture, const address *src);
     /* First pass, once per pair: what the response changed; the result is
-     * allocated in wmem_file_scope. `request` holds the request's bytes. */
-    void *(*compare)(void *capture, tvbuff_t *request, tvbuff_t *response, packet_info *pinfo);
+     * allocated in wmem_file_scope. `request` holds the request's bytes,
+     * `txn` the pair (its request frame, its round trip). */
+    void *(*compare)(void *capture, tvbuff_t *request, tvbuff_t *response, const dg_transaction *txn,
+                     packet_info *pinfo);
     /* Every pass: shows a compare() result on the response. */
     void (*show)(const void *result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
     /* Statistics (tshark -z FILTER,tree): nodes under the pairing's own. */

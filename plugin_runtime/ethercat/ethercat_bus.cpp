@@ -22,10 +22,12 @@
  * frame where the capture showed them, so every pass shows the same ones.
  */
 #include "ethercat_bus.h"
+#include "ethercat_cycles.h"
 #include "dissgen_label.h"
 
 #include <epan/expert.h>
 
+#include <math.h>
 #include <string.h>
 
 namespace dg_ecat {
@@ -150,12 +152,21 @@ struct bus_model {
 
 struct bus_frame {
     const bus_model *model;
-    gboolean returned;   /* inputs are shown from returned frames, outputs from frames as sent */
-    guint count;
     addressed *d;
-    guint event_count;
     bus_event *events;
+    union {                              /* ethercat_cycles.cpp's, laid out with the counts */
+        struct {                         /* in what was padding: */
+            guint32 period, nominal;     /* a sent frame's cycle_mark */
+        } cycle_times;
+        double dc_drift;                 /* a returned frame's DC drift (NAN: none) */
+    } timing;
+    guint16 cycle;
+    guint16 count;       /* datagrams: at most max_datagrams */
+    guint16 event_count;
+    guint8 returned;     /* inputs are shown from returned frames, outputs from frames as sent */
 };
+/* One per EtherCAT frame: the cycle and clock figures must not make it grow. */
+static_assert(sizeof(bus_frame) <= 3 * sizeof(void *) + 16, "bus_frame grew");
 
 namespace {
 
@@ -680,10 +691,10 @@ bus_frame *new_frame(const bus_model *m, guint count, const events *ev)
     /* One allocation for the frame and its datagrams. */
     bus_frame *f = (bus_frame *)wmem_alloc0(wmem_file_scope(), sizeof(bus_frame) + count * sizeof(addressed));
     f->model = m;
-    f->count = count;
+    f->count = (guint16)count;
     f->d = (addressed *)(f + 1);
     if (ev && ev->count) {
-        f->event_count = ev->count;
+        f->event_count = (guint16)MIN(ev->count, G_MAXUINT16);
         f->events = (bus_event *)wmem_memdup(wmem_file_scope(), ev->list, ev->count * sizeof(bus_event));
     }
     return f;
@@ -1110,15 +1121,33 @@ bus_model *bus_new(const dg_bus *design)
     return m;
 }
 
-bus_frame *bus_sent(bus_model *m, tvbuff_t *tvb, packet_info *)
+bus_frame *bus_sent(bus_model *m, const datagram *d, guint n)
 {
-    datagram d[max_datagrams];
-    guint header;
-    guint n = read_frame(tvb, &header, d, max_datagrams);
     bus_frame *f = new_frame(m, n, NULL);
     for (guint i = 0; i < n; i++) f->d[i] = address_of(m, &d[i]);
     return f;
 }
+
+void bus_set_cycle(bus_frame *f, const cycle_mark *c)
+{
+    f->cycle = c->cycle;
+    f->timing.cycle_times.period = c->period_ns;
+    f->timing.cycle_times.nominal = c->nominal_ns;
+}
+
+cycle_mark bus_cycle(const bus_frame *f)
+{
+    cycle_mark c = {0, 0, 0};
+    if (f->returned) return c;
+    c.cycle = f->cycle;
+    c.period_ns = f->timing.cycle_times.period;
+    c.nominal_ns = f->timing.cycle_times.nominal;
+    return c;
+}
+
+void bus_set_dc_drift(bus_frame *f, double drift) { f->timing.dc_drift = drift; }
+
+double bus_dc_drift(const bus_frame *f) { return f->returned ? f->timing.dc_drift : NAN; }
 
 bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
                         packet_info *pinfo)
@@ -1142,6 +1171,7 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const data
     }
     bus_frame *f = new_frame(m, n, &ev);
     f->returned = TRUE;
+    f->timing.dc_drift = NAN;
     for (guint i = 0; i < n; i++) {
         f->d[i] = address_of(m, &s[i]);
         f->d[i].stats = flags[i];

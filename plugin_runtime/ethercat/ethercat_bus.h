@@ -39,14 +39,21 @@ struct bus_model;   /* capture-wide, wmem_file_scope */
 struct bus_frame;   /* one frame's slaves and network-check findings, wmem_file_scope */
 
 bus_model *bus_new(const dg_bus *design);
-/* First pass. A frame as sent (a request, or one whose response is not paired):
- * which slave each datagram addresses. */
-bus_frame *bus_sent(bus_model *m, tvbuff_t *tvb, packet_info *pinfo);
+/* First pass. A frame as sent (a request, or one whose response is not paired),
+ * its n datagrams as read_frame() read them: which slave each one addresses. */
+bus_frame *bus_sent(bus_model *m, const datagram *d, guint n);
 /* First pass. A returned frame with the frame as sent: what it teaches about
  * the bus, and which slave each datagram addresses. s and b are their first n
  * datagrams as read_frame() read them. */
 bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
                         packet_info *pinfo);
+/* A sent frame's cycle (ethercat_cycles.h), kept with its slaves. */
+struct cycle_mark;
+void bus_set_cycle(bus_frame *f, const cycle_mark *c);
+cycle_mark bus_cycle(const bus_frame *f);
+/* A returned frame's distributed-clock drift (ethercat_cycles.h), NAN when none. */
+void bus_set_dc_drift(bus_frame *f, double drift);
+double bus_dc_drift(const bus_frame *f);
 /* Every pass: the slave items and the network-check expert infos. A line per
  * datagram names its slave; `details` (the preference) prints the slave's
  * fields under it, else they are added hidden when a filter names them. */

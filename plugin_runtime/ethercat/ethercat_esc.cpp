@@ -28,6 +28,7 @@
  */
 #include "ethercat_esc.h"
 #include "ethercat_bus.h"
+#include "ethercat_cycles.h"
 #include "dissgen_label.h"
 
 #include <epan/expert.h>
@@ -69,6 +70,7 @@ struct capture_hints {
     gboolean marking_seen; /* a slave set the locally administered bit: the capture shows direction */
     guint8 master[6];      /* the (unmarked) source of the frames answered so far */
     bus_model *bus;        /* the slaves the capture shows (ethercat_bus.cpp) */
+    cycle_model *cycles;   /* the cycles it finds (ethercat_cycles.cpp) */
 };
 
 int hf_esc = -1, hf_datagram = -1, hf_wkc_added = -1, hf_slaves_passed = -1, hf_data_changed = -1;
@@ -140,6 +142,7 @@ void *esc_capture_new(const dg_protocol *p)
 {
     capture_hints *h = wmem_new0(wmem_file_scope(), capture_hints);
     h->bus = bus_new(static_cast<const dg_bus *>(p->analysis_data));
+    h->cycles = cycles_new();
     return h;
 }
 
@@ -221,7 +224,7 @@ gboolean esc_key_changed(tvbuff_t *request, tvbuff_t *message)
 }
 
 
-void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, packet_info *pinfo)
+void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, const dg_transaction *txn, packet_info *pinfo)
 {
     datagram sent[max_datagrams], back[max_datagrams];
     guint sent_length, back_length;
@@ -239,7 +242,10 @@ void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, packet_i
     r->length_changed = sent_length != back_length || sent_count != back_count;
     for (guint i = 0; i < r->count; i++) compare_datagram(&r->d[i], &sent[i], &back[i], request, response);
     check_forwarding(r);
-    r->bus = bus_returned(((capture_hints *)capture)->bus, request, response, sent, back, r->count, pinfo);
+    capture_hints *h = (capture_hints *)capture;
+    r->bus = bus_returned(h->bus, request, response, sent, back, r->count, pinfo);
+    if (!r->length_changed) cycles_returned(h->cycles, sent, back, r->count, txn, pinfo);
+    bus_set_dc_drift(r->bus, dc_returned(h->cycles, sent, back, r->count, response, pinfo));
     return r;
 }
 
@@ -348,6 +354,7 @@ void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *t
                                      "Frame length changed: sent with %u bytes of datagrams (%u datagrams), came "
                                      "back with %u (%u datagrams)",
                                      r->sent_length, r->sent_count, r->back_length, r->back_count);
+    gboolean dc_shown = !tree;
     for (guint i = 0; i < r->count; i++) {
         const compared *c = &r->d[i];
         gboolean shown = printed && (show_details || unusual(c));
@@ -357,19 +364,33 @@ void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *t
             if (!shown) proto_item_set_hidden(proto_tree_get_parent(dg));
         }
         show_datagram_experts(c, i, tvb, pinfo, dg);
+        if (!dc_shown && dc_datagram(&c->sent, &c->back)) {
+            dc_show(&c->back, bus_dc_drift(r->bus), tvb, tree);
+            dc_shown = TRUE;
+        }
     }
     bus_show(r->bus, tvb, pinfo, tree, show_details);
 }
 
-/* A frame as sent (or returned without its request): only the slaves. */
+/* A frame as sent: its slaves and its cycle. */
 void *esc_sent(void *capture, tvbuff_t *tvb, packet_info *pinfo)
 {
-    return bus_sent(((capture_hints *)capture)->bus, tvb, pinfo);
+    capture_hints *h = (capture_hints *)capture;
+    datagram d[max_datagrams];
+    guint header_length;
+    guint n = read_frame(tvb, &header_length, d, max_datagrams);
+    bus_frame *f = bus_sent(h->bus, d, n);
+    cycle_mark c = cycles_sent(h->cycles, d, n, pinfo);
+    if (c.cycle) bus_set_cycle(f, &c);
+    return f;
 }
 
 void esc_show_sent(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
-    bus_show((const bus_frame *)data, tvb, pinfo, tree, show_details);
+    const bus_frame *f = (const bus_frame *)data;
+    cycle_mark c = bus_cycle(f);
+    cycles_show(&c, tvb, pinfo, tree);
+    bus_show(f, tvb, pinfo, tree, show_details);
 }
 
 /* --- statistics ---------------------------------------------------------- */
@@ -418,6 +439,7 @@ void esc_register(int proto, const char *filter)
                                    "printed where something is unusual, and every field stays filterable.",
                                    &show_details);
     bus_register(proto, filter);
+    cycles_register(proto, filter);
 }
 
 } /* namespace */

@@ -45,7 +45,7 @@ packages=(libwireshark-dev libwsutil-dev libwiretap-dev)
 # The flags a plugin is built with (CMakeLists.txt, generator/build_plugin.cpp)
 # plus -Wall -Wextra -Werror: a deprecation is an error here.
 # The runtime's sources: the generic ones and every analysis's (each is compiled here).
-runtime_sources=(plugin_runtime/dissgen_walk.cpp plugin_runtime/dissgen_conditions.cpp plugin_runtime/dissgen_text.cpp plugin_runtime/dissgen_handoff.cpp plugin_runtime/dissgen_register.cpp plugin_runtime/dissgen_pairing.cpp plugin_runtime/dissgen_expr.cpp plugin_runtime/dissgen_validity.cpp plugin_runtime/dissgen_request.cpp plugin_runtime/ethercat/ethercat_esc.cpp plugin_runtime/ethercat/ethercat_bus.cpp)
+runtime_sources=(plugin_runtime/dissgen_walk.cpp plugin_runtime/dissgen_conditions.cpp plugin_runtime/dissgen_text.cpp plugin_runtime/dissgen_handoff.cpp plugin_runtime/dissgen_register.cpp plugin_runtime/dissgen_pairing.cpp plugin_runtime/dissgen_expr.cpp plugin_runtime/dissgen_validity.cpp plugin_runtime/dissgen_request.cpp plugin_runtime/ethercat/ethercat_esc.cpp plugin_runtime/ethercat/ethercat_bus.cpp plugin_runtime/ethercat/ethercat_cycles.cpp)
 flags=(-std=c++17 -O2 -fPIC -DWS_BUILD_DLL -Wall -Wextra -Werror -Werror=attributes -I"$root/plugin_runtime")
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/dissgen-multiversion-XXXXXX")

@@ -112,6 +112,7 @@ TESTS = {
     "corpus_padding": integration("test_corpus_padding.py"),
     "plugin_contents": integration("test_plugin_contents.py"),
     "reserved_names": integration("test_reserved_names.py"),
+    "cycles": integration("test_cycles.py"),
 }
 
 

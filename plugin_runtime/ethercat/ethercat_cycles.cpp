@@ -1,0 +1,698 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* The cycles of an EtherCAT capture (see ethercat_cycles.h and the manual,
+ * "Cycles"), decided on the first pass from what came before each frame:
+ *
+ *  - A frame's signature is the command, address (ADP and ADO, or the
+ *    logical address) and data length of each of its datagrams, in order.
+ *  - A signature that transfers a mailbox or does what only a start-up
+ *    does is never a cycle: a non-logical datagram addressing ESC memory at
+ *    0x1000 or above (the mailboxes), the SyncManager 0/1 status bytes
+ *    (0x0805, 0x080D, which masters poll for mail), the SII interface
+ *    (0x0500-0x050F) or the DC port receive times (0x0900-0x090F, latched
+ *    to measure the topology).
+ *  - A period is the time from a frame sent to the next one sent with its
+ *    signature. It is regular when it is above 0, the previous frame came
+ *    back before this one was sent (not a retry after a timeout) and this
+ *    frame is not a poll: sent less than one round trip after that return
+ *    (a master sending the same frame again as soon as it is back, as while
+ *    waiting for a state or an EEPROM read).
+ *  - A signature becomes a cycle with its first window of `window` (8)
+ *    regular periods in a row, all within half of their median either way
+ *    (and that median below 2^32 ns): the frame that completes the window is
+ *    the cycle's first marked frame. From then on every frame sent with that
+ *    signature is in the cycle, whatever its period.
+ *  - A marked frame's period is the time since the signature's previous
+ *    frame (0 if the timestamps went backwards); its nominal period the median (the lower of the two middle
+ *    values for an even count) of the cycle's periods so far: the window's
+ *    and those of every marked frame up to this one; its jitter the period
+ *    minus the nominal period.
+ *
+ * Memory: each sent frame's mark (10 bytes) lives in its bus_frame; the
+ * model keeps per cycle its periods (4 bytes each, in two heaps for the
+ * running median) and the round trips of its returned frames (4 bytes each),
+ * for `-z ecatr,cycles`.
+ */
+#include "ethercat_cycles.h"
+
+#include <epan/stat_tap_ui.h>
+#include <epan/stats_tree.h>
+#include <epan/tap.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+namespace dg_ecat {
+
+namespace {
+
+const guint window = 8;
+const guint ring = 16; /* the last frames of a cycle whose return may still come */
+
+struct sig_datagram {
+    guint8 cmd;
+    guint16 adp, ado, length;
+};
+
+/* A growing array of 32-bit values in wmem_file_scope. */
+struct u32_vec {
+    guint32 *v;
+    guint n, cap;
+    void push(guint32 x)
+    {
+        if (n == cap) {
+            cap = cap ? 2 * cap : 16;
+            v = (guint32 *)wmem_realloc(wmem_file_scope(), v, cap * sizeof(guint32));
+        }
+        v[n++] = x;
+    }
+};
+
+/* A binary heap over u32_vec: max-heap when `max`, else min-heap. */
+gboolean before(guint32 a, guint32 b, gboolean max) { return max ? a > b : a < b; }
+
+void heap_push(u32_vec *h, guint32 x, gboolean max)
+{
+    h->push(x);
+    for (guint i = h->n - 1; i > 0;) {
+        guint p = (i - 1) / 2;
+        if (!before(h->v[i], h->v[p], max)) break;
+        guint32 t = h->v[i];
+        h->v[i] = h->v[p];
+        h->v[p] = t;
+        i = p;
+    }
+}
+
+guint32 heap_pop(u32_vec *h, gboolean max)
+{
+    guint32 top = h->v[0];
+    h->v[0] = h->v[--h->n];
+    for (guint i = 0;;) {
+        guint l = 2 * i + 1, r = l + 1, best = i;
+        if (l < h->n && before(h->v[l], h->v[best], max)) best = l;
+        if (r < h->n && before(h->v[r], h->v[best], max)) best = r;
+        if (best == i) break;
+        guint32 t = h->v[i];
+        h->v[i] = h->v[best];
+        h->v[best] = t;
+        i = best;
+    }
+    return top;
+}
+
+struct cycle {
+    guint16 number;
+    guint count;             /* datagrams of its signature */
+    const sig_datagram *sig;
+    u32_vec low, high;       /* its periods: low a max-heap holding the lower half (one more when odd) */
+    guint32 window_periods[window]; /* the qualifying window's: not carried by a marked frame */
+    guint frames;            /* marked frames */
+    guint32 first_frame;     /* the first marked frame */
+    double jitter_sum, jitter_squares;
+    u32_vec rtts;            /* round trips of the marked frames answered, ns */
+    guint answered;
+    guint32 recent[ring];    /* the last marked frames sent, oldest overwritten */
+    guint32 latest_answered; /* the latest marked frame answered */
+    guint unanswered_tail;   /* marked frames sent after it */
+    guint wkc_errors;
+    guint16 *wkc_high;       /* per datagram, the highest working counter returned */
+    cycle *next;
+};
+
+struct signature {
+    guint32 hash;
+    guint count;
+    sig_datagram *d;
+    gboolean eligible;
+    guint32 last_sent_frame;
+    nstime_t last_sent;
+    guint32 last_answered_frame; /* the last of its frames answered, and when */
+    nstime_t last_return;
+    nstime_t last_rtt;
+    guint64 recent[window];      /* its last regular periods, a ring */
+    guint regular;               /* how many in a row (up to window) */
+    guint next_slot;
+    cycle *cyc;
+};
+
+} /* namespace */
+
+/* The first system time of each width returned in the capture, and when. */
+struct dc_reference {
+    gboolean known;
+    guint64 systime;
+    gint64 at;   /* capture time, ns */
+};
+
+struct cycle_model {
+    wmem_map_t *signatures;      /* signature -> itself */
+    cycle *first, *last;
+    guint16 cycles;
+    wmem_map_t *long_periods;    /* frame -> gint64 *, periods of 2^32 ns or more */
+    dc_reference dc32, dc64;
+    guint32 last_frame;          /* the last frame the first pass brought here */
+    /* the last frames sent and their signatures, so that most returns find
+     * theirs without hashing their datagrams again */
+    struct {
+        guint32 frame;
+        signature *sig;
+    } recent_sent[ring];
+};
+
+namespace {
+
+cycle_model *current; /* the open capture's, for -z ecatr,cycles and long periods */
+
+guint sig_hash(gconstpointer p) { return ((const signature *)p)->hash; }
+
+gboolean sig_equal(gconstpointer a, gconstpointer b)
+{
+    const signature *x = (const signature *)a, *y = (const signature *)b;
+    if (x->hash != y->hash || x->count != y->count) return FALSE;
+    for (guint i = 0; i < x->count; i++)
+        if (x->d[i].cmd != y->d[i].cmd || x->d[i].adp != y->d[i].adp || x->d[i].ado != y->d[i].ado ||
+            x->d[i].length != y->d[i].length)
+            return FALSE;
+    return TRUE;
+}
+
+gboolean overlaps(guint from, guint length, guint lo, guint hi) { return from <= hi && from + length > lo; }
+
+/* Mailbox transfers and SII reads: never cyclic process data. */
+gboolean mailbox_or_sii(const sig_datagram *d)
+{
+    if (d->cmd == 0 || (d->cmd >= 10 && d->cmd <= 12)) return FALSE; /* NOP, LRD/LWR/LRW */
+    guint ado = d->ado, len = d->length;
+    return ado + len > 0x1000 || overlaps(ado, len, 0x0805, 0x0805) || overlaps(ado, len, 0x080D, 0x080D) ||
+           overlaps(ado, len, 0x0500, 0x050F) || overlaps(ado, len, 0x0900, 0x090F);
+}
+
+signature *signature_of(cycle_model *m, const datagram *d, guint n)
+{
+    sig_datagram probe_d[max_datagrams];
+    guint32 h = 2166136261u ^ n;
+    for (guint i = 0; i < n; i++) {
+        probe_d[i].cmd = d[i].cmd;
+        probe_d[i].adp = d[i].adp;
+        probe_d[i].ado = d[i].ado;
+        probe_d[i].length = d[i].length;
+        h = (h ^ d[i].cmd) * 16777619u;
+        h = (h ^ ((guint32)d[i].adp | (guint32)d[i].ado << 16)) * 16777619u;
+        h = (h ^ d[i].length) * 16777619u;
+    }
+    signature probe = {};
+    probe.hash = h;
+    probe.count = n;
+    probe.d = probe_d;
+    signature *s = (signature *)wmem_map_lookup(m->signatures, &probe);
+    if (s) return s;
+    s = wmem_new0(wmem_file_scope(), signature);
+    s->hash = h;
+    s->count = n;
+    s->d = (sig_datagram *)wmem_memdup(wmem_file_scope(), probe_d, n * sizeof(sig_datagram));
+    s->eligible = n > 0;
+    for (guint i = 0; i < n; i++)
+        if (mailbox_or_sii(&s->d[i])) s->eligible = FALSE;
+    wmem_map_insert(m->signatures, s, s);
+    return s;
+}
+
+gint64 ns_of(const nstime_t *t) { return (gint64)t->secs * 1000000000 + t->nsecs; }
+
+/* The median of the regular periods in the window, when all of them lie
+ * within half of it either way; 0 otherwise. */
+guint64 window_median(const signature *s)
+{
+    guint64 v[window];
+    memcpy(v, s->recent, sizeof v);
+    for (guint i = 1; i < window; i++)
+        for (guint j = i; j > 0 && v[j - 1] > v[j]; j--) {
+            guint64 t = v[j];
+            v[j] = v[j - 1];
+            v[j - 1] = t;
+        }
+    guint64 median = v[(window - 1) / 2];
+    if (median == 0 || median > G_MAXUINT32) return 0;
+    if (2 * v[0] < median || 2 * v[window - 1] > 3 * median) return 0;
+    return median;
+}
+
+void add_period(cycle *c, guint32 p)
+{
+    /* low holds the lower half, its top the (lower) median */
+    if (c->low.n == 0 || p <= c->low.v[0])
+        heap_push(&c->low, p, TRUE);
+    else
+        heap_push(&c->high, p, FALSE);
+    if (c->low.n > c->high.n + 1)
+        heap_push(&c->high, heap_pop(&c->low, TRUE), FALSE);
+    else if (c->high.n > c->low.n)
+        heap_push(&c->low, heap_pop(&c->high, FALSE), TRUE);
+}
+
+cycle *new_cycle(cycle_model *m, signature *s, guint32 frame)
+{
+    cycle *c = wmem_new0(wmem_file_scope(), cycle);
+    c->number = ++m->cycles;
+    c->count = s->count;
+    c->sig = s->d;
+    c->first_frame = frame;
+    c->wkc_high = wmem_alloc0_array(wmem_file_scope(), guint16, s->count ? s->count : 1);
+    if (m->last)
+        m->last->next = c;
+    else
+        m->first = c;
+    m->last = c;
+    /* the window's periods, oldest first; the last is the marking frame's own */
+    for (guint i = 0; i + 1 < window; i++) {
+        guint32 p = (guint32)s->recent[(s->next_slot + i) % window];
+        c->window_periods[i] = p;
+        add_period(c, p);
+    }
+    return c;
+}
+
+void capture_cleanup(void) { current = NULL; }
+
+} /* namespace */
+
+cycle_model *cycles_new(void)
+{
+    cycle_model *m = wmem_new0(wmem_file_scope(), cycle_model);
+    m->signatures = wmem_map_new(wmem_file_scope(), sig_hash, sig_equal);
+    current = m;
+    return m;
+}
+
+cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_info *pinfo)
+{
+    cycle_mark mark = {0, 0, 0};
+    m->last_frame = pinfo->num;
+    signature *s = signature_of(m, d, n);
+    m->recent_sent[pinfo->num % ring].frame = pinfo->num;
+    m->recent_sent[pinfo->num % ring].sig = s;
+    if (!s->eligible) return mark;
+    guint32 previous = s->last_sent_frame;
+    nstime_t previous_time = s->last_sent;
+    s->last_sent_frame = pinfo->num;
+    s->last_sent = pinfo->abs_ts;
+    if (!previous) return mark;
+    gint64 period = ns_of(&pinfo->abs_ts) - ns_of(&previous_time);
+    if (!s->cyc) {
+        gboolean answered = s->last_answered_frame == previous;
+        gboolean poll = answered && ns_of(&pinfo->abs_ts) - ns_of(&s->last_return) < ns_of(&s->last_rtt);
+        if (period <= 0 || !answered || poll) {
+            s->regular = 0;
+            return mark;
+        }
+        s->recent[s->next_slot] = (guint64)period;
+        s->next_slot = (s->next_slot + 1) % window;
+        if (s->regular < window) s->regular++;
+        if (s->regular < window || !window_median(s)) return mark;
+        s->cyc = new_cycle(m, s, pinfo->num);
+    }
+    cycle *c = s->cyc;
+    guint32 stored = period < 0 ? 0 : period >= (gint64)G_MAXUINT32 ? G_MAXUINT32 : (guint32)period;
+    if (stored == G_MAXUINT32) {
+        if (!m->long_periods) m->long_periods = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+        gint64 *exact = wmem_new(wmem_file_scope(), gint64);
+        *exact = period;
+        wmem_map_insert(m->long_periods, GUINT_TO_POINTER(pinfo->num), exact);
+    }
+    add_period(c, stored);
+    mark.cycle = c->number;
+    mark.period_ns = stored;
+    mark.nominal_ns = c->low.v[0];
+    gint64 shown = stored == G_MAXUINT32 ? period : stored; /* what cycles_show() shows */
+    double jitter = (double)(shown - (gint64)mark.nominal_ns);
+    c->frames++;
+    c->jitter_sum += jitter;
+    c->jitter_squares += jitter * jitter;
+    c->recent[c->frames % ring] = pinfo->num;
+    c->unanswered_tail++;
+    return mark;
+}
+
+void cycles_returned(cycle_model *m, const datagram *s, const datagram *b, guint n, const dg_transaction *txn,
+                     const packet_info *pinfo)
+{
+    m->last_frame = pinfo->num;
+    if (!txn) return;
+    guint slot = txn->request_frame % ring;
+    signature *sig = m->recent_sent[slot].frame == txn->request_frame && m->recent_sent[slot].sig->count == n
+                         ? m->recent_sent[slot].sig
+                         : signature_of(m, s, n);
+    if (!sig->eligible) return;
+    if (txn->request_frame >= sig->last_answered_frame) {
+        sig->last_answered_frame = txn->request_frame;
+        sig->last_return = pinfo->abs_ts;
+        sig->last_rtt = txn->round_trip;
+    }
+    cycle *c = sig->cyc;
+    if (!c || txn->request_frame < c->first_frame) return;
+    gint64 rtt = ns_of(&txn->round_trip);
+    c->rtts.push(rtt < 0 ? 0 : rtt > (gint64)G_MAXUINT32 ? G_MAXUINT32 : (guint32)rtt);
+    c->answered++;
+    if (txn->request_frame > c->latest_answered) {
+        c->latest_answered = txn->request_frame;
+        guint tail = 0;
+        for (guint i = 0; i < ring; i++) /* unused slots hold 0 */
+            if (c->recent[i] > txn->request_frame) tail++;
+        c->unanswered_tail = tail;
+    }
+    gboolean error = FALSE;
+    for (guint i = 0; i < n && i < c->count; i++) {
+        if (b[i].wkc <= s[i].wkc || b[i].wkc < c->wkc_high[i]) error = TRUE;
+        if (b[i].wkc > c->wkc_high[i]) c->wkc_high[i] = b[i].wkc;
+    }
+    if (error) c->wkc_errors++;
+}
+
+/* --- distributed clocks ---------------------------------------------------- */
+
+gboolean dc_datagram(const datagram *s, const datagram *b)
+{
+    return (s->cmd == 13 || s->cmd == 14) && s->ado == 0x0910 && (s->length == 4 || s->length == 8) &&
+           b->cmd == s->cmd && b->ado == s->ado && b->length == s->length && b->wkc > s->wkc;
+}
+
+namespace {
+
+guint64 systime_of(tvbuff_t *tvb, const datagram *b)
+{
+    return b->length == 8 ? dg_tvb_get_uint64(tvb, data_offset(b), ENC_LITTLE_ENDIAN)
+                           : dg_tvb_get_uint32(tvb, data_offset(b), ENC_LITTLE_ENDIAN);
+}
+
+} /* namespace */
+
+/* The drift is the DC time elapsed since the reference less the capture time
+ * elapsed, per second of capture time. A 32-bit system time wraps every
+ * 4.29 s: it is unwrapped to the value nearest the reference plus the
+ * capture time elapsed. */
+double dc_returned(cycle_model *m, const datagram *s, const datagram *b, guint n, tvbuff_t *back,
+                   const packet_info *pinfo)
+{
+    guint i = 0;
+    while (i < n && !dc_datagram(&s[i], &b[i])) i++;
+    if (i == n || (guint)data_offset(&b[i]) + b[i].length > tvb_captured_length(back)) return NAN;
+    guint64 raw = systime_of(back, &b[i]);
+    gint64 at = ns_of(&pinfo->abs_ts);
+    dc_reference *ref = b[i].length == 8 ? &m->dc64 : &m->dc32;
+    if (!ref->known) {
+        ref->known = TRUE;
+        ref->systime = raw;
+        ref->at = at;
+        return NAN;
+    }
+    gint64 elapsed = at - ref->at;
+    if (elapsed <= 0) return NAN;
+    gint64 dc_elapsed;
+    if (b[i].length == 8) {
+        dc_elapsed = (gint64)(raw - ref->systime);
+    } else {
+        /* the wrap count that puts the value nearest the capture's clock */
+        gint64 low = (gint64)((raw - ref->systime) & 0xFFFFFFFFu);
+        gint64 wraps = (elapsed - low + ((gint64)1 << 31)) >> 32;
+        dc_elapsed = low + (wraps << 32);
+    }
+    return (double)(dc_elapsed - elapsed) * 1e9 / (double)elapsed;
+}
+
+/* --- items -------------------------------------------------------------- */
+
+namespace {
+
+int hf_cycle = -1, hf_period = -1, hf_jitter = -1, hf_systime = -1, hf_drift = -1;
+
+nstime_t nstime_of(gint64 ns)
+{
+    nstime_t t;
+    t.secs = (time_t)(ns / 1000000000);
+    t.nsecs = (int)(ns % 1000000000);
+    return t;
+}
+
+gint64 period_of(const cycle_mark *c, guint32 frame)
+{
+    if (c->period_ns != G_MAXUINT32 || !current || !current->long_periods) return c->period_ns;
+    const gint64 *exact = (const gint64 *)wmem_map_lookup(current->long_periods, GUINT_TO_POINTER(frame));
+    return exact ? *exact : c->period_ns;
+}
+
+} /* namespace */
+
+namespace {
+
+/* proto_field_is_referenced: a visible tree, or a filter, column or -e naming
+ * the field; tshark -T fields of other fields skips the items. */
+gboolean any_referenced(proto_tree *tree, const int *hf, guint n)
+{
+    for (guint i = 0; i < n; i++)
+        if (proto_field_is_referenced(tree, hf[i])) return TRUE;
+    return FALSE;
+}
+
+} /* namespace */
+
+void dc_show(const datagram *b, double drift, tvbuff_t *tvb, proto_tree *tree)
+{
+    const int dc_fields[] = {hf_systime, hf_drift};
+    if (!tree || !any_referenced(tree, dc_fields, G_N_ELEMENTS(dc_fields))) return;
+    proto_item *it = proto_tree_add_uint64(tree, hf_systime, tvb, data_offset(b), b->length, systime_of(tvb, b));
+    proto_item_set_generated(it);
+    if (isnan(drift)) return;
+    it = proto_tree_add_double(tree, hf_drift, tvb, data_offset(b), b->length, drift);
+    proto_item_set_generated(it);
+}
+
+void cycles_show(const cycle_mark *c, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    const int cycle_fields[] = {hf_cycle, hf_period, hf_jitter};
+    if (!tree || !c->cycle || !any_referenced(tree, cycle_fields, G_N_ELEMENTS(cycle_fields))) return;
+    proto_item *it = proto_tree_add_uint(tree, hf_cycle, tvb, 0, 0, c->cycle);
+    proto_item_set_generated(it);
+    gint64 period = period_of(c, pinfo->num);
+    nstime_t t = nstime_of(period);
+    it = proto_tree_add_time(tree, hf_period, tvb, 0, 0, &t);
+    proto_item_set_generated(it);
+    t = nstime_of(period - (gint64)c->nominal_ns);
+    it = proto_tree_add_time(tree, hf_jitter, tvb, 0, 0, &t);
+    proto_item_set_generated(it);
+}
+
+/* --- -z ecatr,cycles and the statistics tree ----------------------------- */
+
+namespace {
+
+int compare_u32(const void *a, const void *b)
+{
+    guint32 x = *(const guint32 *)a, y = *(const guint32 *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Minimum, lower median, nearest-rank 99th percentile and maximum. */
+struct quantiles {
+    guint n;
+    guint32 min, median, p99, max;
+};
+
+quantiles quantiles_of(guint32 *v, guint n)
+{
+    quantiles q = {n, 0, 0, 0, 0};
+    if (!n) return q;
+    qsort(v, n, sizeof *v, compare_u32);
+    q.min = v[0];
+    q.median = v[(n - 1) / 2];
+    q.p99 = v[(99 * (guint64)n + 99) / 100 - 1];
+    q.max = v[n - 1];
+    return q;
+}
+
+/* A cycle's whole-capture figures, from the capture's state. */
+struct figures {
+    guint32 nominal;
+    quantiles period, rtt;
+    double jitter_sd;
+    guint lost;
+};
+
+figures figures_of(const cycle *c)
+{
+    figures f = {};
+    f.nominal = c->low.n ? c->low.v[0] : 0;
+    /* the marked frames' periods: the cycle's less the window's */
+    guint total = c->low.n + c->high.n;
+    guint32 *all = g_new(guint32, total + 1);
+    memcpy(all, c->low.v, c->low.n * sizeof(guint32));
+    if (c->high.n) memcpy(all + c->low.n, c->high.v, c->high.n * sizeof(guint32));
+    qsort(all, total, sizeof *all, compare_u32);
+    guint32 win[window];
+    memcpy(win, c->window_periods, sizeof win);
+    qsort(win, window - 1, sizeof *win, compare_u32);
+    guint n = 0, w = 0;
+    for (guint i = 0; i < total; i++) {
+        if (w < window - 1 && all[i] == win[w])
+            w++;
+        else
+            all[n++] = all[i];
+    }
+    f.period = quantiles_of(all, n);
+    g_free(all);
+    double mean = c->frames ? c->jitter_sum / c->frames : 0;
+    double var = c->frames ? c->jitter_squares / c->frames - mean * mean : 0;
+    f.jitter_sd = var > 0 ? sqrt(var) : 0.0;
+    guint32 *rtts = g_new(guint32, c->rtts.n + 1);
+    if (c->rtts.n) memcpy(rtts, c->rtts.v, c->rtts.n * sizeof(guint32));
+    f.rtt = quantiles_of(rtts, c->rtts.n);
+    g_free(rtts);
+    guint unanswered = c->frames - c->answered;
+    f.lost = unanswered - MIN(c->unanswered_tail, unanswered);
+    return f;
+}
+
+/* "LRW 0x00010000 (4 bytes), FRMW 0x1001:0x0910 (8 bytes)" */
+char *signature_text(const cycle *c)
+{
+    GString *t = g_string_new("");
+    for (guint i = 0; i < c->count; i++) {
+        const sig_datagram *d = &c->sig[i];
+        if (i) g_string_append(t, ", ");
+        if (d->cmd >= 10 && d->cmd <= 12)
+            g_string_append_printf(t, "%s 0x%08x", command_name(d->cmd), (guint32)d->ado << 16 | d->adp);
+        else
+            g_string_append_printf(t, "%s 0x%04x:0x%04x", command_name(d->cmd), d->adp, d->ado);
+        g_string_append_printf(t, " (%u bytes)", d->length);
+    }
+    return g_string_free(t, FALSE);
+}
+
+const char *cycles_filter = "ecatr";
+
+void print_quantiles(const char *what, const quantiles *q)
+{
+    if (!q->n)
+        printf("  %s: none\n", what);
+    else
+        printf("  %s min/median/p99/max (ns): %u %u %u %u\n", what, q->min, q->median, q->p99, q->max);
+}
+
+/* At the end of the capture, from the capture's state (complete by then). */
+void cycles_draw(void *)
+{
+    printf("===================================================================\n");
+    printf("EtherCAT cycles (%s)\n", cycles_filter);
+    if (!current || !current->first) printf("No cycles\n");
+    for (const cycle *c = current ? current->first : NULL; c; c = c->next) {
+        figures f = figures_of(c);
+        char *sig = signature_text(c);
+        printf("Cycle %u: %s\n", c->number, sig);
+        g_free(sig);
+        printf("  frames: %u\n", c->frames);
+        printf("  nominal period (ns): %u\n", f.nominal);
+        print_quantiles("period", &f.period);
+        printf("  jitter std dev (ns): %.1f\n", f.jitter_sd);
+        print_quantiles("round trip", &f.rtt);
+        printf("  frames returned: %u\n", c->answered);
+        printf("  frames lost: %u\n", f.lost);
+        printf("  working counter errors: %u\n", c->wkc_errors);
+    }
+    printf("===================================================================\n");
+}
+
+tap_packet_status cycles_packet(void *, packet_info *, epan_dissect_t *, const void *, tap_flags_t)
+{
+    return TAP_PACKET_DONT_REDRAW;
+}
+
+void cycles_cli_init(const char *, void *)
+{
+    /* Listens to the frame tap (every frame) only so that the draw runs at the end. */
+    GString *error = register_tap_listener("frame", &cycles_filter, NULL, TL_REQUIRES_NOTHING, NULL, cycles_packet,
+                                           cycles_draw, NULL);
+    if (error) {
+        fprintf(stderr, "%s,cycles: %s\n", cycles_filter, error->str);
+        g_string_free(error, TRUE);
+    }
+}
+
+/* The statistics tree (Wireshark's Statistics menu): the same figures, set
+ * once the capture's state is complete, which it is when a frame is tapped
+ * that the first pass has gone beyond (the GUI taps a capture once it is
+ * read, tshark -2 in its second pass). In one pass tshark taps each frame as
+ * the first pass reaches it: the tree stays empty; -z ecatr,cycles is the
+ * way there. */
+gboolean st_filled;
+
+void st_init(stats_tree *) { st_filled = FALSE; }
+
+void st_set(stats_tree *st, const char *name, int parent, guint64 value)
+{
+    stats_tree_create_node(st, name, parent, STAT_DT_INT, FALSE);
+    set_stat_node(st, name, parent, FALSE, (gint)MIN(value, (guint64)G_MAXINT));
+}
+
+void st_quantiles(stats_tree *st, guint cycle, const char *what, const quantiles *q, int parent)
+{
+    const char *const names[] = {"min", "median", "p99", "max"};
+    const guint32 values[] = {q->min, q->median, q->p99, q->max};
+    for (guint i = 0; q->n && i < 4; i++) {
+        char *name = g_strdup_printf("Cycle %u %s %s (ns)", cycle, what, names[i]);
+        st_set(st, name, parent, values[i]);
+        g_free(name);
+    }
+}
+
+tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *, const void *, tap_flags_t)
+{
+    if (st_filled || !current || pinfo->num >= current->last_frame) return TAP_PACKET_DONT_REDRAW;
+    st_filled = TRUE;
+    for (const cycle *c = current->first; c; c = c->next) {
+        figures f = figures_of(c);
+        char *sig = signature_text(c);
+        char *name = g_strdup_printf("Cycle %u: %s", c->number, sig);
+        int id = stats_tree_create_node(st, name, 0, STAT_DT_INT, TRUE);
+        set_stat_node(st, name, 0, FALSE, (gint)c->frames);
+        g_free(name);
+        g_free(sig);
+        char label[96];
+#define ST_ROW(text, value)                                                  \
+    do {                                                                     \
+        g_snprintf(label, sizeof label, "Cycle %u " text, c->number);        \
+        st_set(st, label, id, value);                                        \
+    } while (0)
+        ST_ROW("frames", c->frames);
+        ST_ROW("nominal period (ns)", f.nominal);
+        st_quantiles(st, c->number, "period", &f.period, id);
+        ST_ROW("jitter std dev (ns)", (guint64)(f.jitter_sd + 0.5));
+        st_quantiles(st, c->number, "round trip", &f.rtt, id);
+        ST_ROW("frames returned", c->answered);
+        ST_ROW("frames lost", f.lost);
+        ST_ROW("working counter errors", c->wkc_errors);
+#undef ST_ROW
+    }
+    return TAP_PACKET_REDRAW;
+}
+
+} /* namespace */
+
+void cycles_register(int proto, const char *filter)
+{
+    static hf_register_info hf[] = {DG_CYCLE_FIELDS(DG_HF_ROW) DG_DC_FIELDS(DG_HF_ROW)};
+    static const char *const names[] = {DG_CYCLE_FIELDS(DG_FIELD_NAME) DG_DC_FIELDS(DG_FIELD_NAME)};
+    dg_name_fields(hf, names, G_N_ELEMENTS(hf), filter);
+    proto_register_field_array(proto, hf, (int)G_N_ELEMENTS(hf));
+    register_cleanup_routine(capture_cleanup);
+    cycles_filter = filter;
+    static stat_tap_ui ui = {REGISTER_STAT_GROUP_GENERIC, NULL, NULL, cycles_cli_init, 0, NULL};
+    ui.cli_string = g_strdup_printf("%s,cycles", filter);
+    register_stat_tap_ui(&ui, NULL);
+    /* Statistics > "EtherCAT cycles" in Wireshark (tshark -2 -z ecatr.cycles,tree) */
+    stats_tree_register_plugin("frame", g_strdup_printf("%s.cycles", filter),
+                               g_strdup_printf("%s cycles", proto_get_protocol_short_name(find_protocol_by_id(proto))),
+                               0, st_packet, st_init, NULL);
+}
+
+} /* namespace dg_ecat */
