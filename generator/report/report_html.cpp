@@ -64,7 +64,7 @@ std::vector<int64_t> values_of(const std::vector<TimedValue>& series) {
     return v;
 }
 
-// Jitter histogram: [[bin centre µs, count], ...].
+// Jitter histogram: [[bin's lower edge µs, count], ...].
 std::string histogram_json(const std::vector<TimedValue>& series) {
     if (series.empty()) return "[]";
     int64_t lo = series.front().ns, hi = lo;
@@ -72,10 +72,13 @@ std::string histogram_json(const std::vector<TimedValue>& series) {
     int64_t width = std::max<int64_t>(1, (hi - lo) / static_cast<int64_t>(kHistogramBins) + 1);
     std::vector<uint64_t> counts(static_cast<size_t>((hi - lo) / width + 1));
     for (const TimedValue& p : series) counts[static_cast<size_t>((p.ns - lo) / width)]++;
+    // A step plot draws a bin from its x to the next one's: each bin at its
+    // lower edge, and an empty one after the last to close it.
     std::string out = "[";
-    for (size_t i = 0; i < counts.size(); ++i) {
-        double centre = static_cast<double>(lo + static_cast<int64_t>(i) * width) + static_cast<double>(width) / 2;
-        out += (i ? "," : "") + std::string("[") + num(centre / 1000.0) + "," + std::to_string(counts[i]) + "]";
+    for (size_t i = 0; i <= counts.size(); ++i) {
+        double edge = static_cast<double>(lo + static_cast<int64_t>(i) * width);
+        out += (i ? "," : "") + std::string("[") + num(edge / 1000.0) + "," +
+               std::to_string(i < counts.size() ? counts[i] : 0) + "]";
     }
     return out + "]";
 }
@@ -134,7 +137,7 @@ const char kScript[] = R"JS(
   const stateNames = {1: 'INIT', 2: 'PREOP', 3: 'BOOT', 4: 'SAFEOP', 8: 'OP'};
   const stateLevel = {1: 1, 2: 2, 3: 2.5, 4: 3, 8: 4};
   const common = {customBars: true, legend: 'follow', labelsSeparateLines: true,
-                  xlabel: 'Capture time (s)', animatedZooms: false};
+                  xlabel: 'Capture time (s)', animatedZooms: false, axes: {y: {axisLabelWidth: 64}}};
   function bars(series) { return series.map(p => [p[0], p[1]]); }
   function chart(id, rows, options) {
     const el = document.getElementById(id);
@@ -147,8 +150,8 @@ const char kScript[] = R"JS(
           Object.assign({labels: ['t', 'Period (µs)'], ylabel: 'Period (µs)',
                          title: 'Cycle ' + c.number + ': period over time'}, common));
     chart('jitter-' + c.number, c.histogram,
-          {labels: ['Jitter (µs)', 'Frames'], stepPlot: true, fillGraph: true, xlabel: 'Jitter (µs)',
-           ylabel: 'Frames', title: 'Cycle ' + c.number + ': jitter histogram'});
+          {labels: ['Jitter (µs)', 'Frames'], stepPlot: true, fillGraph: true, xRangePad: 12, xlabel: 'Jitter (µs)',
+           ylabel: 'Frames', title: 'Cycle ' + c.number + ': jitter histogram', axes: {y: {axisLabelWidth: 64}}});
   });
   // Round trips with the lost frames and working-counter errors as marks on top.
   const top = data.round_trip.reduce((m, p) => Math.max(m, p[1][2]), 0) * 1.05 || 1;
