@@ -357,16 +357,19 @@ int cmd_report(const std::string& capture, const std::string& out_path, std::str
         }
     } cleanup{plugin_root};
 
-    std::vector<std::string> fields = TimingModelBuilder::timing_fields(known_fields(stream));
+    std::vector<std::string> known = known_fields(stream);
+    std::vector<std::string> fields = TimingModelBuilder::timing_fields(known);
     if (std::find(fields.begin(), fields.end(), "ecatr.time") == fields.end()) {
         std::cerr << "dissgen: report: " << stream.tshark << " has no EtherCAT plugin of dissgen (no field ecatr.time): "
                      "install it first, e.g. dissgen install rules/ethercat.xml\n";
         return 1;
     }
     stream.fields = fields;
+    stream.extra_args = TimingModelBuilder::statistics_args(known);
     TimingModel model;
     model.capture = capture;
     TimingModelBuilder builder(fields, model);
+    stream.on_other_line = [&](std::string_view line) { builder.add_statistics_line(line); };
     std::string error = read_capture(stream, capture, [&](const FieldRow& row) { builder.add(row); });
     if (!error.empty()) {
         std::cerr << "dissgen: report: " << error << "\n";

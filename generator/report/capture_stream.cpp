@@ -151,13 +151,12 @@ std::vector<std::string> known_fields(const CaptureStream& stream) {
 
 std::string read_capture(const CaptureStream& stream, const std::string& capture,
                          const std::function<void(const FieldRow&)>& on_row) {
-    std::vector<std::string> argv{stream.tshark, "-n", "-r", capture, "-T", "fields",
-                                  "-E", "occurrence=a", "-E", std::string("aggregator=") + kValueSeparator};
+    // One custom column per field, unresolved ("0x0130", not its name), every occurrence.
+    std::string columns;
+    for (size_t i = 0; i < stream.fields.size(); ++i)
+        columns += (i ? "," : "") + std::string("\"f") + std::to_string(i) + "\",\"%Cus:" + stream.fields[i] + ":0:U\"";
+    std::vector<std::string> argv{stream.tshark, "-n", "-r", capture, "-T", "tabs", "-o", "gui.column.format:" + columns};
     argv.insert(argv.end(), stream.extra_args.begin(), stream.extra_args.end());
-    for (const std::string& f : stream.fields) {
-        argv.push_back("-e");
-        argv.push_back(f);
-    }
     Child child = spawn(argv, stream);
     if (child.pid < 0) return "cannot start " + stream.tshark + ": " + std::strerror(errno);
     FILE* in = fdopen(child.out, "r");
@@ -171,8 +170,12 @@ std::string read_capture(const CaptureStream& stream, const std::string& capture
         std::string_view l(line, static_cast<size_t>(len));
         if (!l.empty() && l.back() == '\n') l.remove_suffix(1);
         split_row(l, row);
-        if (row.size() == stream.fields.size()) on_row(row);
-        progress.frame();
+        if (row.size() == stream.fields.size()) {
+            on_row(row);
+            progress.frame();
+        } else if (stream.on_other_line) {
+            stream.on_other_line(l);
+        }
         if (err.size() < 65536) drain(child.err, err);
     }
     free(line);

@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Reads a capture through tshark, one row of field values per frame
-// (`tshark -T fields`), as it decodes: the report sees exactly the numbers
-// the installed plugin shows, and memory does not grow with the capture.
+// Reads a capture through tshark, one row of field values per frame, as it
+// decodes: the report sees exactly the numbers the installed plugin shows,
+// and memory does not grow with the capture. The fields are custom columns
+// of summary lines (`-T tabs`, unresolved values): tshark then builds only
+// the items they name, where `-T fields` builds every frame's whole tree
+// (twice the time in Wireshark 4.0).
 #pragma once
 
 #include <functional>
@@ -13,15 +16,16 @@ namespace dissgen {
 
 // One frame's values, in the order the fields were asked for. A field that
 // occurs several times in the frame holds its values joined by kValueSeparator
-// (a control character, so that names and messages may hold commas); a field
-// the frame lacks is empty.
-constexpr char kValueSeparator = '\x1f';
+// (a column's: a text value may hold one too); a field the frame lacks is
+// empty, an item without a value (FT_NONE) shows as a check mark.
+constexpr char kValueSeparator = ',';
 using FieldRow = std::vector<std::string_view>;
 
 struct CaptureStream {
     std::string tshark = "tshark";       // $DISSGEN_TSHARK, else from PATH
     std::vector<std::string> fields;     // display-filter names
-    std::vector<std::string> extra_args; // e.g. -o preferences
+    std::vector<std::string> extra_args; // e.g. -z statistics, printed after the rows
+    std::function<void(std::string_view)> on_other_line;  // lines that are not rows (statistics)
     std::vector<std::pair<std::string, std::string>> environment;  // added to tshark's environment
 };
 

@@ -285,7 +285,10 @@ std::string write_report_html(const TimingModel& m, const std::string& tool_vers
     else {
         out << "<ul id=\"network\">\n";
         for (const std::string& f : m.network) out << "<li>" << escape_html(f) << "</li>\n";
-        out << "</ul>\n";
+        out << "</ul>\n<p class=\"note\">In frame";
+        if (m.network_frames.size() > 1) out << "s";
+        for (size_t i = 0; i < m.network_frames.size(); ++i) out << (i ? ", " : " ") << m.network_frames[i];
+        out << ".</p>\n";
     }
 
     // The data the charts draw.

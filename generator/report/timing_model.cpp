@@ -18,8 +18,8 @@ const char* const kTimingFields[] = {
     "ecatr.request_in",      "ecatr.no_response_to",    "ecatr.expert.wkc",
     "ecatr.slave.position",  "ecatr.slave.name",        "ecatr.datagram.reg.alstatus.status",
     "ecatr.expert.network.ok", "ecatr.expert.network.count", "ecatr.expert.network.model",
-    "_ws.expert.message",
 };
+const char kNetworkExperts[] = "ecatr.expert.network.ok || ecatr.expert.network.count || ecatr.expert.network.model";
 
 // base 0: "0x0130" as tshark prints hexadecimal fields, "12" as decimal ones.
 bool parse_uint(std::string_view text, uint64_t& value, int base = 0) {
@@ -124,6 +124,26 @@ std::vector<std::string> TimingModelBuilder::timing_fields(const std::vector<std
     return fields;
 }
 
+std::vector<std::string> TimingModelBuilder::statistics_args(const std::vector<std::string>& known) {
+    if (std::find(known.begin(), known.end(), "ecatr.expert.network.ok") == known.end()) return {};
+    return {"-z", std::string("expert,chat,") + kNetworkExperts};
+}
+
+// "           1   Protocol              ECATR  The bus matches the design: ..."
+// (frequency, group, protocol, summary): the network check's summaries.
+void TimingModelBuilder::add_statistics_line(std::string_view line) {
+    if (line.find("design") == std::string_view::npos) return;
+    size_t at = 0;
+    for (int token = 0; token < 3; ++token) {
+        at = line.find_first_not_of(' ', at);
+        if (at == std::string_view::npos) return;
+        at = line.find(' ', at);
+        if (at == std::string_view::npos) return;
+    }
+    at = line.find_first_not_of(' ', at);
+    if (at != std::string_view::npos) model_.network.emplace_back(line.substr(at));
+}
+
 TimingModelBuilder::TimingModelBuilder(const std::vector<std::string>& fields, TimingModel& model) : model_(model) {
     for (size_t i = 0; i < fields.size(); ++i) columns_[fields[i]] = static_cast<int>(i);
     model_.has_cycle_fields = column("ecatr.cycle") >= 0;
@@ -167,12 +187,7 @@ void TimingModelBuilder::add(const FieldRow& row) {
     const char* network[] = {"ecatr.expert.network.ok", "ecatr.expert.network.count", "ecatr.expert.network.model"};
     bool network_finding = false;
     for (const char* f : network) network_finding |= !value(row, column(f)).empty();
-    if (network_finding) {
-        // The frame's expert messages; keep those of the network check.
-        for (std::string_view m : split_values(value(row, column("_ws.expert.message"))))
-            if (m.find("design") != std::string_view::npos)
-                model_.network.push_back("frame " + std::to_string(frame) + ": " + std::string(m));
-    }
+    if (network_finding) model_.network_frames.push_back(static_cast<uint32_t>(frame));
 }
 
 // The frame's datagrams in the words of -z ecatr,cycles:

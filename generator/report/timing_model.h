@@ -68,7 +68,8 @@ struct TimingModel {
     std::vector<TimedValue> round_trip;  // every return, cycle or not
     std::vector<Event> lost, wkc_errors;  // ecatr.no_response_to, ecatr.expert.wkc
     std::map<unsigned, SlaveTimeline> slaves;  // by position
-    std::vector<std::string> network;          // the network check's findings, in order
+    std::vector<std::string> network;          // the network check's findings (the expert infos' texts)
+    std::vector<uint32_t> network_frames;      // the frames that carry them
     bool has_cycle_fields = false;             // the plugin shows ecatr.cycle
 };
 
@@ -78,8 +79,14 @@ public:
     // The fields to ask tshark for, among `known` (those the installed tshark has).
     static std::vector<std::string> timing_fields(const std::vector<std::string>& known);
 
+    // What else to ask tshark for: the network check's expert infos (-z expert),
+    // whose texts come after the rows.
+    static std::vector<std::string> statistics_args(const std::vector<std::string>& known);
+
     TimingModelBuilder(const std::vector<std::string>& fields, TimingModel& model);
     void add(const FieldRow& row);
+    // A line of the statistics after the rows.
+    void add_statistics_line(std::string_view line);
 
 private:
     int column(const char* field) const;

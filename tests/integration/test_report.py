@@ -259,13 +259,14 @@ class TestReport(TsharkTestCase, unittest.TestCase):
         generated(cls.capture, two_task_capture())
         os.chmod(cls.capture, 0o644)
 
-    def report(self, capture, name, check=True):
+    def report(self, capture, name, check=True, extra=(), environment=None):
         out = os.path.join(self.out, name + ".html")
-        cmd = [self.dissgen, "report", capture, "-o", out]
+        cmd = [self.dissgen, "report", capture, "-o", out] + list(extra)
         if self.env.as_nobody:
             cmd = ["setpriv", "--reuid=%d" % NOBODY, "--regid=%d" % NOBODY, "--clear-groups"] + cmd
         started = time.monotonic()
-        p = subprocess.run(cmd, env=self.env.env(), cwd=self.env.home, capture_output=True, text=True, timeout=1800)
+        p = subprocess.run(cmd, env=dict(self.env.env(), **(environment or {})), cwd=self.env.home,
+                           capture_output=True, text=True, timeout=1800)
         took = time.monotonic() - started
         if check and p.returncode != 0:
             self.fail("dissgen report %s: exit %d\n%s%s" % (name, p.returncode, p.stdout, p.stderr))
@@ -357,6 +358,34 @@ class TestReport(TsharkTestCase, unittest.TestCase):
             shutil.rmtree(bare["HOME"], ignore_errors=True)
             check(q.returncode == 1 and "dissgen install" in q.stderr,
                   "tshark without the plugin: exit 1, says how to install it (%d: %s)" % (q.returncode, q.stderr.strip()))
+
+    def test_with_a_catalogue_and_a_design(self):
+        """--esi and --network: a plugin built for the run names the slaves and checks the bus."""
+        source = os.path.abspath(ARGS.source_dir)
+        corpus = os.path.join(source, "..", "shared", "corpus")
+        capture = os.path.join(corpus, "ethercat", "soem-sdinfo-ek1100-el1004.pcapng")
+        if not os.path.exists(capture):
+            self.skipTest("no corpus at %s" % corpus)
+        if not self.env.as_nobody and os.geteuid() == 0:
+            self.skipTest("needs a user other than root")
+        # What dissgen reads as the tshark user: copies it can read.
+        runtime = self.env.path("runtime")
+        if not os.path.isdir(runtime):
+            shutil.copytree(os.path.join(source, "plugin_runtime"), runtime)
+            subprocess.run(["chmod", "-R", "a+rX", runtime], check=True)
+        esi = [self.env.readable(os.path.join(corpus, "esi", f)) for f in ("Beckhoff_EK11xx.xml", "Beckhoff_EL1xxx.xml")]
+        rules = self.env.readable(os.path.join(source, "rules", "ethercat.xml"))
+        design = self.env.readable(os.path.join(source, "tests", "network", "soem_design.xml"))
+        args = ["--rules", rules, "--network", design] + [a for f in esi for a in ("--esi", f)]
+        _p, page, took = self.report(self.env.readable(capture), "design", extra=args,
+                                     environment={"DISSGEN_RUNTIME_DIR": runtime})
+        with self.checks() as check:
+            check("<td>EK1100</td>" in page and "<td>EL1004</td>" in page,
+                  "the slaves named from the ESI files (%.1f s, the plugin's build included)" % took)
+            m = re.search(r'<ul id="network">(.*?)</ul>', page, re.S)
+            # The design has a third slave (an AKD drive) that the capture's bus lacks.
+            check(m is not None and "<li>design: 3 slaves, bus: 2</li>" in m.group(1),
+                  "the network check's finding, whole: %s" % (m.group(1).strip() if m else "none"))
 
     def test_corpus_reports_match_the_fields(self):
         corpus = ARGS.corpus or os.path.join(os.path.abspath(ARGS.source_dir), "..", "shared", "corpus", "ethercat")
