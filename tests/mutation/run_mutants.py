@@ -12,8 +12,10 @@ dissgen_runtime); the checkout itself is never touched.  Then for each mutant: t
 mutated file is written, the build is brought up to date (only what the file feeds),
 and the mutant's tests run in the order given until one fails: the mutant is KILLED.
 When all pass it SURVIVED.  A mutant whose snippet is not found exactly once, or that
-does not build, is INVALID (the code moved on: refresh the mutant).  Before a test
-first judges a mutant, it runs once on the unmutated copy and must pass.
+does not build, is INVALID (the code moved on: refresh the mutant).  A kill counts only
+if the killing test passes on the unmutated copy: the first time a test kills a mutant, it
+runs once there (the check stops when it fails).  --work DIR keeps the copy and its build
+for the next run.
 
 --budget SECONDS (CI: the whole check must fit its time limit) starts no mutant once
 that much time has gone; the mutants then run from a place in the list that the source
@@ -220,11 +222,20 @@ def run(cmd, cwd=None, timeout=None, log=None):
 
 
 def copy_tree(source, dest):
+    """Copy source into dest, without build*/ and .git; a file already there with the same
+    bytes is left alone (its time too), so that a kept build stays up to date."""
     def ignore(folder, names):
         if os.path.abspath(folder) == os.path.abspath(source):
             return [n for n in names if n.startswith("build") or n == ".git"]
         return [n for n in names if n == "__pycache__"]
-    shutil.copytree(source, dest, symlinks=True, ignore=ignore)
+
+    def copy_if_changed(a, b):
+        if os.path.isfile(b) and not os.path.islink(b):
+            with open(a, "rb") as x, open(b, "rb") as y:
+                if x.read() == y.read():
+                    return b
+        return shutil.copy2(a, b)
+    shutil.copytree(source, dest, symlinks=True, ignore=ignore, copy_function=copy_if_changed, dirs_exist_ok=True)
 
 
 def build(src, build_dir, jobs, log):
@@ -247,22 +258,26 @@ def tail(text, lines=15):
     return "\n".join("    " + l for l in text.strip().splitlines()[-lines:])
 
 
+def run_baseline(t, src, build_dir, jobs, log):
+    """Test t on the unmutated copy (rebuilt first): True when it passes."""
+    ok, _, out = build(src, build_dir, jobs, log)
+    status, secs, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log) \
+        if ok else (1, 0, out)
+    print("baseline %-13s %s (%.0fs)" % (t, "pass" if status == 0 else "FAIL", secs), flush=True)
+    if status != 0:
+        print("the unmutated tree fails '%s': fix that first\n%s" % (t, tail(out)))
+    return status == 0
+
+
 def judge(m, src, build_dir, jobs, log, originals, baselined, no_baseline=False):
     """Plant mutant m in the copy, rebuild, run its tests; the copy is restored after.
-    Returns (verdict, detail), or None when a test fails on the unmutated copy."""
+    Returns (verdict, detail), or None when a test fails on the unmutated copy.
+
+    A test judges a mutant only if it passes on the unmutated copy: the test that killed
+    a mutant is run there once (the first time it kills one), after the copy is restored.
+    A mutant that passed every test survived whatever those tests do unmutated."""
     if getattr(m, "equivalent", None) is not None:
         return "EQUIV", "not run (equivalent.txt): " + m.equivalent
-    for t in m.tests:   # the tree is unmutated here: the test must pass on it first
-        if t in baselined or no_baseline:
-            continue
-        ok, _, out = build(src, build_dir, jobs, log)
-        status, secs, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log) \
-            if ok else (1, 0, out)
-        print("baseline %-13s %s (%.0fs)" % (t, "pass" if status == 0 else "FAIL", secs), flush=True)
-        if status != 0:
-            print("the unmutated tree fails '%s': fix that first\n%s" % (t, tail(out)))
-            return None
-        baselined.add(t)
     if m.problem:
         return "INVALID", m.problem
     path = os.path.join(src, m.file)
@@ -276,6 +291,7 @@ def judge(m, src, build_dir, jobs, log, originals, baselined, no_baseline=False)
         return "INVALID", str(e)
     with open(path, "w", encoding="utf-8") as fh:
         fh.write(mutated)
+    killer = None
     try:
         ok, _, out = build(src, build_dir, jobs, log)
         if not ok:
@@ -283,11 +299,18 @@ def judge(m, src, build_dir, jobs, log, originals, baselined, no_baseline=False)
         for t in m.tests:
             status, _, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log)
             if status != 0:
-                return "KILLED", "by " + t
-        return "SURVIVED", "passed: " + " ".join(m.tests)
+                killer = t
+                break
+        if killer is None:
+            return "SURVIVED", "passed: " + " ".join(m.tests)
     finally:
         with open(path, "w", encoding="utf-8") as fh:
             fh.write(originals[m.file])
+    if killer not in baselined and not no_baseline:
+        if not run_baseline(killer, src, build_dir, jobs, log):
+            return None
+        baselined.add(killer)
+    return "KILLED", "by " + killer
 
 
 def pick_window(spec, count, source_dir):
@@ -309,6 +332,8 @@ def main(argv=None):
     ap.add_argument("--only", nargs="*", help="mutant names (file names without .mut, or systematic ids) to run")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--keep", action="store_true", help="keep the temporary copy (and its log)")
+    ap.add_argument("--work", metavar="DIR", help="copy and build in DIR and keep them (a later run with the same "
+                    "DIR rewrites only the files that changed, and rebuilds only what they feed)")
     ap.add_argument("--list", action="store_true", help="list the mutants and their tests, run nothing")
     ap.add_argument("--check", action="store_true", help="only check that every mutant still applies")
     ap.add_argument("--no-baseline", action="store_true", help="skip the run on the unmutated copy")
@@ -388,7 +413,8 @@ def main(argv=None):
         return SKIP_CODE
 
     t0 = time.monotonic()
-    work = tempfile.mkdtemp(prefix="dissgen-mutation-")
+    work = os.path.abspath(args.work) if args.work else tempfile.mkdtemp(prefix="dissgen-mutation-")
+    os.makedirs(work, exist_ok=True)
     src, build_dir, log = os.path.join(work, "src"), os.path.join(work, "build"), os.path.join(work, "log.txt")
     print("mutation check: %d mutants%s, copy and log in %s" % (
         len(mutants), " and %d systematic ones" % len(extra) if extra else "", work), flush=True)
@@ -397,7 +423,7 @@ def main(argv=None):
         copy_tree(os.path.abspath(args.source_dir), src)
         # Corpus tests look for ../shared/corpus beside the source tree: the copy gets the same.
         shared = os.path.join(os.path.abspath(args.source_dir), "..", "shared")
-        if os.path.isdir(shared):
+        if os.path.isdir(shared) and not os.path.lexists(os.path.join(work, "shared")):
             os.symlink(os.path.realpath(shared), os.path.join(work, "shared"))
         status, secs, out = run(["cmake", "-S", src, "-B", build_dir, "-DCMAKE_BUILD_TYPE=RelWithDebInfo"], log=log)
         ok, bsecs, bout = build(src, build_dir, args.jobs, log) if status == 0 else (False, 0, out)
@@ -428,7 +454,7 @@ def main(argv=None):
             results.append((m, verdict))
             print("%-8s %-34s %s (%.0fs)" % (verdict, m.name, detail, time.monotonic() - start), flush=True)
     finally:
-        if not args.keep:
+        if not args.keep and not args.work:
             shutil.rmtree(work, ignore_errors=True)
 
     killed = sum(1 for _, v in results if v == "KILLED")
