@@ -372,6 +372,15 @@ def pdo_checks(check, dissgen, source_dir, design=True):
     yes = {"1", "True"}
     no = {"0", "False"}
     lrw = len(frames) - 1   # the LRW as sent, then returned
+    if design:
+        # The same LRW sent with its working counter already at 4 (a frame the master passes
+        # on): the slaves add 3 (met), then 2 (one short). What counts is what they added.
+        for k, back_wkc in enumerate((7, 6)):
+            i = len(steps) + k
+            frames.append(pg.Frame([pg.Datagram(12, idx=i, lad=0x10000, data=bytes(1) + outputs, wkc=4)],
+                                   src_mac=master))
+            frames.append(pg.Frame([pg.Datagram(12, idx=i, lad=0x10000, data=bytes([inputs]) + outputs,
+                                                wkc=back_wkc)], src_mac=back))
     if not design:
         fields = fields[:6]
     with TsharkEnv() as env:
@@ -395,6 +404,11 @@ def pdo_checks(check, dissgen, source_dir, design=True):
             if design:
                 check(sent["ecatr.wkc.expected"] == ["3"] and ret["ecatr.wkc.expected"] == ["3"] and
                       not ret["ecatr.expert.wkc"], "expected working counter 3 (EL1004 +1, EL2004 +2), met" + tag)
+                met, short = rows[lrw + 3], rows[lrw + 5]
+                check(not met["ecatr.expert.wkc"] and len(short["ecatr.expert.wkc"]) == 1,
+                      "sent with working counter 4: returned 7 is met, 6 is one short (the slaves' additions "
+                      "count, not the returned counter)%s: %s, %s" % (tag, met["ecatr.expert.wkc"],
+                                                                      short["ecatr.expert.wkc"]))
             else:
                 tree = env.tshark(["-r", path, "-V"] + (["-2"] if two_pass else [])).stdout.split("\nFrame ")
                 titles = [re.findall(r"\[(EL\d+ \(position \d\): \w+)\]", tree[k - 1]) for k in (lrw, lrw + 1)]
