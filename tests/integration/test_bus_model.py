@@ -554,6 +554,11 @@ def coe_checks(check, dissgen, source_dir, shared):
     complete = [(sdo_complete_access(0x1A02, [0x60000101, 0x00000007], 4), 1),
                 (sdo_complete_access(0x1C13, [0x1A02, 0x1A13], 2), 1)]
 
+    # (b') the same with a complete access of no bytes to 0x1A02 between: nothing to learn
+    # from it (it neither empties 0x1A02 nor completes it).
+    complete_empty = [complete[0], (coe_mailbox(2, struct.pack("<BHBI", 0x21 | 0x10, 0x1A02, 0, 0)), 1),
+                      complete[1]]
+
     def after_complete(data):
         return {ch1: [bits_of(data, 0, 1)], latch[0]: [data[1]], latch[1]: [data[2]],
                 latch[2]: [bits_of(data, 24, 64)], latch[3]: [bits_of(data, 88, 64)]}
@@ -601,6 +606,7 @@ def coe_checks(check, dissgen, source_dir, shared):
         for case, steps, want, want_middle, same_frame in (
                 ("one subindex at a time", expedited, after_expedited, middle_expedited, False),
                 ("complete access", complete, after_complete, None, True),
+                ("complete access of no bytes between", complete_empty, after_complete, None, True),
                 ("an upload answered", upload, after_upload, None, False),
                 ("odd traffic", odd, after_odd, None, False),
                 ("no configuration", [], defaults, None, False)):
