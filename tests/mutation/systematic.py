@@ -92,7 +92,7 @@ TESTS_BY_FILE = {
     "generator/build_plugin.cpp": ["loading", "plugin_contents", "everything"],
     "generator/wireshark_env.cpp": ["loading", "everything"],
     "generator/main.cpp": ["unit", "loading", "everything", "plugin_contents"],
-    "generator/ethercat/": ["esi", "bus_tables", "bus_pdo"],
+    "generator/ethercat/": ["esi", "bus_tables", "bus_pdo", "bus_coe"],
     "generator/": ["unit", "rules_err", "widths", "everything"],
     "plugin_runtime/": ["widths", "everything", "layout"],
 }
