@@ -358,6 +358,9 @@ def pdo_checks(check, dissgen, source_dir, design=True):
     ]
     if not design:
         steps += sii_reads(0x1002, 2, 0x03EC3052, 0x00130000) + sii_reads(0x1003, 2, 0x07D43052, 0x00100000)
+        # position 3: a product the ESI file does not have (its datagrams name no model)
+        steps += [(pg.Datagram(2, adp=0xFFFD, ado=0x0010, data=struct.pack("<H", 0x1004)), None, 1)]
+        steps += sii_reads(0x1004, 2, 0x0BADC0DE, 0x00100000)
     steps.append((pg.Datagram(12, lad=0x10000, data=bytes(1) + outputs), bytes([inputs]) + outputs, 3))
     frames = []
     for i, (d, data, wkc) in enumerate(steps):
@@ -414,6 +417,10 @@ def pdo_checks(check, dissgen, source_dir, design=True):
                 titles = [re.findall(r"\[(EL\d+ \(position \d\): \w+)\]", tree[k - 1]) for k in (lrw, lrw + 1)]
                 check(titles == [["EL2004 (position 2): outputs"], ["EL1004 (position 1): inputs"]],
                       "subtrees named by the model and position the SII gave%s: %s" % (tag, titles))
+                unknown = sorted(set(re.findall(r"Slave at position 3[^\]\n]*", "\n".join(tree))))
+                check(unknown == ["Slave at position 3"],
+                      "the slave whose product the ESI file lacks is named by its position only%s: %s" % (
+                          tag, unknown))
 
 
 # ----------------------------------------------------------------------------- CoE PDO configuration
