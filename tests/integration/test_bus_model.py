@@ -300,6 +300,11 @@ def stats_checks(check, env, corpus):
         check({p: v.get("Datagrams") for p, v in one.items()} == counts,
               "%s: per-slave datagram counts are those of the returned frames' ecatr.slave.position (%s)"
               % (name, counts))
+        mailbox = {p: v.get("Mailbox datagrams", 0) for p, v in one.items()}
+        check(all(mailbox[p] <= v.get("Datagrams", 0) for p, v in one.items()),
+              "%s: mailbox datagrams per slave, each at most its datagrams (%s)" % (name, mailbox))
+        if name == "replay-mailbox-el6910.pcapng":
+            check(sum(mailbox.values()) > 0, "%s: a capture of mailbox exchanges counts mailbox datagrams" % name)
 
 
 def eni_checks(check, dissgen, rules, shared):
