@@ -80,7 +80,7 @@ TESTS_BY_FILE = {
     "generator/validator.cpp": ["rules_err", "unit", "widths", "everything"],
     "generator/quiet.cpp": ["unit", "quiet"],
     "generator/expression.cpp": ["unit", "rules_err", "computed"],
-    "generator/emit_cpp.cpp": ["field_types", "widths", "everything", "layout"],
+    "generator/emit_cpp.cpp": ["field_types", "widths", "everything", "typed_values", "computed", "layout"],
     "generator/emit_validity.cpp": ["validity_unit", "validity"],
     "generator/parser.cpp": ["unit", "rules_err", "widths", "everything"],
     "generator/xml_input.cpp": ["unit", "rules_err", "esi"],
