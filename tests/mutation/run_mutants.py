@@ -348,7 +348,8 @@ def main(argv=None):
     ap.add_argument("--window", metavar="K/N",
                     help="every N-th mutant from the K-th (in name order); K 'commit': the commit picks it")
     ap.add_argument("--extra-systematic", type=int, default=0, metavar="N",
-                    help="after the hand-written mutants, N systematic ones (a window the commit picks)")
+                    help="after the hand-written mutants, N systematic ones (a window the commit picks); "
+                         "their survivors are reported, not failed")
     ap.add_argument("--extra-budget", type=float, default=300, metavar="SECONDS",
                     help="start no extra systematic mutant after this many more seconds")
     args = ap.parse_args(argv)
@@ -444,7 +445,7 @@ def main(argv=None):
                     not_run += [x for x in extra if x not in [r[0] for r in results]]
                     break
             elif args.budget and time.monotonic() - t0 > args.budget:
-                not_run += mutants[i:]
+                not_run.append(m)
                 continue
             start = time.monotonic()
             outcome = judge(m, src, build_dir, args.jobs, log, originals, baselined, args.no_baseline)
@@ -474,7 +475,12 @@ def main(argv=None):
         print("not run within the budget (%d): %s" % (len(not_run), " ".join(m.name for m in not_run)))
     # Generated mutants that do not compile are killed by the compiler: only hand-written ones
     # must apply and build.
-    bad = [m for m, v in results if v == "SURVIVED" or (v == "INVALID" and not isinstance(m, systematic.SiteMutant))]
+    # The CI window of systematic mutants (--extra-systematic) reports its survivors without
+    # failing the check: most generated sites are not triaged yet (tests/mutation/README.md).
+    bad = [m for m, v in results if m not in extra and
+           (v == "SURVIVED" or (v == "INVALID" and not isinstance(m, systematic.SiteMutant)))]
+    if any(v == "SURVIVED" for m, v in results if m in extra):
+        print("systematic survivors above: triage them (a test, or a line in equivalent.txt)")
     return 0 if judged and not bad else 1
 
 
