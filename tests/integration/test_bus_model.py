@@ -300,6 +300,11 @@ def stats_checks(check, env, corpus):
         check({p: v.get("Datagrams") for p, v in one.items()} == counts,
               "%s: per-slave datagram counts are those of the returned frames' ecatr.slave.position (%s)"
               % (name, counts))
+        mailbox = {p: v.get("Mailbox datagrams", 0) for p, v in one.items()}
+        check(all(mailbox[p] <= v.get("Datagrams", 0) for p, v in one.items()),
+              "%s: mailbox datagrams per slave, each at most its datagrams (%s)" % (name, mailbox))
+        if name == "replay-mailbox-el6910.pcapng":
+            check(sum(mailbox.values()) > 0, "%s: a capture of mailbox exchanges counts mailbox datagrams" % name)
 
 
 def eni_checks(check, dissgen, rules, shared):
@@ -358,6 +363,9 @@ def pdo_checks(check, dissgen, source_dir, design=True):
     ]
     if not design:
         steps += sii_reads(0x1002, 2, 0x03EC3052, 0x00130000) + sii_reads(0x1003, 2, 0x07D43052, 0x00100000)
+        # position 3: a product the ESI file does not have (its datagrams name no model)
+        steps += [(pg.Datagram(2, adp=0xFFFD, ado=0x0010, data=struct.pack("<H", 0x1004)), None, 1)]
+        steps += sii_reads(0x1004, 2, 0x0BADC0DE, 0x00100000)
     steps.append((pg.Datagram(12, lad=0x10000, data=bytes(1) + outputs), bytes([inputs]) + outputs, 3))
     frames = []
     for i, (d, data, wkc) in enumerate(steps):
@@ -372,6 +380,15 @@ def pdo_checks(check, dissgen, source_dir, design=True):
     yes = {"1", "True"}
     no = {"0", "False"}
     lrw = len(frames) - 1   # the LRW as sent, then returned
+    if design:
+        # The same LRW sent with its working counter already at 4 (a frame the master passes
+        # on): the slaves add 3 (met), then 2 (one short). What counts is what they added.
+        for k, back_wkc in enumerate((7, 6)):
+            i = len(steps) + k
+            frames.append(pg.Frame([pg.Datagram(12, idx=i, lad=0x10000, data=bytes(1) + outputs, wkc=4)],
+                                   src_mac=master))
+            frames.append(pg.Frame([pg.Datagram(12, idx=i, lad=0x10000, data=bytes([inputs]) + outputs,
+                                                wkc=back_wkc)], src_mac=back))
     if not design:
         fields = fields[:6]
     with TsharkEnv() as env:
@@ -395,11 +412,20 @@ def pdo_checks(check, dissgen, source_dir, design=True):
             if design:
                 check(sent["ecatr.wkc.expected"] == ["3"] and ret["ecatr.wkc.expected"] == ["3"] and
                       not ret["ecatr.expert.wkc"], "expected working counter 3 (EL1004 +1, EL2004 +2), met" + tag)
+                met, short = rows[lrw + 3], rows[lrw + 5]
+                check(not met["ecatr.expert.wkc"] and len(short["ecatr.expert.wkc"]) == 1,
+                      "sent with working counter 4: returned 7 is met, 6 is one short (the slaves' additions "
+                      "count, not the returned counter)%s: %s, %s" % (tag, met["ecatr.expert.wkc"],
+                                                                      short["ecatr.expert.wkc"]))
             else:
                 tree = env.tshark(["-r", path, "-V"] + (["-2"] if two_pass else [])).stdout.split("\nFrame ")
                 titles = [re.findall(r"\[(EL\d+ \(position \d\): \w+)\]", tree[k - 1]) for k in (lrw, lrw + 1)]
                 check(titles == [["EL2004 (position 2): outputs"], ["EL1004 (position 1): inputs"]],
                       "subtrees named by the model and position the SII gave%s: %s" % (tag, titles))
+                unknown = sorted(set(re.findall(r"Slave at position 3[^\]\n]*", "\n".join(tree))))
+                check(unknown == ["Slave at position 3"],
+                      "the slave whose product the ESI file lacks is named by its position only%s: %s" % (
+                          tag, unknown))
 
 
 # ----------------------------------------------------------------------------- CoE PDO configuration
@@ -540,6 +566,11 @@ def coe_checks(check, dissgen, source_dir, shared):
     complete = [(sdo_complete_access(0x1A02, [0x60000101, 0x00000007], 4), 1),
                 (sdo_complete_access(0x1C13, [0x1A02, 0x1A13], 2), 1)]
 
+    # (b') the same with a complete access of no bytes to 0x1A02 between: nothing to learn
+    # from it (it neither empties 0x1A02 nor completes it).
+    complete_empty = [complete[0], (coe_mailbox(2, struct.pack("<BHBI", 0x21 | 0x10, 0x1A02, 0, 0)), 1),
+                      complete[1]]
+
     def after_complete(data):
         return {ch1: [bits_of(data, 0, 1)], latch[0]: [data[1]], latch[1]: [data[2]],
                 latch[2]: [bits_of(data, 24, 64)], latch[3]: [bits_of(data, 88, 64)]}
@@ -587,6 +618,7 @@ def coe_checks(check, dissgen, source_dir, shared):
         for case, steps, want, want_middle, same_frame in (
                 ("one subindex at a time", expedited, after_expedited, middle_expedited, False),
                 ("complete access", complete, after_complete, None, True),
+                ("complete access of no bytes between", complete_empty, after_complete, None, True),
                 ("an upload answered", upload, after_upload, None, False),
                 ("odd traffic", odd, after_odd, None, False),
                 ("no configuration", [], defaults, None, False)):

@@ -14,6 +14,7 @@ rqc.expert.no_request_context once, and raises no malformed expert. Needs no cor
 """
 
 import os
+import re
 import random
 import struct
 import sys
@@ -197,6 +198,16 @@ class TestRequestContext(TsharkTestCase, unittest.TestCase):
         with self.checks() as check:
             check("The request of this response is not in the capture" in out,
                   "the expert info says why the values are missing")
+            # Where it sits: at the start of the message, covering no byte (the whole
+            # message, not one of its fields, lacks its request).
+            pdml = self.env.tshark(["-r", self.orphan_path, "-T", "pdml", "-c", "3"]).stdout
+            starts = re.findall(r'<proto name="rqc"[^>]*\bpos="(\d+)"', pdml)
+            experts = re.findall(r'<field name="_ws\.expert" showname="[^"]*The request of this response is not '
+                                 r'in the capture[^>]*>', pdml)
+            places = [(re.search(r'\bpos="(\d+)"', e).group(1), re.search(r'\bsize="(\d+)"', e).group(1))
+                      for e in experts]
+            check(len(starts) == 3 and places == [(p, "0") for p in starts],
+                  "the expert info is at the message's start (%s), 0 bytes long: %s" % (starts, places))
 
 
 class TestRequestContextDecodedKeys(TestRequestContext):

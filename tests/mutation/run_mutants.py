@@ -12,8 +12,10 @@ dissgen_runtime); the checkout itself is never touched.  Then for each mutant: t
 mutated file is written, the build is brought up to date (only what the file feeds),
 and the mutant's tests run in the order given until one fails: the mutant is KILLED.
 When all pass it SURVIVED.  A mutant whose snippet is not found exactly once, or that
-does not build, is INVALID (the code moved on: refresh the mutant).  Before a test
-first judges a mutant, it runs once on the unmutated copy and must pass.
+does not build, is INVALID (the code moved on: refresh the mutant).  A kill counts only
+if the killing test passes on the unmutated copy: the first time a test kills a mutant, it
+runs once there (the check stops when it fails).  --work DIR keeps the copy and its build
+for the next run.
 
 --budget SECONDS (CI: the whole check must fit its time limit) starts no mutant once
 that much time has gone; the mutants then run from a place in the list that the source
@@ -34,6 +36,9 @@ import subprocess
 import sys
 import tempfile
 import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import systematic  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SKIP_CODE = 77
@@ -220,11 +225,20 @@ def run(cmd, cwd=None, timeout=None, log=None):
 
 
 def copy_tree(source, dest):
+    """Copy source into dest, without build*/ and .git; a file already there with the same
+    bytes is left alone (its time too), so that a kept build stays up to date."""
     def ignore(folder, names):
         if os.path.abspath(folder) == os.path.abspath(source):
             return [n for n in names if n.startswith("build") or n == ".git"]
         return [n for n in names if n == "__pycache__"]
-    shutil.copytree(source, dest, symlinks=True, ignore=ignore)
+
+    def copy_if_changed(a, b):
+        if os.path.isfile(b) and not os.path.islink(b):
+            with open(a, "rb") as x, open(b, "rb") as y:
+                if x.read() == y.read():
+                    return b
+        return shutil.copy2(a, b)
+    shutil.copytree(source, dest, symlinks=True, ignore=ignore, copy_function=copy_if_changed, dirs_exist_ok=True)
 
 
 def build(src, build_dir, jobs, log):
@@ -247,13 +261,82 @@ def tail(text, lines=15):
     return "\n".join("    " + l for l in text.strip().splitlines()[-lines:])
 
 
+def run_baseline(t, src, build_dir, jobs, log):
+    """Test t on the unmutated copy (rebuilt first): True when it passes."""
+    ok, _, out = build(src, build_dir, jobs, log)
+    status, secs, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log) \
+        if ok else (1, 0, out)
+    print("baseline %-13s %s (%.0fs)" % (t, "pass" if status == 0 else "FAIL", secs), flush=True)
+    if status != 0:
+        print("the unmutated tree fails '%s': fix that first\n%s" % (t, tail(out)))
+    return status == 0
+
+
+def judge(m, src, build_dir, jobs, log, originals, baselined, no_baseline=False):
+    """Plant mutant m in the copy, rebuild, run its tests; the copy is restored after.
+    Returns (verdict, detail), or None when a test fails on the unmutated copy.
+
+    A test judges a mutant only if it passes on the unmutated copy: the test that killed
+    a mutant is run there once (the first time it kills one), after the copy is restored.
+    A mutant that passed every test survived whatever those tests do unmutated."""
+    if getattr(m, "equivalent", None) is not None:
+        return "EQUIV", "not run (equivalent.txt): " + m.equivalent
+    if m.problem:
+        return "INVALID", m.problem
+    path = os.path.join(src, m.file)
+    if m.file not in originals:
+        originals[m.file] = open(path, encoding="utf-8").read() if os.path.isfile(path) else None
+    if originals[m.file] is None:
+        return "INVALID", "no file %s: refresh the mutant" % m.file
+    try:
+        mutated = m.mutate(originals[m.file])
+    except ValueError as e:
+        return "INVALID", str(e)
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write(mutated)
+    killer = None
+    try:
+        ok, _, out = build(src, build_dir, jobs, log)
+        if not ok:
+            return "INVALID", "does not build: refresh the mutant\n" + tail(out)
+        for t in m.tests:
+            status, _, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log)
+            if status != 0:
+                killer = t
+                break
+        if killer is None:
+            return "SURVIVED", "passed: " + " ".join(m.tests)
+    finally:
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(originals[m.file])
+    if killer not in baselined and not no_baseline:
+        if not run_baseline(killer, src, build_dir, jobs, log):
+            return None
+        baselined.add(killer)
+    return "KILLED", "by " + killer
+
+
+def pick_window(spec, count, source_dir):
+    """--window K/N: (k, n); K may be 'commit' (the source tree's commit picks it)."""
+    m = re.match(r"^(\d+|commit)/(\d+)$", spec)
+    if not m or int(m.group(2)) < 1:
+        raise SystemExit("--window wants K/N (K a number below N, or 'commit'), not %r" % spec)
+    n = int(m.group(2))
+    k = commit_number(source_dir) % n if m.group(1) == "commit" else int(m.group(1))
+    if k >= n:
+        raise SystemExit("--window %s: K must be below N" % spec)
+    return k, n
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--source-dir", default=os.path.normpath(os.path.join(HERE, "..", "..")))
     ap.add_argument("--mutants", default=os.path.join(HERE, "mutants"), help="folder of *.mut files")
-    ap.add_argument("--only", nargs="*", help="mutant names (file names without .mut) to run")
+    ap.add_argument("--only", nargs="*", help="mutant names (file names without .mut, or systematic ids) to run")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--keep", action="store_true", help="keep the temporary copy (and its log)")
+    ap.add_argument("--work", metavar="DIR", help="copy and build in DIR and keep them (a later run with the same "
+                    "DIR rewrites only the files that changed, and rebuilds only what they feed)")
     ap.add_argument("--list", action="store_true", help="list the mutants and their tests, run nothing")
     ap.add_argument("--check", action="store_true", help="only check that every mutant still applies")
     ap.add_argument("--no-baseline", action="store_true", help="skip the run on the unmutated copy")
@@ -261,24 +344,57 @@ def main(argv=None):
                     help="start no mutant after this many seconds (0: run all)")
     ap.add_argument("--without", nargs="*", default=[], metavar="TEST",
                     help="leave these tests out (to measure what the others kill)")
+    ap.add_argument("--systematic", action="store_true",
+                    help="the generated mutants of systematic.py instead of the hand-written ones")
+    ap.add_argument("--sample", type=int, default=0, metavar="N", help="a random sample of N of the mutants")
+    ap.add_argument("--seed", type=int, default=1, help="the sample's random seed")
+    ap.add_argument("--window", metavar="K/N",
+                    help="every N-th mutant from the K-th (in name order); K 'commit': the commit picks it")
+    ap.add_argument("--extra-systematic", type=int, default=0, metavar="N",
+                    help="after the hand-written mutants, N systematic ones (a window the commit picks); "
+                         "their survivors are reported, not failed")
+    ap.add_argument("--extra-budget", type=float, default=300, metavar="SECONDS",
+                    help="start no extra systematic mutant after this many more seconds")
     args = ap.parse_args(argv)
 
-    mutants = [Mutant(p) for p in sorted(glob.glob(os.path.join(args.mutants, "*.mut")))]
+    if args.systematic:   # the equivalent ones too, so that samples and windows stay put
+        mutants = systematic.mutants(args.source_dir, include_equivalent=True)
+    else:
+        mutants = [Mutant(p) for p in sorted(glob.glob(os.path.join(args.mutants, "*.mut")))]
     if args.only:
         missing = set(args.only) - {m.name for m in mutants}
+        if missing and not args.systematic:   # a systematic id given without --systematic
+            generated = {m.name: m for m in systematic.mutants(args.source_dir, include_equivalent=True)}
+            mutants += [generated[n] for n in sorted(missing) if n in generated]
+            missing = set(args.only) - {m.name for m in mutants}
         if missing:
             print("no such mutant: %s" % " ".join(sorted(missing)))
             return 2
         mutants = [m for m in mutants if m.name in args.only]
-    for m in mutants:
+    if args.window:
+        k, n = pick_window(args.window, len(mutants), args.source_dir)
+        mutants = systematic.window(mutants, k, n)
+    if args.sample:
+        mutants = systematic.sample(mutants, args.sample, args.seed)
+    extra = []
+    if args.extra_systematic:
+        generated = systematic.mutants(args.source_dir, include_equivalent=True)
+        n = max(1, -(-len(generated) // args.extra_systematic))
+        extra = systematic.window(generated, commit_number(args.source_dir) % n, n)[:args.extra_systematic]
+    for m in mutants + extra:
         m.tests = [t for t in m.tests if t not in args.without]
     if args.list:
-        for m in mutants:
-            print("%-34s %-36s %s" % (m.name, m.file, " ".join(m.tests)))
+        for m in mutants + extra:
+            print("%-34s %-36s %s" % (m.name, m.path if args.systematic or m in extra else m.file,
+                                      " ".join(m.tests)))
         return 0
     uncovered = check_coverage(args.source_dir)
     if uncovered:
         print("the TESTS table names no way to run: %s (add a name for each)" % ", ".join(uncovered))
+        return 1
+    unknown = sorted({t for tests in systematic.TESTS_BY_FILE.values() for t in tests} - set(TESTS))
+    if unknown:
+        print("systematic.TESTS_BY_FILE names tests the runner does not know: %s" % " ".join(unknown))
         return 1
     if args.check:
         bad = 0
@@ -291,7 +407,8 @@ def main(argv=None):
                 bad += 1
                 print("INVALID  %s: %s" % (m.name, e))
         print("%d of %d mutants apply" % (len(mutants) - bad, len(mutants)))
-        return 1 if bad else 0
+        stale = systematic.main(["--source-dir", args.source_dir, "--check-equivalent"])
+        return 1 if bad or stale else 0
     if args.budget and mutants:
         start = commit_number(args.source_dir) % len(mutants)
         mutants = mutants[start:] + mutants[:start]
@@ -300,15 +417,17 @@ def main(argv=None):
         return SKIP_CODE
 
     t0 = time.monotonic()
-    work = tempfile.mkdtemp(prefix="dissgen-mutation-")
+    work = os.path.abspath(args.work) if args.work else tempfile.mkdtemp(prefix="dissgen-mutation-")
+    os.makedirs(work, exist_ok=True)
     src, build_dir, log = os.path.join(work, "src"), os.path.join(work, "build"), os.path.join(work, "log.txt")
-    print("mutation check: %d mutants, copy and log in %s" % (len(mutants), work), flush=True)
+    print("mutation check: %d mutants%s, copy and log in %s" % (
+        len(mutants), " and %d systematic ones" % len(extra) if extra else "", work), flush=True)
     results, not_run = [], []
     try:
         copy_tree(os.path.abspath(args.source_dir), src)
         # Corpus tests look for ../shared/corpus beside the source tree: the copy gets the same.
         shared = os.path.join(os.path.abspath(args.source_dir), "..", "shared")
-        if os.path.isdir(shared):
+        if os.path.isdir(shared) and not os.path.lexists(os.path.join(work, "shared")):
             os.symlink(os.path.realpath(shared), os.path.join(work, "shared"))
         status, secs, out = run(["cmake", "-S", src, "-B", build_dir, "-DCMAKE_BUILD_TYPE=RelWithDebInfo"], log=log)
         ok, bsecs, bout = build(src, build_dir, args.jobs, log) if status == 0 else (False, 0, out)
@@ -317,75 +436,55 @@ def main(argv=None):
             print(tail(bout))
             return 1
 
-        baselined = set(TESTS) if args.no_baseline else set()
+        baselined = set()
         originals = {}
-        for i, m in enumerate(mutants):
-            if args.budget and time.monotonic() - t0 > args.budget:
-                not_run = mutants[i:]
-                break
-            for t in m.tests:   # the tree is unmutated here: the test must pass on it first
-                if t in baselined:
-                    continue
-                ok, _, out = build(src, build_dir, args.jobs, log)
-                status, secs, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log) \
-                    if ok else (1, 0, out)
-                print("baseline %-13s %s (%.0fs)" % (t, "pass" if status == 0 else "FAIL", secs), flush=True)
-                if status != 0:
-                    print("the unmutated tree fails '%s': fix that first\n%s" % (t, tail(out)))
-                    return 1
-                baselined.add(t)
+        extra_start = None
+        for i, m in enumerate(mutants + extra):
+            if m in extra:
+                if extra_start is None:
+                    extra_start = time.monotonic()
+                    print("systematic mutants (window of %d):" % len(extra), flush=True)
+                if time.monotonic() - extra_start > args.extra_budget:
+                    not_run += [x for x in extra if x not in [r[0] for r in results]]
+                    break
+            elif args.budget and time.monotonic() - t0 > args.budget:
+                not_run.append(m)
+                continue
             start = time.monotonic()
-            verdict, detail = None, ""
-            if m.problem:
-                verdict, detail = "INVALID", m.problem
-            else:
-                path = os.path.join(src, m.file)
-                if m.file not in originals:
-                    originals[m.file] = open(path, encoding="utf-8").read() if os.path.isfile(path) else None
-                if originals[m.file] is None:
-                    verdict, detail = "INVALID", "no file %s: refresh the mutant" % m.file
-                else:
-                    try:
-                        mutated = m.mutate(originals[m.file])
-                    except ValueError as e:
-                        verdict, detail = "INVALID", str(e)
-            if verdict is None:
-                with open(path, "w", encoding="utf-8") as fh:
-                    fh.write(mutated)
-                ok, _, out = build(src, build_dir, args.jobs, log)
-                if not ok:
-                    verdict, detail = "INVALID", "does not build: refresh the mutant\n" + tail(out)
-                else:
-                    verdict = "SURVIVED"
-                    for t in m.tests:
-                        status, _, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log)
-                        if status != 0:
-                            verdict, detail = "KILLED", "by " + t
-                            break
-                    if verdict == "SURVIVED":
-                        detail = "passed: " + " ".join(m.tests)
-                with open(path, "w", encoding="utf-8") as fh:
-                    fh.write(originals[m.file])
+            outcome = judge(m, src, build_dir, args.jobs, log, originals, baselined, args.no_baseline)
+            if outcome is None:
+                return 1
+            verdict, detail = outcome
             results.append((m, verdict))
             print("%-8s %-34s %s (%.0fs)" % (verdict, m.name, detail, time.monotonic() - start), flush=True)
     finally:
-        if not args.keep:
+        if not args.keep and not args.work:
             shutil.rmtree(work, ignore_errors=True)
 
     killed = sum(1 for _, v in results if v == "KILLED")
-    total = len(results)
+    invalid = sum(1 for _, v in results if v == "INVALID")
+    equivalent = sum(1 for _, v in results if v == "EQUIV")
+    judged = len(results) - equivalent
+    total = judged - invalid
     cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
-    print("\nkilled %d of %d mutants (%.0f%%), %d survived, %d invalid; %.0fs in all, %.0fs of CPU "
-          "(builds, tests, tshark)" % (
+    print("\nkilled %d of %d mutants (%.1f%%), %d survived; besides, %d invalid (do not build) and %d "
+          "equivalent not run; %.0fs in all, %.0fs of CPU (builds, tests, tshark)" % (
               killed, total, 100.0 * killed / max(total, 1), sum(1 for _, v in results if v == "SURVIVED"),
-              sum(1 for _, v in results if v == "INVALID"), time.monotonic() - t0, cpu.ru_utime + cpu.ru_stime))
+              invalid, equivalent, time.monotonic() - t0, cpu.ru_utime + cpu.ru_stime))
     for m, v in results:
-        if v != "KILLED":
+        if v not in ("KILLED", "EQUIV"):
             print("  %s %s (%s): %s" % (v, m.name, m.file, " ".join(m.why)))
     if not_run:
-        print("not run within the budget of %.0fs (%d): %s" % (args.budget, len(not_run),
-                                                              " ".join(m.name for m in not_run)))
-    return 0 if total and killed == total else 1
+        print("not run within the budget (%d): %s" % (len(not_run), " ".join(m.name for m in not_run)))
+    # Generated mutants that do not compile are killed by the compiler: only hand-written ones
+    # must apply and build.
+    # The CI window of systematic mutants (--extra-systematic) reports its survivors without
+    # failing the check: most generated sites are not triaged yet (tests/mutation/README.md).
+    bad = [m for m, v in results if m not in extra and
+           (v == "SURVIVED" or (v == "INVALID" and not isinstance(m, systematic.SiteMutant)))]
+    if any(v == "SURVIVED" for m, v in results if m in extra):
+        print("systematic survivors above: triage them (a test, or a line in equivalent.txt)")
+    return 0 if judged and not bad else 1
 
 
 if __name__ == "__main__":
