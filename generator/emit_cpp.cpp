@@ -501,12 +501,13 @@ void Emitter::protocol_struct() {
         std::snprintf(timeout, sizeof timeout, "%.9g", p_.pairing->timeout);
         const Analysis* analysis = find_analysis(p_.pairing->analysis);
         o_ << "\n/* Request/response pairing (<pairing>, line " << p_.pairing->line
-           << "): timeout in seconds, analysis. */\n";
+           << "): timeout in seconds, analysis, responses in the order of their requests. */\n";
         if (analysis)
             o_ << "/* The " << c_string(analysis->name) << " analysis, compiled in from the runtime. */\n"
                << "extern \"C\" const struct dg_analysis " << analysis->symbol << ";\n";
         o_ << "static const dg_pairing " << f << "_pairing = { " << timeout << ", "
-           << (analysis ? "&" + analysis->symbol : std::string("NULL")) << " };\n";
+           << (analysis ? "&" + analysis->symbol : std::string("NULL")) << ", " << (p_.pairing->ordered ? 1 : 0)
+           << " };\n";
         if (!p_.request_fields.empty()) request_context();
     }
     o_ << "\nstatic dg_protocol " << f << "_protocol =\n    " << protocol_row() << ";\n\n";

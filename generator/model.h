@@ -219,6 +219,10 @@ struct Pairing {
     int line = 0;
     std::vector<PairingKey> keys;
     double timeout = 1.0;   // seconds a request waits for its response
+    // order="request" (true): responses come back in the order of their
+    // requests (per connection); order="any": in any order, so none is out
+    // of order and later answers do not give a request up
+    bool ordered = true;
     // derived by the validator when a value reads request{...}: some key
     // field is not at a fixed offset, so a response looks its request up
     // with the key values the walk decoded before its first request{...}

@@ -51,7 +51,7 @@ const std::vector<std::string> kEnumAttributes = {"value", "name"};
 const std::vector<std::string> kHookAttributes = {"table", "value"};
 const std::vector<std::string> kHeuristicAttributes = {"table", "enabled"};
 const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};
-const std::vector<std::string> kPairingAttributes = {"timeout", "analysis"};
+const std::vector<std::string> kPairingAttributes = {"timeout", "analysis", "order"};
 const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
                                                 "origin",  "enum",      "nondisplay",
@@ -459,6 +459,15 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
                                    "': expected seconds, more than 0 and at most 3600 (e.g. 0.1)");
         else
             pairing.timeout = v;
+    }
+    if (attrs.count("order")) {
+        const std::string order = trim(attrs["order"]);
+        if (order == "any")
+            pairing.ordered = false;
+        else if (order != "request")
+            diags_.error(line, "bad order '" + attrs["order"] +
+                                   "': expected request (responses come back in the order of their requests, the "
+                                   "default) or any");
     }
     if (attrs.count("analysis")) {
         pairing.analysis = trim(attrs["analysis"]);

@@ -20,6 +20,11 @@ extern "C" {
 /* unit_name_string (unit="..." labels): packet.h includes it up to 4.2 only. */
 #include <epan/unit_strings.h>
 
+#include <epan/prefs.h>
+#include <epan/stat_tap_ui.h>
+
+#include <tuple>
+#include <type_traits>
 #include <utility>
 
 /* True when the headers compiled against are Wireshark MAJOR.MINOR or later.
@@ -62,6 +67,25 @@ extern "C" {
 
 /* What a heuristic dissector returns: gboolean up to 4.2, bool from 4.4 on. */
 typedef decltype(std::declval<heur_dissector_t>()(nullptr, nullptr, nullptr, nullptr)) dg_heur_result;
+
+/* The variable of a bool preference: gboolean up to 4.2, bool from 4.4 on
+ * (the type prefs_register_bool_preference() points its last argument at). */
+template <typename R, typename... A> std::tuple_element_t<sizeof...(A) - 1, std::tuple<A...>> dg_last_argument(R (*)(A...));
+typedef std::remove_pointer_t<decltype(dg_last_argument(&prefs_register_bool_preference))> dg_pref_bool;
+
+/* What a command-line statistic's init callback (stat_tap_ui.init) returns:
+ * nothing up to 4.4, whether it worked from 4.6 on. dg_tap_init_done(ok)
+ * returns that. */
+typedef decltype(std::declval<stat_tap_init_cb>()(nullptr, nullptr)) dg_tap_init_result;
+template <typename R = dg_tap_init_result> R dg_tap_init_done(bool ok)
+{
+    if constexpr (std::is_void_v<R>) {
+        (void)ok;
+        return;
+    } else {
+        return ok;
+    }
+}
 
 /* 4.4 renamed tvb_find_guint8 too (stringz leaves look for their NUL). */
 #if DG_WS_AT_LEAST(4, 4)

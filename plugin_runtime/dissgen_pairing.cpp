@@ -186,6 +186,13 @@ guint64 *answered_in(const capture_state *c, const dg_transaction *t)
     return (guint64 *)wmem_array_index(c->scope_answered, t->order_scope);
 }
 
+/* More than `by` later requests of t's order scope were answered: t is overtaken
+ * (never where responses come in any order). */
+gboolean overtaken(const capture_state *c, const dg_transaction *t, guint64 by)
+{
+    return protocol->pairing->ordered && *answered_in(c, t) > t->seq + by;
+}
+
 key_entry *entry_for(capture_state *c, const guint64 *keys, guint key_count)
 {
     pair_key probe = {key_count, (guint64 *)keys};
@@ -309,7 +316,7 @@ const guint64 max_overtaken = 16;
 
 gboolean given_up(const capture_state *c, const pending *q, const packet_info *pinfo, double timeout)
 {
-    if (*answered_in(c, q->txn) > q->txn->seq + max_overtaken) return TRUE;
+    if (overtaken(c, q->txn, max_overtaken)) return TRUE;
     nstime_t age;
     nstime_delta(&age, &pinfo->abs_ts, &q->txn->request_time);
     return nstime_to_sec(&age) > timeout;
@@ -453,8 +460,7 @@ void forget_requests(capture_state *c)
     while (c->sent.head) {
         pending *q = c->sent.head;
         if (!q->done) {
-            if (*answered_in(c, q->txn) <= q->txn->seq + max_overtaken && !timed_out(c, &q->txn->request_time))
-                return;
+            if (!overtaken(c, q->txn, max_overtaken) && !timed_out(c, &q->txn->request_time)) return;
             give_up(c, q);
         }
         drop_head(&c->sent, FALSE);
@@ -578,7 +584,7 @@ dg_frame_pairing *response_to(capture_state *c, dg_transaction *t, const guint8 
     nstime_delta(&t->round_trip, &pinfo->abs_ts, &t->request_time);
     fp->txn = t;
     guint64 *answered = answered_in(c, t);
-    fp->out_of_order = t->seq < *answered;
+    fp->out_of_order = protocol->pairing->ordered && t->seq < *answered;
     if (t->seq > *answered) *answered = t->seq;
     if (t->seq > c->answered_max) c->answered_max = t->seq;
     if (analysis && analysis->compare && request_bytes) {
@@ -735,7 +741,7 @@ gboolean known_lost(const dg_transaction *t)
 {
     if (t->given_up_in) return TRUE;
     if (!capture) return FALSE;
-    if (*answered_in(capture, t) > t->seq) return TRUE;
+    if (overtaken(capture, t, 0)) return TRUE;
     nstime_t waited;
     nstime_delta(&waited, &capture->previous_time, &t->request_time);
     return nstime_to_sec(&waited) > protocol->pairing->timeout;

@@ -199,6 +199,7 @@ struct dg_analysis; /* dissgen_pairing.h; each analysis defines its own in its f
 typedef struct dg_pairing {
     double timeout;          /* seconds a request waits for its response */
     const struct dg_analysis *analysis; /* NULL, or the protocol analysis the rule file names */
+    guint8 ordered;          /* order="request": responses come in their requests' order (per connection) */
 } dg_pairing;
 
 /* request{Name} in computed values: a response reads fields of its paired

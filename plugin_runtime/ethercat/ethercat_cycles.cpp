@@ -607,7 +607,7 @@ tap_packet_status cycles_packet(void *, packet_info *, epan_dissect_t *, const v
     return TAP_PACKET_DONT_REDRAW;
 }
 
-void cycles_cli_init(const char *, void *)
+dg_tap_init_result cycles_cli_init(const char *, void *)
 {
     /* Listens to the frame tap (every frame) only so that the draw runs at the end. */
     GString *error = register_tap_listener("frame", &cycles_filter, NULL, TL_REQUIRES_NOTHING, NULL, cycles_packet,
@@ -616,6 +616,7 @@ void cycles_cli_init(const char *, void *)
         fprintf(stderr, "%s,cycles: %s\n", cycles_filter, error->str);
         g_string_free(error, TRUE);
     }
+    return dg_tap_init_done(error == NULL);
 }
 
 /* The statistics tree (Wireshark's Statistics menu): the same figures, set

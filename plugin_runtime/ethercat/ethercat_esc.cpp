@@ -314,7 +314,7 @@ void show_datagram_experts(const compared *c, guint i, tvbuff_t *tvb, packet_inf
 
 /* "Show slave and ESC details on every datagram" (the preference): off, a
  * datagram's comparison is printed only when something is unusual. */
-gboolean show_details = FALSE;
+dg_pref_bool show_details = FALSE;
 
 /* Someone may read the comparison: a visible tree (the details pane, -V,
  * -T fields), or a filter or column naming one of its fields. */

@@ -402,7 +402,7 @@ TEST(Pairing, KeysAreFlaggedAndThePairingIsEmitted) {
     std::string code = emit_cpp(*f.proto, "t.xml");
     // The generated code names the analysis object: the runtime looks nothing up.
     EXPECT_TRUE(contains(code, "extern \"C\" const struct dg_analysis dg_ethercat_esc;")) << code;
-    EXPECT_TRUE(contains(code, "static const dg_pairing tst_pairing = { 0.25, &dg_ethercat_esc };")) << code;
+    EXPECT_TRUE(contains(code, "static const dg_pairing tst_pairing = { 0.25, &dg_ethercat_esc, 1 };")) << code;
     EXPECT_TRUE(contains(code, ".pairing(&tst_pairing);")) << code;
     EXPECT_TRUE(contains(code, ".show(DG_SHOW_HEX).flags(DG_NUMERIC|DG_KEY)")) << code;
     EXPECT_EQ(code.find(".show(DG_SHOW_DEC).flags(DG_NUMERIC|DG_KEY)"), std::string::npos) << "only the key is flagged";
@@ -420,7 +420,14 @@ TEST(Pairing, DefaultTimeoutIsOneSecondAndNoAnalysis) {
     Front f = front_end(rules("  <pairing><key field=\"node[@name='Id']\"/></pairing>\n"
                               "  <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
-    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL };"));
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 1 };"));
+}
+
+TEST(Pairing, ResponsesInAnyOrder) {
+    Front f = front_end(rules("  <pairing order=\"any\"><key field=\"node[@name='Id']\"/></pairing>\n"
+                              "  <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 0 };"));
 }
 
 }  // namespace
