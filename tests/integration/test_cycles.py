@@ -26,7 +26,7 @@ import sys
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import TsharkTestCase, corpus_captures, run_unittests  # noqa: E402
+from tshark_env import TsharkTestCase, corpus_captures, relative_time_ns, run_unittests  # noqa: E402
 import pcaprewrite as pr  # noqa: E402
 from test_losses import ecat_frame, generated as write_pcap, returned  # noqa: E402
 
@@ -277,14 +277,6 @@ def dc_reference(cap, rows):
     return out
 
 
-def time_ns(text):
-    """A relative time as tshark prints it ("-0.000012345") in ns."""
-    neg = text.startswith("-")
-    sec, _, frac = text.lstrip("-").partition(".")
-    v = int(sec) * 10**9 + int((frac + "000000000")[:9])
-    return -v if neg else v
-
-
 def parse_tree(text):
     """tshark -2 -z ecatr.cycles,tree: {(cycle, row name): count}."""
     out = {}
@@ -354,8 +346,8 @@ class TestCycles(TsharkTestCase, unittest.TestCase):
         got = {}
         for num, r in two.items():
             if r["ecatr.cycle"]:
-                got[num] = (int(r["ecatr.cycle"][0]), time_ns(r["ecatr.cycle.period"][0]),
-                            time_ns(r["ecatr.cycle.jitter"][0]))
+                got[num] = (int(r["ecatr.cycle"][0]), relative_time_ns(r["ecatr.cycle.period"][0]),
+                            relative_time_ns(r["ecatr.cycle.jitter"][0]))
         wrong = [n for n in set(got) | set(ref.marks) if got.get(n) != ref.marks.get(n)]
         check(not wrong, "%s: %d frames marked, each cycle, period and jitter as computed to the ns%s" % (
             name, len(got), "" if not wrong else " (first wrong: frame %d: got %s, computed %s)" % (
@@ -366,7 +358,7 @@ class TestCycles(TsharkTestCase, unittest.TestCase):
         check(not differ, "%s: one pass shows the same cycle fields as -2%s" % (
             name, "" if not differ else " (first differing frame %d)" % min(differ)))
         rtt_wrong = [n for n, r in two.items() if r["ecatr.request_in"] and r["ecatr.time"] and
-                     time_ns(r["ecatr.time"][0]) != ns_of(cap, cap.packets[n - 1]) -
+                     relative_time_ns(r["ecatr.time"][0]) != ns_of(cap, cap.packets[n - 1]) -
                      ns_of(cap, cap.packets[int(r["ecatr.request_in"][0]) - 1])]
         check(not rtt_wrong, "%s: every round trip (ecatr.time) is the timestamps' difference to the ns" % name)
         stats = parse_cycles(z)

@@ -34,7 +34,7 @@ import unittest
 import zlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import NOBODY, TsharkTestCase, corpus_captures, run_unittests  # noqa: E402
+from tshark_env import NOBODY, TsharkTestCase, corpus_captures, relative_time_ns, run_unittests  # noqa: E402
 import pcaprewrite as pr  # noqa: E402
 from test_losses import MASTER, ecat_frame, generated, returned  # noqa: E402
 
@@ -114,14 +114,6 @@ def report_table(page):
     return {int(r[0]): r for r in reader.rows if r}
 
 
-def ns(text):
-    """'-0.000001250' (seconds) -> -1250."""
-    neg = text.startswith("-")
-    whole, _, frac = text.lstrip("-").partition(".")
-    v = int(whole) * 10**9 + int((frac + "000000000")[:9])
-    return -v if neg else v
-
-
 def quantiles(values):
     """min, lower median, nearest-rank p99, max."""
     v = sorted(values)
@@ -145,13 +137,14 @@ def cycle_figures(rows):
                                                               "answered": [], "wkc": 0, "high": None})
             c["sent"].append(frame)
             cycle_of[frame] = c
-            c["period"] += [ns(v) for v in r["ecatr.cycle.period"]]
-            c["jitter"] += [ns(v) for v in r["ecatr.cycle.jitter"]]
+            c["period"] += [relative_time_ns(v) for v in r["ecatr.cycle.period"]]
+            c["jitter"] += [relative_time_ns(v) for v in r["ecatr.cycle.jitter"]]
             if r["ecatr.cycle.jitter"]:
-                c["nominal"] = ns(r["ecatr.cycle.period"][0]) - ns(r["ecatr.cycle.jitter"][0])
+                period, jitter = (relative_time_ns(r[f][0]) for f in ("ecatr.cycle.period", "ecatr.cycle.jitter"))
+                c["nominal"] = period - jitter
         if r["ecatr.time"] and r["ecatr.request_in"] and int(r["ecatr.request_in"][0]) in cycle_of:
             c = cycle_of[int(r["ecatr.request_in"][0])]
-            c["rtt"].append(min(max(ns(r["ecatr.time"][0]), 0), 2**32 - 1))
+            c["rtt"].append(min(max(relative_time_ns(r["ecatr.time"][0]), 0), 2**32 - 1))
             c["answered"].append(int(r["ecatr.request_in"][0]))
             back, added = r["ecatr.datagram.wkc"], r["ecatr.esc.wkc_added"]
             if c["high"] is None:

@@ -66,6 +66,14 @@ def corpus_captures(folder):
     return sorted(f for f in os.listdir(folder) if f.endswith((".pcap", ".pcapng"))) if os.path.isdir(folder) else []
 
 
+def relative_time_ns(text):
+    """A relative time as tshark prints it, in seconds ("-0.000012345"), as whole ns (-12345)."""
+    negative = text.startswith("-")
+    seconds, _, fraction = text.lstrip("-").partition(".")
+    ns = int(seconds) * 10**9 + int((fraction + "000000000")[:9])
+    return -ns if negative else ns
+
+
 def read_tshark_output(path, xml=False):
     """The text tshark wrote to path (JSON or PDML), made parseable: tshark cuts a long label
     at a byte count, which may fall inside a UTF-8 character (a long string from random
