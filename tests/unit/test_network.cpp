@@ -3,10 +3,14 @@
 // tests/golden/bus_*.golden; regenerate with UPDATE_GOLDEN=1).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <regex>
+#include <set>
 #include <sstream>
+#include <tuple>
 
 #include "ethercat/emit_catalogue.h"
 #include "ethercat/esi_reader.h"
@@ -307,6 +311,98 @@ TEST(BusTables, CatalogueAloneRegistersAFieldPerModelEntry) {
               "ecatr.pdo.el2004.channel_1.output\tFT_BOOLEAN\tEL2004 Channel 1.Output\tesi\n"
               "ecatr.pdo.el2004.channel_1.mode\tFT_UINT8\tEL2004 Channel 1.Mode\tesi\n"
               "ecatr.pdo.el2004.channel_1.setpoint\tFT_INT16\tEL2004 Channel 1.Setpoint\tesi\n");
+}
+
+// The PDO rows of the embedded tables read back (index, output, assigned by default, mapping as
+// "index:subindex/bits" items) must be the catalogue's PDOs: an RxPdo is an output, a TxPdo an input.
+using PdoRow = std::tuple<unsigned, bool, bool, std::vector<std::string>>;
+
+std::set<PdoRow> pdo_rows(const std::string& tables) {
+    const std::regex map_re(R"(\{ 0x([0-9a-f]+), (\d+), (\d+) \})");
+    const std::regex pdo_re(R"(\{ 0x([0-9a-f]+), (\d), (\d), (\d+), (\d+) \})");
+    auto block = [&](const std::string& name) {
+        size_t at = tables.find(name + "[] = {");
+        EXPECT_NE(at, std::string::npos) << name;
+        return at == std::string::npos ? std::string() : tables.substr(at, tables.find("};", at) - at);
+    };
+    std::vector<std::string> maps;
+    const std::string map_text = block("ecatr_maps");
+    for (std::sregex_iterator m(map_text.begin(), map_text.end(), map_re), e; m != e; ++m)
+        maps.push_back((*m)[1].str() + ":" + (*m)[3].str() + "/" + (*m)[2].str());
+    std::set<PdoRow> rows;
+    const std::string pdo_text = block("ecatr_pdos");
+    for (std::sregex_iterator m(pdo_text.begin(), pdo_text.end(), pdo_re), e; m != e; ++m) {
+        size_t first = std::stoul((*m)[4]), count = std::stoul((*m)[5]);
+        EXPECT_LE(first + count, maps.size()) << m->str();
+        if (first + count > maps.size()) continue;
+        rows.insert({std::stoul((*m)[1], nullptr, 16), (*m)[2] == "1", (*m)[3] == "1",
+                     std::vector<std::string>(maps.begin() + first, maps.begin() + first + count)});
+    }
+    return rows;
+}
+
+std::set<PdoRow> catalogue_pdos(const Catalogue& cat) {
+    std::set<PdoRow> rows;
+    for (const EsiDevice& dev : cat.devices)
+        for (const EsiPdo& p : dev.pdos) {
+            std::vector<std::string> map;
+            for (const EsiEntry& en : p.entries) {
+                char item[32];
+                std::snprintf(item, sizeof item, "%04x:%u/%u", en.index, en.subindex, en.bit_length);
+                map.push_back(item);
+            }
+            rows.insert({p.index, !p.tx, p.sm >= 0, map});
+        }
+    return rows;
+}
+
+// A catalogue with inputs and outputs, some PDOs not assigned by default, unnamed PDOs and entries.
+const char* const kUnnamedEsi = R"(<EtherCATInfo Version="1.6">
+  <Vendor><Id>#x00000002</Id><Name>Example</Name></Vendor>
+  <Descriptions><Groups><Group><Type>T</Type><Name>T</Name></Group></Groups><Devices>
+    <Device Physics="KK">
+      <Type ProductCode="#x00001234" RevisionNo="#x00010000">EL9999</Type>
+      <Name>Mixed I/O</Name>
+      <RxPdo Fixed="1" Sm="2"><Index>#x1600</Index>
+        <Entry><Index>#x7000</Index><SubIndex>1</SubIndex><BitLen>1</BitLen><DataType>BOOL</DataType></Entry>
+        <Entry><Index>#x7000</Index><SubIndex>2</SubIndex><BitLen>7</BitLen><Name>Mode</Name>
+          <DataType>BIT7</DataType></Entry>
+      </RxPdo>
+      <RxPdo Fixed="1"><Index>#x1601</Index><Name>Spare</Name>
+        <Entry><Index>#x7010</Index><SubIndex>1</SubIndex><BitLen>8</BitLen><Name>Value</Name>
+          <DataType>USINT</DataType></Entry>
+      </RxPdo>
+      <TxPdo Fixed="1" Sm="3"><Index>#x1a00</Index><Name>Status</Name>
+        <Entry><Index>#x60ab</Index><SubIndex>17</SubIndex><BitLen>16</BitLen><DataType>UINT</DataType></Entry>
+      </TxPdo>
+    </Device>
+  </Devices></Descriptions>
+</EtherCATInfo>
+)";
+
+Catalogue unnamed_catalogue() {
+    Catalogue cat;
+    Diagnostics diags;
+    EXPECT_TRUE(read_esi(kUnnamedEsi, "unnamed.xml", cat, diags)) << diags.format("unnamed.xml");
+    return cat;
+}
+
+TEST(BusTables, PdoRowsAreTheCataloguesPdos) {
+    for (const Catalogue& cat : {small_catalogue(), unnamed_catalogue()}) {
+        std::set<PdoRow> want = catalogue_pdos(cat);
+        EXPECT_EQ(pdo_rows(emit_bus(cat, {nullptr, false}, "ecatr").tables), want);
+        EXPECT_TRUE(std::any_of(want.begin(), want.end(), [](const PdoRow& r) { return std::get<1>(r); }));
+        EXPECT_TRUE(std::any_of(want.begin(), want.end(), [](const PdoRow& r) { return !std::get<1>(r); }));
+    }
+}
+
+// An entry without a name is named by its object (index in 4 hex digits, subindex), under its
+// PDO's name when the PDO has one (the filters, in the order of the default process data).
+TEST(BusTables, UnnamedEntriesAreNamedByTheirObject) {
+    std::istringstream lines(list_bus_fields(unnamed_catalogue(), {nullptr, false}, "ecatr"));
+    std::string filters;
+    for (std::string line; std::getline(lines, line);) filters += line.substr(0, line.find('\t')) + "\n";
+    EXPECT_EQ(filters, "ecatr.pdo.el9999.entry_7000_1\necatr.pdo.el9999.mode\necatr.pdo.el9999.status.entry_60ab_17\n");
 }
 
 TEST(BusTables, BitNTakesTheSmallestFieldThatHoldsIt) {
