@@ -8,7 +8,9 @@ a response (tests/rules/transactions.xml, UDP port 47480, keys: transaction and 
 A response never opens a transaction and a request never answers one: a response whose request
 was not captured is linked to nothing, and the request that follows with the same key waits
 for its own response. A request sent again with the same key gives up the first one, which is
-reported lost (with -2 on itself, in one pass on the request that proved it). Needs no corpus.
+reported lost (with -2 on itself, in one pass on the request that proved it), and so is one the
+capture goes on for longer than the timeout after; one the capture ends exactly the timeout after
+is still in flight. Needs no corpus.
 """
 
 import os
@@ -40,9 +42,12 @@ MESSAGES = [
     (70, "response", 5, 1),   # 12: another orphan (a response never answers a response)
     (80, "request", 5, 1),    # 13
     (81, "response", 5, 1),   # 14: answers 13
+    (100, "request", 7, 1),   # 15: lost: 17 comes more than the timeout (1 s) after it
+    (101, "request", 6, 1),   # 16: in flight: 17 comes exactly the timeout after it
+    (1101, "response", 8, 1), # 17: an orphan, the capture's last message
 ]
 PAIRS = {3: 2, 6: 5, 9: 8, 10: 7, 14: 13}
-LOST = {4: 5}  # lost request: the frame that proves it
+LOST = {4: 5, 15: 17}  # lost request: the frame that proves it
 
 
 def frame(direction, transaction, unit, n):
@@ -93,7 +98,7 @@ class TestTransactions(TsharkTestCase, unittest.TestCase):
                     back = {int(r["txnp.response_in"]): n for n, r in rows.items() if r["txnp.response_in"]}
                     check(back == PAIRS, "%s: each answered request links its response (%s)" % (mode, back))
                     flagged = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
-                    check(flagged == set(LOST), "%s: no_response exactly on the lost request %s (%s)" % (
+                    check(flagged == set(LOST), "%s: no_response exactly on the lost requests %s (%s)" % (
                         mode, sorted(LOST), sorted(flagged)))
                 else:
                     flagged = {n: r["txnp.no_response_to"] for n, r in rows.items() if r["txnp.expert.no_response"]}
