@@ -14,6 +14,7 @@ from the bytes written), and the label of every block instance ("Channel 2",
   - else a word window (kind 4, base = address * 2, otherwise + if),
   - else a page window (kind 6, base = address - 16, a child with its own if),
   - else a window whose base is the Echo byte (kind 7),
+  - else, for kind 9, a field whose length comes from the Echo byte,
   - else, for kind 8, the data as one item when the record has its Echo byte
     (a <when field> on a field only some records have: without it, raw bytes),
   - else a mailbox when the counter AFTER the data is 1 (peek counted from the
@@ -23,7 +24,7 @@ and an Echo byte precedes the data when that counter is 2 (peek from the node
 itself, past the data). Malformed variants (windows past the end of the
 capture, counters cut off so a peek cannot read them or ending exactly at the
 end of the capture so it can, a mailbox too short for
-its header, a base below zero, a base from a field the record lacks) must give
+its header, a base below zero, a base or a length from a field the record lacks) must give
 our expert infos where the fault is and the tree so far.
 
     test_layout.py --dissgen build/bin/dissgen --source-dir .
@@ -140,6 +141,10 @@ class Expected:
     def add(self, name, pos, size, show=None, label=None):
         self.items.append(Item(name, pos, size, show, label))
 
+    def expert(self, name, pos, size):
+        """An expert info at the fault: over the bytes left of what was cut short, none for a bad base."""
+        self.experts.append((name, pos, size))
+
     def num(self, name, pos, size):
         self.add(name, pos, size, le(self.payload[pos:pos + size]))
 
@@ -148,7 +153,7 @@ class Expected:
         self.add("lyt.rec", o, None)
         for name, p, s in (("kind", 0, 1), ("mode", 1, 1), ("address", 2, 2), ("length", 4, 2)):
             if o + p + s > end:
-                self.experts.append("lyt.expert.truncated")
+                self.expert("lyt.expert.truncated", o + p, end - (o + p))
                 return False
             self.num("lyt.rec." + name, o + p, s)
         d = o + 6
@@ -164,7 +169,7 @@ class Expected:
         avail = min(r.length, end - d)
         past = r.length > end - d
         if past:
-            self.experts.append("lyt.expert.past_end")
+            self.expert("lyt.expert.past_end", d, end - d)
         if r.kind in (1, 2) and r.address <= 0x0FFF and r.mode == 0:
             self.add("lyt.rec.reg", d, avail)
             for name, pos, size, i, text in window_items(self, r.address, d, avail, REGISTERS):
@@ -176,7 +181,7 @@ class Expected:
         elif r.kind == 6:
             self.add("lyt.rec.pages", d, avail if r.address >= 16 else 0)   # stops at the window's start
             if r.address < 16:
-                self.experts.append("lyt.expert.bad_length")     # base out of range
+                self.expert("lyt.expert.bad_length", d, 0)     # base out of range
                 return False
             for name, pos, size, i, text in window_items(self, r.address - 16, d, avail, PAGES):
                 if name != "lyt.rec.pages.wflag" or r.mode == 1:
@@ -184,10 +189,16 @@ class Expected:
         elif r.kind == 7:
             self.add("lyt.rec.echoed", d, avail if echo else 0)
             if not echo:
-                self.experts.append("lyt.expert.bad_length")     # base field not in this packet
+                self.expert("lyt.expert.bad_length", d, 0)     # base field not in this packet
                 return False
             for name, pos, size, i, text in window_items(self, 0xE5, d, avail, ECHOED):
                 self.add(name, pos, size, le(self.payload[pos:pos + size]), text)
+        elif r.kind == 9:
+            if not echo:
+                self.expert("lyt.expert.bad_length", d, 0)     # length field not in this packet
+                return False
+            assert r.length == 0xE5 - 224, "a kind 9 record carries as many data bytes as Echo - 224 says"
+            self.add("lyt.rec.echosized", d, r.length)
         elif r.kind == 8 and echo:
             if avail > 0:
                 self.add("lyt.rec.echodata", d, avail)
@@ -195,11 +206,11 @@ class Expected:
             self.add("lyt.rec.mbx", d, avail if avail >= 3 else None)
             inner = d + avail
             if inner - d < 2:
-                self.experts.append("lyt.expert.truncated")
+                self.expert("lyt.expert.truncated", d, inner - d)
                 return False
             self.num("lyt.rec.mbx.len", d, 2)
             if inner - d < 3:
-                self.experts.append("lyt.expert.truncated")
+                self.expert("lyt.expert.truncated", d + 2, inner - d - 2)
                 return False
             self.num("lyt.rec.mbx.type", d + 2, 1)
             if inner - d > 3:
@@ -212,7 +223,7 @@ class Expected:
         c = d + r.length
         for name, p, s in (("counter", 0, 2), ("more", 2, 1)):
             if c + p + s > end:
-                self.experts.append("lyt.expert.truncated")
+                self.expert("lyt.expert.truncated", c + p, end - (c + p))
                 return False
             self.num("lyt.rec." + name, c + p, s)
         return r.more != 0
@@ -257,6 +268,8 @@ def valid_packets(rng, count):
         n = rng.choice([1, 1, 2, 3])
         out.append(([random_record(rng, int(i + 1 < n)) for i in range(n)], None))
     # A read of 0x0000..0x0FFF shows every register it covers.
+    # A length from the Echo byte (0xE5 - 224 = 5 bytes), which only some records have.
+    out.append(([Record(9, 0, 0x0010, bytes(range(5)), 2, 0)], None))
     whole = Record(1, 0, 0x0000, bytes(rng.randrange(256) for _ in range(0x1000)), 0, 0)
     out.append(([whole], None))
     # Every branch once: registers, words, mailbox (peek 1), raw (peek 2, kind 5), pages, echoed,
@@ -285,6 +298,8 @@ def malformed_packets():
         ([Record(6, 1, 0x0008, data[:8], 0, 0)], None),
         # a window base from a field this record does not have
         ([Record(7, 0, 0x0000, data[:8], 0, 0)], None),
+        # a length from a field this record does not have
+        ([Record(9, 0, 0x0000, data[:5], 0, 0)], None),
         # a mailbox too short for its header
         ([Record(2, 0, 0x2000, data[:1], 1, 0)], None),
         # a length past the end of the packet: the peek finds no counter, raw bytes and past_end
@@ -391,8 +406,10 @@ class Layout(unittest.TestCase):
     def test_experts_where_the_fault_is(self):
         for i, exp in enumerate(self.expected):
             with self.subTest(packet=i + 1):
-                got = [f.get("name") for f in pdml_items(self.proto(i)) if f.get("name") in EXPERTS]
-                self.assertEqual(got, exp.experts)
+                got = [(f.get("name"), int(item.get("pos")) - UDP_HEAD, int(item.get("size")))
+                       for item in self.proto(i).iter("field") if item.find("field[@name='_ws.expert']") is not None
+                       for f in item.iter("field") if f.get("name") in EXPERTS]
+                self.assertEqual(got, exp.experts, "(name, position, size) of each expert info")
         for i in range(self.valid_count):
             self.assertEqual(self.expected[i].experts, [], "valid packet %d has a fault in the model" % (i + 1))
 
@@ -413,7 +430,7 @@ class Layout(unittest.TestCase):
             seen.update(it.name for it in exp.items)
         for name in ("lyt.rec.reg", "lyt.rec.words", "lyt.rec.mbx", "lyt.rec.raw", "lyt.rec.reg.ch",
                      "lyt.rec.words.word", "lyt.rec.echo", "lyt.rec.pages.word", "lyt.rec.pages.wflag",
-                     "lyt.rec.echoed.reg", "lyt.rec.echodata"):
+                     "lyt.rec.echoed.reg", "lyt.rec.echodata", "lyt.rec.echosized"):
             self.assertIn(name, seen)
 
 
