@@ -24,7 +24,9 @@
 6. Process data by name (generated frames, tests/esi_ok/small_io.xml with
    tests/network/small_design.xml): after the stations and FMMUs are set, an LRW shows the
    EL2004's outputs (ecatr.pdo.el2004.*) in the frame as sent and the EL1004's inputs
-   (ecatr.pdo.el1004.*) in the returned one, with the values written into the bytes here.
+   (ecatr.pdo.el1004.*) in the returned one, with the values written into the bytes here; sent
+   again with its working counter already counted, returned short by 1, 2 or 3: ecatr.expert.wkc
+   naming the one slave whose part the shortfall is, none when it is two slaves' parts.
 7. Process data as the master configures it over CoE (generated frames, an EL1252 of
    ../shared/corpus/esi/Beckhoff_EL1xxx.xml identified from its SII): 0x1C13 and a mapping
    written one subindex at a time (with a write the slave did not take and a segmented
@@ -367,30 +369,37 @@ def pdo_checks(check, dissgen, source_dir, design=True):
         steps += [(pg.Datagram(2, adp=0xFFFD, ado=0x0010, data=struct.pack("<H", 0x1004)), None, 1)]
         steps += sii_reads(0x1004, 2, 0x0BADC0DE, 0x00100000)
     steps.append((pg.Datagram(12, lad=0x10000, data=bytes(1) + outputs), bytes([inputs]) + outputs, 3))
+    ring = 4   # slaves: small_design.xml's, or positions 0 to 3
     frames = []
     for i, (d, data, wkc) in enumerate(steps):
         d.idx = i
         frames.append(pg.Frame([d], src_mac=master))
-        r = pg.Datagram(d.cmd, idx=i, adp=d.adp, ado=d.ado, lad=d.lad, data=data if data else d.data, wkc=wkc)
+        # As the ring returns it: each of the slaves counts the address of an auto-increment
+        # (position) command up.
+        adp = (d.adp + ring) & 0xFFFF if d.cmd in (1, 2, 3) else d.adp
+        r = pg.Datagram(d.cmd, idx=i, adp=adp, ado=d.ado, lad=d.lad, data=data if data else d.data, wkc=wkc)
         frames.append(pg.Frame([r], src_mac=back))
     fields = ["ecatr.pdo.el1004.channel_1.input", "ecatr.pdo.el1004.channel_2.input",
               "ecatr.pdo.el1004.channel_3.input", "ecatr.pdo.el2004.channel_1.output",
               "ecatr.pdo.el2004.channel_1.mode", "ecatr.pdo.el2004.channel_1.setpoint",
-              "ecatr.wkc.expected", "ecatr.expert.wkc"]
+              "ecatr.wkc.expected", "ecatr.expert.wkc", "_ws.expert.message"]
     yes = {"1", "True"}
     no = {"0", "False"}
     lrw = len(frames) - 1   # the LRW as sent, then returned
     if design:
         # The same LRW sent with its working counter already at 4 (a frame the master passes
-        # on): the slaves add 3 (met), then 2 (one short). What counts is what they added.
-        for k, back_wkc in enumerate((7, 6)):
+        # on): the slaves add 3 (met), then 2, 1 and 0 (one, two and three short). What counts is
+        # what they added; a shortfall one slave's part accounts for names it (position 1, the
+        # EL1004, reads: 1; position 2, the EL2004, writes: 2; neither identified from its SII
+        # here), one of both slaves' parts names none.
+        for k, back_wkc in enumerate((7, 6, 5, 4)):
             i = len(steps) + k
             frames.append(pg.Frame([pg.Datagram(12, idx=i, lad=0x10000, data=bytes(1) + outputs, wkc=4)],
                                    src_mac=master))
             frames.append(pg.Frame([pg.Datagram(12, idx=i, lad=0x10000, data=bytes([inputs]) + outputs,
                                                 wkc=back_wkc)], src_mac=back))
     if not design:
-        fields = fields[:6]
+        fields = fields[:6] + fields[-1:]
     with TsharkEnv() as env:
         env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"),
                            ["--esi", os.path.join(source_dir, "tests", "esi_ok", "small_io.xml")] +
@@ -409,6 +418,9 @@ def pdo_checks(check, dissgen, source_dir, design=True):
             check([ret[f][0] if ret[f] else "" for f in fields[:3]] in (["1", "0", "1"], ["True", "False", "True"]),
                   "LRW returned: EL1004 inputs by name (1, 0, 1)%s: %s" % (tag, ret))
             check(not any(ret[f] for f in fields[3:6]), "LRW returned: no EL2004 outputs" + tag)
+            noisy = {n: r["_ws.expert.message"] for n, r in rows.items() if n <= lrw + 1 and r["_ws.expert.message"]}
+            check(not noisy, "the exchanges up to the LRW, as the ring returns them, raise no expert info%s: %s"
+                  % (tag, noisy))
             if design:
                 check(sent["ecatr.wkc.expected"] == ["3"] and ret["ecatr.wkc.expected"] == ["3"] and
                       not ret["ecatr.expert.wkc"], "expected working counter 3 (EL1004 +1, EL2004 +2), met" + tag)
@@ -417,6 +429,13 @@ def pdo_checks(check, dissgen, source_dir, design=True):
                       "sent with working counter 4: returned 7 is met, 6 is one short (the slaves' additions "
                       "count, not the returned counter)%s: %s, %s" % (tag, met["ecatr.expert.wkc"],
                                                                       short["ecatr.expert.wkc"]))
+                texts = [[m for m in rows[lrw + 3 + 2 * k]["_ws.expert.message"] if "working counter" in m]
+                         for k in range(4)]
+                head = "LRW: expected working counter 3, got "
+                want = [[], [head + "2: the slave at position 1 did not read its inputs"],
+                        [head + "1: the slave at position 2 did not write its outputs"], [head + "0"]]
+                check(texts == want, "the shortfall names the one slave whose part it is, none when it is "
+                      "two slaves' parts%s: %s" % (tag, texts))
             else:
                 tree = env.tshark(["-r", path, "-V"] + (["-2"] if two_pass else [])).stdout.split("\nFrame ")
                 titles = [re.findall(r"\[(EL\d+ \(position \d\): \w+)\]", tree[k - 1]) for k in (lrw, lrw + 1)]
