@@ -7,7 +7,9 @@ Modbus/TCP's read functions over UDP port 47502, keys: transaction and unit).
 
 Generated captures of read transactions, several in flight at once (different keys, answered
 out of order). Function 3: each register's number is the request's reference plus its index;
-function 1 (one byte per coil): as many coils as the request's quantity, numbered the same way.
+function 1 (one byte per coil): as many coils as the request's quantity, numbered the same way;
+both show the request's reference as the first register, right after the keys, also in a response
+that ends there (and none when it ends inside them).
 Checked against the bytes in one pass and with -2. The same capture without its requests:
 every response decodes what it can (register values, no numbers, no coils), says so with
 rqc.expert.no_request_context once, and raises no malformed expert. Needs no corpus.
@@ -27,7 +29,7 @@ import pcapgen  # noqa: E402
 ARGS = None
 PORT = 47502
 CLIENT, SERVER = b"\x0a\x00\x00\x01", b"\x0a\x00\x00\x02"
-FIELDS = ["frame.number", "rqc.transaction", "rqc.registers.values.register.value",
+FIELDS = ["frame.number", "rqc.transaction", "rqc.first_register", "rqc.registers.values.register.value",
           "rqc.registers.values.register.number", "rqc.coils.coil.state", "rqc.coils.coil.number",
           "rqc.coils.coil_count", "rqc.request_in", "rqc.expert.no_request_context", "rqc.expert.bad_length",
           "_ws.expert.severity"]
@@ -90,11 +92,12 @@ def expected(txn, with_request):
     """What a response shows, as tshark -T fields prints it."""
     _, _, function, reference, quantity, values = txn
     numbers = ",".join(str(reference + i) for i in range(quantity)) if with_request else ""
+    first = {"rqc.first_register": str(reference) if with_request else ""}
     if function == 3:
-        return {"rqc.registers.values.register.value": ",".join("0x%04x" % v for v in values),
+        return {**first, "rqc.registers.values.register.value": ",".join("0x%04x" % v for v in values),
                 "rqc.registers.values.register.number": numbers,
                 "rqc.coils.coil.state": "", "rqc.coils.coil.number": "", "rqc.coils.coil_count": ""}
-    return {"rqc.registers.values.register.value": "", "rqc.registers.values.register.number": "",
+    return {**first, "rqc.registers.values.register.value": "", "rqc.registers.values.register.number": "",
             "rqc.coils.coil.state": ",".join("0x%02x" % v for v in values) if with_request else "",
             "rqc.coils.coil.number": numbers, "rqc.coils.coil_count": str(quantity) if with_request else ""}
 
@@ -192,6 +195,26 @@ class TestRequestContext(TsharkTestCase, unittest.TestCase):
                 check(not wrong, "%s: %d responses without their requests: register values kept, no numbers, "
                       "no coils, one note each and nothing malformed%s" % (
                           mode, len(self.orphans), "" if not wrong else " (wrong: %s)" % wrong[:2]))
+
+    def test_response_cut_after_its_keys(self):
+        """A response that ends right after its keys (the unit) still finds its request: the first
+        register shows; one byte shorter, it has no keys to look with and shows none."""
+        name = (lambda k: None) if self.CLIENT is None else self.CLIENT
+        frames, cuts = [], []
+        for k, cut in ((3, 0), (4, 1)):
+            txn = self.txns[k]
+            head = len(payload("response", txn, name(k))) - len(modbus("response", txn))
+            frames += [frame("request", payload("request", txn, name(k))),
+                       frame("response", payload("response", txn, name(k))[:head + 7 - cut])]
+            cuts.append(str(txn[3]) if cut == 0 else "")
+        path = self.env.add_file("cut.pcap", pcapgen.raw_pcap_bytes(frames))
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = self.rows(path, two_pass)
+                got = [rows[n]["rqc.first_register"] for n in (2, 4)]
+                check(got == cuts and rows[2]["rqc.request_in"] == "1" and not rows[2]["rqc.expert.no_request_context"],
+                      "%s: the response cut after its unit shows its request's first register, the one cut inside "
+                      "it none (%s, want %s)" % ("-2" if two_pass else "one pass", got, cuts))
 
     def test_expert_text(self):
         out = self.env.tshark(["-r", self.orphan_path, "-V", "-c", "1"]).stdout
