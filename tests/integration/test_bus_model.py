@@ -363,8 +363,31 @@ def pdo_checks(check, dissgen, source_dir, design=True):
         (pg.Datagram(5, adp=0x1002, ado=0x0600, data=el1004), None, 1),
         (pg.Datagram(5, adp=0x1003, ado=0x0600, data=fmmu(0x10001, 3, 2)), None, 1),  # EL2004 writes
     ]
+    # Position 1's SyncManagers written at once: 0 and 1 mailboxes, 2 in mailbox mode too (only 0
+    # and 1 are the mailboxes the model follows), 3 buffered; then its AL status read three times,
+    # an upload request written to its mailbox and 4 bytes of its SyncManager 2 buffer read (too
+    # few to be decoded as a mailbox).
+    sms = [(0x1000, 128, 0x26), (0x1080, 128, 0x22), (0x1100, 8, 0x26), (0x1180, 8, 0x20)]
+    states = (2, 2, 4)   # PREOP, PREOP, SAFEOP
+    steps += [(pg.Datagram(5, adp=0x1002, ado=0x0800, data=b"".join(
+        struct.pack("<HHBBBB", start, length, control, 0, 1, 0) for start, length, control in sms)), None, 1)]
+    steps += [(pg.Datagram(4, adp=0x1002, ado=0x0130, data=bytes(2)), struct.pack("<H", al), 1) for al in states]
+    steps += [(pg.Datagram(5, adp=0x1002, ado=0x1000, data=coe_mailbox(2, struct.pack("<BHBI", 0x40, 0x1018, 1, 0))),
+               None, 1),
+              (pg.Datagram(4, adp=0x1002, ado=0x1100, data=bytes(4)), None, 1)]
+    mailbox = sum(1 for d, _data, _wkc in steps if d.adp == 0x1002 and d.cmd in (4, 5) and
+                  any(start <= d.ado < start + length for start, length, _c in sms[:2]))
+    al_changes = sum(1 for a, b in zip(states, states[1:]) if a != b)
     if not design:
         steps += sii_reads(0x1002, 2, 0x03EC3052, 0x00130000) + sii_reads(0x1003, 2, 0x07D43052, 0x00100000)
+        # Then words 0x0108.. of position 2's EEPROM (past the identity), read twice: in between the
+        # address's low byte alone is written again (1 byte, 0x08): its high byte stays, and what
+        # is read there is not the identity.
+        other = struct.pack("<II", 0x0BADC0DE, 0x12345678)
+        steps += [(pg.Datagram(5, adp=0x1003, ado=0x0502, data=struct.pack("<HI", 0x0100, 0x0108)), None, 1),
+                  (pg.Datagram(4, adp=0x1003, ado=0x0508, data=bytes(8)), other, 1),
+                  (pg.Datagram(5, adp=0x1003, ado=0x0504, data=b"\x08"), None, 1),
+                  (pg.Datagram(4, adp=0x1003, ado=0x0508, data=bytes(8)), other, 1)]
         # position 3: a product the ESI file does not have (its datagrams name no model)
         steps += [(pg.Datagram(2, adp=0xFFFD, ado=0x0010, data=struct.pack("<H", 0x1004)), None, 1)]
         steps += sii_reads(0x1004, 2, 0x0BADC0DE, 0x00100000)
@@ -421,6 +444,10 @@ def pdo_checks(check, dissgen, source_dir, design=True):
             noisy = {n: r["_ws.expert.message"] for n, r in rows.items() if n <= lrw + 1 and r["_ws.expert.message"]}
             check(not noisy, "the exchanges up to the LRW, as the ring returns them, raise no expert info%s: %s"
                   % (tag, noisy))
+            stats = slave_stats(env, path, two_pass).get(1, {})
+            check((stats.get("Mailbox datagrams", 0), stats.get("AL state changes", 0)) == (mailbox, al_changes),
+                  "position 1: %d mailbox datagrams (inside SyncManagers 0 and 1), %d AL state change%s: %s"
+                  % (mailbox, al_changes, tag, stats))
             if design:
                 check(sent["ecatr.wkc.expected"] == ["3"] and ret["ecatr.wkc.expected"] == ["3"] and
                       not ret["ecatr.expert.wkc"], "expected working counter 3 (EL1004 +1, EL2004 +2), met" + tag)
