@@ -26,7 +26,11 @@
    EL2004's outputs (ecatr.pdo.el2004.*) in the frame as sent and the EL1004's inputs
    (ecatr.pdo.el1004.*) in the returned one, with the values written into the bytes here; sent
    again with its working counter already counted, returned short by 1, 2 or 3: ecatr.expert.wkc
-   naming the one slave whose part the shortfall is, none when it is two slaves' parts.
+   naming the one slave whose part the shortfall is, none when it is two slaves' parts. Every
+   exchange comes back as the ring returns it (auto-increment addresses counted up) and raises no
+   expert info; -z ecatr,tree counts position 1's mailbox datagrams (inside SyncManagers 0 and 1,
+   not 2 though it is written in mailbox mode) and AL state changes as the bytes do; EEPROM words
+   read past the identity, the address's low byte alone rewritten in between, leave it.
 7. Process data as the master configures it over CoE (generated frames, an EL1252 of
    ../shared/corpus/esi/Beckhoff_EL1xxx.xml identified from its SII): 0x1C13 and a mapping
    written one subindex at a time (with a write the slave did not take and a segmented
