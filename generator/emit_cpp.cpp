@@ -576,8 +576,13 @@ void Emitter::request_context() {
                            std::to_string(n.in_bit_group ? n.shift : 0) + ", " +
                            std::to_string(n.in_bit_group ? n.bits : 0) + " }");
     }
-    for (const Node* n : p_.request_fields)
+    std::vector<std::string> instance_rows;  // per kept field: 1 when kept per instance (read by position)
+    bool by_position = false;
+    for (const Node* n : p_.request_fields) {
         slot_rows.push_back("/* " + n->name + ", line " + std::to_string(n->line) + " */ " + std::to_string(n->slot));
+        instance_rows.push_back(n->keeps_instances ? "1" : "0");
+        by_position = by_position || n->keeps_instances;
+    }
     o_ << (p_.pairing->keys_decoded
                ? "/* request{...}: no key fields at fixed offsets (a response looks its request up with the key\n"
                  " * values decoded before its first request{...}), and the slots of the fields a request keeps\n"
@@ -585,9 +590,12 @@ void Emitter::request_context() {
                : "/* request{...}: the key fields at fixed offsets (offset, bytes, little-endian, shift, bits), and the\n"
                  " * slots of the fields a request keeps for its responses. */\n")
        << c_array("static const dg_fixed_field " + f + "_request_keys", key_rows)
-       << c_array("static const gint16 " + f + "_request_slots", slot_rows)
-       << "static const dg_request_context " << f << "_request_context = { " << f << "_request_keys, "
-       << key_rows.size() << ", " << f << "_request_slots, " << slot_rows.size() << " };\n";
+       << c_array("static const gint16 " + f + "_request_slots", slot_rows);
+    if (by_position)  // fields in a repeated node: every instance is kept
+        o_ << c_array("static const guint8 " + f + "_request_by_position", instance_rows);
+    o_ << "static const dg_request_context " << f << "_request_context = { " << f << "_request_keys, "
+       << key_rows.size() << ", " << f << "_request_slots, " << slot_rows.size() << ", "
+       << (by_position ? f + "_request_by_position" : std::string("NULL")) << " };\n";
 }
 
 void Emitter::register_functions() {
@@ -686,7 +694,7 @@ bool needs_extra(const Node& n) {
     return (n.is_leaf() && (n.display == Display::String || n.display == Display::StringZ ||
                             n.display == Display::Time)) ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
-           n.keeps_values || n.is_computed() || n.has_unit_label() || n.is_overlay();
+           n.keeps_values || n.keeps_instances || n.is_computed() || n.has_unit_label() || n.is_overlay();
 }
 
 void Emitter::extra_table() {
@@ -722,6 +730,7 @@ std::string Emitter::extra_row(const Node& n) const {
     if (!n.from_up && slot(n.from) >= 0) add("from_slot", std::to_string(slot(n.from)));
     if (n.from_up) add("from_up", std::to_string(n.from_up));
     if (n.keeps_values) add("keep_values", "");
+    if (n.keeps_instances) add("keep_instances", "");
     if (n.has_unit_label()) add("unit", c_string(" " + n.unit));
     if (slot(n.overlay) >= 0) add("overlay", std::to_string(slot(n.overlay)));
     if (n.is_computed())

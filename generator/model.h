@@ -165,6 +165,7 @@ struct Node {
     std::string value_text;                 // as written, for messages
     // derived by the validator
     bool keeps_values = false;              // an offsets table: every instance's value is kept
+    bool keeps_instances = false;           // request{...} reads it by position: each instance's value is kept
     unsigned from_up = 0;                   // from an enclosing container: k levels up (0: an earlier field)
     bool is_located() const { return offsets.has_value(); }
     // overlay="XPATH": a container decoded over the bytes of an earlier node

@@ -757,12 +757,32 @@ bool Validator::check_request_field(Node& n, Expr& e) {
                                  "or a computed value");
         return false;
     }
-    for (const Node* r = t; r; r = r->parent)
-        if (r->is_repeated()) {
-            diags_.error(n.line, what + " is inside repeated node " + quote(*r) + at_line(*r) +
-                                     ": a request keeps one value of each field; use a field outside every repeat");
+    // In a repeated node: the request keeps the value of each instance, and
+    // the reader takes the one of its own instance (its innermost repeat's
+    // index): the reply to a request's third item reads the third item.
+    const Node* repeat = nullptr;
+    for (const Node* r = t; r; r = r->parent) {
+        if (!r->is_repeated()) continue;
+        if (repeat) {
+            diags_.error(n.line, what + " is inside repeated nodes " + quote(*repeat) + at_line(*repeat) + " and " +
+                                     quote(*r) + at_line(*r) +
+                                     ": a request keeps the values of one repeat level; use a field inside one "
+                                     "repeated node at the most");
             return false;
         }
+        repeat = r;
+    }
+    if (repeat) {
+        bool reader_repeated = false;
+        for (const Node* r = &n; r && !reader_repeated; r = r->parent) reader_repeated = r->is_repeated();
+        if (!reader_repeated) {
+            diags_.error(n.line, what + " is inside repeated node " + quote(*repeat) + at_line(*repeat) +
+                                     ": a request keeps its value per instance, read by position, and " + quote(n) +
+                                     " is not inside a repeated node whose instance number would choose one; use "
+                                     "a field outside every repeat, or read it from inside a repeat");
+            return false;
+        }
+    }
     if (only_in(*t, Direction::Response)) {
         diags_.error(n.line, what + " is " + quote(*t) + at_line(*t) +
                                  ", which is decoded only in responses (direction=\"response\"): a request never "
@@ -778,6 +798,7 @@ bool Validator::check_request_field(Node& n, Expr& e) {
     e.request_index = static_cast<int>(it - kept.begin());
     if (it == kept.end()) kept.push_back(t);
     mark_slot(e.target);
+    if (repeat) e.target->keeps_instances = true;
     return true;
 }
 

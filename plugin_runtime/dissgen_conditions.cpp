@@ -61,6 +61,28 @@ void table_append(dg_state *st, const dg_node *n, guint64 value)
     t->values[t->count++] = value;
 }
 
+void table_put(dg_state *st, const dg_node *n, guint64 value)
+{
+    dg_table *t = table_of(st, n->slot);
+    const guint i = st->instance;
+    if (i >= DG_MAX_TABLE) {
+        t->overflow = TRUE;
+        return;
+    }
+    if (i >= t->capacity) {
+        guint capacity = t->capacity ? t->capacity : 16;
+        while (capacity <= i) capacity *= 2;
+        capacity = MIN(capacity, (guint)DG_MAX_TABLE);
+        t->values = (guint64 *)wmem_realloc(st->pinfo->pool, t->values, capacity * sizeof(guint64));
+        t->present = (guint8 *)wmem_realloc(st->pinfo->pool, t->present, capacity);
+        memset(t->present + t->capacity, 0, capacity - t->capacity);
+        t->capacity = capacity;
+    }
+    t->values[i] = value;
+    t->present[i] = 1;
+    if (i >= t->count) t->count = i + 1;
+}
+
 /* The slot says the table is there, even when no instance follows (a count of 0). */
 void table_reset(dg_state *st, const dg_node *n, gint offset)
 {

@@ -41,7 +41,17 @@ typedef struct dg_request_values {
     guint count;
     guint64 *values;
     guint8 *present;         /* per value: the request had the field */
+    /* per value, for a field kept by position (dg_request_context.by_position):
+     * its instances (NULL when the request had none, or no field is kept so) */
+    const struct dg_request_table *tables;
 } dg_request_values;
+
+/* A field's value in each instance of its repeated node, in a request. */
+typedef struct dg_request_table {
+    guint count;
+    const guint64 *values;
+    const guint8 *present;   /* per instance: decoded */
+} dg_request_table;
 
 /* The requests a message proved lost: each was given up while this message
  * was paired (its key reused, or its timeout passed). */

@@ -33,7 +33,7 @@ const guint32 frame_key = 0x72716378u; /* "rqcx" */
 
 /* Saved for a message that found no request: a frame without it was not
  * decoded on the first pass. */
-const dg_request_values no_request = {0, NULL, NULL};
+const dg_request_values no_request = {0, NULL, NULL, NULL};
 
 expert_field ei_no_request_context = EI_INIT;
 
@@ -87,10 +87,22 @@ const dg_request_values *keep_values(const dg_state *st)
     v->count = rc->kept_count;
     v->values = wmem_alloc_array(wmem_file_scope(), guint64, rc->kept_count);
     v->present = (guint8 *)wmem_alloc0(wmem_file_scope(), rc->kept_count);
+    v->tables = NULL;
     for (guint16 i = 0; i < rc->kept_count; i++) {
         const gint16 slot = rc->slots[i];
         v->present[i] = st->present[slot];
         v->values[i] = st->present[slot] ? st->slots[slot].value : 0;
+    }
+    if (rc->by_position) {
+        dg_request_table *tables = wmem_alloc0_array(wmem_file_scope(), dg_request_table, rc->kept_count);
+        for (guint16 i = 0; i < rc->kept_count; i++) {
+            const dg_table *t = rc->by_position[i] && st->tables ? &st->tables[rc->slots[i]] : NULL;
+            if (!t || !t->count) continue;
+            tables[i].count = t->count;
+            tables[i].values = (const guint64 *)wmem_memdup(wmem_file_scope(), t->values, t->count * sizeof(guint64));
+            tables[i].present = (const guint8 *)wmem_memdup(wmem_file_scope(), t->present, t->count);
+        }
+        v->tables = tables;
     }
     return v;
 }
@@ -136,7 +148,16 @@ gboolean read_request(const void *context, gint16 index, guint64 *value)
         st->request_missed = TRUE;
         return FALSE;
     }
-    if (index < 0 || (guint)index >= st->request->count || !st->request->present[index]) return FALSE;
+    if (index < 0 || (guint)index >= st->request->count) return FALSE;
+    const dg_request_context *rc = st->p->request_context;
+    if (rc->by_position && rc->by_position[index]) {
+        /* by position: the request's instance of the reader's own instance number */
+        const dg_request_table *t = &st->request->tables[index];
+        if (st->instance >= t->count || !t->present[st->instance]) return FALSE;
+        *value = t->values[st->instance];
+        return TRUE;
+    }
+    if (!st->request->present[index]) return FALSE;
     *value = st->request->values[index];
     return TRUE;
 }

@@ -87,6 +87,8 @@ typedef struct dg_extra {
     gint16 from_slot = -1;
     guint8 from_up = 0;
     guint8 keep_values = 0;   /* an offset leaf: the value of every instance is kept (up to DG_MAX_TABLE) */
+    guint8 keep_instances = 0; /* request{...} reads it by position: each instance's value is kept, at its
+                                * instance number (up to DG_MAX_TABLE) */
     const char *unit = nullptr; /* unit="°C" on a number: " °C", written after its value in summaries */
     /* overlay="XPATH": this container decodes the bytes of the node in
      * overlay_slot (a leaf or container decoded before it: its slot keeps
@@ -220,6 +222,10 @@ typedef struct dg_request_context {
     guint16 key_count;          /* 0: the keys the walk decoded (DG_KEY), read when needed */
     const gint16 *slots;        /* the slots of the fields a request keeps */
     guint16 kept_count;
+    /* per kept field, 1: it is in a repeated node, the request keeps each
+     * instance's value (the slot's table) and a response reads the one of its
+     * own instance number; NULL: no such field */
+    const guint8 *by_position;
 } dg_request_context;
 
 typedef struct dg_protocol {

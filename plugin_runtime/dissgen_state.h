@@ -51,6 +51,7 @@ struct dg_table {
     guint64 *values;
     guint count, capacity;
     gboolean overflow; /* more than DG_MAX_TABLE instances */
+    guint8 *present;   /* keep_instances: per instance, decoded (values[i] holds it); count: the last one + 1 */
 };
 
 /* Summaries of one repeated node's instances, gathered for the Info column
@@ -123,6 +124,8 @@ gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char
 /* The table of the offset leaf in `slot`, allocated on first use. */
 dg_table *table_of(dg_state *st, gint16 slot);
 void table_append(dg_state *st, const dg_node *n, guint64 value);
+/* keep_instances: the value of the current instance (st->instance). */
+void table_put(dg_state *st, const dg_node *n, guint64 value);
 /* An offset leaf's repetition starts a new, empty table. */
 void table_reset(dg_state *st, const dg_node *n, gint offset);
 
@@ -208,6 +211,7 @@ static inline __attribute__((always_inline)) void store(dg_state *st, const dg_n
     if (n->flags & DG_KEY) key_append(st, value);
     if (n->slot < 0) return;
     if (n->extra && n->extra->keep_values) table_append(st, n, value);
+    if (n->extra && n->extra->keep_instances) table_put(st, n, value);
     dg_slot *s = &st->slots[n->slot];
     s->value = value;
     s->offset = offset;

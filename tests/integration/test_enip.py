@@ -889,20 +889,23 @@ class Services(unittest.TestCase):
         names = [self.P + "service", self.P + "rr", self.P + "genstat", self.P + "msp.count", self.P + "msp.offset",
                  self.P + "msp.request.service", self.P + "msp.request.path.class", self.P + "msp.request.data",
                  self.P + "msp_reply.count", self.P + "msp_reply.offset", self.P + "msp_reply.reply.service",
-                 self.P + "msp_reply.reply.genstat", self.P + "msp_reply.reply.data", self.P + "data", "_ws.expert"]
+                 self.P + "msp_reply.reply.genstat", self.P + "msp_reply.reply.data",
+                 self.P + "msp_reply.reply.requested_attribute", self.P + "msp_reply.reply.id_attr.vendor",
+                 self.P + "data", "_ws.expert"]
         rows = fields(ENV, cap, names)
         # each embedded request: its service, class and data (the second one's three words)
         self.assertEqual([rows[0][n] for n in names],
                          ["0x0a", "0x00", "", "2", "6,14", "0x0e,0x03", "0x01,0xf5", "02 00 03 00 05 00",
-                          "", "", "", "", "", "", ""])
-        # each embedded reply: its service and status; the first one's data
+                          "", "", "", "", "", "", "", "", ""])
+        # each embedded reply: its service and status; the first one decoded by the first embedded
+        # request (Identity, attribute 1: the vendor), the second one (TCP/IP object) has no data
         self.assertEqual([rows[1][n] for n in names],
                          ["0x0a", "0x01", "0x1e", "", "", "", "", "", "2", "6,12", "0x0e,0x03", "0x00,0x05",
-                          "01 00", "", ""])
+                          "", "1", "0x0001", "", ""])
         # An error reply carries no services: nothing to decode, nothing malformed to report; its
         # request (the same sender context) was answered by the first reply, so it says that it
         # cannot read what its request named.
-        self.assertEqual([rows[2][n] for n in names], ["0x0a", "0x01", "0x08"] + [""] * 11 + [NO_REQUEST_NOTE])
+        self.assertEqual([rows[2][n] for n in names], ["0x0a", "0x01", "0x08"] + [""] * 13 + [NO_REQUEST_NOTE])
         s = differential(ENV.path("msp.pcap"))
         self.assertEqual(s["frames_differ"], [])
         self.assertEqual(s["fields"], s["agree"])
@@ -1052,14 +1055,16 @@ IDENTITY_FIELDS = (("cip.id.vendor_id", "vendor"), ("cip.id.device_type", "devty
                    ("cip.id.product_code", "prodcode"), ("cip.id.major_rev", "revision.major"),
                    ("cip.id.minor_rev", "revision.minor"), ("cip.id.status", "status"),
                    ("cip.id.serial_number", "serial"), ("cip.id.product_name", "name"))
-OUR_IDENTITY = ("enipr.cpf.item.cip.id.", "enipr.cpf.item.cip.id_attr.", "enipr.cpf.item.cip.id_list.attr.value.")
+OUR_IDENTITY = ("enipr.cpf.item.cip.id.", "enipr.cpf.item.cip.id_attr.", "enipr.cpf.item.cip.id_list.attr.value.",
+                "enipr.cpf.item.cip.msp_reply.reply.id.", "enipr.cpf.item.cip.msp_reply.reply.id_attr.",
+                "enipr.cpf.item.cip.msp_reply.reply.id_list.attr.value.")
 
 
 def identity_values(capture_path):
-    """Per capture and Identity field: Wireshark's values outside Multiple Service Packet
-    replies, ours equal to them, different, missing; ours in all; Wireshark's inside Multiple
-    Service Packet replies (their requests are items of an offset table, which a request does
-    not keep: left raw); the differences."""
+    """Per capture and Identity field: Wireshark's values, ours equal to them, different,
+    missing; ours in all; how many of Wireshark's are inside Multiple Service Packet replies
+    (each decoded by the embedded request at its position: request{...} of a field in a
+    repeated node); the differences."""
     theirs_names = [t for t, _ in IDENTITY_FIELDS]
     ours_names = [prefix + o for _, o in IDENTITY_FIELDS for prefix in OUR_IDENTITY]
     theirs = fields(BARE, capture_path, ["frame.number", "cip.service"] + theirs_names)
@@ -1081,7 +1086,6 @@ def identity_values(capture_path):
             c["ours"] += len(b)
             if msp:
                 c["in_msp"] += len(a)
-                continue
             c["wireshark"] += len(a)
             same = sum(1 for x, y in zip(a, b) if x == y)
             c["equal"] += same
@@ -1099,25 +1103,28 @@ class IdentityReplies(TsharkTestCase, unittest.TestCase):
 
     def test_identity_values_agree_with_wireshark(self):
         corpus, files = corpus_files(self)
-        grand = 0
+        grand = grand_msp = 0
         with self.checks() as check:
             for f in files:
                 total, per_field, diffs = identity_values(ENV.readable(os.path.join(corpus, f)))
                 grand += total["wireshark"]
+                grand_msp += total["in_msp"]
                 if not total["wireshark"] and not total["ours"] and not total["in_msp"]:
                     continue
-                print("%s: Wireshark's cip.id values %d: ours equal %d, different %d, missing %d; %d more in "
-                      "Multiple Service Packet replies, left raw (%s)" % (
+                print("%s: Wireshark's cip.id values %d: ours equal %d, different %d, missing %d; %d of them in "
+                      "Multiple Service Packet replies (%s)" % (
                           f, total["wireshark"], total["equal"], total["different"], total["missing"],
                           total["in_msp"], ", ".join("%s %d/%d%s" % (
-                              n.split(".")[-1], c["equal"], c["wireshark"], "+%d" % c["in_msp"] if c["in_msp"] else "")
+                              n.split(".")[-1], c["equal"], c["wireshark"], " (%d in MSP)" % c["in_msp"] if c["in_msp"] else "")
                               for n, c in per_field.items() if c["wireshark"] or c["in_msp"])), file=sys.stderr)
                 check(total["ours"] == total["equal"], "%s: ours decode no Identity value Wireshark does not" % f)
                 check(not diffs, "%s: every Identity value as Wireshark's cip.id.* (%s)"
                       % (f, "; ".join(diffs[:5]) or "%d values" % total["wireshark"]))
-            # EIP-RebootorRestart.pcap has Get Attributes All and Get Attribute List replies
+            # EIP-RebootorRestart.pcap has Get Attributes All and Get Attribute List replies, and
+            # Get Attribute List replies inside Multiple Service Packet replies (as enip_cip_example)
             if "EIP-RebootorRestart.pcap" in files:
                 check(grand > 0, "the corpus has Identity values to compare")
+                check(grand_msp > 0, "the corpus has Identity values inside Multiple Service Packet replies")
 
 
 def connected(seq, cip, connection, session=0x11020100):

@@ -41,7 +41,7 @@ import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pcapgen as pg  # noqa: E402
-from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
+from tshark_env import TsharkTestCase, relative_time_ns, run_unittests  # noqa: E402
 
 NAMES = pg.CMD_NAMES
 WRITES = {2, 5, 8, 11}                  # APWR FPWR BWR LWR
@@ -151,7 +151,8 @@ def decode(env, path, two_pass):
 
 # --------------------------------------------------------------- computed values
 
-COMPUTED = ["ecatr.datagram.mbx.totallength", "ecatr.datagram.mbx.length", "ecatr.gateway.totallength"]
+COMPUTED = ["ecatr.datagram.mbx.totallength", "ecatr.datagram.mbx.length", "ecatr.gateway.totallength",
+            "ecatr.datagram.recvdelay1"]
 
 
 def mailbox(length, mtype=0x6, data_len=None):
@@ -179,6 +180,19 @@ def computed_frames():
     for length in (0, 12, 300):
         out.append((pg.Frame([], header_type=5, padding=mailbox(length)),
                     {"ecatr.gateway.totallength": [str(length + 6)]}))
+    # DC receive times read back (0x0900 on): port 1's minus port 0's, modulo 2^32 (the local
+    # clock wraps); a read that does not cover port 1's time, a write and an unanswered read
+    # (working counter 0: not the slave's bytes) have none.
+    for cmd, ado, times, wkc, want in (
+            (4, 0x0900, (1000, 1600), 1, ["600"]), (7, 0x0900, (0xFFFFFF00, 0x100, 5, 6), 3, ["512"]),
+            (1, 0x0900, (0x10, 0x10), 1, ["0"]), (4, 0x08FC, (7, 1000, 1310), 1, ["310"]),
+            (4, 0x0900, (1000,), 1, []), (5, 0x0900, (1000, 1600), 1, []), (4, 0x0900, (1000, 1600), 0, [])):
+        d = pg.Datagram(cmd=cmd, idx=9, adp=0x1001, ado=ado, data=struct.pack("<%dI" % len(times), *times), wkc=wkc)
+        out.append((pg.Frame([d]), {"ecatr.datagram.recvdelay1": want}))
+    # Two reads in one frame, each with its own difference.
+    ds = [pg.Datagram(cmd=4, idx=10 + k, adp=0x1001 + k, ado=0x0900, data=struct.pack("<II", 50, 50 + d), wkc=1)
+          for k, d in enumerate((200, 90))]
+    out.append((pg.Frame(ds), {"ecatr.datagram.recvdelay1": ["200", "90"]}))
     return out
 
 
@@ -267,6 +281,32 @@ class TestEscCommands(TsharkTestCase, unittest.TestCase):
                 len(fs), "".join("\n       " + b for b in bad[:6])))
             shown = env.tshark(["-r", path, "-V", "-Y", "frame.number == 1"]).stdout
             check("[Total length: 16 bytes]" in shown, "the tree shows the value with its unit (16 bytes)")
+            shown = env.tshark(["-r", path, "-V", "-Y", "ecatr.datagram.recvdelay1 == 600"]).stdout
+            check("[Loop delay port 0 to port 1: 600 ns]" in shown, "the tree shows the loop delay in ns")
+
+    def test_loop_delay_on_real_captures(self):
+        """ecatr.datagram.recvdelay1 on the corpus's reads of the DC receive times: port 1's
+        time minus port 0's (as ecatr.datagram.reg.recv0/recv1 show them), modulo 2^32 ns."""
+        folder = os.path.join(os.path.abspath(self.args.source_dir), "..", "shared", "corpus", "ethercat")
+        names = [f for f in ("replay-dc.pcapng", "replay-ek1100-el2828-el2889.pcapng") if os.path.exists(
+            os.path.join(folder, f))]
+        if not names:
+            self.skipTest("no EtherCAT corpus at %s" % folder)
+        with self.checks() as check:
+            for name in names:
+                path = self.env.readable(os.path.join(folder, name))
+                rows = self.env.field_rows(path, ["frame.number", "ecatr.datagram.reg.recv0", "ecatr.datagram.reg.recv1",
+                                                  "ecatr.datagram.recvdelay1"], aggregator="|",
+                                           display_filter="ecatr.datagram.recvdelay1")
+                bad, n = [], 0
+                for frame, r in rows.items():
+                    want = [str((relative_time_ns(b) - relative_time_ns(a)) % 2**32)
+                            for a, b in zip(r["ecatr.datagram.reg.recv0"], r["ecatr.datagram.reg.recv1"])]
+                    n += len(want)
+                    if r["ecatr.datagram.recvdelay1"] != want:
+                        bad.append((frame, r))
+                check(n > 0 and not bad, "%s: %d loop delays, each port 1's receive time minus port 0's%s"
+                      % (name, n, ": %s" % bad[:3] if bad else ""))
 
 
 if __name__ == "__main__":

@@ -258,6 +258,13 @@ def request_context_frames():
     return paired + [m.frame("response", m.payload("response", t)) for t in txns[:10]]
 
 
+def request_by_position_frames():
+    """tests/rules/request_by_position.xml: batches answered by position, out of order, then
+    responses without their requests (test_request_context.py's messages)."""
+    import test_request_context as m
+    return m.batch_frames(47506, 20)[3]
+
+
 def request_context_decoded_keys_frames():
     """tests/rules/request_context_decoded_keys.xml: the same, each message behind a client name
     of its own length, so that the keys are not at fixed offsets."""
@@ -307,6 +314,7 @@ CAPTURES = {
     "tests/rules/computed.xml": computed_frames,
     "tests/rules/request_context.xml": request_context_frames,
     "tests/rules/request_context_decoded_keys.xml": request_context_decoded_keys_frames,
+    "tests/rules/request_by_position.xml": request_by_position_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,

@@ -12,7 +12,9 @@ both show the request's reference as the first register, right after the keys, a
 that ends there (and none when it ends inside them).
 Checked against the bytes in one pass and with -2. The same capture without its requests:
 every response decodes what it can (register values, no numbers, no coils), says so with
-rqc.expert.no_request_context once, and raises no malformed expert. Needs no corpus.
+rqc.expert.no_request_context once, and raises no malformed expert. And a field of a repeated
+node read by position (tests/rules/request_by_position.xml): each answer of a batch decoded by
+the request's operation at its position. Needs no corpus.
 """
 
 import os
@@ -239,6 +241,97 @@ class TestRequestContextDecodedKeys(TestRequestContext):
     decoded before its first request{...}."""
     RULES = "request_context_decoded_keys.xml"
     CLIENT = staticmethod(client_name)
+
+
+# --- request{Name} by position (tests/rules/request_by_position.xml, UDP 47505) -------------
+
+BATCH_PORT = 47505
+BATCH_FIELDS = ["frame.number", "batch.answer.word", "batch.answer.text", "batch.expert.no_request_context",
+                "_ws.expert.severity"]
+
+
+def batches(seed, n):
+    """n batches: (transaction, [(kind, address, answer)]): kind 1 a word, kind 2 a text."""
+    rng = random.Random(seed)
+    out = []
+    for t in range(n):
+        ops = []
+        for _ in range(rng.choice([0, 1, 2, 3, 5, 8])):
+            kind = rng.choice([1, 2])
+            answer = rng.randrange(0x10000) if kind == 1 else bytes(rng.choice(b"abcxyz") for _ in range(rng.randrange(1, 6)))
+            ops.append((kind, rng.randrange(0x10000), answer))
+        out.append((0x100 + t, ops))
+    return out
+
+
+def batch_message(direction, batch):
+    transaction, ops = batch
+    head = struct.pack(">HB", transaction, len(ops))
+    if direction == "request":
+        return head + b"".join(struct.pack(">BH", kind, address) for kind, address, _ in ops)
+    return head + b"".join(struct.pack(">H", a) if kind == 1 else bytes([len(a)]) + a for kind, _, a in ops)
+
+
+def batch_frame(direction, data):
+    sport, dport = (40001, BATCH_PORT) if direction == "request" else (BATCH_PORT, 40001)
+    src, dst = (CLIENT, SERVER) if direction == "request" else (SERVER, CLIENT)
+    u = struct.pack("!HHHH", sport, dport, 8 + len(data), 0) + data
+    ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src, dst)
+    ip = ip[:10] + struct.pack("!H", pcapgen.ip_checksum(ip)) + ip[12:]
+    return b"\x02\x00\x00\x00\x00\x02\x02\x00\x00\x00\x00\x01\x08\x00" + ip + u
+
+
+def batch_frames(seed=47505, n=40):
+    """The batches' requests and responses, several in flight and answered out of order, then
+    five responses again without their requests (transactions never sent)."""
+    bs = batches(seed, n)
+    order = schedule(bs, seed)
+    frames = [batch_frame(d, batch_message(d, bs[k])) for d, k in order]
+    orphans = [(0x7000 + k, ops) for k, (_, ops) in enumerate(bs) if ops][:5]
+    return bs, order, orphans, frames + [batch_frame("response", batch_message("response", b)) for b in orphans]
+
+
+class TestRequestByPosition(TsharkTestCase, unittest.TestCase):
+    """A field of a repeated node read by position: each answer of a batch is a word or a text
+    as the operation at its position in the request says (request{Kind} in the answer's
+    repeat, the request keeping every operation's Kind). Requests in flight together, answered
+    out of order; responses without their requests show no word and no text, and say so."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "request_by_position.xml"), "batch")
+        cls.batches, cls.order, cls.orphans, frames = batch_frames()
+        cls.path = cls.env.add_file("batches.pcap", pcapgen.raw_pcap_bytes(frames))
+
+    def test_answers_decoded_by_the_operation_at_their_position(self):
+        in_flight = max(sum(1 for d, k in self.order[:i] if d == "request") -
+                        sum(1 for d, k in self.order[:i] if d == "response") for i in range(len(self.order)))
+        with self.checks() as check:
+            check(in_flight > 1, "batches in flight together (%d at most)" % in_flight)
+            for two_pass in (False, True):
+                mode = "-2" if two_pass else "one pass"
+                rows = {n: {f: ",".join(v) for f, v in r.items()}
+                        for n, r in self.env.field_rows(self.path, BATCH_FIELDS, two_pass).items()}
+                wrong = []
+                for n, (d, k) in enumerate(self.order, 1):
+                    if d != "response":
+                        continue
+                    ops = self.batches[k][1]
+                    want = {"batch.answer.word": ",".join("0x%04x" % a for kind, _, a in ops if kind == 1),
+                            "batch.answer.text": ",".join(a.decode() for kind, _, a in ops if kind == 2),
+                            "batch.expert.no_request_context": ""}
+                    got = {f: rows[n][f] for f in want}
+                    if got != want:
+                        wrong.append((n, got, want))
+                check(not wrong, "%s: %d responses, each answer a word or a text as its request's operation at "
+                      "the same position says%s" % (mode, sum(1 for d, _ in self.order if d == "response"),
+                                                    "" if not wrong else " (wrong: %s)" % wrong[:2]))
+                first = len(self.order) + 1
+                orphan_rows = [rows[first + i] for i in range(len(self.orphans))]
+                check(all(r["batch.answer.word"] == "" and r["batch.answer.text"] == "" and
+                          r["batch.expert.no_request_context"] == "1" for r in orphan_rows),
+                      "%s: responses without their requests: no word, no text, one note each (%s)"
+                      % (mode, [(r["batch.answer.word"], r["batch.expert.no_request_context"]) for r in orphan_rows]))
 
 
 if __name__ == "__main__":

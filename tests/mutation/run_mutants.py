@@ -111,6 +111,7 @@ TESTS = {
     "computed": integration("test_computed.py"),
     "overlays": integration("test_overlays.py"),
     "request_context": integration("test_request_context.py"),
+    "request_by_position": integration("test_request_context.py", "TestRequestByPosition"),
     "losses": integration("test_losses.py"),
     "losses_corpus": integration("test_losses.py", "--with-corpus"),
     "findings": integration("test_findings.py"),
