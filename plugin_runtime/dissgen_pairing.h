@@ -7,8 +7,12 @@
  *   capture state (one per open capture, reset by the init routine)
  *     key values -> pending requests (oldest first), the last message seen
  *     the analysis's capture-wide state (e.g. a model of the EtherCAT bus)
- *   frame state (p_add_proto_data, one per message of a frame)
- *     dg_frame_pairing: role, the transaction, the analysis's result
+ *   frame state (a compact record per message: the capture's frame table,
+ *   indexed by frame number, for a frame's first message; p_add_proto_data
+ *   for the others), only what display needs: the role, the partner's
+ *   frame, the round trip, the analysis's result; a request's transaction
+ *   only while it is not answered. dg_pairing_dissect() hands out the
+ *   record as a dg_frame_pairing (and its dg_transaction) in pinfo->pool.
  *
  * Later passes (tshark -2, the GUI in any order, display filters) only read
  * what the first pass stored, so they show the same items. A protocol
