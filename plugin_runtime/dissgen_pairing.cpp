@@ -43,11 +43,12 @@ struct pair_key {
     guint64 *values;
 };
 
-/* What later passes show of one message: kept for the whole capture, so as
- * small as it can be. The first message of each frame keeps it in the
- * capture's frame table (inline, indexed by frame number), any other
- * message of a frame with p_add_proto_data. A request's transaction is kept
- * only while it is not answered (an unanswered one says why on display); once
+/* What later passes show of one message: kept for the whole capture, so 16
+ * bytes. The first message of each frame keeps it in the capture's frame
+ * table (inline, indexed by frame number), any other message of a frame
+ * with p_add_proto_data. What few messages need sits in maps beside the
+ * table: the requests it proved lost, a round trip beyond 2 s, and the
+ * transaction of a request not answered (which says why on display); once
  * answered, the two frames' numbers and the round trip say everything. */
 struct kept {
     guint32 partner;      /* request: its response's frame (0: none yet); response: its
@@ -55,12 +56,11 @@ struct kept {
     guint8 role;          /* dg_role; 0: not paired on the first pass */
     guint8 out_of_order;  /* response: a later request was answered first */
     guint16 lost_count;   /* requests it proved lost (capture_state.lost_lists) */
-    union {
-        gint64 round_trip_ns;  /* response */
-        dg_transaction *txn;   /* request not answered (yet) */
-    } u;
-    void *analysis;       /* response: the analysis's comparison; request: its sent() result */
+    gint32 round_trip;    /* response: in ns; long_trip: see capture_state.long_trips */
+    guint32 analysis;     /* response: the analysis's comparison; request: its sent() result */
 };
+static_assert(sizeof(kept) == 16, "kept grew");
+const gint32 long_trip = G_MININT32;
 
 /* Frames per chunk of the frame table: chunks never move, so a kept record
  * stays where pending requests and key entries point. */
@@ -126,6 +126,8 @@ struct capture_state {
     gboolean clock_set;
     wmem_array_t *table;         /* the frame table: chunks of table_chunk kept records */
     wmem_map_t *lost_lists;      /* kept record -> the dg_lost it proved (kept.lost_count) */
+    wmem_map_t *long_trips;      /* kept record -> its round trip in ns (gint64), beyond a gint32 */
+    wmem_map_t *unanswered;      /* kept record of a request not answered -> its transaction */
     /* The requests the message being paired proves lost (give_up). */
     guint32 frame;               /* that message's frame */
     dg_lost *lost;
@@ -188,6 +190,8 @@ capture_state *current_capture(void)
         capture->scope_answered = wmem_array_sized_new(wmem_file_scope(), sizeof(guint64), 4);
         capture->table = wmem_array_new(wmem_file_scope(), sizeof(kept *));
         capture->lost_lists = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+        capture->long_trips = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+        capture->unanswered = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
         guint64 none = 0;
         wmem_array_append_one(capture->scope_answered, none);
         if (analysis && analysis->capture_new) capture->analysis = analysis->capture_new(protocol);
@@ -565,7 +569,7 @@ void orphan_guessed_from(capture_state *c, const packet_info *pinfo)
     for (pending *q = c->sent.head; q && c->guessed; q = q->next_sent) {
         if (q->done || !q->guessed || !addresses_equal(&q->src, &pinfo->src)) continue;
         q->record->role = DG_ROLE_ORPHAN;
-        q->record->u.txn = NULL;
+        wmem_map_remove(c->unanswered, q->record);
         retire(c, q);
         wmem_free(wmem_file_scope(), q->txn); /* retired without a loss: nothing names it */
     }
@@ -634,7 +638,13 @@ void response_to(capture_state *c, dg_transaction *t, kept *request, const guint
     nstime_delta(&t->round_trip, &pinfo->abs_ts, &t->request_time);
     k->partner = t->request_frame;
     /* nstime_delta gives seconds and nanoseconds of one sign: exact both ways. */
-    k->u.round_trip_ns = (gint64)t->round_trip.secs * 1000000000 + t->round_trip.nsecs;
+    gint64 ns = (gint64)t->round_trip.secs * 1000000000 + t->round_trip.nsecs;
+    if (ns > long_trip && ns <= G_MAXINT32) {
+        k->round_trip = (gint32)ns;
+    } else {
+        k->round_trip = long_trip;
+        wmem_map_insert(c->long_trips, k, wmem_memdup(wmem_file_scope(), &ns, sizeof ns));
+    }
     guint64 *answered = answered_in(c, t);
     k->out_of_order = protocol->pairing->ordered && t->seq < *answered;
     if (t->seq > *answered) *answered = t->seq;
@@ -645,7 +655,7 @@ void response_to(capture_state *c, dg_transaction *t, kept *request, const guint
         tvb_free(bytes);
     }
     request->partner = pinfo->num;
-    request->u.txn = NULL;
+    wmem_map_remove(c->unanswered, request);
     wmem_free(wmem_file_scope(), t);
 }
 
@@ -694,7 +704,7 @@ void new_request(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, packet_
     t->seq = ++c->requests;
     t->order_scope = order_scope_of(c, pinfo);
     k->role = DG_ROLE_REQUEST;
-    k->u.txn = t;
+    wmem_map_insert(c->unanswered, k, t);
     if (!nstime_is_zero(&e->last_request_time) && nstime_cmp(&pinfo->abs_ts, &e->last_request_time) > 0)
         nstime_delta(&e->request_period, &pinfo->abs_ts, &e->last_request_time);
     e->last_request_time = pinfo->abs_ts;
@@ -799,20 +809,24 @@ const dg_frame_pairing *view_of(const capture_state *c, const kept *k, packet_in
     switch (k->role) {
     case DG_ROLE_REQUEST:
         if (!k->partner) {
-            fp->txn = k->u.txn; /* not answered: its own transaction */
+            /* not answered: its own transaction */
+            fp->txn = (dg_transaction *)wmem_map_lookup(c->unanswered, k);
             break;
         }
         v->txn.request_frame = pinfo->num;
         v->txn.response_frame = k->partner;
         fp->txn = &v->txn;
         break;
-    case DG_ROLE_RESPONSE:
+    case DG_ROLE_RESPONSE: {
         v->txn.request_frame = k->partner;
         v->txn.response_frame = pinfo->num;
-        v->txn.round_trip.secs = (time_t)(k->u.round_trip_ns / 1000000000);
-        v->txn.round_trip.nsecs = (int)(k->u.round_trip_ns % 1000000000);
+        gint64 ns = k->round_trip;
+        if (k->round_trip == long_trip) ns = *(const gint64 *)wmem_map_lookup(c->long_trips, k);
+        v->txn.round_trip.secs = (time_t)(ns / 1000000000);
+        v->txn.round_trip.nsecs = (int)(ns % 1000000000);
         fp->txn = &v->txn;
         break;
+    }
     case DG_ROLE_DUPLICATE:
         fp->duplicate_of = k->partner;
         break;

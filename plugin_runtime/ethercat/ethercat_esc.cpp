@@ -74,14 +74,15 @@ struct kind {
 };
 
 /* One EtherCAT frame, sent or returned: kept for every frame of the
- * capture, so 16 bytes, handed out from chunks (capture_hints.records). */
+ * capture, so 16 bytes, in chunks (capture_hints.records); the pairing keeps
+ * its number (from 1). */
 struct record {
     guint32 kind;                     /* into capture_hints.kinds */
     guint16 cycle;                    /* its bus_frame's cycle and timing */
     decltype(bus_frame::timing) timing;
 };
 static_assert(sizeof(record) <= 16, "record grew");
-const guint records_per_chunk = 4096;
+const guint records_shift = 12, records_per_chunk = 1u << records_shift;
 
 struct capture_hints {
     gboolean marking_seen; /* a slave set the locally administered bit: the capture shows direction */
@@ -91,8 +92,8 @@ struct capture_hints {
     wmem_map_t *shapes;    /* shape -> itself */
     wmem_array_t *kinds;   /* the kinds of frame seen */
     wmem_map_t *kind_ids;  /* kind -> its index in kinds + 1 */
-    record *records;       /* the chunk records are handed out from */
-    guint records_used;    /* of it */
+    wmem_array_t *records; /* chunks of records_per_chunk records */
+    guint32 record_count;
 };
 
 /* The capture's hints: what a record's kind indexes. (A record is shown
@@ -222,7 +223,7 @@ gboolean kind_equal(gconstpointer a, gconstpointer b)
 }
 
 /* A frame's record: its comparison (NULL for a frame as sent) and its slaves. */
-record *new_record(capture_hints *h, const shape *esc, const bus_frame *f)
+guint32 new_record(capture_hints *h, const shape *esc, const bus_frame *f)
 {
     kind probe = {esc, f->shape};
     guint id = GPOINTER_TO_UINT(wmem_map_lookup(h->kind_ids, &probe));
@@ -231,20 +232,23 @@ record *new_record(capture_hints *h, const shape *esc, const bus_frame *f)
         id = wmem_array_get_count(h->kinds);
         wmem_map_insert(h->kind_ids, wmem_memdup(wmem_file_scope(), &probe, sizeof probe), GUINT_TO_POINTER(id));
     }
-    if (!h->records || h->records_used == records_per_chunk) {
-        h->records = wmem_alloc_array(wmem_file_scope(), record, records_per_chunk);
-        h->records_used = 0;
+    if (h->record_count % records_per_chunk == 0) {
+        record *chunk = wmem_alloc_array(wmem_file_scope(), record, records_per_chunk);
+        wmem_array_append_one(h->records, chunk);
     }
-    record *r = &h->records[h->records_used++];
+    guint32 n = h->record_count++;
+    record *r = &(*(record **)wmem_array_index(h->records, n >> records_shift))[n % records_per_chunk];
     r->kind = id - 1;
     r->cycle = f->cycle;
     r->timing = f->timing;
-    return r;
+    return n + 1;
 }
 
-/* What record r keeps: its frame's slaves and timing, and its comparison. */
-bus_frame frame_of(const record *r, const shape **esc)
+/* What record `number` keeps: its frame's slaves and timing, and its comparison. */
+bus_frame frame_of(guint32 number, const shape **esc)
 {
+    guint32 n = number - 1;
+    const record *r = &(*(record **)wmem_array_index(hints->records, n >> records_shift))[n % records_per_chunk];
     const kind *k = (const kind *)wmem_array_index(hints->kinds, r->kind);
     if (esc) *esc = k->esc;
     bus_frame f;
@@ -261,6 +265,7 @@ void *esc_capture_new(const dg_protocol *p)
     h->shapes = wmem_map_new(wmem_file_scope(), shape_hash, shape_equal);
     h->kinds = wmem_array_new(wmem_file_scope(), sizeof(kind));
     h->kind_ids = wmem_map_new(wmem_file_scope(), kind_hash, kind_equal);
+    h->records = wmem_array_new(wmem_file_scope(), sizeof(record *));
     h->bus = bus_new(static_cast<const dg_bus *>(p->analysis_data));
     h->cycles = cycles_new();
     return h;
@@ -344,7 +349,7 @@ gboolean esc_key_changed(tvbuff_t *request, tvbuff_t *message)
 }
 
 
-void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, const dg_transaction *txn, packet_info *pinfo)
+guint32 esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, const dg_transaction *txn, packet_info *pinfo)
 {
     datagram sent[max_datagrams], back[max_datagrams];
     guint sent_length, back_length;
@@ -456,10 +461,10 @@ gboolean unusual(const compared *c)
     return c->changed || (is_write(c->sent.cmd) && c->data_changed) || wkc_added(c) < 0 || c->forwarding;
 }
 
-void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+void esc_show(guint32 data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     const shape *r;
-    const bus_frame frame = frame_of((const record *)data, &r);
+    const bus_frame frame = frame_of(data, &r);
     /* Printed: every datagram with the preference, else the unusual ones. The
      * others are added hidden (filterable, not printed) for whoever may read
      * them. Expert infos always. */
@@ -498,7 +503,7 @@ void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *t
 }
 
 /* A frame as sent: its slaves and its cycle. */
-void *esc_sent(void *capture, tvbuff_t *tvb, packet_info *pinfo)
+guint32 esc_sent(void *capture, tvbuff_t *tvb, packet_info *pinfo)
 {
     capture_hints *h = (capture_hints *)capture;
     datagram d[max_datagrams];
@@ -511,9 +516,9 @@ void *esc_sent(void *capture, tvbuff_t *tvb, packet_info *pinfo)
     return new_record(h, NULL, &f);
 }
 
-void esc_show_sent(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+void esc_show_sent(guint32 data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
-    const bus_frame f = frame_of((const record *)data, NULL);
+    const bus_frame f = frame_of(data, NULL);
     cycle_mark c = bus_cycle(&f);
     cycles_show(&c, tvb, pinfo, tree);
     bus_show(&f, tvb, pinfo, tree, show_details);
@@ -530,10 +535,10 @@ void esc_stats_init(stats_tree *st, int parent)
     bus_stats_init(st, parent);
 }
 
-void esc_stats_response(stats_tree *st, int parent, const void *data)
+void esc_stats_response(stats_tree *st, int parent, guint32 data)
 {
     const shape *r;
-    const bus_frame frame = frame_of((const record *)data, &r);
+    const bus_frame frame = frame_of(data, &r);
     char label[32];
     for (guint i = 0; i < r->count; i++) {
         const compared *c = &r->d[i];
