@@ -67,21 +67,22 @@ struct shape {
     compared *d;                      /* count of them, right after the shape */
 };
 
-/* What a frame shows that frames alike share: its comparison and its slaves. */
+/* What a frame shows that frames alike share: its comparison, its slaves
+ * and its cycle (the cycle's number, the same for every frame of a cycle). */
 struct kind {
     const shape *esc;                 /* NULL: a frame as sent */
     const bus_shape *bus;             /* the slaves (ethercat_bus.cpp) */
+    guint16 cycle;                    /* bus_frame's */
 };
 
 /* One EtherCAT frame, sent or returned: kept for every frame of the
- * capture, so 16 bytes, in chunks (capture_hints.records); the pairing keeps
+ * capture, so 12 bytes, in chunks (capture_hints.records); the pairing keeps
  * its number (from 1). */
 struct record {
     guint32 kind;                     /* into capture_hints.kinds */
-    guint16 cycle;                    /* its bus_frame's cycle and timing */
-    decltype(bus_frame::timing) timing;
+    guint32 timing[2];                /* its bus_frame's timing (memcpy: 4-byte aligned) */
 };
-static_assert(sizeof(record) <= 16, "record grew");
+static_assert(sizeof(record) == 12 && sizeof(record::timing) == sizeof(bus_frame::timing), "record grew");
 const guint records_shift = 12, records_per_chunk = 1u << records_shift;
 
 struct capture_hints {
@@ -213,19 +214,19 @@ const shape *intern(capture_hints *h, const shape *probe)
 guint kind_hash(gconstpointer v)
 {
     const kind *k = (const kind *)v;
-    return g_direct_hash(k->esc) ^ g_direct_hash(k->bus);
+    return g_direct_hash(k->esc) ^ g_direct_hash(k->bus) ^ k->cycle;
 }
 
 gboolean kind_equal(gconstpointer a, gconstpointer b)
 {
     const kind *x = (const kind *)a, *y = (const kind *)b;
-    return x->esc == y->esc && x->bus == y->bus;
+    return x->esc == y->esc && x->bus == y->bus && x->cycle == y->cycle;
 }
 
 /* A frame's record: its comparison (NULL for a frame as sent) and its slaves. */
 guint32 new_record(capture_hints *h, const shape *esc, const bus_frame *f)
 {
-    kind probe = {esc, f->shape};
+    kind probe = {esc, f->shape, f->cycle};
     guint id = GPOINTER_TO_UINT(wmem_map_lookup(h->kind_ids, &probe));
     if (!id) {
         wmem_array_append_one(h->kinds, probe);
@@ -239,8 +240,7 @@ guint32 new_record(capture_hints *h, const shape *esc, const bus_frame *f)
     guint32 n = h->record_count++;
     record *r = &(*(record **)wmem_array_index(h->records, n >> records_shift))[n % records_per_chunk];
     r->kind = id - 1;
-    r->cycle = f->cycle;
-    r->timing = f->timing;
+    memcpy(r->timing, &f->timing, sizeof r->timing);
     return n + 1;
 }
 
@@ -253,8 +253,8 @@ bus_frame frame_of(guint32 number, const shape **esc)
     if (esc) *esc = k->esc;
     bus_frame f;
     f.shape = k->bus;
-    f.cycle = r->cycle;
-    f.timing = r->timing;
+    f.cycle = k->cycle;
+    memcpy(&f.timing, r->timing, sizeof f.timing);
     return f;
 }
 
