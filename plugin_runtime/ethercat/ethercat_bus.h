@@ -40,7 +40,7 @@ const char *command_name(guint8 cmd);
  * ethercat_bus.cpp and ethercat_esc.cpp) keep a datagram, so that frames
  * alike compare equal byte for byte. */
 datagram kept_datagram(const datagram *d, gboolean index);
-/* FNV-1a of n bytes, on from h (2166136261 to start). */
+/* FNV-1a of n bytes (32-bit words, then the bytes left), on from h (2166136261 to start). */
 guint hash_bytes(guint h, const void *bytes, gsize n);
 
 struct bus_model;   /* capture-wide, wmem_file_scope */
