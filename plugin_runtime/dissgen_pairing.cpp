@@ -43,6 +43,30 @@ struct pair_key {
     guint64 *values;
 };
 
+/* What later passes show of one message: kept for the whole capture, so 16
+ * bytes. The first message of each frame keeps it in the capture's frame
+ * table (inline, indexed by frame number), any other message of a frame
+ * with p_add_proto_data. What few messages need sits in maps beside the
+ * table: the requests it proved lost, a round trip beyond 2 s, and the
+ * transaction of a request not answered (which says why on display); once
+ * answered, the two frames' numbers and the round trip say everything. */
+struct kept {
+    guint32 partner;      /* request: its response's frame (0: none yet); response: its
+                           * request's; duplicate: the frame it repeats */
+    guint8 role;          /* dg_role; 0: not paired on the first pass */
+    guint8 out_of_order;  /* response: a later request was answered first */
+    guint16 lost_count;   /* requests it proved lost (capture_state.lost_lists) */
+    gint32 round_trip;    /* response: in ns; long_trip: see capture_state.long_trips */
+    guint32 analysis;     /* response: the analysis's comparison; request: its sent() result */
+};
+static_assert(sizeof(kept) == 16, "kept grew");
+const gint32 long_trip = G_MININT32;
+
+/* Frames per chunk of the frame table: chunks never move, so a kept record
+ * stays where pending requests and key entries point. */
+const guint table_shift = 12;
+const guint table_chunk = 1u << table_shift;
+
 /* A request waiting for its response. It is in two queues, oldest first:
  * its key's and the capture's; answered or given-up ones are marked done and
  * leave each queue when they reach its head. */
@@ -57,7 +81,7 @@ struct pending {
     guint8 *bytes;  /* the request's bytes, kept for the analysis until answered */
     guint length;
     guint64 key;    /* its first key value (dg_lost) */
-    dg_frame_pairing *record;  /* the request's record */
+    kept *record;              /* the request's record */
     gboolean guessed;          /* taken for a request for want of a better idea */
 };
 
@@ -72,7 +96,7 @@ struct key_entry {
     guint32 last_frame;          /* the last message with this key (duplicates) */
     nstime_t last_time;
     guint8 last_role;            /* dg_role */
-    dg_frame_pairing *last_record; /* its record (adopt_orphan) */
+    kept *last_record;           /* its record (adopt_orphan) */
     address last_src;
     guint8 last_src_bytes[16];
     guint8 *last_bytes;
@@ -100,6 +124,10 @@ struct capture_state {
     nstime_t clock;              /* what forgetting goes by (forget_clock) */
     nstime_t previous_time;      /* the last message's time */
     gboolean clock_set;
+    wmem_array_t *table;         /* the frame table: chunks of table_chunk kept records */
+    wmem_map_t *lost_lists;      /* kept record -> the dg_lost it proved (kept.lost_count) */
+    wmem_map_t *long_trips;      /* kept record -> its round trip in ns (gint64), beyond a gint32 */
+    wmem_map_t *unanswered;      /* kept record of a request not answered -> its transaction */
     /* The requests the message being paired proves lost (give_up). */
     guint32 frame;               /* that message's frame */
     dg_lost *lost;
@@ -160,11 +188,45 @@ capture_state *current_capture(void)
         capture = wmem_new0(wmem_file_scope(), capture_state);
         capture->keys = wmem_map_new(wmem_file_scope(), key_hash, key_equal);
         capture->scope_answered = wmem_array_sized_new(wmem_file_scope(), sizeof(guint64), 4);
+        capture->table = wmem_array_new(wmem_file_scope(), sizeof(kept *));
+        capture->lost_lists = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+        capture->long_trips = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+        capture->unanswered = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
         guint64 none = 0;
         wmem_array_append_one(capture->scope_answered, none);
         if (analysis && analysis->capture_new) capture->analysis = analysis->capture_new(protocol);
     }
     return capture;
+}
+
+/* The kept record of the first message of `frame`, in the frame table; with
+ * `create` the table grows to hold it, else NULL when it has none. */
+kept *table_slot(capture_state *c, guint32 frame, gboolean create)
+{
+    guint chunk = frame >> table_shift;
+    if (chunk >= wmem_array_get_count(c->table)) {
+        if (!create) return NULL;
+        kept *none = NULL;
+        while (wmem_array_get_count(c->table) <= chunk) wmem_array_append_one(c->table, none);
+    }
+    kept **at = (kept **)wmem_array_index(c->table, chunk);
+    if (!*at) {
+        if (!create) return NULL;
+        *at = wmem_alloc0_array(wmem_file_scope(), kept, table_chunk);
+    }
+    return &(*at)[frame & (table_chunk - 1)];
+}
+
+/* The kept record of message `message` of this frame (see kept), or NULL. */
+kept *record_of(capture_state *c, packet_info *pinfo, guint message, gboolean create)
+{
+    if (message == 0) return table_slot(c, pinfo->num, create);
+    kept *k = (kept *)p_get_proto_data(wmem_file_scope(), pinfo, *protocol->proto, frame_key + message);
+    if (!k && create) {
+        k = wmem_new0(wmem_file_scope(), kept);
+        p_add_proto_data(wmem_file_scope(), pinfo, *protocol->proto, frame_key + message, k);
+    }
+    return k;
 }
 
 /* The order scope of a request sent in this packet (capture_state.scope_answered). */
@@ -491,15 +553,6 @@ void forget_keys(capture_state *c)
     while (c->oldest && long_ago(c, &c->oldest->last_time)) forget_key(c, c->oldest);
 }
 
-/* A frame's record for a duplicate, a response or an orphan (a request's
- * comes with its transaction). */
-dg_frame_pairing *new_record(guint8 role)
-{
-    dg_frame_pairing *fp = wmem_new0(wmem_file_scope(), dg_frame_pairing);
-    fp->role = role;
-    return fp;
-}
-
 /* The key's waiting requests from this message's source are given up: the
  * sender used the key again, so it no longer waits for them. */
 void give_up_sent_again(capture_state *c, key_entry *e, const packet_info *pinfo)
@@ -516,8 +569,9 @@ void orphan_guessed_from(capture_state *c, const packet_info *pinfo)
     for (pending *q = c->sent.head; q && c->guessed; q = q->next_sent) {
         if (q->done || !q->guessed || !addresses_equal(&q->src, &pinfo->src)) continue;
         q->record->role = DG_ROLE_ORPHAN;
-        q->record->txn = NULL;
+        wmem_map_remove(c->unanswered, q->record);
         retire(c, q);
+        wmem_free(wmem_file_scope(), q->txn); /* retired without a loss: nothing names it */
     }
 }
 
@@ -565,41 +619,51 @@ guint8 direction_of(capture_state *c, tvbuff_t *tvb, packet_info *pinfo, guint8 
     return analysis->direction(c->analysis, tvb, pinfo);
 }
 
-/* The requests this message proved lost go with its record. */
-dg_frame_pairing *with_lost(capture_state *c, dg_frame_pairing *fp)
+/* The requests this message proved lost go with its record (rare: a map
+ * beside the frame table). */
+void with_lost(capture_state *c, kept *k)
 {
-    if (c->lost_count) {
-        fp->lost = (const dg_lost *)wmem_memdup(wmem_file_scope(), c->lost, c->lost_count * sizeof(dg_lost));
-        fp->lost_count = (guint16)MIN(c->lost_count, G_MAXUINT16);
-    }
-    return fp;
+    if (!c->lost_count) return;
+    wmem_map_insert(c->lost_lists, k, wmem_memdup(wmem_file_scope(), c->lost, c->lost_count * sizeof(dg_lost)));
+    k->lost_count = (guint16)MIN(c->lost_count, G_MAXUINT16);
 }
 
-/* The response record for transaction t, whose request's bytes are given. */
-dg_frame_pairing *response_to(capture_state *c, dg_transaction *t, const guint8 *request_bytes, guint request_length,
-                              tvbuff_t *tvb, packet_info *pinfo)
+/* This message, k, answers transaction t, whose request's record and bytes
+ * are given. The transaction is freed: the two records say what it did. */
+void response_to(capture_state *c, dg_transaction *t, kept *request, const guint8 *request_bytes,
+                 guint request_length, kept *k, tvbuff_t *tvb, packet_info *pinfo)
 {
-    dg_frame_pairing *fp = new_record(DG_ROLE_RESPONSE);
+    k->role = DG_ROLE_RESPONSE;
     t->response_frame = pinfo->num;
     nstime_delta(&t->round_trip, &pinfo->abs_ts, &t->request_time);
-    fp->txn = t;
+    k->partner = t->request_frame;
+    /* nstime_delta gives seconds and nanoseconds of one sign: exact both ways. */
+    gint64 ns = (gint64)t->round_trip.secs * 1000000000 + t->round_trip.nsecs;
+    if (ns > long_trip && ns <= G_MAXINT32) {
+        k->round_trip = (gint32)ns;
+    } else {
+        k->round_trip = long_trip;
+        wmem_map_insert(c->long_trips, k, wmem_memdup(wmem_file_scope(), &ns, sizeof ns));
+    }
     guint64 *answered = answered_in(c, t);
-    fp->out_of_order = protocol->pairing->ordered && t->seq < *answered;
+    k->out_of_order = protocol->pairing->ordered && t->seq < *answered;
     if (t->seq > *answered) *answered = t->seq;
     if (t->seq > c->answered_max) c->answered_max = t->seq;
     if (analysis && analysis->compare && request_bytes) {
-        tvbuff_t *request = tvb_new_real_data(request_bytes, request_length, (gint)request_length);
-        fp->analysis = analysis->compare(c->analysis, request, tvb, t, pinfo);
-        tvb_free(request);
+        tvbuff_t *bytes = tvb_new_real_data(request_bytes, request_length, (gint)request_length);
+        k->analysis = analysis->compare(c->analysis, bytes, tvb, t, pinfo);
+        tvb_free(bytes);
     }
-    return fp;
+    request->partner = pinfo->num;
+    wmem_map_remove(c->unanswered, request);
+    wmem_free(wmem_file_scope(), t);
 }
 
-dg_frame_pairing *answer(capture_state *c, pending *q, tvbuff_t *tvb, packet_info *pinfo)
+void answer(capture_state *c, pending *q, kept *k, tvbuff_t *tvb, packet_info *pinfo)
 {
-    dg_frame_pairing *fp = response_to(c, q->txn, q->bytes, q->length, tvb, pinfo);
+    response_to(c, q->txn, q->record, q->bytes, q->length, k, tvb, pinfo);
+    q->txn = NULL; /* freed: a retired request is never looked at again */
     retire(c, q);
-    return fp;
 }
 
 /* A response with nothing to answer, right after an orphan of its key from
@@ -609,50 +673,45 @@ dg_frame_pairing *answer(capture_state *c, pending *q, tvbuff_t *tvb, packet_inf
  * marking was not known yet. It becomes the request, answered by this one.
  * (In one pass it was shown as an orphan already.) Only where the analysis
  * guessed the direction: a transport's direction is never wrong. */
-dg_frame_pairing *adopt_orphan(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo)
+gboolean adopt_orphan(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, packet_info *pinfo)
 {
-    if (e->last_role != DG_ROLE_ORPHAN || !e->last_record) return NULL;
+    if (e->last_role != DG_ROLE_ORPHAN || !e->last_record) return FALSE;
     nstime_t gap;
     nstime_delta(&gap, &pinfo->abs_ts, &e->last_time);
-    if (nstime_to_sec(&gap) > protocol->pairing->timeout) return NULL;
+    if (nstime_to_sec(&gap) > protocol->pairing->timeout) return FALSE;
     int verdict = analysis && analysis->is_response ? analysis->is_response(c->analysis, &e->last_src, &pinfo->src) : -1;
-    if (verdict == 0 || (verdict < 0 && !addresses_equal(&e->last_src, &pinfo->src))) return NULL;
+    if (verdict == 0 || (verdict < 0 && !addresses_equal(&e->last_src, &pinfo->src))) return FALSE;
     dg_transaction *t = wmem_new0(wmem_file_scope(), dg_transaction);
     t->request_frame = e->last_frame;
     t->request_time = e->last_time;
     t->seq = ++c->requests;
     t->order_scope = order_scope_of(c, pinfo);
-    dg_frame_pairing *request = e->last_record;
+    kept *request = e->last_record;
     request->role = DG_ROLE_REQUEST;
-    request->txn = t;
-    return response_to(c, t, e->last_bytes, e->last_length, tvb, pinfo);
+    response_to(c, t, request, e->last_bytes, e->last_length, k, tvb, pinfo);
+    return TRUE;
 }
 
-dg_frame_pairing *new_request(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length,
-                              guint64 key, gboolean guessed)
+/* This message, k, is a new request: it waits for its response. */
+void new_request(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, packet_info *pinfo, guint length,
+                 guint64 key, gboolean guessed)
 {
-    /* Its frame's record and the transaction in one allocation. */
-    struct request_record {
-        dg_frame_pairing fp;
-        dg_transaction txn;
-    };
-    request_record *rec = wmem_new0(wmem_file_scope(), request_record);
-    dg_frame_pairing *fp = &rec->fp;
-    if (analysis && analysis->sent) fp->analysis = analysis->sent(c->analysis, tvb, pinfo);
-    dg_transaction *t = &rec->txn;
+    if (analysis && analysis->sent) k->analysis = analysis->sent(c->analysis, tvb, pinfo);
+    /* Kept until it is answered (response_to frees it), or for good when it is not. */
+    dg_transaction *t = wmem_new0(wmem_file_scope(), dg_transaction);
     t->request_frame = pinfo->num;
     t->request_time = pinfo->abs_ts;
     t->seq = ++c->requests;
     t->order_scope = order_scope_of(c, pinfo);
-    fp->role = DG_ROLE_REQUEST;
-    fp->txn = t;
+    k->role = DG_ROLE_REQUEST;
+    wmem_map_insert(c->unanswered, k, t);
     if (!nstime_is_zero(&e->last_request_time) && nstime_cmp(&pinfo->abs_ts, &e->last_request_time) > 0)
         nstime_delta(&e->request_period, &pinfo->abs_ts, &e->last_request_time);
     e->last_request_time = pinfo->abs_ts;
     pending *n = wmem_new0(wmem_file_scope(), pending);
     n->txn = t;
     n->key = key;
-    n->record = fp;
+    n->record = k;
     n->guessed = guessed;
     if (guessed) c->guessed++;
     keep_address(&n->src, n->src_bytes, &pinfo->src);
@@ -663,7 +722,6 @@ dg_frame_pairing *new_request(capture_state *c, key_entry *e, tvbuff_t *tvb, pac
     enqueue(&e->waiting, n, TRUE);
     enqueue(&c->sent, n, FALSE);
     c->waiting++;
-    return fp;
 }
 
 /* The pending request this message answers, or NULL for a new request
@@ -692,10 +750,10 @@ pending *classify(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pi
     return q;
 }
 
-dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count, guint length,
-                             guint8 transport_direction)
+/* Pairs message k on the first pass and fills its record. */
+void first_pass(capture_state *c, kept *k, tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count,
+                guint length, guint8 transport_direction)
 {
-    capture_state *c = current_capture();
     c->frame = pinfo->num;
     c->lost_count = 0;
     forget_clock(c, pinfo);
@@ -710,26 +768,71 @@ dg_frame_pairing *first_pass(tvbuff_t *tvb, packet_info *pinfo, const guint64 *k
     gboolean unchanged = again && direction != DG_DIR_REQUEST && unchanged_return(e);
     c->last_frame = pinfo->num;
     if (again && !unchanged) {
-        dg_frame_pairing *fp = new_record(DG_ROLE_DUPLICATE);
-        fp->duplicate_of = e->last_frame;
-        return with_lost(c, fp);
+        k->role = DG_ROLE_DUPLICATE;
+        k->partner = e->last_frame;
+        with_lost(c, k);
+        return;
     }
     if (unchanged) direction = DG_DIR_ANY; /* the waiting request, come back */
 
     gboolean orphan;
     pending *q = classify(c, e, tvb, pinfo, length, direction, unchanged, &orphan);
-    dg_frame_pairing *fp;
     if (q)
-        fp = answer(c, q, tvb, pinfo);
-    else if (orphan && transport_direction == DG_DIR_ANY && (fp = adopt_orphan(c, e, tvb, pinfo)) != NULL)
+        answer(c, q, k, tvb, pinfo);
+    else if (orphan && transport_direction == DG_DIR_ANY && adopt_orphan(c, e, k, tvb, pinfo))
         ;
     else if (orphan)
-        fp = new_record(DG_ROLE_ORPHAN);
+        k->role = DG_ROLE_ORPHAN;
     else
-        fp = new_request(c, e, tvb, pinfo, length, keys[0], direction == DG_DIR_ANY);
-    remember_last(c, e, tvb, pinfo, length, fp->role);
-    e->last_record = fp;
-    return with_lost(c, fp);
+        new_request(c, e, k, tvb, pinfo, length, keys[0], direction == DG_DIR_ANY);
+    remember_last(c, e, tvb, pinfo, length, k->role);
+    e->last_record = k;
+    with_lost(c, k);
+}
+
+/* What later passes show of record k (the first pass too, so that every pass
+ * shows the same), in pinfo->pool: the frame's record and its transaction as
+ * dissgen_pairing.h has them. */
+const dg_frame_pairing *view_of(const capture_state *c, const kept *k, packet_info *pinfo)
+{
+    struct view {
+        dg_frame_pairing fp;
+        dg_transaction txn;
+    };
+    view *v = wmem_new0(pinfo->pool, view);
+    dg_frame_pairing *fp = &v->fp;
+    fp->role = k->role;
+    fp->out_of_order = k->out_of_order;
+    fp->lost_count = k->lost_count;
+    fp->analysis = k->analysis;
+    if (k->lost_count) fp->lost = (const dg_lost *)wmem_map_lookup(c->lost_lists, k);
+    switch (k->role) {
+    case DG_ROLE_REQUEST:
+        if (!k->partner) {
+            /* not answered: its own transaction */
+            fp->txn = (dg_transaction *)wmem_map_lookup(c->unanswered, k);
+            break;
+        }
+        v->txn.request_frame = pinfo->num;
+        v->txn.response_frame = k->partner;
+        fp->txn = &v->txn;
+        break;
+    case DG_ROLE_RESPONSE: {
+        v->txn.request_frame = k->partner;
+        v->txn.response_frame = pinfo->num;
+        gint64 ns = k->round_trip;
+        if (k->round_trip == long_trip) ns = *(const gint64 *)wmem_map_lookup(c->long_trips, k);
+        v->txn.round_trip.secs = (time_t)(ns / 1000000000);
+        v->txn.round_trip.nsecs = (int)(ns % 1000000000);
+        fp->txn = &v->txn;
+        break;
+    }
+    case DG_ROLE_DUPLICATE:
+        fp->duplicate_of = k->partner;
+        break;
+    default: break;
+    }
+    return fp;
 }
 
 /* A request not answered: lost when a later message proved it (given_up_in),
@@ -854,20 +957,21 @@ void dg_pairing_register(const dg_protocol *p)
     register_cleanup_routine(capture_cleanup);
 }
 
-const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
+const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
                                            const guint64 *keys, guint key_count, gint length, guint message,
                                            guint8 direction)
 {
     /* A message cut short before its first key field answers and asks nothing. */
     if (key_count == 0) return NULL;
-    dg_frame_pairing *fp =
-        (dg_frame_pairing *)p_get_proto_data(wmem_file_scope(), pinfo, *p->proto, frame_key + message);
-    if (!fp) {
+    kept *k = capture ? record_of(capture, pinfo, message, FALSE) : NULL;
+    if (!k || !k->role) {
         if (PINFO_FD_VISITED(pinfo)) return NULL; /* not paired on the first pass: nothing to show */
         guint len = length > 0 ? (guint)length : tvb_captured_length(tvb);
-        fp = first_pass(tvb, pinfo, keys, key_count, len, direction);
-        p_add_proto_data(wmem_file_scope(), pinfo, *p->proto, frame_key + message, fp);
+        capture_state *c = current_capture();
+        k = record_of(c, pinfo, message, TRUE);
+        first_pass(c, k, tvb, pinfo, keys, key_count, len, direction);
     }
+    const dg_frame_pairing *fp = view_of(capture, k, pinfo);
     show(fp, tvb, pinfo, tree);
     return fp;
 }

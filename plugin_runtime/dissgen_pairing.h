@@ -7,8 +7,12 @@
  *   capture state (one per open capture, reset by the init routine)
  *     key values -> pending requests (oldest first), the last message seen
  *     the analysis's capture-wide state (e.g. a model of the EtherCAT bus)
- *   frame state (p_add_proto_data, one per message of a frame)
- *     dg_frame_pairing: role, the transaction, the analysis's result
+ *   frame state (a compact record per message: the capture's frame table,
+ *   indexed by frame number, for a frame's first message; p_add_proto_data
+ *   for the others), only what display needs: the role, the partner's
+ *   frame, the round trip, the analysis's result; a request's transaction
+ *   only while it is not answered. dg_pairing_dissect() hands out the
+ *   record as a dg_frame_pairing (and its dg_transaction) in pinfo->pool.
  *
  * Later passes (tshark -2, the GUI in any order, display filters) only read
  * what the first pass stored, so they show the same items. A protocol
@@ -78,7 +82,7 @@ typedef struct dg_frame_pairing {
     guint8 out_of_order;     /* response: a later request was answered first */
     guint16 lost_count;      /* requests this message proved lost */
     guint32 duplicate_of;    /* duplicate: the frame it repeats */
-    void *analysis;          /* response: the analysis's comparison; request: its sent() result */
+    guint32 analysis;        /* response: the analysis's comparison; request: its sent() result; 0 none */
     const dg_lost *lost;     /* lost_count of them, or NULL */
 } dg_frame_pairing;
 
@@ -100,21 +104,22 @@ typedef struct dg_analysis {
      * all the same (its request was not captured): TRUE, or FALSE when it may
      * be a request. */
     gboolean (*is_returned)(void *capture, const address *src);
-    /* First pass, once per pair: what the response changed; the result is
-     * allocated in wmem_file_scope. `request` holds the request's bytes,
-     * `txn` the pair (its request frame, its round trip). */
-    void *(*compare)(void *capture, tvbuff_t *request, tvbuff_t *response, const dg_transaction *txn,
-                     packet_info *pinfo);
+    /* First pass, once per pair: what the response changed, as a number the
+     * analysis gives its result (kept in wmem_file_scope; 0: none): the
+     * pairing keeps 4 bytes a message for it. `request` holds the request's
+     * bytes, `txn` the pair (its request frame, its round trip). */
+    guint32 (*compare)(void *capture, tvbuff_t *request, tvbuff_t *response, const dg_transaction *txn,
+                       packet_info *pinfo);
     /* Every pass: shows a compare() result on the response. */
-    void (*show)(const void *result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+    void (*show)(guint32 result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
     /* Statistics (tshark -z FILTER,tree): nodes under the pairing's own. */
     void (*stats_init)(stats_tree *st, int parent);
-    void (*stats_response)(stats_tree *st, int parent, const void *result);
-    /* First pass, a request: the analysis's result for it (wmem_file_scope),
-     * or NULL. */
-    void *(*sent)(void *capture, tvbuff_t *tvb, packet_info *pinfo);
+    void (*stats_response)(stats_tree *st, int parent, guint32 result);
+    /* First pass, a request: the number of the analysis's result for it (as
+     * compare's), or 0. */
+    guint32 (*sent)(void *capture, tvbuff_t *tvb, packet_info *pinfo);
     /* Every pass: shows a sent() result. */
-    void (*show_sent)(const void *result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+    void (*show_sent)(guint32 result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
     /* First pass, before pairing: what the message's own bytes and source say
      * it is, DG_DIR_REQUEST or DG_DIR_RESPONSE, or DG_DIR_ANY when they cannot
      * tell. With this callback a message that cannot tell is a request unless

@@ -148,25 +148,24 @@ struct bus_model {
     gint64 count_reported; /* the last count that differed from the design, -1 none */
     gboolean mismatch, ok_noted;
     gboolean fmmus_known;  /* some slave's FMMU configuration was seen */
+    wmem_map_t *shapes;    /* bus_shape -> itself: the frames' shapes without events */
 };
 
-struct bus_frame {
+/* What a frame's datagrams address and what the network check found there:
+ * the same for every frame of a cycle, so it is interned (bus_model.shapes)
+ * and a capture of a million cyclic frames keeps a handful. The datagram
+ * indexes, which change from frame to frame and which nothing here shows,
+ * are left out (0). A shape with expert infos (events) is its frame's own. */
+struct bus_shape {
     const bus_model *model;
-    addressed *d;
+    addressed *d;        /* count of them, right after the shape */
     bus_event *events;
-    union {                              /* ethercat_cycles.cpp's, laid out with the counts */
-        struct {                         /* in what was padding: */
-            guint32 period, nominal;     /* a sent frame's cycle_mark */
-        } cycle_times;
-        double dc_drift;                 /* a returned frame's DC drift (NAN: none) */
-    } timing;
-    guint16 cycle;
     guint16 count;       /* datagrams: at most max_datagrams */
     guint16 event_count;
     guint8 returned;     /* inputs are shown from returned frames, outputs from frames as sent */
 };
 /* One per EtherCAT frame: the cycle and clock figures must not make it grow. */
-static_assert(sizeof(bus_frame) <= 3 * sizeof(void *) + 16, "bus_frame grew");
+static_assert(sizeof(bus_frame) <= sizeof(void *) + 16, "bus_frame grew");
 
 namespace {
 
@@ -686,18 +685,56 @@ addressed address_of(const bus_model *m, const datagram *s)
     return a;
 }
 
-bus_frame *new_frame(const bus_model *m, guint count, const events *ev)
+/* a as a shape keeps it: every byte set (padding 0), so that equal shapes
+ * compare equal byte for byte; no index. */
+addressed kept_form(const addressed *a)
 {
-    /* One allocation for the frame and its datagrams. */
-    bus_frame *f = (bus_frame *)wmem_alloc0(wmem_file_scope(), sizeof(bus_frame) + count * sizeof(addressed));
-    f->model = m;
-    f->count = (guint16)count;
-    f->d = (addressed *)(f + 1);
-    if (ev && ev->count) {
-        f->event_count = (guint16)MIN(ev->count, G_MAXUINT16);
-        f->events = (bus_event *)wmem_memdup(wmem_file_scope(), ev->list, ev->count * sizeof(bus_event));
+    addressed k;
+    memset(&k, 0, sizeof k);
+    k.dgram = kept_datagram(&a->dgram, FALSE);
+    k.expected_wkc = a->expected_wkc;
+    k.position = a->position;
+    k.station = a->station;
+    k.stats = a->stats;
+    k.by_station = a->by_station;
+    k.logical = a->logical;
+    return k;
+}
+
+guint shape_hash(gconstpointer v)
+{
+    const bus_shape *s = (const bus_shape *)v;
+    return hash_bytes(2166136261u ^ s->count ^ ((guint)s->returned << 16), s->d, s->count * sizeof(addressed));
+}
+
+gboolean shape_equal(gconstpointer a, gconstpointer b)
+{
+    const bus_shape *x = (const bus_shape *)a, *y = (const bus_shape *)b;
+    return x->count == y->count && x->returned == y->returned &&
+           memcmp(x->d, y->d, x->count * sizeof(addressed)) == 0;
+}
+
+/* The frame's shape: its datagrams `d` (kept_form) and its events. */
+const bus_shape *shape_of(bus_model *m, addressed *d, guint count, gboolean returned, const events *ev)
+{
+    bus_shape probe = {m, d, NULL, (guint16)count, 0, (guint8)returned};
+    gboolean own = ev && ev->count;
+    if (!own) {
+        const bus_shape *found = (const bus_shape *)wmem_map_lookup(m->shapes, &probe);
+        if (found) return found;
     }
-    return f;
+    /* One allocation for the shape and its datagrams. */
+    bus_shape *s = (bus_shape *)wmem_alloc0(wmem_file_scope(), sizeof(bus_shape) + count * sizeof(addressed));
+    *s = probe;
+    s->d = (addressed *)(s + 1);
+    if (count) memcpy(s->d, d, count * sizeof(addressed));
+    if (own) {
+        s->event_count = (guint16)MIN(ev->count, G_MAXUINT16);
+        s->events = (bus_event *)wmem_memdup(wmem_file_scope(), ev->list, ev->count * sizeof(bus_event));
+    } else {
+        wmem_map_insert(m->shapes, s, s);
+    }
+    return s;
 }
 
 /* Someone may read the slave's fields: a visible tree (the details pane, -V,
@@ -1112,20 +1149,51 @@ guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max)
     return n;
 }
 
+datagram kept_datagram(const datagram *d, gboolean index)
+{
+    datagram k;
+    memset(&k, 0, sizeof k);
+    k.offset = d->offset;
+    k.cmd = d->cmd;
+    k.idx = index ? d->idx : 0;
+    k.adp = d->adp;
+    k.ado = d->ado;
+    k.length = d->length;
+    k.wkc = d->wkc;
+    return k;
+}
+
+guint hash_bytes(guint h, const void *bytes, gsize n)
+{
+    const guint8 *b = (const guint8 *)bytes;
+    gsize i = 0;
+    for (; i + 4 <= n; i += 4) { /* a word at a time: every frame's shapes are hashed */
+        guint32 w;
+        memcpy(&w, b + i, 4);
+        h = (h ^ w) * 16777619u;
+    }
+    for (; i < n; i++) h = (h ^ b[i]) * 16777619u;
+    return h;
+}
+
 bus_model *bus_new(const dg_bus *design)
 {
     bus_model *m = wmem_new0(wmem_file_scope(), bus_model);
     m->design = design;
     m->stations = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+    m->shapes = wmem_map_new(wmem_file_scope(), shape_hash, shape_equal);
     m->count_reported = -1;
     return m;
 }
 
-bus_frame *bus_sent(bus_model *m, const datagram *d, guint n)
+void bus_sent(bus_model *m, const datagram *d, guint n, bus_frame *f)
 {
-    bus_frame *f = new_frame(m, n, NULL);
-    for (guint i = 0; i < n; i++) f->d[i] = address_of(m, &d[i]);
-    return f;
+    addressed a[max_datagrams];
+    for (guint i = 0; i < n; i++) {
+        addressed x = address_of(m, &d[i]);
+        a[i] = kept_form(&x);
+    }
+    f->shape = shape_of(m, a, n, FALSE, NULL);
 }
 
 void bus_set_cycle(bus_frame *f, const cycle_mark *c)
@@ -1138,7 +1206,7 @@ void bus_set_cycle(bus_frame *f, const cycle_mark *c)
 cycle_mark bus_cycle(const bus_frame *f)
 {
     cycle_mark c = {0, 0, 0};
-    if (f->returned) return c;
+    if (f->shape->returned) return c;
     c.cycle = f->cycle;
     c.period_ns = f->timing.cycle_times.period;
     c.nominal_ns = f->timing.cycle_times.nominal;
@@ -1147,10 +1215,10 @@ cycle_mark bus_cycle(const bus_frame *f)
 
 void bus_set_dc_drift(bus_frame *f, double drift) { f->timing.dc_drift = drift; }
 
-double bus_dc_drift(const bus_frame *f) { return f->returned ? f->timing.dc_drift : NAN; }
+double bus_dc_drift(const bus_frame *f) { return f->shape->returned ? f->timing.dc_drift : NAN; }
 
-bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
-                        packet_info *pinfo)
+void bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
+                  packet_info *pinfo, bus_frame *f)
 {
     events ev = {};
     guint8 flags[max_datagrams] = {};
@@ -1169,20 +1237,21 @@ bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const data
             for (guint p = 0; m->count_known && p < m->count && p < max_positions; p++)
                 learn_sii_address(slave_at(m, p), &s[i], sent);
     }
-    bus_frame *f = new_frame(m, n, &ev);
-    f->returned = TRUE;
-    f->timing.dc_drift = NAN;
+    addressed a[max_datagrams];
     for (guint i = 0; i < n; i++) {
-        f->d[i] = address_of(m, &s[i]);
-        f->d[i].stats = flags[i];
-        f->d[i].dgram = b[i]; /* the items go over the returned datagram */
+        addressed x = address_of(m, &s[i]);
+        x.stats = flags[i];
+        x.dgram = b[i]; /* the items go over the returned datagram */
+        a[i] = kept_form(&x);
     }
-    return f;
+    f->shape = shape_of(m, a, n, TRUE, &ev);
+    f->timing.dc_drift = NAN;
 }
 
-void bus_show(const bus_frame *f, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, gboolean details)
+void bus_show(const bus_frame *frame, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, gboolean details)
 {
-    if (!f) return;
+    if (!frame) return;
+    const bus_shape *f = frame->shape;
     /* Items only into a tree (without one, e.g. summary lines, the labels
      * would be built for nobody); the expert infos below always. */
     for (guint i = 0; tree && i < f->count; i++) {
@@ -1215,9 +1284,10 @@ const char *const st_wkc_expected = "Unexpected working counter";
 /* Rows appear with their first count (no rows of zeros). */
 void bus_stats_init(stats_tree *, int) {}
 
-void bus_stats_frame(stats_tree *st, int parent, const bus_frame *f)
+void bus_stats_frame(stats_tree *st, int parent, const bus_frame *frame)
 {
-    if (!f) return;
+    if (!frame) return;
+    const bus_shape *f = frame->shape;
     char label[48];
     for (guint i = 0; i < f->count; i++) {
         const addressed *a = &f->d[i];

@@ -35,18 +35,39 @@ guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max);
 
 const char *command_name(guint8 cmd);
 
+/* d with every byte set (padding 0), its index only with `index`: how the
+ * shapes of frames (what the frames of a cycle share, interned by
+ * ethercat_bus.cpp and ethercat_esc.cpp) keep a datagram, so that frames
+ * alike compare equal byte for byte. */
+datagram kept_datagram(const datagram *d, gboolean index);
+/* FNV-1a of n bytes (32-bit words, then the bytes left), on from h (2166136261 to start). */
+guint hash_bytes(guint h, const void *bytes, gsize n);
+
 struct bus_model;   /* capture-wide, wmem_file_scope */
-struct bus_frame;   /* one frame's slaves and network-check findings, wmem_file_scope */
+struct bus_shape;   /* what the frames of a cycle share, interned by the model */
+
+/* One frame's slaves and network-check findings (its shape, which frames
+ * alike share) and its timing: kept for every EtherCAT frame, so small. */
+struct bus_frame {
+    const bus_shape *shape;
+    union {                              /* ethercat_cycles.cpp's */
+        struct {
+            guint32 period, nominal;     /* a sent frame's cycle_mark */
+        } cycle_times;
+        double dc_drift;                 /* a returned frame's DC drift (NAN: none) */
+    } timing;
+    guint16 cycle;
+};
 
 bus_model *bus_new(const dg_bus *design);
 /* First pass. A frame as sent (a request, or one whose response is not paired),
- * its n datagrams as read_frame() read them: which slave each one addresses. */
-bus_frame *bus_sent(bus_model *m, const datagram *d, guint n);
+ * its n datagrams as read_frame() read them: which slave each one addresses, in *f. */
+void bus_sent(bus_model *m, const datagram *d, guint n, bus_frame *f);
 /* First pass. A returned frame with the frame as sent: what it teaches about
- * the bus, and which slave each datagram addresses. s and b are their first n
- * datagrams as read_frame() read them. */
-bus_frame *bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
-                        packet_info *pinfo);
+ * the bus, and which slave each datagram addresses, in *f. s and b are their
+ * first n datagrams as read_frame() read them. */
+void bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
+                  packet_info *pinfo, bus_frame *f);
 /* A sent frame's cycle (ethercat_cycles.h), kept with its slaves. */
 struct cycle_mark;
 void bus_set_cycle(bus_frame *f, const cycle_mark *c);

@@ -27,7 +27,9 @@
  *    and those of every marked frame up to this one; its jitter the period
  *    minus the nominal period.
  *
- * Memory: each sent frame's mark (10 bytes) lives in its bus_frame; the
+ * Memory: each sent frame's mark lives in its frame's record
+ * (ethercat_esc.cpp: the cycle number with what the frames of the cycle
+ * share, the periods in the frame's own 8 bytes); the
  * model keeps per cycle its periods (4 bytes each, in two heaps for the
  * running median) and the round trips of its returned frames (4 bytes each),
  * for `-z ecatr,cycles`.

@@ -42,9 +42,8 @@ using namespace dg_ecat;
 
 enum esc_change { CHANGED_CMD = 1, CHANGED_IDX = 2, CHANGED_LEN = 4, CHANGED_ADDR = 8 };
 
-/* One returned datagram compared with the one sent; kept for every returned
- * datagram of the capture (wmem_file_scope), so what the two datagrams say
- * is not stored twice. Its items go over `back`, the returned datagram. */
+/* One returned datagram compared with the one sent, as a frame's comparison
+ * (a shape) keeps it. Its items go over `back`, the returned datagram. */
 struct compared {
     datagram sent, back;
     guint16 advance;        /* ADP advance: slaves passed */
@@ -57,21 +56,50 @@ struct compared {
 
 gint32 wkc_added(const compared *c) { return (gint32)c->back.wkc - (gint32)c->sent.wkc; }
 
-struct result {
+/* A returned frame compared with the one sent: the same for every frame of a
+ * cycle (what changes from frame to frame, the datagram indexes, is left
+ * out unless it is what changed), so interned (capture_hints.shapes). */
+struct shape {
     guint count;
     gboolean length_changed;
     guint sent_length, back_length;   /* header lengths */
     guint sent_count, back_count;     /* datagrams */
-    compared *d;
-    bus_frame *bus;                   /* the slaves (ethercat_bus.cpp) */
+    compared *d;                      /* count of them, right after the shape */
 };
+
+/* What a frame shows that frames alike share: its comparison, its slaves
+ * and its cycle (the cycle's number, the same for every frame of a cycle). */
+struct kind {
+    const shape *esc;                 /* NULL: a frame as sent */
+    const bus_shape *bus;             /* the slaves (ethercat_bus.cpp) */
+    guint16 cycle;                    /* bus_frame's */
+};
+
+/* One EtherCAT frame, sent or returned: kept for every frame of the
+ * capture, so 12 bytes, in chunks (capture_hints.records); the pairing keeps
+ * its number (from 1). */
+struct record {
+    guint32 kind;                     /* into capture_hints.kinds */
+    guint32 timing[2];                /* its bus_frame's timing (memcpy: 4-byte aligned) */
+};
+static_assert(sizeof(record) == 12 && sizeof(record::timing) == sizeof(bus_frame::timing), "record grew");
+const guint records_shift = 12, records_per_chunk = 1u << records_shift;
 
 struct capture_hints {
     gboolean marking_seen; /* a slave set the locally administered bit: the capture shows direction */
     guint8 master[6];      /* the (unmarked) source of the frames answered so far */
     bus_model *bus;        /* the slaves the capture shows (ethercat_bus.cpp) */
     cycle_model *cycles;   /* the cycles it finds (ethercat_cycles.cpp) */
+    wmem_map_t *shapes;    /* shape -> itself */
+    wmem_array_t *kinds;   /* the kinds of frame seen */
+    wmem_map_t *kind_ids;  /* kind -> its index in kinds + 1 */
+    wmem_array_t *records; /* chunks of records_per_chunk records */
+    guint32 record_count;
 };
+
+/* The capture's hints: what a record's kind indexes. (A record is shown
+ * only for a frame of the capture it was made in, the current one.) */
+capture_hints *hints;
 
 int hf_esc = -1, hf_datagram = -1, hf_wkc_added = -1, hf_slaves_passed = -1, hf_data_changed = -1;
 gint ett_esc = -1, ett_datagram = -1;
@@ -117,7 +145,7 @@ void compare_datagram(compared *c, const datagram *s, const datagram *b, tvbuff_
 /* The frame's usual advance is the most common one among its auto-increment
  * and broadcast datagrams (a tie goes to the earliest); a datagram that
  * advanced otherwise did not pass the same slaves. */
-void check_forwarding(result *r)
+void check_forwarding(shape *r)
 {
     guint best_votes = 0;
     guint16 usual = 0;
@@ -138,9 +166,106 @@ void check_forwarding(result *r)
     }
 }
 
+compared kept_compared(const compared *c)
+{
+    compared k;
+    memset(&k, 0, sizeof k);
+    k.sent = kept_datagram(&c->sent, c->changed & CHANGED_IDX);
+    k.back = kept_datagram(&c->back, c->changed & CHANGED_IDX);
+    k.advance = c->advance;
+    k.majority = c->majority;
+    k.changed = c->changed;
+    k.has_advance = c->has_advance;
+    k.data_changed = c->data_changed;
+    k.forwarding = c->forwarding;
+    return k;
+}
+
+guint shape_hash(gconstpointer v)
+{
+    const shape *s = (const shape *)v;
+    const guint fields[] = {s->count, (guint)s->length_changed, s->sent_length, s->back_length, s->sent_count,
+                            s->back_count};
+    return hash_bytes(hash_bytes(2166136261u, fields, sizeof fields), s->d, s->count * sizeof(compared));
+}
+
+gboolean shape_equal(gconstpointer a, gconstpointer b)
+{
+    const shape *x = (const shape *)a, *y = (const shape *)b;
+    return x->count == y->count && x->length_changed == y->length_changed && x->sent_length == y->sent_length &&
+           x->back_length == y->back_length && x->sent_count == y->sent_count && x->back_count == y->back_count &&
+           memcmp(x->d, y->d, x->count * sizeof(compared)) == 0;
+}
+
+/* The interned copy of `probe` (its d[] in kept_compared form). */
+const shape *intern(capture_hints *h, const shape *probe)
+{
+    const shape *found = (const shape *)wmem_map_lookup(h->shapes, probe);
+    if (found) return found;
+    /* One allocation for the shape and its datagrams. */
+    shape *s = (shape *)wmem_alloc(wmem_file_scope(), sizeof(shape) + probe->count * sizeof(compared));
+    *s = *probe;
+    s->d = (compared *)(s + 1);
+    if (probe->count) memcpy(s->d, probe->d, probe->count * sizeof(compared));
+    wmem_map_insert(h->shapes, s, s);
+    return s;
+}
+
+guint kind_hash(gconstpointer v)
+{
+    const kind *k = (const kind *)v;
+    return g_direct_hash(k->esc) ^ g_direct_hash(k->bus) ^ k->cycle;
+}
+
+gboolean kind_equal(gconstpointer a, gconstpointer b)
+{
+    const kind *x = (const kind *)a, *y = (const kind *)b;
+    return x->esc == y->esc && x->bus == y->bus && x->cycle == y->cycle;
+}
+
+/* A frame's record: its comparison (NULL for a frame as sent) and its slaves. */
+guint32 new_record(capture_hints *h, const shape *esc, const bus_frame *f)
+{
+    kind probe = {esc, f->shape, f->cycle};
+    guint id = GPOINTER_TO_UINT(wmem_map_lookup(h->kind_ids, &probe));
+    if (!id) {
+        wmem_array_append_one(h->kinds, probe);
+        id = wmem_array_get_count(h->kinds);
+        wmem_map_insert(h->kind_ids, wmem_memdup(wmem_file_scope(), &probe, sizeof probe), GUINT_TO_POINTER(id));
+    }
+    if (h->record_count % records_per_chunk == 0) {
+        record *chunk = wmem_alloc_array(wmem_file_scope(), record, records_per_chunk);
+        wmem_array_append_one(h->records, chunk);
+    }
+    guint32 n = h->record_count++;
+    record *r = &(*(record **)wmem_array_index(h->records, n >> records_shift))[n % records_per_chunk];
+    r->kind = id - 1;
+    memcpy(r->timing, &f->timing, sizeof r->timing);
+    return n + 1;
+}
+
+/* What record `number` keeps: its frame's slaves and timing, and its comparison. */
+bus_frame frame_of(guint32 number, const shape **esc)
+{
+    guint32 n = number - 1;
+    const record *r = &(*(record **)wmem_array_index(hints->records, n >> records_shift))[n % records_per_chunk];
+    const kind *k = (const kind *)wmem_array_index(hints->kinds, r->kind);
+    if (esc) *esc = k->esc;
+    bus_frame f;
+    f.shape = k->bus;
+    f.cycle = k->cycle;
+    memcpy(&f.timing, r->timing, sizeof f.timing);
+    return f;
+}
+
 void *esc_capture_new(const dg_protocol *p)
 {
     capture_hints *h = wmem_new0(wmem_file_scope(), capture_hints);
+    hints = h;
+    h->shapes = wmem_map_new(wmem_file_scope(), shape_hash, shape_equal);
+    h->kinds = wmem_array_new(wmem_file_scope(), sizeof(kind));
+    h->kind_ids = wmem_map_new(wmem_file_scope(), kind_hash, kind_equal);
+    h->records = wmem_array_new(wmem_file_scope(), sizeof(record *));
     h->bus = bus_new(static_cast<const dg_bus *>(p->analysis_data));
     h->cycles = cycles_new();
     return h;
@@ -224,29 +349,33 @@ gboolean esc_key_changed(tvbuff_t *request, tvbuff_t *message)
 }
 
 
-void *esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, const dg_transaction *txn, packet_info *pinfo)
+guint32 esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, const dg_transaction *txn, packet_info *pinfo)
 {
     datagram sent[max_datagrams], back[max_datagrams];
     guint sent_length, back_length;
     guint sent_count = read_frame(request, &sent_length, sent, max_datagrams);
     guint back_count = read_frame(response, &back_length, back, max_datagrams);
     guint count = MIN(sent_count, back_count);
-    /* One allocation for the frame and its datagrams. */
-    result *r = (result *)wmem_alloc0(wmem_file_scope(), sizeof(result) + count * sizeof(compared));
-    r->d = (compared *)(r + 1);
-    r->count = count;
-    r->sent_length = sent_length;
-    r->back_length = back_length;
-    r->sent_count = sent_count;
-    r->back_count = back_count;
-    r->length_changed = sent_length != back_length || sent_count != back_count;
-    for (guint i = 0; i < r->count; i++) compare_datagram(&r->d[i], &sent[i], &back[i], request, response);
-    check_forwarding(r);
+    compared d[max_datagrams];
+    memset(d, 0, count * sizeof(compared));
+    shape probe;
+    memset(&probe, 0, sizeof probe);
+    probe.d = d;
+    probe.count = count;
+    probe.sent_length = sent_length;
+    probe.back_length = back_length;
+    probe.sent_count = sent_count;
+    probe.back_count = back_count;
+    probe.length_changed = sent_length != back_length || sent_count != back_count;
+    for (guint i = 0; i < count; i++) compare_datagram(&d[i], &sent[i], &back[i], request, response);
+    check_forwarding(&probe);
+    for (guint i = 0; i < count; i++) d[i] = kept_compared(&d[i]);
     capture_hints *h = (capture_hints *)capture;
-    r->bus = bus_returned(h->bus, request, response, sent, back, r->count, pinfo);
-    if (!r->length_changed) cycles_returned(h->cycles, sent, back, r->count, txn, pinfo);
-    bus_set_dc_drift(r->bus, dc_returned(h->cycles, sent, back, r->count, response, pinfo));
-    return r;
+    bus_frame f = {};
+    bus_returned(h->bus, request, response, sent, back, count, pinfo, &f);
+    if (!probe.length_changed) cycles_returned(h->cycles, sent, back, count, txn, pinfo);
+    bus_set_dc_drift(&f, dc_returned(h->cycles, sent, back, count, response, pinfo));
+    return new_record(h, intern(h, &probe), &f);
 }
 
 /* The datagram's items, when someone looks at them; `tree` is the analysis's subtree. */
@@ -332,9 +461,10 @@ gboolean unusual(const compared *c)
     return c->changed || (is_write(c->sent.cmd) && c->data_changed) || wkc_added(c) < 0 || c->forwarding;
 }
 
-void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+void esc_show(guint32 data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
-    const result *r = (const result *)data;
+    const shape *r;
+    const bus_frame frame = frame_of(data, &r);
     /* Printed: every datagram with the preference, else the unusual ones. The
      * others are added hidden (filterable, not printed) for whoever may read
      * them. Expert infos always. */
@@ -365,32 +495,33 @@ void esc_show(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *t
         }
         show_datagram_experts(c, i, tvb, pinfo, dg);
         if (!dc_shown && dc_datagram(&c->sent, &c->back)) {
-            dc_show(&c->back, bus_dc_drift(r->bus), tvb, tree);
+            dc_show(&c->back, bus_dc_drift(&frame), tvb, tree);
             dc_shown = TRUE;
         }
     }
-    bus_show(r->bus, tvb, pinfo, tree, show_details);
+    bus_show(&frame, tvb, pinfo, tree, show_details);
 }
 
 /* A frame as sent: its slaves and its cycle. */
-void *esc_sent(void *capture, tvbuff_t *tvb, packet_info *pinfo)
+guint32 esc_sent(void *capture, tvbuff_t *tvb, packet_info *pinfo)
 {
     capture_hints *h = (capture_hints *)capture;
     datagram d[max_datagrams];
     guint header_length;
     guint n = read_frame(tvb, &header_length, d, max_datagrams);
-    bus_frame *f = bus_sent(h->bus, d, n);
+    bus_frame f = {};
+    bus_sent(h->bus, d, n, &f);
     cycle_mark c = cycles_sent(h->cycles, d, n, pinfo);
-    if (c.cycle) bus_set_cycle(f, &c);
-    return f;
+    if (c.cycle) bus_set_cycle(&f, &c);
+    return new_record(h, NULL, &f);
 }
 
-void esc_show_sent(const void *data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+void esc_show_sent(guint32 data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
-    const bus_frame *f = (const bus_frame *)data;
-    cycle_mark c = bus_cycle(f);
+    const bus_frame f = frame_of(data, NULL);
+    cycle_mark c = bus_cycle(&f);
     cycles_show(&c, tvb, pinfo, tree);
-    bus_show(f, tvb, pinfo, tree, show_details);
+    bus_show(&f, tvb, pinfo, tree, show_details);
 }
 
 /* --- statistics ---------------------------------------------------------- */
@@ -404,9 +535,10 @@ void esc_stats_init(stats_tree *st, int parent)
     bus_stats_init(st, parent);
 }
 
-void esc_stats_response(stats_tree *st, int parent, const void *data)
+void esc_stats_response(stats_tree *st, int parent, guint32 data)
 {
-    const result *r = (const result *)data;
+    const shape *r;
+    const bus_frame frame = frame_of(data, &r);
     char label[32];
     for (guint i = 0; i < r->count; i++) {
         const compared *c = &r->d[i];
@@ -416,7 +548,7 @@ void esc_stats_response(stats_tree *st, int parent, const void *data)
         tick_stat_node(st, label, cmd_id, FALSE);
         if (wkc_added(c) < 0) tick_stat_node(st, st_wkc_down, parent, FALSE);
     }
-    bus_stats_frame(st, parent, r->bus);
+    bus_stats_frame(st, parent, &frame);
 }
 
 void esc_register(int proto, const char *filter)
