@@ -162,6 +162,22 @@ void add_device_pdos(BusLayout& l, const EsiDevice& dev, uint32_t first, uint32_
     l.device_pdos.push_back(r);
 }
 
+// What names a PDO entry: "PDO.Entry", the entry alone in a PDO without a name, the PDO
+// alone for an entry without one (the dissector shows the object beside it).
+std::string entry_name(const NetEntry& e) {
+    if (e.pdo_name.empty() || e.entry.name.empty()) return e.pdo_name + e.entry.name;
+    return e.pdo_name + "." + e.entry.name;
+}
+
+// A field's label: its owner and the entry's name; an entry without a name adds its object as
+// the dissector shows it ("EL9999 Status 0x60ab:11", "EL9999 0x7000:01").
+std::string field_label(const std::string& owner, const NetEntry& e) {
+    std::string label = owner + " " + entry_name(e);
+    if (e.entry.name.empty())
+        label += (e.pdo_name.empty() ? "" : " ") + hexn(e.entry.index, 4) + ":" + hexn(e.entry.subindex, 2).substr(2);
+    return label;
+}
+
 BusLayout make_bus_layout(const Catalogue& cat, const BusOptions& opt, const std::string& filter) {
     BusLayout l;
     const Network* net = opt.network;
@@ -197,7 +213,7 @@ BusLayout make_bus_layout(const Catalogue& cat, const BusOptions& opt, const std
         fld.ident = "hf_";
         for (char c : f) fld.ident += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
         for (int k = 2; !idents.insert(fld.ident).second; ++k) fld.ident += "_" + std::to_string(k);
-        fld.label = owner + " " + (e.pdo_name.empty() ? "" : e.pdo_name + ".") + e.entry.name;
+        fld.label = field_label(owner, e);
         fld.blurb = std::string(e.output ? "Output" : "Input") + " of PDO " + hexn(e.pdo_index, 4) + ", object " +
                     hexn(e.entry.index, 4) + ":" + hexn(e.entry.subindex, 2) + ", " +
                     (e.entry.data_type.empty() ? "" : e.entry.data_type + ", ") + std::to_string(e.entry.bit_length) +
@@ -280,7 +296,7 @@ EmbeddedTables emit_bus(const Catalogue& cat, const BusOptions& opt, const std::
         if (i == 0 || l.entry_owner[i] != last_owner)
             o << "    /* " << i << ": " << l.entry_owner[i] << " */\n";
         last_owner = l.entry_owner[i];
-        std::string name = e.pdo_name.empty() ? e.entry.name : e.pdo_name + "." + e.entry.name;
+        std::string name = entry_name(e);
         o << "    { " << hexn(e.entry.index, 4) << ", " << static_cast<unsigned>(e.entry.subindex) << ", "
           << (e.output ? 1 : 0) << ", " << e.entry.bit_length << ", " << hexn(e.pdo_index, 4) << ", " << e.bit_offset
           << ", " << e.logical_bit << ", " << c_string(e.entry.is_padding() ? "(padding)" : name) << ", "

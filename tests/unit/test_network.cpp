@@ -397,12 +397,24 @@ TEST(BusTables, PdoRowsAreTheCataloguesPdos) {
 }
 
 // An entry without a name is named by its object (index in 4 hex digits, subindex), under its
-// PDO's name when the PDO has one (the filters, in the order of the default process data).
+// PDO's name when the PDO has one (the filters, in the order of the default process data); its
+// label gives the object as the dissector shows it (subindex in hex), after the PDO's name.
 TEST(BusTables, UnnamedEntriesAreNamedByTheirObject) {
     std::istringstream lines(list_bus_fields(unnamed_catalogue(), {nullptr, false}, "ecatr"));
-    std::string filters;
-    for (std::string line; std::getline(lines, line);) filters += line.substr(0, line.find('\t')) + "\n";
+    std::string filters, labels;
+    for (std::string line; std::getline(lines, line);) {
+        std::vector<std::string> cols;
+        for (size_t at = 0, tab; at <= line.size(); at = tab + 1) {
+            tab = line.find('\t', at);
+            if (tab == std::string::npos) tab = line.size();
+            cols.push_back(line.substr(at, tab - at));
+        }
+        ASSERT_GE(cols.size(), 3u) << line;
+        filters += cols[0] + "\n";
+        labels += cols[2] + "\n";
+    }
     EXPECT_EQ(filters, "ecatr.pdo.el9999.entry_7000_1\necatr.pdo.el9999.mode\necatr.pdo.el9999.status.entry_60ab_17\n");
+    EXPECT_EQ(labels, "EL9999 0x7000:01\nEL9999 Mode\nEL9999 Status 0x60ab:11\n");
 }
 
 TEST(BusTables, BitNTakesTheSmallestFieldThatHoldsIt) {
