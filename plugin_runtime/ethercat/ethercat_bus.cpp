@@ -1026,8 +1026,9 @@ void show_generic(proto_tree *tree, const placed *e, tvbuff_t *tvb, gint data, g
     g_snprintf(object, sizeof object, "0x%04x:%02x", e->index, e->subindex);
     proto_item *it;
     if (e->known)
-        it = proto_tree_add_string_format_value(tree, hf_pdo_entry, tvb, offset, bytes, object, "%s %s (%s%s%u bit)",
-                                                object, e->known->name, e->known->data_type,
+        it = proto_tree_add_string_format_value(tree, hf_pdo_entry, tvb, offset, bytes, object, "%s%s%s (%s%s%u bit)",
+                                                object, *e->known->name ? " " : "", e->known->name,
+                                                e->known->data_type,
                                                 *e->known->data_type ? ", " : "", e->bits);
     else
         it = proto_tree_add_string_format_value(tree, hf_pdo_entry, tvb, offset, bytes, object,
