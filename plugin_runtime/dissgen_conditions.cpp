@@ -105,12 +105,6 @@ namespace {
 
 /* --- conditions ---------------------------------------------------------- */
 
-gboolean condition_holds(const dg_state *st, const dg_node *n)
-{
-    const dg_slot *s = &st->slots[n->if_slot];
-    return st->present[n->if_slot] && in_ranges(st->p, n->in_first, n->in_count, s->value);
-}
-
 gboolean hook_holds(const dg_state *st, const dg_node *n)
 {
     return in_ranges(st->p, n->hook_first, n->hook_count, st->hook_value);

@@ -233,6 +233,12 @@ static inline void clear_slots(dg_state *st, const dg_node *n)
     if (n->slot_count) memset(&st->present[n->slot_first], 0, n->slot_count);
 }
 
+/* Whether the value of n's if="..." field was decoded and is in its ranges. */
+static inline gboolean condition_holds(const dg_state *st, const dg_node *n)
+{
+    return st->present[n->if_slot] && in_ranges(st->p, n->in_first, n->in_count, st->slots[n->if_slot].value);
+}
+
 /* Whether n is decoded at `offset`. *chain_taken says whether a member of the
  * current chain of alternatives (a conditional node and the otherwise nodes
  * after it) was decoded; an otherwise node is skipped when one was. */
@@ -241,6 +247,13 @@ static inline gboolean selected(const dg_state *st, const dg_node *n, gint offse
     if (!n->alt && !n->hook_count && n->if_slot < 0 && !n->when_count && !n->extra) {
         *chain_taken = FALSE; /* unconditional: ends any chain */
         return TRUE;
+    }
+    if (!n->alt && !n->hook_count && !n->when_count && !n->extra) {
+        /* if="..." alone (most conditional nodes), without a call: a member
+         * of a chain when it holds */
+        gboolean holds = condition_holds(st, n);
+        *chain_taken = holds;
+        return holds;
     }
     return selected_conditional(st, n, offset, chain_taken);
 }
