@@ -298,7 +298,13 @@ void dg_rt::dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gin
     guint lo = base > w->max_span ? first_at_or_after(places, 0, w->place_count, base - w->max_span + 1) : 0;
     guint hi = first_at_or_after(places, lo, w->place_count, last);
     if (w->address_order_is_document_order || hi - lo < 2) {
-        for (guint k = lo; k < hi && !st->stopped; k++) dissect_place(st, &places[k], tree, start, base, last, in_summary);
+        const dg_node *nodes = st->p->nodes;
+        for (guint k = lo; k < hi && !st->stopped; k++) {
+            const dg_place *pl = &places[k];
+            /* most places of a register window are quiet: no call for them */
+            if (st->quiet && nodes[pl->node].quiet_size && nodes[pl->node].quiet_size <= pl->size) continue;
+            dissect_place(st, pl, tree, start, base, last, in_summary);
+        }
     } else {
         const dg_place **order = wmem_alloc_array(st->pinfo->pool, const dg_place *, hi - lo);
         for (guint k = lo; k < hi; k++) order[k - lo] = &places[k];
