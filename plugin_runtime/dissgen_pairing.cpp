@@ -47,8 +47,9 @@ struct pair_key {
  * bytes. The first message of each frame keeps it in the capture's frame
  * table (inline, indexed by frame number), any other message of a frame
  * with p_add_proto_data. What few messages need sits in maps beside the
- * table: the requests it proved lost, a round trip beyond 2 s, and the
- * transaction of a request not answered (which says why on display); once
+ * table: the requests it proved lost, a round trip beyond 2 s, and (in an
+ * array) the transaction of a request not answered (which says why on
+ * display); once
  * answered, the two frames' numbers and the round trip say everything. */
 struct kept {
     guint32 partner;      /* request: its response's frame (0: none yet); response: its
@@ -56,7 +57,8 @@ struct kept {
     guint8 role;          /* dg_role; 0: not paired on the first pass */
     guint8 out_of_order;  /* response: a later request was answered first */
     guint16 lost_count;   /* requests it proved lost (capture_state.lost_lists) */
-    gint32 round_trip;    /* response: in ns; long_trip: see capture_state.long_trips */
+    gint32 round_trip;    /* response: in ns; long_trip: see capture_state.long_trips;
+                           * request not answered: its slot in capture_state.unanswered + 1 */
     guint32 analysis;     /* response: the analysis's comparison; request: its sent() result */
 };
 static_assert(sizeof(kept) == 16, "kept grew");
@@ -80,6 +82,7 @@ struct pending {
     guint8 src_bytes[16];  /* src's data when it fits (kept_address) */
     guint8 *bytes;  /* the request's bytes, kept for the analysis until answered */
     guint length;
+    guint capacity; /* of bytes (a buffer used again: capture_state.spare) */
     guint64 key;    /* its first key value (dg_lost) */
     kept *record;              /* the request's record */
     gboolean guessed;          /* taken for a request for want of a better idea */
@@ -101,6 +104,7 @@ struct key_entry {
     guint8 last_src_bytes[16];
     guint8 *last_bytes;
     guint last_length;
+    guint last_capacity;         /* of last_bytes, which each message of the key fills again */
     nstime_t last_request_time;  /* this key's last request */
     nstime_t request_period;     /* between its last two requests; 0 until there are two */
 };
@@ -127,12 +131,49 @@ struct capture_state {
     wmem_array_t *table;         /* the frame table: chunks of table_chunk kept records */
     wmem_map_t *lost_lists;      /* kept record -> the dg_lost it proved (kept.lost_count) */
     wmem_map_t *long_trips;      /* kept record -> its round trip in ns (gint64), beyond a gint32 */
-    wmem_map_t *unanswered;      /* kept record of a request not answered -> its transaction */
+    /* The transactions of requests not answered, at the slot their records
+     * name (kept.round_trip); a slot let go of (NULL) is on free_slots, for
+     * the next request: an array, where a map would hash and allocate on
+     * every request and its answer. */
+    wmem_array_t *unanswered;    /* dg_transaction * */
+    guint32 *free_slots;
+    guint free_count, free_capacity;
     /* The requests the message being paired proves lost (give_up). */
     guint32 frame;               /* that message's frame */
     dg_lost *lost;
     guint lost_count, lost_capacity;
+    /* A request's bytes buffer its answer freed, for the next request
+     * (one allocation and one free fewer per pair). */
+    guint8 *spare;
+    guint spare_capacity;
+    /* Transactions answered and requests let go of, for the next requests:
+     * most are answered within a few messages, so these stay short. */
+    struct recycled *free_transactions, *free_pending;
 };
+
+/* A freed transaction or pending request on a capture_state free list. */
+struct recycled {
+    recycled *next;
+};
+static_assert(sizeof(recycled) <= sizeof(dg_transaction) && sizeof(recycled) <= sizeof(pending), "recycled");
+
+/* A zeroed T from `list` (wmem_file_scope()'s when it is empty). */
+template <typename T> T *new_recycled(recycled **list)
+{
+    recycled *r = *list;
+    if (!r) return wmem_new0(wmem_file_scope(), T);
+    *list = r->next;
+    memset((void *)r, 0, sizeof(T));
+    return (T *)(void *)r;
+}
+
+/* p is no longer used: on `list` for new_recycled(). */
+void recycle(recycled **list, void *p)
+{
+    recycled *r = (recycled *)p;
+    r->next = *list;
+    *list = r;
+}
 
 /* One protocol per plugin, and each plugin links its own runtime. */
 const dg_protocol *protocol;
@@ -191,7 +232,7 @@ capture_state *current_capture(void)
         capture->table = wmem_array_new(wmem_file_scope(), sizeof(kept *));
         capture->lost_lists = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
         capture->long_trips = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
-        capture->unanswered = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+        capture->unanswered = wmem_array_new(wmem_file_scope(), sizeof(dg_transaction *));
         guint64 none = 0;
         wmem_array_append_one(capture->scope_answered, none);
         if (analysis && analysis->capture_new) capture->analysis = analysis->capture_new(protocol);
@@ -227,6 +268,41 @@ kept *record_of(capture_state *c, packet_info *pinfo, guint message, gboolean cr
         p_add_proto_data(wmem_file_scope(), pinfo, *protocol->proto, frame_key + message, k);
     }
     return k;
+}
+
+/* Request k, not answered, has transaction t until answered (set_answered). */
+void set_unanswered(capture_state *c, kept *k, dg_transaction *t)
+{
+    guint32 slot;
+    if (c->free_count) {
+        slot = c->free_slots[--c->free_count];
+        *(dg_transaction **)wmem_array_index(c->unanswered, slot) = t;
+    } else {
+        slot = wmem_array_get_count(c->unanswered);
+        wmem_array_append_one(c->unanswered, t);
+    }
+    k->round_trip = (gint32)(slot + 1);
+}
+
+/* Request k is no longer waiting (answered, or an orphan after all): its slot goes. */
+void set_answered(capture_state *c, kept *k)
+{
+    if (k->round_trip <= 0) return; /* none: an orphan taken for the request */
+    guint32 slot = (guint32)k->round_trip - 1;
+    *(dg_transaction **)wmem_array_index(c->unanswered, slot) = NULL;
+    if (c->free_count == c->free_capacity) {
+        c->free_capacity = c->free_capacity ? 2 * c->free_capacity : 16;
+        c->free_slots = (guint32 *)wmem_realloc(wmem_file_scope(), c->free_slots, c->free_capacity * sizeof(guint32));
+    }
+    c->free_slots[c->free_count++] = slot;
+    k->round_trip = 0;
+}
+
+/* The transaction of request k, not answered. */
+dg_transaction *unanswered_of(const capture_state *c, const kept *k)
+{
+    if (k->round_trip <= 0) return NULL;
+    return *(dg_transaction **)wmem_array_index(c->unanswered, (guint)k->round_trip - 1);
 }
 
 /* The order scope of a request sent in this packet (capture_state.scope_answered). */
@@ -320,6 +396,18 @@ void unlink_entry(capture_state *c, key_entry *e)
     e->older = e->newer = NULL;
 }
 
+/* *buffer (of *capacity bytes) holds the first `length` bytes of tvb, in a
+ * larger buffer only when they do not fit. */
+void fill_buffer(guint8 **buffer, guint *capacity, tvbuff_t *tvb, guint length)
+{
+    if (length > *capacity || !*buffer) {
+        wmem_free(wmem_file_scope(), *buffer);
+        *buffer = length ? (guint8 *)wmem_alloc(wmem_file_scope(), length) : NULL;
+        *capacity = length;
+    }
+    if (length) tvb_memcpy(tvb, *buffer, 0, length);
+}
+
 void remember_last(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length, guint8 role)
 {
     unlink_entry(c, e);
@@ -331,11 +419,14 @@ void remember_last(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *p
     c->newest = e;
     e->last_time = pinfo->abs_ts;
     e->last_role = role;
-    wmem_free(wmem_file_scope(), e->last_bytes);
-    drop_address(&e->last_src, e->last_src_bytes);
     e->last_frame = pinfo->num;
-    keep_address(&e->last_src, e->last_src_bytes, &pinfo->src);
-    e->last_bytes = (guint8 *)tvb_memdup(wmem_file_scope(), tvb, 0, length);
+    /* Mostly the key's previous message came from the same source with as
+     * many bytes: its address and buffer serve again. */
+    if (!addresses_equal(&e->last_src, &pinfo->src)) {
+        drop_address(&e->last_src, e->last_src_bytes);
+        keep_address(&e->last_src, e->last_src_bytes, &pinfo->src);
+    }
+    fill_buffer(&e->last_bytes, &e->last_capacity, tvb, length);
     e->last_length = length;
 }
 
@@ -346,7 +437,13 @@ void retire(capture_state *c, pending *q)
     q->done = TRUE;
     c->waiting--;
     if (q->guessed) c->guessed--;
-    wmem_free(wmem_file_scope(), q->bytes);
+    if (q->bytes && (!c->spare || q->capacity > c->spare_capacity)) {
+        wmem_free(wmem_file_scope(), c->spare);
+        c->spare = q->bytes;
+        c->spare_capacity = q->capacity;
+    } else {
+        wmem_free(wmem_file_scope(), q->bytes);
+    }
     q->bytes = NULL;
     drop_address(&q->src, q->src_bytes);
 }
@@ -367,9 +464,9 @@ void give_up(capture_state *c, pending *q)
     retire(c, q);
 }
 
-void release(pending *q)
+void release(capture_state *c, pending *q)
 {
-    if (--q->queues == 0) wmem_free(wmem_file_scope(), q);
+    if (--q->queues == 0) recycle(&c->free_pending, q);
 }
 
 /* A response may come back after those of later requests (a reordering, or
@@ -386,12 +483,12 @@ gboolean given_up(const capture_state *c, const pending *q, const packet_info *p
 
 /* Takes a done request off the head of a queue. `in_key` says which link the
  * queue uses. */
-void drop_head(queue *qu, gboolean in_key)
+void drop_head(capture_state *c, queue *qu, gboolean in_key)
 {
     pending *q = qu->head;
     qu->head = in_key ? q->next : q->next_sent;
     if (!qu->head) qu->tail = NULL;
-    release(q);
+    release(c, q);
 }
 
 /* The oldest request of a queue still waiting (given-up ones retired on the
@@ -402,7 +499,7 @@ pending *oldest_waiting(capture_state *c, queue *qu, gboolean in_key, const pack
         pending *q = qu->head;
         if (!q->done && given_up(c, q, pinfo, protocol->pairing->timeout)) give_up(c, q);
         if (!q->done) return q;
-        drop_head(qu, in_key);
+        drop_head(c, qu, in_key);
     }
     return NULL;
 }
@@ -525,7 +622,7 @@ void forget_requests(capture_state *c)
             if (!overtaken(c, q->txn, max_overtaken) && !timed_out(c, &q->txn->request_time)) return;
             give_up(c, q);
         }
-        drop_head(&c->sent, FALSE);
+        drop_head(c, &c->sent, FALSE);
     }
 }
 
@@ -536,7 +633,7 @@ void forget_key(capture_state *c, key_entry *e)
     for (pending *q = e->waiting.head, *next; q; q = next) {
         next = q->next;
         give_up(c, q);
-        release(q);
+        release(c, q);
     }
     unlink_entry(c, e);
     wmem_map_remove(c->keys, e->key);
@@ -569,9 +666,9 @@ void orphan_guessed_from(capture_state *c, const packet_info *pinfo)
     for (pending *q = c->sent.head; q && c->guessed; q = q->next_sent) {
         if (q->done || !q->guessed || !addresses_equal(&q->src, &pinfo->src)) continue;
         q->record->role = DG_ROLE_ORPHAN;
-        wmem_map_remove(c->unanswered, q->record);
+        set_answered(c, q->record);
         retire(c, q);
-        wmem_free(wmem_file_scope(), q->txn); /* retired without a loss: nothing names it */
+        recycle(&c->free_transactions, q->txn); /* retired without a loss: nothing names it */
     }
 }
 
@@ -655,8 +752,8 @@ void response_to(capture_state *c, dg_transaction *t, kept *request, const guint
         tvb_free(bytes);
     }
     request->partner = pinfo->num;
-    wmem_map_remove(c->unanswered, request);
-    wmem_free(wmem_file_scope(), t);
+    set_answered(c, request);
+    recycle(&c->free_transactions, t);
 }
 
 void answer(capture_state *c, pending *q, kept *k, tvbuff_t *tvb, packet_info *pinfo)
@@ -681,7 +778,7 @@ gboolean adopt_orphan(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, pa
     if (nstime_to_sec(&gap) > protocol->pairing->timeout) return FALSE;
     int verdict = analysis && analysis->is_response ? analysis->is_response(c->analysis, &e->last_src, &pinfo->src) : -1;
     if (verdict == 0 || (verdict < 0 && !addresses_equal(&e->last_src, &pinfo->src))) return FALSE;
-    dg_transaction *t = wmem_new0(wmem_file_scope(), dg_transaction);
+    dg_transaction *t = new_recycled<dg_transaction>(&c->free_transactions);
     t->request_frame = e->last_frame;
     t->request_time = e->last_time;
     t->seq = ++c->requests;
@@ -692,23 +789,24 @@ gboolean adopt_orphan(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, pa
     return TRUE;
 }
 
-/* This message, k, is a new request: it waits for its response. */
-void new_request(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, packet_info *pinfo, guint length,
+/* This message, k, is a new request: it waits for its response, a new
+ * transaction (returned). */
+dg_transaction *new_request(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, packet_info *pinfo, guint length,
                  guint64 key, gboolean guessed)
 {
     if (analysis && analysis->sent) k->analysis = analysis->sent(c->analysis, tvb, pinfo);
     /* Kept until it is answered (response_to frees it), or for good when it is not. */
-    dg_transaction *t = wmem_new0(wmem_file_scope(), dg_transaction);
+    dg_transaction *t = new_recycled<dg_transaction>(&c->free_transactions);
     t->request_frame = pinfo->num;
     t->request_time = pinfo->abs_ts;
     t->seq = ++c->requests;
     t->order_scope = order_scope_of(c, pinfo);
     k->role = DG_ROLE_REQUEST;
-    wmem_map_insert(c->unanswered, k, t);
+    set_unanswered(c, k, t);
     if (!nstime_is_zero(&e->last_request_time) && nstime_cmp(&pinfo->abs_ts, &e->last_request_time) > 0)
         nstime_delta(&e->request_period, &pinfo->abs_ts, &e->last_request_time);
     e->last_request_time = pinfo->abs_ts;
-    pending *n = wmem_new0(wmem_file_scope(), pending);
+    pending *n = new_recycled<pending>(&c->free_pending);
     n->txn = t;
     n->key = key;
     n->record = k;
@@ -716,12 +814,18 @@ void new_request(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, packet_
     if (guessed) c->guessed++;
     keep_address(&n->src, n->src_bytes, &pinfo->src);
     if (analysis && analysis->compare) {
-        n->bytes = (guint8 *)tvb_memdup(wmem_file_scope(), tvb, 0, length);
+        if (length && c->spare && c->spare_capacity >= length) {
+            n->bytes = c->spare;
+            n->capacity = c->spare_capacity;
+            c->spare = NULL;
+        }
+        fill_buffer(&n->bytes, &n->capacity, tvb, length);
         n->length = length;
     }
     enqueue(&e->waiting, n, TRUE);
     enqueue(&c->sent, n, FALSE);
     c->waiting++;
+    return t;
 }
 
 /* The pending request this message answers, or NULL for a new request
@@ -750,8 +854,9 @@ pending *classify(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pi
     return q;
 }
 
-/* Pairs message k on the first pass and fills its record. */
-void first_pass(capture_state *c, kept *k, tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count,
+/* Pairs message k on the first pass and fills its record. Returns the
+ * transaction of a new request (capture_state.unanswered has it too), else NULL. */
+dg_transaction *first_pass(capture_state *c, kept *k, tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count,
                 guint length, guint8 transport_direction)
 {
     c->frame = pinfo->num;
@@ -771,11 +876,12 @@ void first_pass(capture_state *c, kept *k, tvbuff_t *tvb, packet_info *pinfo, co
         k->role = DG_ROLE_DUPLICATE;
         k->partner = e->last_frame;
         with_lost(c, k);
-        return;
+        return NULL;
     }
     if (unchanged) direction = DG_DIR_ANY; /* the waiting request, come back */
 
     gboolean orphan;
+    dg_transaction *t = NULL;
     pending *q = classify(c, e, tvb, pinfo, length, direction, unchanged, &orphan);
     if (q)
         answer(c, q, k, tvb, pinfo);
@@ -784,16 +890,19 @@ void first_pass(capture_state *c, kept *k, tvbuff_t *tvb, packet_info *pinfo, co
     else if (orphan)
         k->role = DG_ROLE_ORPHAN;
     else
-        new_request(c, e, k, tvb, pinfo, length, keys[0], direction == DG_DIR_ANY);
+        t = new_request(c, e, k, tvb, pinfo, length, keys[0], direction == DG_DIR_ANY);
     remember_last(c, e, tvb, pinfo, length, k->role);
     e->last_record = k;
     with_lost(c, k);
+    return t;
 }
 
 /* What later passes show of record k (the first pass too, so that every pass
  * shows the same), in pinfo->pool: the frame's record and its transaction as
- * dissgen_pairing.h has them. */
-const dg_frame_pairing *view_of(const capture_state *c, const kept *k, packet_info *pinfo)
+ * dissgen_pairing.h has them. `fresh`: the transaction the first pass just
+ * made for k, a new request (else NULL: capture_state.unanswered has it). */
+const dg_frame_pairing *view_of(const capture_state *c, const kept *k, packet_info *pinfo,
+                                const dg_transaction *fresh)
 {
     struct view {
         dg_frame_pairing fp;
@@ -810,7 +919,7 @@ const dg_frame_pairing *view_of(const capture_state *c, const kept *k, packet_in
     case DG_ROLE_REQUEST:
         if (!k->partner) {
             /* not answered: its own transaction */
-            fp->txn = (dg_transaction *)wmem_map_lookup(c->unanswered, k);
+            fp->txn = fresh ? (dg_transaction *)fresh : unanswered_of(c, k);
             break;
         }
         v->txn.request_frame = pinfo->num;
@@ -964,14 +1073,15 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *, tvbuff_t *tvb, p
     /* A message cut short before its first key field answers and asks nothing. */
     if (key_count == 0) return NULL;
     kept *k = capture ? record_of(capture, pinfo, message, FALSE) : NULL;
+    const dg_transaction *fresh = NULL;
     if (!k || !k->role) {
         if (PINFO_FD_VISITED(pinfo)) return NULL; /* not paired on the first pass: nothing to show */
         guint len = length > 0 ? (guint)length : tvb_captured_length(tvb);
         capture_state *c = current_capture();
         k = record_of(c, pinfo, message, TRUE);
-        first_pass(c, k, tvb, pinfo, keys, key_count, len, direction);
+        fresh = first_pass(c, k, tvb, pinfo, keys, key_count, len, direction);
     }
-    const dg_frame_pairing *fp = view_of(capture, k, pinfo);
+    const dg_frame_pairing *fp = view_of(capture, k, pinfo, fresh);
     show(fp, tvb, pinfo, tree);
     return fp;
 }

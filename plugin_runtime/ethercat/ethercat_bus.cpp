@@ -1221,8 +1221,12 @@ double bus_dc_drift(const bus_frame *f) { return f->shape->returned ? f->timing.
 void bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
                   packet_info *pinfo, bus_frame *f)
 {
-    events ev = {};
-    guint8 flags[max_datagrams] = {};
+    /* Only what is used is set: zeroing every possible event and datagram
+     * would cost more than the rest of a cyclic frame's work. */
+    events ev;
+    ev.count = 0;
+    guint8 flags[max_datagrams];
+    memset(flags, 0, n * sizeof flags[0]);
     for (guint i = 0; i < n; i++) {
         if (logical(s[i].cmd) && s[i].cmd == b[i].cmd && s[i].adp == b[i].adp && s[i].ado == b[i].ado &&
             s[i].length == b[i].length)

@@ -204,7 +204,7 @@ signature *signature_of(cycle_model *m, const datagram *d, guint n)
         h = (h ^ ((guint32)d[i].adp | (guint32)d[i].ado << 16)) * 16777619u;
         h = (h ^ d[i].length) * 16777619u;
     }
-    signature probe = {};
+    signature probe; /* what sig_hash() and sig_equal() read, no more (not its ring) */
     probe.hash = h;
     probe.count = n;
     probe.d = probe_d;

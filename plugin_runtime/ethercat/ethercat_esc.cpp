@@ -84,6 +84,11 @@ struct record {
 };
 static_assert(sizeof(record) == 12 && sizeof(record::timing) == sizeof(bus_frame::timing), "record grew");
 const guint records_shift = 12, records_per_chunk = 1u << records_shift;
+const guint recent_slots = 64;
+
+/* The slot of capture_hints.recent for a frame with these slaves. */
+guint recent_slot(const void *bus) { return (guint)(((guintptr)bus >> 3) * 2654435761u) >> 26; }
+static_assert(recent_slots == 64, "recent_slot gives 6 bits");
 
 struct capture_hints {
     gboolean marking_seen; /* a slave set the locally administered bit: the capture shows direction */
@@ -95,6 +100,13 @@ struct capture_hints {
     wmem_map_t *kind_ids;  /* kind -> its index in kinds + 1 */
     wmem_array_t *records; /* chunks of records_per_chunk records */
     guint32 record_count;
+    /* The comparison and the kind last found for a frame of each slot's
+     * slaves (its bus_shape): frames alike follow each other, so most find
+     * theirs here, with a comparison instead of hashing. */
+    struct {
+        const shape *esc;
+        guint32 kind;                 /* its index in kinds + 1, 0: none yet */
+    } recent[recent_slots];
 };
 
 /* The capture's hints: what a record's kind indexes. (A record is shown
@@ -197,18 +209,22 @@ gboolean shape_equal(gconstpointer a, gconstpointer b)
            memcmp(x->d, y->d, x->count * sizeof(compared)) == 0;
 }
 
-/* The interned copy of `probe` (its d[] in kept_compared form). */
-const shape *intern(capture_hints *h, const shape *probe)
+/* The interned copy of `probe` (its d[] in kept_compared form), for a
+ * returned frame with these slaves. */
+const shape *intern(capture_hints *h, const shape *probe, const void *bus)
 {
+    guint slot = recent_slot(bus);
+    const shape *last = h->recent[slot].esc;
+    if (last && shape_equal(last, probe)) return last;
     const shape *found = (const shape *)wmem_map_lookup(h->shapes, probe);
-    if (found) return found;
+    if (found) return h->recent[slot].esc = found;
     /* One allocation for the shape and its datagrams. */
     shape *s = (shape *)wmem_alloc(wmem_file_scope(), sizeof(shape) + probe->count * sizeof(compared));
     *s = *probe;
     s->d = (compared *)(s + 1);
     if (probe->count) memcpy(s->d, probe->d, probe->count * sizeof(compared));
     wmem_map_insert(h->shapes, s, s);
-    return s;
+    return h->recent[slot].esc = s;
 }
 
 guint kind_hash(gconstpointer v)
@@ -227,12 +243,17 @@ gboolean kind_equal(gconstpointer a, gconstpointer b)
 guint32 new_record(capture_hints *h, const shape *esc, const bus_frame *f)
 {
     kind probe = {esc, f->shape, f->cycle};
-    guint id = GPOINTER_TO_UINT(wmem_map_lookup(h->kind_ids, &probe));
+    guint slot = recent_slot(f->shape);
+    guint id = h->recent[slot].kind;
+    if (!id || !kind_equal((const kind *)wmem_array_index(h->kinds, id - 1), &probe)) {
+        id = GPOINTER_TO_UINT(wmem_map_lookup(h->kind_ids, &probe));
+    }
     if (!id) {
         wmem_array_append_one(h->kinds, probe);
         id = wmem_array_get_count(h->kinds);
         wmem_map_insert(h->kind_ids, wmem_memdup(wmem_file_scope(), &probe, sizeof probe), GUINT_TO_POINTER(id));
     }
+    h->recent[slot].kind = id;
     if (h->record_count % records_per_chunk == 0) {
         record *chunk = wmem_alloc_array(wmem_file_scope(), record, records_per_chunk);
         wmem_array_append_one(h->records, chunk);
@@ -375,7 +396,7 @@ guint32 esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, const 
     bus_returned(h->bus, request, response, sent, back, count, pinfo, &f);
     if (!probe.length_changed) cycles_returned(h->cycles, sent, back, count, txn, pinfo);
     bus_set_dc_drift(&f, dc_returned(h->cycles, sent, back, count, response, pinfo));
-    return new_record(h, intern(h, &probe), &f);
+    return new_record(h, intern(h, &probe, f.shape), &f);
 }
 
 /* The datagram's items, when someone looks at them; `tree` is the analysis's subtree. */
