@@ -64,25 +64,6 @@ std::vector<int64_t> values_of(const std::vector<TimedValue>& series) {
     return v;
 }
 
-// Jitter histogram: [[bin's lower edge µs, count], ...].
-std::string histogram_json(const std::vector<TimedValue>& series) {
-    if (series.empty()) return "[]";
-    int64_t lo = series.front().ns, hi = lo;
-    for (const TimedValue& p : series) lo = std::min(lo, p.ns), hi = std::max(hi, p.ns);
-    int64_t width = std::max<int64_t>(1, (hi - lo) / static_cast<int64_t>(kHistogramBins) + 1);
-    std::vector<uint64_t> counts(static_cast<size_t>((hi - lo) / width + 1));
-    for (const TimedValue& p : series) counts[static_cast<size_t>((p.ns - lo) / width)]++;
-    // A step plot draws a bin from its x to the next one's: each bin at its
-    // lower edge, and an empty one after the last to close it.
-    std::string out = "[";
-    for (size_t i = 0; i <= counts.size(); ++i) {
-        double edge = static_cast<double>(lo + static_cast<int64_t>(i) * width);
-        out += (i ? "," : "") + std::string("[") + num(edge / 1000.0) + "," +
-               std::to_string(i < counts.size() ? counts[i] : 0) + "]";
-    }
-    return out + "]";
-}
-
 std::string events_json(const std::vector<Event>& events) {
     std::string out = "[";
     size_t step = events.size() > kMarkerLimit ? (events.size() + kMarkerLimit - 1) / kMarkerLimit : 1;
@@ -198,6 +179,24 @@ td:nth-child(2), th:nth-child(2) { text-align: left; }
 std::string dygraphs_dir() {
     const char* env = std::getenv("DISSGEN_DYGRAPHS_DIR");
     return env && *env ? env : "/usr/share/javascript/dygraphs";
+}
+
+std::string histogram_json(const std::vector<TimedValue>& series) {
+    if (series.empty()) return "[]";
+    int64_t lo = series.front().ns, hi = lo;
+    for (const TimedValue& p : series) lo = std::min(lo, p.ns), hi = std::max(hi, p.ns);
+    int64_t width = std::max<int64_t>(1, (hi - lo) / static_cast<int64_t>(kHistogramBins) + 1);
+    std::vector<uint64_t> counts(static_cast<size_t>((hi - lo) / width + 1));
+    for (const TimedValue& p : series) counts[static_cast<size_t>((p.ns - lo) / width)]++;
+    // A step plot draws a bin from its x to the next one's: each bin at its
+    // lower edge, and an empty one after the last to close it.
+    std::string out = "[";
+    for (size_t i = 0; i <= counts.size(); ++i) {
+        double edge = static_cast<double>(lo + static_cast<int64_t>(i) * width);
+        out += (i ? "," : "") + std::string("[") + num(edge / 1000.0) + "," +
+               std::to_string(i < counts.size() ? counts[i] : 0) + "]";
+    }
+    return out + "]";
 }
 
 std::string series_json(const std::vector<TimedValue>& series, size_t buckets) {

@@ -22,4 +22,9 @@ std::string write_report_html(const TimingModel& model, const std::string& tool_
 // so that hours of capture draw quickly and no spike is lost.
 std::string series_json(const std::vector<TimedValue>& series, size_t buckets);
 
+// The jitter histogram as [[bin's lower edge µs, frames], ...]: at most 80
+// bins of whole nanoseconds from the smallest value to the largest, then an
+// empty bin that closes the step plot.
+std::string histogram_json(const std::vector<TimedValue>& series);
+
 }  // namespace dissgen

@@ -18,13 +18,15 @@ offsets   tests/rules/offsets_from.xml: offsets= counted from the container arou
           (from=".."), from the one around that (from="../..") and one more up ("../../.."),
           each container starting at another byte: the entries are where the table says (their
           tags and bodies), with the first right after the table or after a gap, entries of a
-          single byte, the last one ending with the message; no expert info. An offset one
-          byte inside the table gives offs.expert.bad_offset and no entry.
+          single byte, the last one ending with the message; no expert info. A first offset
+          one byte inside the table, or a second one before the first, gives
+          offs.expert.bad_offset and no entry, and its message names the entry and the reason.
 
     test_edges.py --dissgen build/bin/dissgen --source-dir . [TestEdges.test_handoff_...|-k peek|-k offsets]
 """
 import os
 import random
+import re
 import struct
 import sys
 import unittest
@@ -193,7 +195,7 @@ KINDS = {  # kind: (filter prefix, bytes from the base to the table's count, off
 }
 
 
-def offsets_message(kind, entries, gap, first_shift=0):
+def offsets_message(kind, entries, gap, first_shift=0, second_before_first=False):
     """Kind, Pad, the heads of the containers, the table, a gap, the entries (tag, body).
     Returns (payload, [(tag, body)] expected)."""
     _prefix, heads, size = KINDS[kind]
@@ -204,6 +206,8 @@ def offsets_message(kind, entries, gap, first_shift=0):
         offsets.append(at)
         at += 1 + len(body)
     offsets[0] -= first_shift
+    if second_before_first:
+        offsets[1] = offsets[0] - 1
     head = bytes(range(0xA0, 0xA0 + heads))
     fmt = "<B" + ("B" if size == 1 else "H") * n
     return (bytes([kind, 0xEE]) + head + struct.pack(fmt, n, *offsets) + bytes(gap)
@@ -221,11 +225,15 @@ def offsets_checks(check, dissgen, source_dir):
             entries = [(0x10 * (k + 1) + kind, bytes(rng.getrandbits(8) for _ in range(s)))
                        for k, s in enumerate(sizes)]
             payload, want = offsets_message(kind, entries, gap)
-            cases.append((kind, payload, want, False, "kind %d, %d entries (%s bytes), gap %d" % (
+            cases.append((kind, payload, want, None, "kind %d, %d entries (%s bytes), gap %d" % (
                 kind, n, sizes, gap)))
         payload, _ = offsets_message(kind, [(0x77, b"\x01"), (0x78, b"")], 0, first_shift=1)
-        cases.append((kind, payload, [], True, "kind %d, the first offset one byte inside the table" % kind))
-    names = ["_ws.expert", "offs.expert.bad_offset"]
+        cases.append((kind, payload, [], "'Entry' 1 of 2: offset %d (byte %d) is before the bytes left",
+                      "kind %d, the first offset one byte inside the table" % kind))
+        payload, _ = offsets_message(kind, [(0x77, b"\x01\x02"), (0x78, b"")], 1, second_before_first=True)
+        cases.append((kind, payload, [], "'Entry' 2 of 2: offset %d (byte %d) is smaller than the one before it",
+                      "kind %d, the second offset before the first" % kind))
+    names = ["_ws.expert", "_ws.expert.message", "offs.expert.bad_offset"]
     for prefix, _h, _s in KINDS.values():
         names += [prefix + ".entry.tag", prefix + ".entry.body"]
     with TsharkEnv() as env:
@@ -239,10 +247,16 @@ def offsets_checks(check, dissgen, source_dir):
             got = ([int(t, 16) for t in r[prefix + ".entry.tag"]],
                    [b.replace(" ", "").replace(":", "") for b in r[prefix + ".entry.body"]], bool(r["offs.expert.bad_offset"]),
                    len(r["_ws.expert"]))
-            want = ([t for t, _b in entries], [b.hex() for _t, b in entries if b], bad, 1 if bad else 0)
+            want = ([t for t, _b in entries], [b.hex() for _t, b in entries if b], bool(bad), 1 if bad else 0)
             check(got == want, "%s: entries where the table says, %s%s" % (
                 what, "offs.expert.bad_offset" if bad else "no expert info",
                 "" if got == want else "\n       got  %s\n       want %s" % (got, want)))
+            if bad:
+                # which entry is wrong, and how: the number and the reason
+                pattern = re.escape(bad).replace("%d", r"\d+")
+                message = " ".join(r["_ws.expert.message"])
+                check(re.match(pattern, message) is not None, "%s: the message says %r (%s)" % (
+                    what, bad.split(": ", 1)[0] + ": ... " + bad.rsplit(" is ", 1)[1], message))
 
 
 class TestEdges(TsharkTestCase, unittest.TestCase):

@@ -165,6 +165,22 @@ TEST(ReportChart, LongSeriesKeepEveryExtreme) {
     EXPECT_EQ(short_json, "[[0.500000,[1.500,1.500,1.500]],[1.000000,[-0.250,-0.250,-0.250]]]");
 }
 
+// The histogram's bins are whole nanoseconds, (max - min) / 80 + 1 wide,
+// from the smallest value: at most 80 of them, whatever the values' sign.
+TEST(ReportChart, HistogramBinsSpanTheValues) {
+    std::string json = histogram_json({{0.0, 1000}, {0.1, 1010}, {0.2, 1011}, {0.3, 1800}});
+    // 800 ns wide: 11 ns bins, 73 of them (the last from 1792 ns), then the closing one.
+    EXPECT_EQ(json.rfind("[[1.000,2],[1.011,1],[1.022,0],", 0), 0u) << json;
+    EXPECT_NE(json.find(",[1.792,1],[1.803,0]]"), std::string::npos) << json;
+    size_t entries = 0;
+    for (size_t at = json.find("],["); at != std::string::npos; at = json.find("],[", at + 1)) ++entries;
+    EXPECT_EQ(entries + 1, 74u);
+    std::string negative = histogram_json({{0.0, -500}, {0.1, 300}});
+    EXPECT_EQ(negative.rfind("[[-0.500,1],[-0.489,0],", 0), 0u) << negative;
+    EXPECT_EQ(histogram_json({}), "[]");
+    EXPECT_EQ(histogram_json({{0.0, 7}}), "[[0.007,1],[0.008,0]]");
+}
+
 TEST(ReportPage, SelfContainedAndEscaped) {
     TimingModel m;
     m.capture = "/x/<evil>.pcap";
