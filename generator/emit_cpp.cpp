@@ -299,6 +299,15 @@ private:
     void tables();
     void node_table();
     std::string node_row(const Node& n) const;
+    // compiled walks: a function per list of siblings (dg_list_walk)
+    bool has_walk(const Node& n) const { return n.is_container() && !n.children.empty() && !l_.window_index.count(&n); }
+    std::string walk_name(const Node* owner) const;
+    void walk_declarations();
+    void walk_definitions();
+    // compiled summaries: a function per summarised container (dg_summary_text)
+    std::string summary_name(int node) const { return p_.filter + "_summary_" + std::to_string(node); }
+    void summary_definitions();
+    void summary_pieces(size_t first, size_t count, const std::string& complete, int depth);
     std::vector<std::string> summary_rows() const;
     std::string protocol_row() const;
     void request_context();
@@ -341,7 +350,10 @@ std::string Emitter::run() {
     value_strings();
     tables();
     extra_table();
+    walk_declarations();
     node_table();
+    walk_definitions();
+    summary_definitions();
     protocol_struct();
     register_functions();
     return o_.str();
@@ -357,7 +369,7 @@ void Emitter::header() {
        << " * GNU General Public License, version 2 or later: so is the plugin.\n"
        << " * SPDX-License-Identifier: GPL-2.0-or-later\n"
        << " */\n"
-       << "#include \"dissgen_rows.h\"\n" << (has_validity(p_) ? "#include \"dissgen_validity.h\"\n" : "")
+       << "#include \"dissgen_rows.h\"\n#include \"dissgen_state.h\"\n" << (has_validity(p_) ? "#include \"dissgen_validity.h\"\n" : "")
        << (extra_ ? extra_->includes : "") << "\n";
 }
 
@@ -488,7 +500,96 @@ std::string Emitter::node_row(const Node& n) const {
     if (n.otherwise) add("alt", "DG_ALT_OTHERWISE");
     if (l_.window_index.count(&n)) add("window", std::to_string(l_.window_index.at(&n)));
     if (quiet_.count(&n)) add("quiet_size", std::to_string(quiet_.at(&n)) + "u");
+    if (has_walk(n)) add("walk", walk_name(&n));
+    if (!n.summary_pieces.empty()) add("summarize", summary_name(n.doc_index - 1));
     return named_row(start, set);
+}
+
+// The walk of a container's children (owner NULL: the top-level nodes).
+std::string Emitter::walk_name(const Node* owner) const {
+    return p_.filter + "_walk_" + (owner ? std::to_string(owner->doc_index - 1) : std::string("top"));
+}
+
+void Emitter::walk_declarations() {
+    o_ << "/* The lists of siblings, compiled: each member decoded in turn, its node a\n"
+       << " * constant (dissgen_state.h, dissect_child). */\n";
+    const char* params = "(dg_rt::dg_state *st, proto_tree *tree, gint *offset, gint end, gboolean in_summary)";
+    o_ << "static void " << walk_name(nullptr) << params << ";\n";
+    for (const Node* n : l_.nodes)
+        if (has_walk(*n)) o_ << "static void " << walk_name(n) << params << ";\n";
+    o_ << "\n/* The summaries, compiled: the pieces in turn (dissgen_text.cpp, append_pieces). */\n";
+    for (const Node* n : l_.nodes)
+        if (!n->summary_pieces.empty())
+            o_ << "static gboolean " << summary_name(n->doc_index - 1) << "(const dg_rt::dg_state *st, dg_rt::dg_text *out);\n";
+    o_ << "\n";
+}
+
+// The statements of pieces [first, first + count) at nesting `depth`;
+// `complete` is the flag a value that shows nothing clears.
+void Emitter::summary_pieces(size_t first, size_t count, const std::string& complete, int depth) {
+    const std::string in(4 * static_cast<size_t>(depth), ' ');
+    for (size_t i = first; i < first + count; ++i) {
+        const Layout::Piece& p = l_.pieces[i];
+        if (p.group) {
+            // left out unless every value it shows itself (not those of parts inside it) was decoded
+            std::string decoded;
+            for (size_t j = i + 1; j < i + 1 + p.group; ++j) {
+                const Layout::Piece& q = l_.pieces[j];
+                if (q.group) j += q.group;
+                else if (q.slot >= 0) decoded += (decoded.empty() ? "" : " && ") + std::string("st->present[") + std::to_string(q.slot) + "]";
+            }
+            std::string part = "part" + std::to_string(depth + 1), mark = "mark" + std::to_string(depth + 1);
+            o_ << in << "if (" << (decoded.empty() ? "TRUE" : decoded) << ") { /* {?...} */\n"
+               << in << "    gsize " << mark << " = out->len;\n" << in << "    gboolean " << part << " = TRUE;\n";
+            summary_pieces(i + 1, p.group, part, depth + 1);
+            o_ << in << "    if (!" << part << ") dg_rt::text_truncate(out, " << mark << ");\n" << in << "}\n";
+            i += p.group;
+        } else if (p.slot < 0) {
+            o_ << in << "dg_rt::text_append(out, " << c_string(p.text) << ", " << p.text.size() << ");\n";
+        } else {
+            std::string value = p.node >= 0 ? summary_name(p.node) + "(st, out)"
+                                             : "dg_rt::append_shown_value(st, out, &st->slots[" + std::to_string(p.slot) + "])";
+            o_ << in << "if (!st->present[" << p.slot << "]) {\n"
+               << in << "    dg_rt::text_append(out, \"-\", 1);\n" << in << "    " << complete << " = FALSE;\n"
+               << in << "} else {\n"
+               << in << "    gsize before = out->len;\n" << in << "    " << value << ";\n"
+               << in << "    if (out->len == before) " << complete << " = FALSE;\n" << in << "}\n";
+        }
+    }
+}
+
+void Emitter::summary_definitions() {
+    for (const Node* n : l_.nodes) {
+        if (n->summary_pieces.empty()) continue;
+        o_ << "static gboolean " << summary_name(n->doc_index - 1)
+           << "(const dg_rt::dg_state *st, dg_rt::dg_text *out)\n{\n    /* line " << n->line << " */\n"
+           << "    gboolean complete = TRUE;\n";
+        summary_pieces(static_cast<size_t>(l_.piece_first.at(n)), n->summary_pieces.size(), "complete", 1);
+        o_ << "    return complete;\n}\n\n";
+    }
+}
+
+void Emitter::walk_definitions() {
+    auto define = [&](const Node* owner, size_t first, size_t count) {
+        o_ << "static void " << walk_name(owner)
+           << "(dg_rt::dg_state *st, proto_tree *tree, gint *offset, gint end, gboolean in_summary)\n{\n";
+        // a name in a comment: "*/" would end it
+        auto comment = [](std::string text) {
+            for (size_t at = text.find("*/"); at != std::string::npos; at = text.find("*/", at)) text.replace(at, 2, "* /");
+            return text;
+        };
+        if (owner) o_ << "    /* " << comment(owner->name) << " (line " << owner->line << ") */\n";
+        o_ << "    gboolean chain_taken = FALSE;\n    dg_rt::list_begin(st, *offset, end);\n";
+        for (size_t i = first; i < first + count; ++i) {
+            int k = l_.children_flat[i];
+            o_ << "    if (!st->stopped) dg_rt::dissect_child(st, &" << p_.filter << "_nodes[" << k
+               << "], tree, offset, end, in_summary, &chain_taken); /* " << comment(l_.nodes[k]->name) << " */\n";
+        }
+        o_ << "    dg_rt::list_end(st);\n}\n\n";
+    };
+    define(nullptr, 0, p_.nodes.size());
+    for (const Node* n : l_.nodes)
+        if (has_walk(*n)) define(n, l_.first_child.at(n), n->children.size());
 }
 
 void Emitter::protocol_struct() {
@@ -536,7 +637,8 @@ std::string Emitter::protocol_row() const {
         "pieces(" + f + "_summary)",
         "slot_count(" + std::to_string(p_.slot_count) + ")",
         "experts(&ei_" + f + ")",
-        "hooks(" + f + "_hooks, " + std::to_string(hook_count) + ")"};
+        "hooks(" + f + "_hooks, " + std::to_string(hook_count) + ")",
+        "top_walk(" + walk_name(nullptr) + ")"};
     if (pdu)
         set.push_back("pdu_length(" + std::to_string(pdu->doc_index - 1) + ", " +
                       std::to_string(p_.pdu_fixed_len - value_bytes(*pdu)) + ", " + std::to_string(p_.pdulengthadd) + ")");

@@ -44,6 +44,8 @@ struct dg_node_row {
     constexpr dg_node_row &alt(guint8 v) { n.alt = v; return *this; }
     constexpr dg_node_row &window(gint16 v) { n.window = v; return *this; }
     constexpr dg_node_row &quiet_size(guint32 bytes) { n.quiet_size = bytes; return *this; }
+    constexpr dg_node_row &walk(dg_list_walk fn) { n.walk = fn; return *this; }
+    constexpr dg_node_row &summarize(dg_summary_text fn) { n.summarize = fn; return *this; }
 };
 
 constexpr dg_node_row dg_node_of(guint8 kind, const char *name, int *hf, int *ett) {
@@ -145,6 +147,7 @@ struct dg_protocol_row {
     constexpr dg_protocol_row &analysis_data(const void *v) { p.analysis_data = v; return *this; }
     constexpr dg_protocol_row &exprs(const dg_expr_op *v) { p.exprs = v; return *this; }
     constexpr dg_protocol_row &request_context(const dg_request_context *v) { p.request_context = v; return *this; }
+    constexpr dg_protocol_row &top_walk(dg_list_walk fn) { p.top_walk = fn; return *this; }
 };
 
 /* Operations of computed values: dg_op(CODE) for operators and index, and

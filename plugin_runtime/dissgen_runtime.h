@@ -143,6 +143,20 @@ typedef struct dg_window {
     gboolean address_order_is_document_order;
 } dg_window;
 
+/* A list of siblings decoded by code the generator compiled for it (the
+ * generated source's *_walk_* functions: dissgen_state.h dissect_child() for
+ * each member, its node a constant), instead of the table walk's loop over
+ * dg_protocol.children. Both decode the same. */
+namespace dg_rt __attribute__((visibility("hidden"))) {
+struct dg_state;
+struct dg_text;
+}
+typedef void (*dg_list_walk)(dg_rt::dg_state *st, proto_tree *tree, gint *offset, gint end, gboolean in_summary);
+/* A container's summary compiled the same way (the generated *_summary_*
+ * functions): appends it to out; FALSE when a value in it showed nothing,
+ * as dissgen_text.cpp append_pieces() says of the pieces' table. */
+typedef gboolean (*dg_summary_text)(const dg_rt::dg_state *st, dg_rt::dg_text *out);
+
 typedef struct dg_node {
     const char *name;
     int *hf;            /* NULL for a container left out of filter names */
@@ -180,6 +194,10 @@ typedef struct dg_node {
      * malformed within these many bytes: a walk with no tree and no tap
      * listener steps over it when they are there. */
     guint32 quiet_size = 0;
+    /* a container's children, compiled (NULL: the table walk) */
+    dg_list_walk walk = NULL;
+    /* its summary, compiled (NULL: the pieces' table) */
+    dg_summary_text summarize = NULL;
 } dg_node;
 
 /* The expert infos of every protocol, one member per row of
@@ -272,6 +290,7 @@ typedef struct dg_protocol {
     /* request{...}: NULL when no value reads the paired request. Generated
      * code gives it only for protocols that use it. */
     const dg_request_context *request_context = nullptr;
+    dg_list_walk top_walk = nullptr; /* the top-level nodes, compiled (NULL: the table walk) */
 } dg_protocol;
 
 /* The entry points generated code calls. C linkage: plain symbol

@@ -111,6 +111,15 @@ void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint 
 void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
                       gboolean in_summary, dg_summaries *sink);
 
+/* A selected member of a list that dissect_child() does not decode inline:
+ * an overlay, the instances of a repeated or located node, or one instance. */
+void dissect_node(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary);
+
+/* DISSGEN_TABLE_WALK set when the plugin registered: containers walk their
+ * children and build their summaries from the tables even when the generator
+ * compiled them (to compare the two; tests/integration/test_compiled_walk.py). */
+extern gboolean table_walk_only;
+
 /* P.padding (dissgen_names.h): registered with the protocol, added by containers. */
 extern int hf_padding;
 
@@ -129,8 +138,8 @@ void table_put(dg_state *st, const dg_node *n, guint64 value);
 /* An offset leaf's repetition starts a new, empty table. */
 void table_reset(dg_state *st, const dg_node *n, gint offset);
 
-/* selected() for a node with a condition, an otherwise or a direction: out of
- * line, so that the unconditional test below is inlined into the walk. */
+/* selected() for a node with ifhook or <when> conditions: out of line, so
+ * that the other tests below are inlined into the walk. */
 gboolean selected_conditional(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken);
 
 /* A window's children, at addresses: dg_node.window. */
@@ -143,6 +152,10 @@ const char *enum_name(const header_field_info *hfi, guint64 value);
 
 /* The summary of container n, in st->text (valid until the next summary). */
 const char *summary_text(const dg_state *st, const dg_node *n);
+
+/* Appends a leaf's value as its tree item shows it, with its unit label (a
+ * compiled summary's value). */
+void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s);
 
 void info_append(dg_state *st, const char *text, gsize len);
 
@@ -222,7 +235,7 @@ static inline __attribute__((always_inline)) void store(dg_state *st, const dg_n
 
 /* Whether store() uses a leaf's value: a later node reads it (slot) or the
  * stats tree counts it. Otherwise the walk need not read it from the tvb. */
-static inline gboolean value_wanted(const dg_state *st, const dg_node *n)
+static inline __attribute__((always_inline)) gboolean value_wanted(const dg_state *st, const dg_node *n)
 {
     return n->slot >= 0 || (st->tap && n->show == DG_SHOW_ENUM) || (n->flags & DG_KEY);
 }
@@ -234,29 +247,135 @@ static inline void clear_slots(dg_state *st, const dg_node *n)
 }
 
 /* Whether the value of n's if="..." field was decoded and is in its ranges. */
-static inline gboolean condition_holds(const dg_state *st, const dg_node *n)
+static inline __attribute__((always_inline)) gboolean condition_holds(const dg_state *st, const dg_node *n)
 {
     return st->present[n->if_slot] && in_ranges(st->p, n->in_first, n->in_count, st->slots[n->if_slot].value);
 }
 
 /* Whether n is decoded at `offset`. *chain_taken says whether a member of the
  * current chain of alternatives (a conditional node and the otherwise nodes
- * after it) was decoded; an otherwise node is skipped when one was. */
-static inline gboolean selected(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken)
+ * after it) was decoded; an otherwise node is skipped when one was. Inline
+ * for if="...", otherwise and direction (with a constant node, as in compiled
+ * walks, only the tests the node has are left); ifhook and <when> out of line. */
+static inline __attribute__((always_inline)) gboolean selected(const dg_state *st, const dg_node *n, gint offset,
+                                                               gboolean *chain_taken)
 {
-    if (!n->alt && !n->hook_count && n->if_slot < 0 && !n->when_count && !n->extra) {
+    if (n->hook_count || n->when_count) return selected_conditional(st, n, offset, chain_taken);
+    const guint8 direction = n->extra ? n->extra->direction : (guint8)DG_DIR_ANY;
+    const gboolean otherwise = (n->alt & DG_ALT_OTHERWISE) != 0;
+    if (!otherwise && n->if_slot < 0 && !direction) {
         *chain_taken = FALSE; /* unconditional: ends any chain */
         return TRUE;
     }
-    if (!n->alt && !n->hook_count && !n->when_count && !n->extra) {
-        /* if="..." alone (most conditional nodes), without a call: a member
-         * of a chain when it holds */
-        gboolean holds = condition_holds(st, n);
-        *chain_taken = holds;
-        return holds;
-    }
-    return selected_conditional(st, n, offset, chain_taken);
+    if (otherwise && *chain_taken) return FALSE;
+    /* a member of a chain: decoded when its condition holds */
+    gboolean holds = (n->if_slot < 0 || condition_holds(st, n)) && (!direction || direction == st->direction);
+    *chain_taken = holds;
+    return holds;
 }
+
+/* --- inline: one member of a list of siblings ---------------------------- */
+
+/* A numeric leaf's item from its bytes already read (a bit group's
+ * whole value: Wireshark masks and shifts it by the field's bitmask), which
+ * costs Wireshark about a third less than proto_tree_add_item() reading them
+ * again. Unsigned displays only; the others are added from the bytes. */
+static inline proto_item *add_numeric_item(const dg_state *st, const dg_node *n, proto_tree *tree, gint offset,
+                                           gint length, guint64 raw)
+{
+    switch (n->show) {
+    case DG_SHOW_HEX: case DG_SHOW_DEC: case DG_SHOW_ENUM:
+        return length <= 4 ? proto_tree_add_uint(tree, *n->hf, st->tvb, offset, length, (guint32)raw)
+                           : proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, length, raw);
+    default:
+        return proto_tree_add_item(tree, *n->hf, st->tvb, offset, length, encoding_of(n));
+    }
+}
+
+/* A member of a bit group: the first reads the group's bytes, each adds
+ * its item and keeps its bits, the last moves past the bytes. */
+static inline __attribute__((always_inline)) void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree,
+                                                                    gint *offset, gint end)
+{
+    if (n->flags & DG_GROUP_FIRST) {
+        if ((gint)n->length > end - *offset) {
+            report(st, tree, &st->p->ei->truncated, *offset, -1, "Truncated: '%s' needs %u bytes, only %d left",
+                   n->name, n->length, end - *offset);
+            return;
+        }
+        st->group_value = read_uint(st->tvb, *offset, n->length, encoding_of(n));
+    }
+    /* No tree (e.g. tshark's summary lines): only values later nodes read are
+     * wanted. proto_tree_add_item() would check the length and return NULL. */
+    if (tree) {
+        proto_item *item = add_numeric_item(st, n, tree, *offset, (gint)n->length, st->group_value);
+        if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+    }
+    if (value_wanted(st, n)) store(st, n, bit_field(st->group_value, n->shift, n->bits), *offset, n->length);
+    if (n->flags & DG_GROUP_LAST) *offset += n->length;
+}
+
+/* The value and item of a numeric leaf (not a time or an address) whose
+ * `len` bytes at offset are all there. */
+static inline __attribute__((always_inline)) void decode_number(dg_state *st, const dg_node *n, proto_tree *tree,
+                                                                gint offset, gint len)
+{
+    guint64 value = 0;
+    if (tree || value_wanted(st, n)) value = read_uint(st->tvb, offset, (guint)len, encoding_of(n));
+    if (tree) {
+        proto_item *item = add_numeric_item(st, n, tree, offset, len, value);
+        if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+    }
+    store(st, n, value, offset, len);
+}
+
+/* A leaf decoded once, with nothing but its bytes: decoded inline. */
+static inline __attribute__((always_inline)) gboolean is_plain_leaf(const dg_node *n)
+{
+    return n->kind == DG_LEAF && !n->extra && n->count.slot < 0 && n->repeat_slot < 0;
+}
+
+static inline __attribute__((always_inline)) gboolean is_plain_number(const dg_node *n)
+{
+    return is_plain_leaf(n) && !(n->flags & DG_GROUP) && (n->flags & DG_NUMERIC) && n->length_kind == DG_LEN_FIXED &&
+           n->show != DG_SHOW_TIME && n->show != DG_SHOW_IPV4;
+}
+
+/* One member of a list of siblings at *offset, before end, when it is
+ * selected (*chain_taken: see selected()). Bit fields and fixed numbers
+ * inline, the rest out of line. Generated code calls it with each member
+ * of a list (a constant node: the tests fold away), the table walk in a loop. */
+static inline __attribute__((always_inline)) void dissect_child(dg_state *st, const dg_node *n, proto_tree *tree,
+                                                                gint *offset, gint end, gboolean in_summary,
+                                                                gboolean *chain_taken)
+{
+    if (!selected(st, n, *offset, chain_taken)) return;
+    if (st->quiet && n->quiet_size && (gint64)n->quiet_size <= (gint64)(end - *offset)) {
+        *offset += (gint)n->quiet_size; /* nobody would see it, and it cannot be malformed */
+        return;
+    }
+    if (is_plain_leaf(n) && (n->flags & DG_GROUP)) {
+        dissect_bit_field(st, n, tree, offset, end);
+    } else if (is_plain_number(n) && (gint)n->length <= end - *offset) {
+        decode_number(st, n, tree, *offset, (gint)n->length);
+        *offset += (gint)n->length;
+    } else {
+        dissect_node(st, n, tree, offset, end, in_summary);
+    }
+}
+
+/* A list of siblings starts at offset and ends at end (for peeks and
+ * offsets counted from a container), and ends. */
+static inline __attribute__((always_inline)) void list_begin(dg_state *st, gint offset, gint end)
+{
+    if (st->lists < DG_MAX_LISTS) {
+        st->list_starts[st->lists] = offset;
+        st->list_ends[st->lists] = end;
+    }
+    st->lists++;
+}
+
+static inline __attribute__((always_inline)) void list_end(dg_state *st) { st->lists--; }
 
 /* The encoding a non-numeric leaf's item is added with. */
 static inline guint item_encoding(const dg_node *n)

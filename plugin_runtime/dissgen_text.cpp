@@ -144,14 +144,6 @@ void append_bare_value(const dg_state *st, dg_text *out, const dg_slot *s)
     }
 }
 
-/* Appends a leaf's value as its tree item shows it, for summaries. */
-void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s)
-{
-    append_bare_value(st, out, s);
-    const dg_extra *x = s->node->extra;
-    if (x && x->unit) append_str(out, x->unit);
-}
-
 /* --- summaries ----------------------------------------------------------- */
 
 /* Whether every value an optional part shows itself (not those of the parts
@@ -214,11 +206,21 @@ void info_separate(dg_state *st)
 
 namespace dg_rt {
 
+void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s)
+{
+    append_bare_value(st, out, s);
+    const dg_extra *x = s->node->extra;
+    if (x && x->unit) append_str(out, x->unit);
+}
+
 const char *summary_text(const dg_state *st, const dg_node *n)
 {
     dg_text *out = st->text;
     text_truncate(out, 0);
-    append_pieces(st, out, n->summary_first, n->summary_count);
+    if (n->summarize && !table_walk_only)
+        n->summarize(st, out);
+    else
+        append_pieces(st, out, n->summary_first, n->summary_count);
     return out->data;
 }
 

@@ -50,42 +50,6 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
 
 /* --- leaves -------------------------------------------------------------- */
 
-/* A numeric leaf's item from its bytes already read (a bit group's
- * whole value: Wireshark masks and shifts it by the field's bitmask), which
- * costs Wireshark about a third less than proto_tree_add_item() reading them
- * again. Unsigned displays only; the others are added from the bytes. */
-proto_item *add_numeric_item(const dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint length,
-                             guint64 raw)
-{
-    switch (n->show) {
-    case DG_SHOW_HEX: case DG_SHOW_DEC: case DG_SHOW_ENUM:
-        return length <= 4 ? proto_tree_add_uint(tree, *n->hf, st->tvb, offset, length, (guint32)raw)
-                           : proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, length, raw);
-    default:
-        return proto_tree_add_item(tree, *n->hf, st->tvb, offset, length, encoding_of(n));
-    }
-}
-
-void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end)
-{
-    if (n->flags & DG_GROUP_FIRST) {
-        if ((gint)n->length > end - *offset) {
-            report(st, tree, &st->p->ei->truncated, *offset, -1, "Truncated: '%s' needs %u bytes, only %d left",
-                   n->name, n->length, end - *offset);
-            return;
-        }
-        st->group_value = read_uint(st->tvb, *offset, n->length, encoding_of(n));
-    }
-    /* No tree (e.g. tshark's summary lines): only values later nodes read are
-     * wanted. proto_tree_add_item() would check the length and return NULL. */
-    if (tree) {
-        proto_item *item = add_numeric_item(st, n, tree, *offset, (gint)n->length, st->group_value);
-        if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
-    }
-    if (value_wanted(st, n)) store(st, n, bit_field(st->group_value, n->shift, n->bits), *offset, n->length);
-    if (n->flags & DG_GROUP_LAST) *offset += n->length;
-}
-
 /* Bytes from offset to the first NUL before end, NUL included; one more than
  * is left when there is none. */
 gint64 stringz_length(const dg_state *st, gint offset, gint end)
@@ -161,8 +125,8 @@ void decode_leaf_value(dg_state *st, const dg_node *n, proto_tree *tree, gint of
         if (value_wanted(st, n)) value = read_uint(st->tvb, offset, 4, encoding_of(n));
         if (tree) item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, encoding_of(n));
     } else if (n->flags & DG_NUMERIC) {
-        if (tree || value_wanted(st, n)) value = read_uint(st->tvb, offset, (guint)len, encoding_of(n));
-        if (tree) item = add_numeric_item(st, n, tree, offset, len, value);
+        decode_number(st, n, tree, offset, len);
+        return;
     } else if (len > 0 && tree) {
         item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, item_encoding(n));
         if (n->show == DG_SHOW_FLOAT) append_unit(n, item);
@@ -341,6 +305,8 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     st->stopped = FALSE;
     if (n->window >= 0) /* a window: children at addresses, not one after another */
         dissect_window(st, n, subtree, offset, inner_end, in_summary || n->summary_count > 0);
+    else if (n->walk && !table_walk_only)
+        n->walk(st, subtree, offset, inner_end, in_summary || n->summary_count > 0);
     else
         dissect_list(st, n->first_child, n->child_count, subtree, offset, inner_end,
                      in_summary || n->summary_count > 0);
@@ -513,33 +479,16 @@ void dissect_overlay(dg_state *st, const dg_node *n, proto_tree *tree, gboolean 
 
 /* --- lists of siblings --------------------------------------------------- */
 
+/* The table walk: the members of a list in the order dg_protocol.children
+ * gives them (a list the generator did not compile). */
 void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
                   gboolean in_summary)
 {
     gboolean chain_taken = FALSE; /* a conditional sibling was decoded: its otherwise members are not */
-    if (st->lists < DG_MAX_LISTS) {
-        st->list_starts[st->lists] = *offset;
-        st->list_ends[st->lists] = end;
-    }
-    st->lists++;
-    for (guint16 i = 0; i < count && !st->stopped; i++) {
-        const dg_node *n = &st->p->nodes[st->p->children[first + i]];
-        if (!selected(st, n, *offset, &chain_taken)) continue;
-        if (st->quiet && n->quiet_size && (gint64)n->quiet_size <= (gint64)(end - *offset)) {
-            *offset += (gint)n->quiet_size; /* nobody would see it, and it cannot be malformed */
-            continue;
-        }
-        if (n->extra && (n->extra->offsets_slot >= 0 || n->extra->overlay_slot >= 0)) {
-            if (n->extra->overlay_slot >= 0)
-                dissect_overlay(st, n, tree, in_summary); /* the bytes of an earlier node */
-            else
-                dissect_located(st, n, tree, offset, end, in_summary); /* offset table */
-        } else if (is_repeated(n))
-            dissect_repeated(st, n, tree, offset, end, in_summary);
-        else
-            dissect_instance(st, n, tree, offset, end, in_summary, NULL);
-    }
-    st->lists--;
+    list_begin(st, *offset, end);
+    for (guint16 i = 0; i < count && !st->stopped; i++)
+        dissect_child(st, &st->p->nodes[st->p->children[first + i]], tree, offset, end, in_summary, &chain_taken);
+    list_end(st);
 }
 
 /* --- one message ----------------------------------------------------------- */
@@ -626,6 +575,21 @@ void begin_message(dg_state *st, dg_message_buffers *b, const dg_protocol *p, tv
 
 namespace dg_rt {
 
+gboolean table_walk_only = FALSE;
+
+void dissect_node(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary)
+{
+    if (n->extra && (n->extra->offsets_slot >= 0 || n->extra->overlay_slot >= 0)) {
+        if (n->extra->overlay_slot >= 0)
+            dissect_overlay(st, n, tree, in_summary); /* the bytes of an earlier node */
+        else
+            dissect_located(st, n, tree, offset, end, in_summary); /* offset table */
+    } else if (is_repeated(n))
+        dissect_repeated(st, n, tree, offset, end, in_summary);
+    else
+        dissect_instance(st, n, tree, offset, end, in_summary, NULL);
+}
+
 void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
                       gboolean in_summary, dg_summaries *sink)
 {
@@ -653,7 +617,10 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
     gint offset = 0;
     if (p->request_context) request_begin(&st, *messages - 1);
-    dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
+    if (p->top_walk && !table_walk_only)
+        p->top_walk(&st, subtree, &offset, st.packet_end, FALSE);
+    else
+        dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
     proto_item_set_len(root, offset);
     if (p->pairing) {
         if (st.request_pending) request_walked(&st);

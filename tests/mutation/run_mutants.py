@@ -119,6 +119,8 @@ TESTS = {
     "plugin_contents": integration("test_plugin_contents.py"),
     "reserved_names": integration("test_reserved_names.py"),
     "cycles": integration("test_cycles.py"),
+    "compiled_walk": integration("test_compiled_walk.py", "CompiledWalk.test_every_rule_file"),
+    "compiled_walk_corpus": integration("test_compiled_walk.py", "CompiledWalk.test_shipped_rules_on_samples_and_corpus"),
 }
 
 

@@ -199,6 +199,32 @@ TEST(Emit, FieldsWithoutFilterNameHaveNoHf) {
     EXPECT_EQ(code.find("\"tst.wrap\""), std::string::npos);
 }
 
+// Every list of siblings but a window's places is compiled: a function that
+// decodes the members in document order, set as its container's walk (the
+// top level's as the protocol's); a summary is compiled piece by piece.
+TEST(Emit, CompiledWalksAndSummaries) {
+    Front f = front_end(rules("  <node name=\"Body\" length=\"rest\" summary=\"kind {Kind}{? at {Address}}\">\n"
+                              "    <node name=\"Kind\" length=\"1byte\"/>\n"
+                              "    <node name=\"Address\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+                              "    <node name=\"Regs\" length=\"rest\" base=\"../node[@name='Address']\">\n"
+                              "      <node name=\"R0\" at=\"0\" length=\"1byte\"/>\n"
+                              "    </node>\n"
+                              "  </node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_NE(code.find(".top_walk(tst_walk_top)"), std::string::npos) << code;
+    EXPECT_NE(code.find(".walk(tst_walk_0)"), std::string::npos) << code;
+    EXPECT_EQ(code.find("tst_walk_3"), std::string::npos) << "a window's places are not a list";
+    size_t body = code.find("static void tst_walk_0(dg_rt::dg_state *st, proto_tree *tree, gint *offset, gint end, "
+                            "gboolean in_summary)\n{");
+    ASSERT_NE(body, std::string::npos) << code;
+    size_t kind = code.find("&tst_nodes[1], tree", body), address = code.find("&tst_nodes[2], tree", body),
+           regs = code.find("&tst_nodes[3], tree", body), end = code.find("\n}\n", body);
+    EXPECT_TRUE(kind < address && address < regs && regs < end) << code;
+    EXPECT_NE(code.find(".summarize(tst_summary_0)"), std::string::npos) << code;
+    EXPECT_NE(code.find("dg_rt::text_append(out, \"kind \", 5);"), std::string::npos) << code;
+}
+
 // Known bug in emit_cpp.cpp make_layout(): when an identifier is taken, the
 // "_<doc_index>" fallback is not checked for uniqueness, so two C variables
 // get the same name and the plugin does not compile. Enable once fixed.
