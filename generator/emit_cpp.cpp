@@ -82,6 +82,7 @@ struct Layout {
         int slot = -1;
         size_t group = 0;  // an optional part of the next `group` pieces
         int node = -1;     // a container whose summary is inserted
+        const Node* leaf = nullptr;  // the field a placeholder shows
     };
     std::vector<Piece> pieces;
     std::map<const Node*, int> piece_first;
@@ -143,7 +144,7 @@ Layout make_layout(const Protocol& proto) {
             l.piece_first[n] = static_cast<int>(l.pieces.size());
             for (const SummaryPiece& p : n->summary_pieces)
                 l.pieces.push_back({p.text, p.leaf ? p.leaf->slot : -1, p.group,
-                                    p.leaf && p.leaf->is_container() ? p.leaf->doc_index - 1 : -1});
+                                    p.leaf && p.leaf->is_container() ? p.leaf->doc_index - 1 : -1, p.leaf});
         }
     }
     layout_conditions_and_windows(l);
@@ -547,8 +548,16 @@ void Emitter::summary_pieces(size_t first, size_t count, const std::string& comp
         } else if (p.slot < 0) {
             o_ << in << "dg_rt::text_append(out, " << c_string(p.text) << ", " << p.text.size() << ");\n";
         } else {
-            std::string value = p.node >= 0 ? summary_name(p.node) + "(st, out)"
-                                             : "dg_rt::append_shown_value(st, out, &st->slots[" + std::to_string(p.slot) + "])";
+            std::string slot = "st->slots[" + std::to_string(p.slot) + "]";
+            std::string value = "dg_rt::append_shown_value(st, out, &" + slot + ")";
+            // A plain hex or decimal number shows its value as such (dissgen_text.cpp, append_bare_value).
+            const Node* f = p.leaf;
+            bool plain = f && f->is_leaf() && f->is_numeric() && !f->is_computed() && !f->unit_given;
+            if (p.node >= 0) value = summary_name(p.node) + "(st, out)";
+            else if (plain && f->display == Display::NumberHex)
+                value = "dg_rt::append_hex(out, " + slot + ".value, " + std::to_string((f->bits + 3) / 4) + ")";
+            else if (plain && f->display == Display::NumberDec)
+                value = "dg_rt::append_dec(out, " + slot + ".value)";
             o_ << in << "if (!st->present[" << p.slot << "]) {\n"
                << in << "    dg_rt::text_append(out, \"-\", 1);\n" << in << "    " << complete << " = FALSE;\n"
                << in << "} else {\n"

@@ -101,17 +101,10 @@ void table_reset(dg_state *st, const dg_node *n, gint offset)
 
 using namespace dg_rt;
 
-namespace {
-
-/* --- conditions ---------------------------------------------------------- */
-
-gboolean hook_holds(const dg_state *st, const dg_node *n)
-{
-    return in_ranges(st->p, n->hook_first, n->hook_count, st->hook_value);
-}
+/* --- conditions (selected() in dissgen_state.h) -------------------------- */
 
 /* The value of the leaf a peek reads ahead, when its bytes are there. */
-gboolean peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guint64 *out)
+gboolean dg_rt::peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guint64 *out)
 {
     if (pk->up > st->lists || st->lists - pk->up >= DG_MAX_LISTS) return FALSE;
     gint64 at = (gint64)(pk->up ? st->list_starts[st->lists - pk->up] : node_start) + pk->offset;
@@ -134,38 +127,6 @@ gboolean peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guin
     guint64 v = read_uint(st->tvb, (gint)at, t->length, encoding_of(t));
     *out = (t->flags & DG_GROUP) ? bit_field(v, t->shift, t->bits) : v;
     return TRUE;
-}
-
-/* Whether every <when> of n holds; node_start is where n would begin. */
-gboolean whens_hold(const dg_state *st, const dg_node *n, gint node_start)
-{
-    for (guint i = 0; i < n->when_count; i++) {
-        const dg_when *w = &st->p->whens[n->when_first + i];
-        guint64 value;
-        if (w->peek >= 0) {
-            if (!peek_value(st, &st->p->peeks[w->peek], node_start, &value)) return FALSE;
-        } else {
-            const dg_slot *s = &st->slots[w->slot];
-            if (!st->present[w->slot]) return FALSE;
-            value = s->value;
-        }
-        if (!in_ranges(st->p, w->in_first, w->in_count, value)) return FALSE;
-    }
-    return TRUE;
-}
-
-} // namespace
-
-gboolean dg_rt::selected_conditional(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken)
-{
-    gboolean otherwise = (n->alt & DG_ALT_OTHERWISE) != 0;
-    if (otherwise && *chain_taken) return FALSE;
-    guint8 direction = n->extra ? n->extra->direction : (guint8)DG_DIR_ANY;
-    gboolean conditional = otherwise || n->hook_count || n->if_slot >= 0 || n->when_count || direction;
-    gboolean holds = (!n->hook_count || hook_holds(st, n)) && (n->if_slot < 0 || condition_holds(st, n)) &&
-                     (!direction || direction == st->direction) && whens_hold(st, n, offset);
-    *chain_taken = conditional && holds;
-    return holds;
 }
 
 namespace {

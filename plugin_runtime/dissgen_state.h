@@ -83,11 +83,7 @@ struct dg_state {
     dg_tap_data *tap;     /* what the stats tree counts; NULL when nobody listens */
     guint8 direction;     /* DG_DIR_REQUEST/RESPONSE when a port hook matched, else DG_DIR_ANY */
     guint32 instance;     /* the instance number of the innermost repeat (computed values' index) */
-    /* where each list of siblings being decoded started (the
-     * message, then each open container), for peeks counted from a container */
-    gint list_starts[DG_MAX_LISTS];
-    gint list_ends[DG_MAX_LISTS]; /* and where each ends: a peek reads nothing beyond */
-    guint lists;
+    guint lists;          /* lists of siblings open: list_starts[0 .. lists) */
     /* the values of the <pairing> key fields (DG_KEY), in decoding order */
     guint64 *keys;
     guint key_count, key_capacity;
@@ -98,6 +94,13 @@ struct dg_state {
      * request is looked up when a value first reads it, with the keys decoded so far */
     mutable gboolean request_pending;
     guint message;                   /* the message's number within the frame */
+    /* Last, not cleared per message (an entry is written when its list
+     * opens, before anything reads it): where each list of siblings being
+     * decoded started (the message, then each open container), for peeks and
+     * offsets counted from a container, and where each ends (a peek reads
+     * nothing beyond). */
+    gint list_starts[DG_MAX_LISTS];
+    gint list_ends[DG_MAX_LISTS];
 };
 
 /* --- dissgen_walk.cpp ---------------------------------------------------- */
@@ -138,9 +141,9 @@ void table_put(dg_state *st, const dg_node *n, guint64 value);
 /* An offset leaf's repetition starts a new, empty table. */
 void table_reset(dg_state *st, const dg_node *n, gint offset);
 
-/* selected() for a node with ifhook or <when> conditions: out of line, so
- * that the other tests below are inlined into the walk. */
-gboolean selected_conditional(const dg_state *st, const dg_node *n, gint offset, gboolean *chain_taken);
+/* The value of the leaf a <when peek> reads ahead from node_start, when its
+ * bytes are there. */
+gboolean peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guint64 *out);
 
 /* A window's children, at addresses: dg_node.window. */
 void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary);
@@ -252,24 +255,42 @@ static inline __attribute__((always_inline)) gboolean condition_holds(const dg_s
     return st->present[n->if_slot] && in_ranges(st->p, n->in_first, n->in_count, st->slots[n->if_slot].value);
 }
 
+/* Whether every <when> of n holds; node_start is where n would begin. */
+static inline __attribute__((always_inline)) gboolean whens_hold(const dg_state *st, const dg_node *n, gint node_start)
+{
+    for (guint i = 0; i < n->when_count; i++) {
+        const dg_when *w = &st->p->whens[n->when_first + i];
+        guint64 value;
+        if (w->peek >= 0) {
+            if (!peek_value(st, &st->p->peeks[w->peek], node_start, &value)) return FALSE;
+        } else {
+            const dg_slot *s = &st->slots[w->slot];
+            if (!st->present[w->slot]) return FALSE;
+            value = s->value;
+        }
+        if (!in_ranges(st->p, w->in_first, w->in_count, value)) return FALSE;
+    }
+    return TRUE;
+}
+
 /* Whether n is decoded at `offset`. *chain_taken says whether a member of the
  * current chain of alternatives (a conditional node and the otherwise nodes
- * after it) was decoded; an otherwise node is skipped when one was. Inline
- * for if="...", otherwise and direction (with a constant node, as in compiled
- * walks, only the tests the node has are left); ifhook and <when> out of line. */
+ * after it) was decoded; an otherwise node is skipped when one was. With a
+ * constant node, as in compiled walks, only the tests the node has are left. */
 static inline __attribute__((always_inline)) gboolean selected(const dg_state *st, const dg_node *n, gint offset,
                                                                gboolean *chain_taken)
 {
-    if (n->hook_count || n->when_count) return selected_conditional(st, n, offset, chain_taken);
     const guint8 direction = n->extra ? n->extra->direction : (guint8)DG_DIR_ANY;
     const gboolean otherwise = (n->alt & DG_ALT_OTHERWISE) != 0;
-    if (!otherwise && n->if_slot < 0 && !direction) {
+    if (!otherwise && !n->hook_count && n->if_slot < 0 && !n->when_count && !direction) {
         *chain_taken = FALSE; /* unconditional: ends any chain */
         return TRUE;
     }
     if (otherwise && *chain_taken) return FALSE;
-    /* a member of a chain: decoded when its condition holds */
-    gboolean holds = (n->if_slot < 0 || condition_holds(st, n)) && (!direction || direction == st->direction);
+    /* a member of a chain: decoded when its conditions hold */
+    gboolean holds = (!n->hook_count || in_ranges(st->p, n->hook_first, n->hook_count, st->hook_value)) &&
+                     (n->if_slot < 0 || condition_holds(st, n)) && (!direction || direction == st->direction) &&
+                     whens_hold(st, n, offset);
     *chain_taken = holds;
     return holds;
 }

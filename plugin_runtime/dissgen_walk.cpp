@@ -533,7 +533,7 @@ struct dg_message_buffers {
 void begin_message(dg_state *st, dg_message_buffers *b, const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo,
                    proto_tree *tree)
 {
-    memset(st, 0, sizeof *st);
+    memset(st, 0, offsetof(dg_state, list_starts)); /* the lists' bounds are written as they open */
     st->p = p;
     st->tvb = tvb;
     st->pinfo = pinfo;
