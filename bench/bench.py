@@ -33,7 +33,9 @@ itself. In one run it
  6. prints medians and ratios; --json writes every sample.
  7. with --instructions FRAMES, also counts the instructions of one tshark run per cell
     under valgrind (callgrind) on a FRAMES-frame capture: immune to other load, so it
-    settles differences that CPU times on a busy machine cannot (summary lines).
+    settles differences that CPU times on a busy machine cannot (summary lines). With
+    --corpus, --scale or --capture that capture's first FRAMES frames (editcap -r), else
+    FRAMES generated ones.
 
 CPU time is user+sys of the tshark process (os.wait4), peak memory its ru_maxrss.
 As root, tshark runs as uid 65534 (Wireshark ignores per-user plugins for root), see
@@ -636,7 +638,13 @@ def main(argv=None):
             if not shutil.which("valgrind"):
                 raise BenchError("--instructions needs valgrind (apt-get install valgrind)")
             small = os.path.join(work, "instr.pcap")
-            generate_capture(small, a.seed, a.instructions, a.max_datagrams, a.max_data)
+            if a.corpus or a.scale or a.capture:
+                p = subprocess.run(["editcap", "-r", capture, small, "1-%d" % a.instructions],
+                                   capture_output=True, text=True)
+                if p.returncode != 0:
+                    raise BenchError("editcap failed:\n" + p.stderr[-2000:])
+            else:
+                generate_capture(small, a.seed, a.instructions, a.max_datagrams, a.max_data)
             os.chmod(small, 0o644)
             info["instr_frames"] = a.instructions
             instr = bench_instructions(envs, small, modes, configs)
