@@ -36,6 +36,16 @@ std::string c_string(const std::string& s) {
     return out + "\"";
 }
 
+namespace {
+
+// Text inside a /* */ comment: a "*/" in it would end the comment.
+std::string comment_text(std::string text) {
+    for (size_t at = text.find("*/"); at != std::string::npos; at = text.find("*/", at)) text.replace(at, 2, "* /");
+    return text;
+}
+
+}  // namespace
+
 std::string c_array(const std::string& declaration, const std::vector<std::string>& rows) {
     std::string out = declaration + "[] = {\n";
     for (const std::string& row : rows) out += "    " + row + ",\n";
@@ -303,10 +313,17 @@ private:
     // compiled walks: a function per list of siblings (dg_list_walk)
     bool has_walk(const Node& n) const { return n.is_container() && !n.children.empty() && !l_.window_index.count(&n); }
     std::string walk_name(const Node* owner) const;
+    std::string walk_signature(const Node* owner) const {
+        return "static void " + walk_name(owner) +
+               "(dg_rt::dg_state *st, proto_tree *tree, gint *offset, gint end, gboolean in_summary)";
+    }
     void walk_declarations();
     void walk_definitions();
     // compiled summaries: a function per summarised container (dg_summary_text)
     std::string summary_name(int node) const { return p_.filter + "_summary_" + std::to_string(node); }
+    std::string summary_signature(const Node& n) const {
+        return "static gboolean " + summary_name(n.doc_index - 1) + "(const dg_rt::dg_state *st, dg_rt::dg_text *out)";
+    }
     void summary_definitions();
     void summary_pieces(size_t first, size_t count, const std::string& complete, int depth);
     std::vector<std::string> summary_rows() const;
@@ -514,14 +531,12 @@ std::string Emitter::walk_name(const Node* owner) const {
 void Emitter::walk_declarations() {
     o_ << "/* The lists of siblings, compiled: each member decoded in turn, its node a\n"
        << " * constant (dissgen_state.h, dissect_child). */\n";
-    const char* params = "(dg_rt::dg_state *st, proto_tree *tree, gint *offset, gint end, gboolean in_summary)";
-    o_ << "static void " << walk_name(nullptr) << params << ";\n";
+    o_ << walk_signature(nullptr) << ";\n";
     for (const Node* n : l_.nodes)
-        if (has_walk(*n)) o_ << "static void " << walk_name(n) << params << ";\n";
+        if (has_walk(*n)) o_ << walk_signature(n) << ";\n";
     o_ << "\n/* The summaries, compiled: the pieces in turn (dissgen_text.cpp, append_pieces). */\n";
     for (const Node* n : l_.nodes)
-        if (!n->summary_pieces.empty())
-            o_ << "static gboolean " << summary_name(n->doc_index - 1) << "(const dg_rt::dg_state *st, dg_rt::dg_text *out);\n";
+        if (!n->summary_pieces.empty()) o_ << summary_signature(*n) << ";\n";
     o_ << "\n";
 }
 
@@ -570,8 +585,7 @@ void Emitter::summary_pieces(size_t first, size_t count, const std::string& comp
 void Emitter::summary_definitions() {
     for (const Node* n : l_.nodes) {
         if (n->summary_pieces.empty()) continue;
-        o_ << "static gboolean " << summary_name(n->doc_index - 1)
-           << "(const dg_rt::dg_state *st, dg_rt::dg_text *out)\n{\n    /* line " << n->line << " */\n"
+        o_ << summary_signature(*n) << "\n{\n    /* line " << n->line << " */\n"
            << "    gboolean complete = TRUE;\n";
         summary_pieces(static_cast<size_t>(l_.piece_first.at(n)), n->summary_pieces.size(), "complete", 1);
         o_ << "    return complete;\n}\n\n";
@@ -580,19 +594,13 @@ void Emitter::summary_definitions() {
 
 void Emitter::walk_definitions() {
     auto define = [&](const Node* owner, size_t first, size_t count) {
-        o_ << "static void " << walk_name(owner)
-           << "(dg_rt::dg_state *st, proto_tree *tree, gint *offset, gint end, gboolean in_summary)\n{\n";
-        // a name in a comment: "*/" would end it
-        auto comment = [](std::string text) {
-            for (size_t at = text.find("*/"); at != std::string::npos; at = text.find("*/", at)) text.replace(at, 2, "* /");
-            return text;
-        };
-        if (owner) o_ << "    /* " << comment(owner->name) << " (line " << owner->line << ") */\n";
+        o_ << walk_signature(owner) << "\n{\n";
+        if (owner) o_ << "    /* " << comment_text(owner->name) << " (line " << owner->line << ") */\n";
         o_ << "    gboolean chain_taken = FALSE;\n    dg_rt::list_begin(st, *offset, end);\n";
         for (size_t i = first; i < first + count; ++i) {
             int k = l_.children_flat[i];
             o_ << "    if (!st->stopped) dg_rt::dissect_child(st, &" << p_.filter << "_nodes[" << k
-               << "], tree, offset, end, in_summary, &chain_taken); /* " << comment(l_.nodes[k]->name) << " */\n";
+               << "], tree, offset, end, in_summary, &chain_taken); /* " << comment_text(l_.nodes[k]->name) << " */\n";
         }
         o_ << "    dg_rt::list_end(st);\n}\n\n";
     };

@@ -177,7 +177,7 @@ void dissect_place(dg_state *st, const dg_place *pl, proto_tree *tree, gint star
                    gboolean in_summary)
 {
     const dg_node *c = &st->p->nodes[pl->node];
-    if (st->quiet && c->quiet_size && c->quiet_size <= pl->size) return; /* unseen, cannot be malformed */
+    if (quiet_within(st, c, pl->size)) return; /* unseen, cannot be malformed */
     gboolean no_chain = FALSE;
     if (!selected(st, c, start, &no_chain)) return;
     guint32 i = 0;
@@ -263,7 +263,7 @@ void dg_rt::dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gin
         for (guint k = lo; k < hi && !st->stopped; k++) {
             const dg_place *pl = &places[k];
             /* most places of a register window are quiet: no call for them */
-            if (st->quiet && nodes[pl->node].quiet_size && nodes[pl->node].quiet_size <= pl->size) continue;
+            if (quiet_within(st, &nodes[pl->node], pl->size)) continue;
             dissect_place(st, pl, tree, start, base, last, in_summary);
         }
     } else {

@@ -362,6 +362,14 @@ static inline __attribute__((always_inline)) gboolean is_plain_number(const dg_n
            n->show != DG_SHOW_TIME && n->show != DG_SHOW_IPV4;
 }
 
+/* Whether a walk nobody sees (no tree, no tap listener) may step over n in
+ * the `bytes` it has: n feeds nothing (dg_node.quiet_size) and cannot be
+ * malformed within them. */
+static inline __attribute__((always_inline)) gboolean quiet_within(const dg_state *st, const dg_node *n, gint64 bytes)
+{
+    return st->quiet && n->quiet_size && (gint64)n->quiet_size <= bytes;
+}
+
 /* One member of a list of siblings at *offset, before end, when it is
  * selected (*chain_taken: see selected()). Bit fields and fixed numbers
  * inline, the rest out of line. Generated code calls it with each member
@@ -371,7 +379,7 @@ static inline __attribute__((always_inline)) void dissect_child(dg_state *st, co
                                                                 gboolean *chain_taken)
 {
     if (!selected(st, n, *offset, chain_taken)) return;
-    if (st->quiet && n->quiet_size && (gint64)n->quiet_size <= (gint64)(end - *offset)) {
+    if (quiet_within(st, n, end - *offset)) {
         *offset += (gint)n->quiet_size; /* nobody would see it, and it cannot be malformed */
         return;
     }

@@ -45,8 +45,8 @@ using namespace dg_rt;
 
 namespace {
 
-void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, gint *offset, gint end,
-                  gboolean in_summary);
+void walk_list(dg_state *st, dg_list_walk walk, guint16 first, guint16 count, proto_tree *tree, gint *offset,
+               gint end, gboolean in_summary);
 
 /* --- leaves -------------------------------------------------------------- */
 
@@ -305,11 +305,9 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     st->stopped = FALSE;
     if (n->window >= 0) /* a window: children at addresses, not one after another */
         dissect_window(st, n, subtree, offset, inner_end, in_summary || n->summary_count > 0);
-    else if (n->walk && !table_walk_only)
-        n->walk(st, subtree, offset, inner_end, in_summary || n->summary_count > 0);
     else
-        dissect_list(st, n->first_child, n->child_count, subtree, offset, inner_end,
-                     in_summary || n->summary_count > 0);
+        walk_list(st, n->walk, n->first_child, n->child_count, subtree, offset, inner_end,
+                  in_summary || n->summary_count > 0);
     st->stopped = st->stopped || was_stopped;
     if (!st->stopped && length >= 0 && *offset < inner_end &&
         (n->length_kind == DG_LEN_FIXED || n->length_kind == DG_LEN_FIELD)) {
@@ -491,6 +489,17 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
     list_end(st);
 }
 
+/* A list of siblings: with the walk the generator compiled for it, else
+ * (none, or DISSGEN_TABLE_WALK) with the table walk. */
+void walk_list(dg_state *st, dg_list_walk walk, guint16 first, guint16 count, proto_tree *tree, gint *offset,
+               gint end, gboolean in_summary)
+{
+    if (walk && !table_walk_only)
+        walk(st, tree, offset, end, in_summary);
+    else
+        dissect_list(st, first, count, tree, offset, end, in_summary);
+}
+
 /* --- one message ----------------------------------------------------------- */
 
 /* Request when the port the hook (or Decode As) matched is the
@@ -617,10 +626,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
     gint offset = 0;
     if (p->request_context) request_begin(&st, *messages - 1);
-    if (p->top_walk && !table_walk_only)
-        p->top_walk(&st, subtree, &offset, st.packet_end, FALSE);
-    else
-        dissect_list(&st, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
+    walk_list(&st, p->top_walk, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
     proto_item_set_len(root, offset);
     if (p->pairing) {
         if (st.request_pending) request_walked(&st);
