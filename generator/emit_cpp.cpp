@@ -468,6 +468,9 @@ void Emitter::condition_and_window_tables() {
         o_ << "/* " << comment << " */\n" << c_array("static const " + std::string(type) + " " + p_.filter + "_" + name, rows);
     };
     table("dg_when", "whens", l_.whens, "<when> conditions: on a field's value or a peek, in ranges (first, count)");
+    o_ << "/* What conditions read; compiled walks pass it as a constant (dissgen_state.h, selected). */\n"
+       << "static const dg_conditions " << p_.filter << "_conditions = { " << p_.filter << "_ranges, "
+       << (l_.whens.empty() ? std::string("NULL") : p_.filter + "_whens") << " };\n\n";
     table("dg_peek", "peeks", l_.peeks, "Look-ahead: target node, offset, field lengths (first, count), from the node (0) or its Nth container");
     table("dg_ref", "peek_lengths", l_.peek_lengths, "Field lengths between a node and the field it peeks at");
     table("dg_window", "windows", l_.windows, "Windows: base address, places (first, count), largest span, document order");
@@ -599,7 +602,7 @@ void Emitter::walk_definitions() {
         o_ << "    gboolean chain_taken = FALSE;\n    dg_rt::list_begin(st, *offset, end);\n";
         for (size_t i = first; i < first + count; ++i) {
             int k = l_.children_flat[i];
-            o_ << "    if (!st->stopped) dg_rt::dissect_child(st, &" << p_.filter << "_nodes[" << k
+            o_ << "    if (!st->stopped) dg_rt::dissect_child(st, &" << p_.filter << "_conditions, &" << p_.filter << "_nodes[" << k
                << "], tree, offset, end, in_summary, &chain_taken); /* " << comment_text(l_.nodes[k]->name) << " */\n";
         }
         o_ << "    dg_rt::list_end(st);\n}\n\n";
@@ -650,7 +653,7 @@ std::string Emitter::protocol_row() const {
         "dissect(dissect_" + f + ", " + (pdu ? "dissect_" + f + "_stream" : "NULL") + ")",
         "nodes(" + f + "_nodes, " + std::to_string(l_.nodes.size()) + ")",
         "children(" + f + "_children, 0, " + std::to_string(p_.nodes.size()) + ")",
-        "ranges(" + f + "_ranges)",
+        "conditions(&" + f + "_conditions)",
         "pieces(" + f + "_summary)",
         "slot_count(" + std::to_string(p_.slot_count) + ")",
         "experts(&ei_" + f + ")",
@@ -663,7 +666,6 @@ std::string Emitter::protocol_row() const {
     auto table = [&](const char* name, const std::vector<std::string>& rows) {
         if (!rows.empty()) set.push_back(std::string(name) + "(" + f + "_" + name + ")");
     };
-    table("whens", l_.whens);
     table("peeks", l_.peeks);
     table("peek_lengths", l_.peek_lengths);
     table("windows", l_.windows);

@@ -179,7 +179,7 @@ void dissect_place(dg_state *st, const dg_place *pl, proto_tree *tree, gint star
     const dg_node *c = &st->p->nodes[pl->node];
     if (quiet_within(st, c, pl->size)) return; /* unseen, cannot be malformed */
     gboolean no_chain = FALSE;
-    if (!selected(st, c, start, &no_chain)) return;
+    if (!selected(st, st->p->conditions, c, start, &no_chain)) return;
     guint32 i = 0;
     if (pl->stride && base > pl->at) i = (guint32)MIN((base - pl->at + pl->stride - 1) / pl->stride, (guint64)pl->instances);
     for (; i < pl->instances && !st->stopped; i++) {

@@ -126,7 +126,7 @@ struct dg_protocol_row {
     constexpr dg_protocol_row &children(const guint16 *v, guint16 top_first, guint16 top_count) {
         p.children = v; p.top_first = top_first; p.top_count = top_count; return *this;
     }
-    constexpr dg_protocol_row &ranges(const dg_range *v) { p.ranges = v; return *this; }
+    constexpr dg_protocol_row &conditions(const dg_conditions *v) { p.conditions = v; return *this; }
     constexpr dg_protocol_row &pieces(const dg_summary_piece *v) { p.pieces = v; return *this; }
     constexpr dg_protocol_row &slot_count(guint16 v) { p.slot_count = v; return *this; }
     constexpr dg_protocol_row &experts(dg_experts *v) { p.ei = v; return *this; }
@@ -138,7 +138,6 @@ struct dg_protocol_row {
     constexpr dg_protocol_row &reassembly(reassembly_table *table, const fragment_items *items) {
         p.reassembly = table; p.fragments = items; return *this;
     }
-    constexpr dg_protocol_row &whens(const dg_when *v) { p.whens = v; return *this; }
     constexpr dg_protocol_row &peeks(const dg_peek *v) { p.peeks = v; return *this; }
     constexpr dg_protocol_row &peek_lengths(const dg_ref *v) { p.peek_lengths = v; return *this; }
     constexpr dg_protocol_row &windows(const dg_window *v) { p.windows = v; return *this; }

@@ -113,6 +113,14 @@ typedef struct dg_when {
     guint16 in_first, in_count;
 } dg_when;
 
+/* What the tests of a node's conditions read (if/in, ifhook, <when>): the
+ * value ranges and the <when> rows (NULL when none). A compiled walk passes
+ * its protocol's as a constant, so each test folds to its comparisons. */
+typedef struct dg_conditions {
+    const dg_range *ranges;
+    const dg_when *whens;
+} dg_conditions;
+
 /* Where a peeked leaf sits: `offset` bytes plus the values of the length
  * references peek_lengths[length_first ..] after the start of the node
  * (up == 0) or of its up-th enclosing container. */
@@ -183,7 +191,7 @@ typedef struct dg_node {
     /* NULL for nodes without string/time/int/float/ipv4 attributes,
      * repeat="rest", direction, dissector or reassembly. */
     const dg_extra *extra = NULL;
-    /* <when> conditions (dg_protocol.whens), DG_ALT_* flags, and
+    /* <when> conditions (dg_conditions.whens), DG_ALT_* flags, and
      * the window (dg_protocol.windows) of a container with 'base'. Generated
      * code gives them only for nodes that use them. */
     guint16 when_first = 0, when_count = 0;
@@ -258,7 +266,7 @@ typedef struct dg_protocol {
     guint16 node_count;
     const guint16 *children; /* child index lists, addressed by first_child/child_count */
     guint16 top_first, top_count; /* the top-level nodes' list in `children` */
-    const dg_range *ranges;
+    const dg_conditions *conditions;
     const dg_summary_piece *pieces;
     guint16 slot_count;
     dg_experts *ei;
@@ -272,8 +280,7 @@ typedef struct dg_protocol {
     /* reassembly across frames (NULL when no node reassembles). */
     reassembly_table *reassembly = NULL;
     const fragment_items *fragments = NULL;
-    /* tables of <when> conditions, peeks and windows (NULL when unused). */
-    const dg_when *whens = NULL;
+    /* tables of peeks and windows (NULL when unused). */
     const dg_peek *peeks = NULL;
     const dg_ref *peek_lengths = NULL;
     const dg_window *windows = NULL;

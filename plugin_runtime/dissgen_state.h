@@ -250,16 +250,18 @@ static inline void clear_slots(dg_state *st, const dg_node *n)
 }
 
 /* Whether the value of n's if="..." field was decoded and is in its ranges. */
-static inline __attribute__((always_inline)) gboolean condition_holds(const dg_state *st, const dg_node *n)
+static inline __attribute__((always_inline)) gboolean condition_holds(const dg_state *st, const dg_conditions *c,
+                                                                      const dg_node *n)
 {
-    return st->present[n->if_slot] && in_ranges(st->p, n->in_first, n->in_count, st->slots[n->if_slot].value);
+    return st->present[n->if_slot] && in_ranges(c->ranges, n->in_first, n->in_count, st->slots[n->if_slot].value);
 }
 
 /* Whether every <when> of n holds; node_start is where n would begin. */
-static inline __attribute__((always_inline)) gboolean whens_hold(const dg_state *st, const dg_node *n, gint node_start)
+static inline __attribute__((always_inline)) gboolean whens_hold(const dg_state *st, const dg_conditions *c,
+                                                                 const dg_node *n, gint node_start)
 {
     for (guint i = 0; i < n->when_count; i++) {
-        const dg_when *w = &st->p->whens[n->when_first + i];
+        const dg_when *w = &c->whens[n->when_first + i];
         guint64 value;
         if (w->peek >= 0) {
             if (!peek_value(st, &st->p->peeks[w->peek], node_start, &value)) return FALSE;
@@ -268,7 +270,7 @@ static inline __attribute__((always_inline)) gboolean whens_hold(const dg_state 
             if (!st->present[w->slot]) return FALSE;
             value = s->value;
         }
-        if (!in_ranges(st->p, w->in_first, w->in_count, value)) return FALSE;
+        if (!in_ranges(c->ranges, w->in_first, w->in_count, value)) return FALSE;
     }
     return TRUE;
 }
@@ -276,9 +278,10 @@ static inline __attribute__((always_inline)) gboolean whens_hold(const dg_state 
 /* Whether n is decoded at `offset`. *chain_taken says whether a member of the
  * current chain of alternatives (a conditional node and the otherwise nodes
  * after it) was decoded; an otherwise node is skipped when one was. With a
- * constant node, as in compiled walks, only the tests the node has are left. */
-static inline __attribute__((always_inline)) gboolean selected(const dg_state *st, const dg_node *n, gint offset,
-                                                               gboolean *chain_taken)
+ * constant node and constant conditions, as in compiled walks, only the tests
+ * the node has are left, each its comparisons with constants. */
+static inline __attribute__((always_inline)) gboolean selected(const dg_state *st, const dg_conditions *c,
+                                                               const dg_node *n, gint offset, gboolean *chain_taken)
 {
     const guint8 direction = n->extra ? n->extra->direction : (guint8)DG_DIR_ANY;
     const gboolean otherwise = (n->alt & DG_ALT_OTHERWISE) != 0;
@@ -288,9 +291,9 @@ static inline __attribute__((always_inline)) gboolean selected(const dg_state *s
     }
     if (otherwise && *chain_taken) return FALSE;
     /* a member of a chain: decoded when its conditions hold */
-    gboolean holds = (!n->hook_count || in_ranges(st->p, n->hook_first, n->hook_count, st->hook_value)) &&
-                     (n->if_slot < 0 || condition_holds(st, n)) && (!direction || direction == st->direction) &&
-                     whens_hold(st, n, offset);
+    gboolean holds = (!n->hook_count || in_ranges(c->ranges, n->hook_first, n->hook_count, st->hook_value)) &&
+                     (n->if_slot < 0 || condition_holds(st, c, n)) && (!direction || direction == st->direction) &&
+                     whens_hold(st, c, n, offset);
     *chain_taken = holds;
     return holds;
 }
@@ -373,12 +376,13 @@ static inline __attribute__((always_inline)) gboolean quiet_within(const dg_stat
 /* One member of a list of siblings at *offset, before end, when it is
  * selected (*chain_taken: see selected()). Bit fields and fixed numbers
  * inline, the rest out of line. Generated code calls it with each member
- * of a list (a constant node: the tests fold away), the table walk in a loop. */
-static inline __attribute__((always_inline)) void dissect_child(dg_state *st, const dg_node *n, proto_tree *tree,
-                                                                gint *offset, gint end, gboolean in_summary,
-                                                                gboolean *chain_taken)
+ * of a list (a constant node and conditions: the tests fold away), the table
+ * walk in a loop. */
+static inline __attribute__((always_inline)) void dissect_child(dg_state *st, const dg_conditions *c, const dg_node *n,
+                                                                proto_tree *tree, gint *offset, gint end,
+                                                                gboolean in_summary, gboolean *chain_taken)
 {
-    if (!selected(st, n, *offset, chain_taken)) return;
+    if (!selected(st, c, n, *offset, chain_taken)) return;
     if (quiet_within(st, n, end - *offset)) {
         *offset += (gint)n->quiet_size; /* nobody would see it, and it cannot be malformed */
         return;

@@ -35,11 +35,11 @@ static inline guint64 bit_mask(guint bits) { return bits >= 64 ? G_MAXUINT64 : (
 /* A bit field's value: `bits` bits from bit `shift` of its group's value. */
 static inline guint64 bit_field(guint64 group, guint shift, guint bits) { return (group >> shift) & bit_mask(bits); }
 
-/* Whether value lies in one of the `count` ranges from p->ranges[first] on. */
-static inline gboolean in_ranges(const dg_protocol *p, guint16 first, guint16 count, guint64 value)
+/* Whether value lies in one of the `count` ranges from ranges[first] on. */
+static inline gboolean in_ranges(const dg_range *ranges, guint16 first, guint16 count, guint64 value)
 {
     for (guint i = 0; i < count; i++) {
-        const dg_range *r = &p->ranges[first + i];
+        const dg_range *r = &ranges[first + i];
         if (value >= r->low && value <= r->high) return TRUE;
     }
     return FALSE;

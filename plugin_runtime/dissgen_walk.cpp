@@ -485,7 +485,8 @@ void dissect_list(dg_state *st, guint16 first, guint16 count, proto_tree *tree, 
     gboolean chain_taken = FALSE; /* a conditional sibling was decoded: its otherwise members are not */
     list_begin(st, *offset, end);
     for (guint16 i = 0; i < count && !st->stopped; i++)
-        dissect_child(st, &st->p->nodes[st->p->children[first + i]], tree, offset, end, in_summary, &chain_taken);
+        dissect_child(st, st->p->conditions, &st->p->nodes[st->p->children[first + i]], tree, offset, end, in_summary,
+                      &chain_taken);
     list_end(st);
 }
 

@@ -194,29 +194,21 @@ TEST(RuntimeText, TruncateOnlyShortens) {
 
 const dg_range kRanges[] = {{1, 3}, {10, 10}, {G_MAXUINT64 - 1, G_MAXUINT64}};
 
-dg_protocol protocol_with_ranges() {
-    dg_protocol p{};
-    p.ranges = kRanges;
-    return p;
-}
-
 TEST(RuntimeRanges, BothBoundsIncluded) {
-    dg_protocol p = protocol_with_ranges();
-    EXPECT_FALSE(in_ranges(&p, 0, 3, 0));
-    EXPECT_TRUE(in_ranges(&p, 0, 3, 1));
-    EXPECT_TRUE(in_ranges(&p, 0, 3, 3));
-    EXPECT_FALSE(in_ranges(&p, 0, 3, 4));
-    EXPECT_TRUE(in_ranges(&p, 0, 3, 10));
-    EXPECT_FALSE(in_ranges(&p, 0, 3, 11));
-    EXPECT_TRUE(in_ranges(&p, 0, 3, G_MAXUINT64));
+    EXPECT_FALSE(in_ranges(kRanges, 0, 3, 0));
+    EXPECT_TRUE(in_ranges(kRanges, 0, 3, 1));
+    EXPECT_TRUE(in_ranges(kRanges, 0, 3, 3));
+    EXPECT_FALSE(in_ranges(kRanges, 0, 3, 4));
+    EXPECT_TRUE(in_ranges(kRanges, 0, 3, 10));
+    EXPECT_FALSE(in_ranges(kRanges, 0, 3, 11));
+    EXPECT_TRUE(in_ranges(kRanges, 0, 3, G_MAXUINT64));
 }
 
 TEST(RuntimeRanges, OnlyTheGivenRangesCount) {
-    dg_protocol p = protocol_with_ranges();
-    EXPECT_FALSE(in_ranges(&p, 0, 0, 1)) << "no ranges: nothing is in them";
-    EXPECT_FALSE(in_ranges(&p, 1, 1, 2)) << "ranges[0] is not among them";
-    EXPECT_TRUE(in_ranges(&p, 1, 1, 10));
-    EXPECT_FALSE(in_ranges(&p, 0, 1, 10)) << "ranges[1] is not among them";
+    EXPECT_FALSE(in_ranges(kRanges, 0, 0, 1)) << "no ranges: nothing is in them";
+    EXPECT_FALSE(in_ranges(kRanges, 1, 1, 2)) << "ranges[0] is not among them";
+    EXPECT_TRUE(in_ranges(kRanges, 1, 1, 10));
+    EXPECT_FALSE(in_ranges(kRanges, 0, 1, 10)) << "ranges[1] is not among them";
 }
 
 TEST(RuntimeRefs, Arithmetic) {
@@ -261,12 +253,12 @@ struct Message {
     dg_peek peeks[1]{};
     dg_slot slots[4]{};
     guint8 present[4]{};
+    dg_conditions conditions{kRanges, whens};
     dg_state st{};
 
     Message() {
-        p.ranges = kRanges;
+        p.conditions = &conditions;
         p.nodes = nodes;
-        p.whens = whens;
         p.peeks = peeks;
         st.p = &p;
         st.slots = slots;
@@ -277,7 +269,7 @@ struct Message {
         slots[slot].value = value;
         present[slot] = TRUE;
     }
-    gboolean selects(const dg_node& n, gboolean* chain_taken) { return selected(&st, &n, 0, chain_taken); }
+    gboolean selects(const dg_node& n, gboolean* chain_taken) { return selected(&st, &conditions, &n, 0, chain_taken); }
 };
 
 TEST(RuntimeConditions, UnconditionalNodesEndAChain) {
@@ -376,7 +368,7 @@ TEST(RuntimeConditions, EveryWhenMustHold) {
 TEST(RuntimeConditions, AWhenOnAnAbsentFieldNeverHolds) {
     Message m;
     dg_range zero[] = {{0, 0}};
-    m.p.ranges = zero;
+    m.conditions.ranges = zero;
     m.whens[0] = {1, -1, 0, 1}; /* slot 1 is 0 */
     dg_node& n = m.nodes[0];
     n.when_count = 1;
@@ -398,7 +390,7 @@ TEST(RuntimeConditions, PeekReadsABitFieldAheadUpToTheEndOfItsList) {
     m.peeks[0] = {3, 2, 0, 0, 0, 0}; /* node 3, 2 bytes after the node's start */
     m.whens[0] = {-1, 0, 0, 1};      /* peek 0 in ranges[0] */
     dg_range is_a5[] = {{0xa5, 0xa5}};
-    m.p.ranges = is_a5;
+    m.conditions.ranges = is_a5;
     dg_node& n = m.nodes[0];
     n.when_count = 1;
     m.st.tvb = t.tvb;
