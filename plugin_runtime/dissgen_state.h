@@ -260,6 +260,8 @@ static inline __attribute__((always_inline)) gboolean condition_holds(const dg_s
 static inline __attribute__((always_inline)) gboolean whens_hold(const dg_state *st, const dg_conditions *c,
                                                                  const dg_node *n, gint node_start)
 {
+    /* unrolled: with a constant node, each <when> folds to its comparisons */
+#pragma GCC unroll 8
     for (guint i = 0; i < n->when_count; i++) {
         const dg_when *w = &c->whens[n->when_first + i];
         guint64 value;

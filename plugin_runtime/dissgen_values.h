@@ -38,6 +38,7 @@ static inline guint64 bit_field(guint64 group, guint shift, guint bits) { return
 /* Whether value lies in one of the `count` ranges from ranges[first] on. */
 static inline gboolean in_ranges(const dg_range *ranges, guint16 first, guint16 count, guint64 value)
 {
+#pragma GCC unroll 8 /* constant ranges (compiled walks) fold to comparisons */
     for (guint i = 0; i < count; i++) {
         const dg_range *r = &ranges[first + i];
         if (value >= r->low && value <= r->high) return TRUE;
