@@ -107,7 +107,7 @@ struct Layout {
     bool node_uses_layout_columns(const Node& n) const { return when_first.count(&n) || window_index.count(&n) || n.otherwise; }
 };
 
-void layout_conditions_and_windows(Layout& l);
+void layout_conditions_and_windows(Layout& l, const std::map<const Node*, uint64_t>& quiet);
 
 std::string ident_for(const Protocol& proto, const Node& n) {
     std::string base = n.filter_name.empty() ? proto.filter + "_" + (n.segment.empty() ? n.name : n.segment)
@@ -117,7 +117,8 @@ std::string ident_for(const Protocol& proto, const Node& n) {
     return out;
 }
 
-Layout make_layout(const Protocol& proto) {
+// quiet: the nodes a walk nobody sees steps over, and their sizes (quiet.h).
+Layout make_layout(const Protocol& proto, const std::map<const Node*, uint64_t>& quiet) {
     Layout l;
     std::set<std::string> used;
     for_each_node(proto.nodes, [&](const Node& n) {
@@ -157,7 +158,7 @@ Layout make_layout(const Protocol& proto) {
                                     p.leaf && p.leaf->is_container() ? p.leaf->doc_index - 1 : -1, p.leaf});
         }
     }
-    layout_conditions_and_windows(l);
+    layout_conditions_and_windows(l, quiet);
     for (const Node* n : l.nodes) {
         if (!n->is_computed()) continue;
         std::vector<ExprRow> rows = compile_expression(*n->value, n->display == Display::Float);
@@ -185,7 +186,7 @@ std::string ref_of(const FieldRef* r);
 
 // <when> rows (their 'in' lists after every other list), peeks,
 // windows and their places sorted by address.
-void layout_conditions_and_windows(Layout& l) {
+void layout_conditions_and_windows(Layout& l, const std::map<const Node*, uint64_t>& quiet) {
     for (const Node* n : l.nodes) {
         if (n->whens.empty()) continue;
         l.when_first[n] = static_cast<int>(l.whens.size());
@@ -221,10 +222,15 @@ void layout_conditions_and_windows(Layout& l) {
         l.windows.push_back("{ " + ref_of(&*n->base) + ", " + std::to_string(l.places.size()) + ", " +
                             std::to_string(kids.size()) + ", " + std::to_string(max_span) + ", " +
                             (document_order ? "TRUE" : "FALSE") + " }");
-        for (const Node* c : kids)
-            l.places.push_back("{ " + std::to_string(c->doc_index - 1) + ", " + hex(*c->at) + ", " +
-                               std::to_string(c->place_bytes) + ", " + std::to_string(c->stride.value_or(0)) + ", " +
-                               std::to_string(c->instances.value_or(1)) + " }");
+        for (const Node* c : kids) {
+            // quiet within its size: each instance is, and the window steps over the place unread
+            auto q = quiet.find(c);
+            bool quiet_place = q != quiet.end() && q->second <= c->place_bytes;
+            l.places.push_back("{ " + std::to_string(c->doc_index - 1) + ", " + (quiet_place ? "TRUE" : "FALSE") + ", " +
+                               hex(*c->at) + ", " + std::to_string(c->place_bytes) + ", " +
+                               std::to_string(c->stride.value_or(0)) + ", " + std::to_string(c->instances.value_or(1)) +
+                               " }");
+        }
     }
 }
 
@@ -299,8 +305,8 @@ std::pair<int, int> slot_span(const Node& n) {
 class Emitter {
 public:
     Emitter(const Protocol& p, const std::string& source, const EmbeddedTables* extra)
-        : p_(p), source_(source), extra_(extra), l_(make_layout(p)),
-          quiet_(quiet_sizes(p, [this](const Node& n) { return is_pairing_key(n); })) {}
+        : p_(p), source_(source), extra_(extra),
+          quiet_(quiet_sizes(p, [this](const Node& n) { return is_pairing_key(n); })), l_(make_layout(p, quiet_)) {}
     std::string run();
 
 private:
@@ -356,8 +362,8 @@ private:
     const Protocol& p_;
     std::string source_;
     const EmbeddedTables* extra_;
+    std::map<const Node*, uint64_t> quiet_;  // nodes stepped over when unseen, and their sizes (before l_)
     Layout l_;
-    std::map<const Node*, uint64_t> quiet_;  // nodes stepped over when unseen, and their sizes
     std::ostringstream o_;
 };
 
@@ -474,7 +480,7 @@ void Emitter::condition_and_window_tables() {
     table("dg_peek", "peeks", l_.peeks, "Look-ahead: target node, offset, field lengths (first, count), from the node (0) or its Nth container");
     table("dg_ref", "peek_lengths", l_.peek_lengths, "Field lengths between a node and the field it peeks at");
     table("dg_window", "windows", l_.windows, "Windows: base address, places (first, count), largest span, document order");
-    table("dg_place", "places", l_.places, "Window children by address: node, address, size, stride, instances");
+    table("dg_place", "places", l_.places, "Window children by address: node, quiet within its size, address, size, stride, instances");
     std::vector<std::string> exprs;
     for (const ExprRow& r : l_.exprs) exprs.push_back(expr_row(r));
     table("dg_expr_op", "exprs", exprs, "Computed values: their operations in postfix order");

@@ -176,8 +176,8 @@ void label_instance(const dg_state *st, const dg_node *n, proto_tree *tree, prot
 void dissect_place(dg_state *st, const dg_place *pl, proto_tree *tree, gint start, guint64 base, guint64 last,
                    gboolean in_summary)
 {
+    if (st->quiet && pl->quiet) return; /* unseen, cannot be malformed */
     const dg_node *c = &st->p->nodes[pl->node];
-    if (quiet_within(st, c, pl->size)) return; /* unseen, cannot be malformed */
     gboolean no_chain = FALSE;
     if (!selected(st, st->p->conditions, c, start, &no_chain)) return;
     guint32 i = 0;
@@ -257,13 +257,14 @@ void dg_rt::dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gin
     /* Places starting at or before base - max_span end at or before base;
      * those starting at or after last are past the window. */
     guint lo = base > w->max_span ? first_at_or_after(places, 0, w->place_count, base - w->max_span + 1) : 0;
-    guint hi = first_at_or_after(places, lo, w->place_count, last);
+    /* the places that may be inside are few and read next: a scan, not a second search */
+    guint hi = lo;
+    while (hi < w->place_count && places[hi].at < last) hi++;
     if (w->address_order_is_document_order || hi - lo < 2) {
-        const dg_node *nodes = st->p->nodes;
         for (guint k = lo; k < hi && !st->stopped; k++) {
             const dg_place *pl = &places[k];
             /* most places of a register window are quiet: no call for them */
-            if (quiet_within(st, &nodes[pl->node], pl->size)) continue;
+            if (st->quiet && pl->quiet) continue;
             dissect_place(st, pl, tree, start, base, last, in_summary);
         }
     } else {

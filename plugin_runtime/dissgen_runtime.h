@@ -136,6 +136,9 @@ typedef struct dg_peek {
  * blocks of `size` bytes, `stride` bytes apart. */
 typedef struct dg_place {
     guint16 node;
+    /* the node is quiet (dg_node.quiet_size) within `size` bytes: a walk
+     * nobody sees steps over each instance without reading the node */
+    gboolean quiet;
     guint64 at;
     guint32 size;
     guint32 stride;

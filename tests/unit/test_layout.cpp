@@ -131,11 +131,23 @@ TEST(Layout, WindowChildrenArePlacedAndSortedByAddress) {
     std::string code = emit_cpp(*f.proto, "t.xml");
     // by address: Id (node 5), Status (4), FMMU (6); the largest span is 15*16+16;
     // the base is Addr's value (slot 1, after Len's) minus 16
-    EXPECT_TRUE(contains(code, "{ 5, 0x0, 4, 0, 1 },\n    { 4, 0x110, 2, 0, 1 },\n    { 6, 0x600, 16, 16, 16 },")) << code;
+    // each quiet within its size (nothing reads them): a walk nobody sees steps over them
+    EXPECT_TRUE(contains(code, "{ 5, TRUE, 0x0, 4, 0, 1 },\n    { 4, TRUE, 0x110, 2, 0, 1 },\n    { 6, TRUE, 0x600, 16, 16, 16 },"))
+        << code;
     EXPECT_TRUE(contains(code, "{ {1, '-', 16}, 0, 3, 256, FALSE }")) << code;
     EXPECT_TRUE(contains(code, "tst_conditions = { tst_ranges, NULL };")) << "no <when> rows: " << code;
     EXPECT_FALSE(contains(code, ".peeks(")) << code;
     EXPECT_TRUE(contains(code, ".windows(tst_windows).places(tst_places)")) << code;
+}
+
+TEST(Layout, APlaceSomeoneReadsIsNotSteppedOver) {
+    // Status shows in the window's summary: a walk without a tree still reads it
+    std::string window = kWindow;
+    window.replace(window.find("base="), 5, "summary=\"{Status}\" base=");
+    Front f = front_end(rules(std::string(kHeader) + window));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_TRUE(contains(code, "{ 5, TRUE, 0x0, 4, 0, 1 },\n    { 4, FALSE, 0x110, 2, 0, 1 },")) << code;
 }
 
 TEST(Layout, WindowLengthNeedNotBeItsChildrensSum) {
