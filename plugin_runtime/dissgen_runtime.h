@@ -43,7 +43,7 @@ enum dg_flags {
 typedef struct dg_ref {
     gint16 slot;    /* -1: none */
     char op;        /* 0, '+', '-' or '*' */
-    gint64 operand;
+    gint32 operand; /* the generator accepts at most 999999999 */
 } dg_ref;
 
 typedef struct dg_range {
@@ -168,10 +168,11 @@ typedef void (*dg_list_walk)(dg_rt::dg_state *st, proto_tree *tree, gint *offset
  * as dissgen_text.cpp append_pieces() says of the pieces' table. */
 typedef gboolean (*dg_summary_text)(const dg_rt::dg_state *st, dg_rt::dg_text *out);
 
-typedef struct dg_node {
-    const char *name;
-    int *hf;            /* NULL for a container left out of filter names */
-    int *ett;           /* containers only */
+/* Two cache lines, the first of them what the walk reads of every node it
+ * meets (kind, lengths, slots, conditions, quiet size, extra, count, hf):
+ * out of line, the walk reads nodes from a table no cache keeps between
+ * frames, so one line a node instead of three. */
+typedef struct alignas(64) dg_node {
     guint8 kind;        /* dg_kind */
     guint8 length_kind; /* dg_length_kind */
     guint8 show;        /* dg_show */
@@ -179,21 +180,13 @@ typedef struct dg_node {
     guint32 length;     /* fixed length in bytes; a bit field's group length */
     guint8 shift, bits; /* bit field: position and width inside its group */
     gint16 slot;        /* where this leaf's value is kept, -1 if nobody reads it */
-    dg_ref length_ref;  /* DG_LEN_FIELD */
-    dg_ref count;       /* slot >= 0: decoded exactly that many times */
     gint16 repeat_slot; /* >= 0: decoded again while that flag is non-zero */
     gint16 if_slot;     /* >= 0: decoded only when that value is in the ranges */
     guint16 in_first, in_count;
-    guint16 first_child, child_count;
-    guint16 slot_first, slot_count; /* slots inside this subtree */
-    guint16 summary_first, summary_count;
     /* ifhook: decoded only when the value the dissector table matched
      * (pinfo->match_uint: the port, the ethertype) is in these ranges.
      * Generated code gives them only for nodes that have the attribute. */
     guint16 hook_first = 0, hook_count = 0;
-    /* NULL for nodes without string/time/int/float/ipv4 attributes,
-     * repeat="rest", direction, dissector or reassembly. */
-    const dg_extra *extra = NULL;
     /* <when> conditions (dg_conditions.whens), DG_ALT_* flags, and
      * the window (dg_protocol.windows) of a container with 'base'. Generated
      * code gives them only for nodes that use them. */
@@ -205,11 +198,24 @@ typedef struct dg_node {
      * malformed within these many bytes: a walk with no tree and no tap
      * listener steps over it when they are there. */
     guint32 quiet_size = 0;
+    /* NULL for nodes without string/time/int/float/ipv4 attributes,
+     * repeat="rest", direction, dissector or reassembly. */
+    const dg_extra *extra = NULL;
+    dg_ref count;       /* slot >= 0: decoded exactly that many times */
+    int *hf;            /* NULL for a container left out of filter names */
+    /* the second line: what containers and their summaries read */
+    int *ett;           /* containers only */
+    dg_ref length_ref;  /* DG_LEN_FIELD */
+    guint16 first_child, child_count;
+    guint16 slot_first, slot_count; /* slots inside this subtree */
+    guint16 summary_first, summary_count;
+    const char *name;
     /* a container's children, compiled (NULL: the table walk) */
     dg_list_walk walk = NULL;
     /* its summary, compiled (NULL: the pieces' table) */
     dg_summary_text summarize = NULL;
 } dg_node;
+static_assert(sizeof(void *) != 8 || sizeof(dg_node) == 128, "dg_node: two cache lines");
 
 /* The expert infos of every protocol, one member per row of
  * DG_RUNTIME_EXPERTS (dissgen_names.h), which the generated code registers. */
