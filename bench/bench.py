@@ -35,7 +35,9 @@ itself. In one run it
     under valgrind (callgrind) on a FRAMES-frame capture: immune to other load, so it
     settles differences that CPU times on a busy machine cannot (summary lines). With
     --corpus, --scale or --capture that capture's first FRAMES frames (editcap -r), else
-    FRAMES generated ones.
+    FRAMES generated ones. --cache-sim counts under cachegrind instead, with its cache and
+    branch simulation: also first-level data cache misses and mispredicted branches, which
+    tell why equal instruction counts can still cost unequal CPU time.
 
 CPU time is user+sys of the tshark process (os.wait4), peak memory its ru_maxrss.
 As root, tshark runs as uid 65534 (Wireshark ignores per-user plugins for root), see
@@ -323,23 +325,39 @@ def bench_decode(envs, capture, runs, modes, configs):
     return results
 
 
-def bench_instructions(envs, capture, modes, configs):
+# What valgrind prints of a whole run: "==pid== D1  misses:  38,169,217  (30,064,629 rd ..."
+VALGRIND_COUNTS = {"instructions": r"I\s+refs:\s+([\d,]+)", "d1_misses": r"D1\s+misses:\s+([\d,]+)",
+                   "mispredicts": r"Mispredicts:\s+([\d,]+)"}
+
+
+def bench_instructions(envs, capture, modes, configs, cache_sim=False):
     """Instructions of one tshark run per configuration and mode under callgrind: no noise
-    from other load, so small differences (summary lines) show."""
+    from other load, so small differences (summary lines) show. With cache_sim, under
+    cachegrind's cache and branch simulation: also the first-level data cache misses and
+    mispredicted branches, {mode: {config: {count: n}}} as the second result."""
     results = {m: {} for m in modes}
+    locality = {m: {} for m in modes} if cache_sim else {}
+    tool = (["--tool=cachegrind", "--cache-sim=yes", "--branch-sim=yes", "--cachegrind-out-file=/dev/null"]
+            if cache_sim else ["--tool=callgrind", "--callgrind-out-file=/dev/null"])
     for mode in modes:
         for cfg in configs:
             env = envs[cfg]
             cmd = env.command(tshark_args(cfg, mode, capture))
             i = cmd.index(env.tshark_bin)
-            cmd[i:i] = ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null"]
+            cmd[i:i] = ["valgrind"] + tool
             s = measure(cmd, env=env.env(), cwd=env.home, what="valgrind %s/%s" % (mode, cfg))
-            m = re.search(r"I\s+refs:\s+([\d,]+)", s.stderr)
-            if not m:
-                raise BenchError("valgrind %s/%s: no instruction count in:\n%s" % (mode, cfg, s.stderr[-1000:]))
-            results[mode][cfg] = int(m.group(1).replace(",", ""))
+            counts = {}
+            for name, pattern in VALGRIND_COUNTS.items():
+                m = re.search(pattern, s.stderr)
+                if m:
+                    counts[name] = int(m.group(1).replace(",", ""))
+                elif name == "instructions" or cache_sim:
+                    raise BenchError("valgrind %s/%s: no %s in:\n%s" % (mode, cfg, name, s.stderr[-1000:]))
+            results[mode][cfg] = counts["instructions"]
+            if cache_sim:
+                locality[mode][cfg] = {k: v for k, v in counts.items() if k != "instructions"}
         log("instructions %-7s %s" % (mode, "  ".join("%s %.0fM" % (c, results[mode][c] / 1e6) for c in configs)))
-    return results
+    return results, locality
 
 
 def bench_startup(envs, empty, runs):
@@ -380,7 +398,7 @@ def table(rows, header):
     return "\n".join([line(header), line(["-" * w for w in widths])] + [line(r) for r in rows])
 
 
-def report(info, decode, startup, install, runs, instr=None):
+def report(info, decode, startup, install, runs, instr=None, locality=None):
     out = []
     cap = info["capture"]
     out.append("Capture: %d frames, %d datagrams (%d-%d a frame), %d commands, data %d-%d bytes (mean %s), %.1f MB; "
@@ -433,6 +451,20 @@ def report(info, decode, startup, install, runs, instr=None):
         out.append("Instructions (millions, valgrind callgrind, %d frames, one run each)" % info["instr_frames"])
         out.append(table(rows, ["mode", "ours", "wireshark", "lua", "floor", "ours/ws", "net ours/ws",
                                 "ours/lua", "net ours/lua"]))
+    if locality:
+        rows = []
+        for mode, c in locality.items():
+            row = [mode]
+            for count in ("d1_misses", "mispredicts"):
+                v = {k: c[k][count] for k in c}
+                row += [fmt(v.get(k, float("nan")) / 1e6, ".2f") for k in ("ours", "wireshark", "floor")]
+                row.append(fmt(net_ratio(v["ours"], v.get("wireshark", float("nan")), v.get("floor", float("nan"))),
+                               ".2f"))
+            rows.append(row)
+        out.append("")
+        out.append("Data cache misses (first level) and mispredicted branches, millions (cachegrind, same runs)")
+        out.append(table(rows, ["mode", "D1 ours", "D1 ws", "D1 floor", "net ours/ws",
+                                "mispred ours", "mispred ws", "mispred floor", "net ours/ws"]))
     if startup:
         base = med(startup["none"], "cpu")
         rows = []
@@ -523,9 +555,14 @@ def main(argv=None):
     ap.add_argument("--instructions", type=int, default=0, metavar="FRAMES",
                     help="also count instructions (valgrind callgrind) on a capture of FRAMES frames, one run "
                          "per cell, e.g. 3000 (about 3 minutes); default 0: off")
+    ap.add_argument("--cache-sim", action="store_true",
+                    help="with --instructions: count under cachegrind's cache and branch simulation, which also "
+                         "gives first-level data cache misses and mispredicted branches (about twice as slow)")
     ap.add_argument("--json", help="write every sample here")
     ap.add_argument("--keep", action="store_true", help="keep the temporary folders (printed)")
     a = ap.parse_args(argv)
+    if a.cache_sim and a.instructions <= 0:
+        ap.error("--cache-sim counts with --instructions FRAMES: give both")
 
     if not (os.path.isfile(a.dissgen) and os.access(a.dissgen, os.X_OK)):
         print("bench: %s is missing; build it first (bash scripts/build.sh)" % a.dissgen, file=sys.stderr)
@@ -633,7 +670,7 @@ def main(argv=None):
                                                 ("%d-field" % a.big_fields, big_rules)],
                                     work, a.install_runs)
 
-        instr = {}
+        instr, locality = {}, {}
         if a.instructions > 0:
             if not shutil.which("valgrind"):
                 raise BenchError("--instructions needs valgrind (apt-get install valgrind)")
@@ -647,9 +684,9 @@ def main(argv=None):
                 generate_capture(small, a.seed, a.instructions, a.max_datagrams, a.max_data)
             os.chmod(small, 0o644)
             info["instr_frames"] = a.instructions
-            instr = bench_instructions(envs, small, modes, configs)
+            instr, locality = bench_instructions(envs, small, modes, configs, a.cache_sim)
 
-        print(report(info, decode, startup, install, a.runs, instr))
+        print(report(info, decode, startup, install, a.runs, instr, locality))
         print("\nTotal bench time %.0f s" % (time.time() - t_start))
         if a.json:
             with open(a.json, "w") as fh:
@@ -657,7 +694,7 @@ def main(argv=None):
                            "decode": {m: {c: list(v) for c, v in per.items()} for m, per in decode.items()},
                            "startup": {k: list(v) for k, v in startup.items()},
                            "install": {"%s %s" % k: list(v) for k, v in install.items()},
-                           "instructions": instr}, fh, indent=1)
+                           "instructions": instr, "locality": locality}, fh, indent=1)
         return 0
     except (BenchError, TsharkError) as e:
         print("bench: %s" % e, file=sys.stderr)
