@@ -81,17 +81,17 @@ static inline void append_hex(dg_text *out, guint64 v, guint digits)
 {
     static const char hex[] = "0123456789abcdef";
     char buf[2 + 16];
-    gsize i = sizeof buf;
-    guint n = 0;
-    do {
-        buf[--i] = hex[v & 0xf];
-        v >>= 4;
-        n++;
-    } while (v);
-    for (; n < digits && n < 16; n++) buf[--i] = '0';
-    buf[--i] = 'x';
-    buf[--i] = '0';
-    text_append(out, buf + i, sizeof buf - i);
+    buf[0] = '0';
+    buf[1] = 'x';
+    guint n = digits < 16 ? digits : 16;
+    if (n == 0 || (n < 16 && (v >> (4 * n)) != 0)) {
+        n = 1; /* wider than `digits`: the digits v needs */
+        while (n < 16 && (v >> (4 * n)) != 0) n++;
+    }
+    /* one digit per place, zeros included: with a constant width (compiled
+     * summaries) the loop unrolls and the copy is of a constant size */
+    for (guint k = n; k > 0; k--, v >>= 4) buf[1 + k] = hex[v & 0xf];
+    text_append(out, buf, 2 + n);
 }
 
 } // namespace dg_rt
