@@ -194,6 +194,16 @@ void dissect_place(dg_state *st, const dg_place *pl, proto_tree *tree, gint star
     }
 }
 
+/* Whether every instance of the place starts before base: none of them is in
+ * the window. The places just below a window are many (those within the
+ * largest span of it): this spares them the call to dissect_place(). */
+inline gboolean all_before(const dg_place *pl, guint64 base)
+{
+    if (pl->at >= base) return FALSE;
+    if (!pl->stride || pl->instances <= 1) return TRUE;
+    return (base - pl->at - 1) / pl->stride >= (guint64)pl->instances - 1; /* the last one starts before base */
+}
+
 /* The first index in [l, h) whose place starts at or after addr. */
 guint first_at_or_after(const dg_place *places, guint l, guint h, guint64 addr)
 {
@@ -264,14 +274,16 @@ void dg_rt::dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gin
         for (guint k = lo; k < hi && !st->stopped; k++) {
             const dg_place *pl = &places[k];
             /* most places of a register window are quiet: no call for them */
-            if (st->quiet && pl->quiet) continue;
+            if ((st->quiet && pl->quiet) || all_before(pl, base)) continue;
             dissect_place(st, pl, tree, start, base, last, in_summary);
         }
     } else {
         const dg_place **order = wmem_alloc_array(st->pinfo->pool, const dg_place *, hi - lo);
-        for (guint k = lo; k < hi; k++) order[k - lo] = &places[k];
-        qsort(order, hi - lo, sizeof *order, compare_node_index);
-        for (guint k = 0; k < hi - lo && !st->stopped; k++) dissect_place(st, order[k], tree, start, base, last, in_summary);
+        guint count = 0;
+        for (guint k = lo; k < hi; k++)
+            if (!all_before(&places[k], base)) order[count++] = &places[k];
+        qsort(order, count, sizeof *order, compare_node_index);
+        for (guint k = 0; k < count && !st->stopped; k++) dissect_place(st, order[k], tree, start, base, last, in_summary);
     }
     *offset = end;
 }
