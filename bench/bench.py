@@ -448,7 +448,8 @@ def report(info, decode, startup, install, runs, instr=None, locality=None):
                         [fmt(ratio(c["ours"], ws), ".3f"), fmt(net_ratio(c["ours"], ws, fl), ".2f"),
                          fmt(ratio(c["ours"], lua), ".2f"), fmt(net_ratio(c["ours"], lua, fl), ".2f")])
         out.append("")
-        out.append("Instructions (millions, valgrind callgrind, %d frames, one run each)" % info["instr_frames"])
+        out.append("Instructions (millions, valgrind %s, %d frames, one run each)"
+                   % (info.get("instr_tool", "callgrind"), info["instr_frames"]))
         out.append(table(rows, ["mode", "ours", "wireshark", "lua", "floor", "ours/ws", "net ours/ws",
                                 "ours/lua", "net ours/lua"]))
     if locality:
@@ -463,8 +464,8 @@ def report(info, decode, startup, install, runs, instr=None, locality=None):
             rows.append(row)
         out.append("")
         out.append("Data cache misses (first level) and mispredicted branches, millions (cachegrind, same runs)")
-        out.append(table(rows, ["mode", "D1 ours", "D1 ws", "D1 floor", "net ours/ws",
-                                "mispred ours", "mispred ws", "mispred floor", "net ours/ws"]))
+        out.append(table(rows, ["mode", "D1 ours", "D1 ws", "D1 floor", "D1 net ours/ws",
+                                "mispred ours", "mispred ws", "mispred floor", "mispred net ours/ws"]))
     if startup:
         base = med(startup["none"], "cpu")
         rows = []
@@ -684,6 +685,7 @@ def main(argv=None):
                 generate_capture(small, a.seed, a.instructions, a.max_datagrams, a.max_data)
             os.chmod(small, 0o644)
             info["instr_frames"] = a.instructions
+            info["instr_tool"] = "cachegrind" if a.cache_sim else "callgrind"
             instr, locality = bench_instructions(envs, small, modes, configs, a.cache_sim)
 
         print(report(info, decode, startup, install, a.runs, instr, locality))

@@ -253,7 +253,8 @@ gboolean window_base(dg_state *st, const dg_node *n, const dg_window *w, proto_t
 
 /* A window's children: each place (each instance of a block) wholly inside
  * [base, base + window length), in document order. Places are sorted by
- * address, so a binary search finds the few that may be inside. */
+ * address: a binary search finds the first that may be inside, a scan the
+ * last, and those whose instances all start before base are skipped. */
 void dg_rt::dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
                            gboolean in_summary)
 {

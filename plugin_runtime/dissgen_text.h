@@ -88,8 +88,7 @@ static inline void append_hex(dg_text *out, guint64 v, guint digits)
         n = 1; /* wider than `digits`: the digits v needs */
         while (n < 16 && (v >> (4 * n)) != 0) n++;
     }
-    /* one digit per place, zeros included: with a constant width (compiled
-     * summaries) the loop unrolls and the copy is of a constant size */
+    /* one loop writes the digits and the zeros before them */
     for (guint k = n; k > 0; k--, v >>= 4) buf[1 + k] = hex[v & 0xf];
     text_append(out, buf, 2 + n);
 }
