@@ -176,7 +176,6 @@ void label_instance(const dg_state *st, const dg_node *n, proto_tree *tree, prot
 void dissect_place(dg_state *st, const dg_place *pl, proto_tree *tree, gint start, guint64 base, guint64 last,
                    gboolean in_summary)
 {
-    if (st->quiet && pl->quiet) return; /* unseen, cannot be malformed */
     const dg_node *c = &st->p->nodes[pl->node];
     gboolean no_chain = FALSE;
     if (!selected(st, st->p->conditions, c, start, &no_chain)) return;
@@ -202,6 +201,14 @@ inline gboolean all_before(const dg_place *pl, guint64 base)
     if (pl->at >= base) return FALSE;
     if (!pl->stride || pl->instances <= 1) return TRUE;
     return (base - pl->at - 1) / pl->stride >= (guint64)pl->instances - 1; /* the last one starts before base */
+}
+
+/* Whether the window calls dissect_place() for the place: not when nobody
+ * would see it (quiet: it cannot be malformed either), nor when none of its
+ * instances can be inside. */
+inline gboolean place_wanted(const dg_state *st, const dg_place *pl, guint64 base)
+{
+    return !(st->quiet && pl->quiet) && !all_before(pl, base);
 }
 
 /* The first index in [l, h) whose place starts at or after addr. */
@@ -273,16 +280,14 @@ void dg_rt::dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gin
     while (hi < w->place_count && places[hi].at < last) hi++;
     if (w->address_order_is_document_order || hi - lo < 2) {
         for (guint k = lo; k < hi && !st->stopped; k++) {
-            const dg_place *pl = &places[k];
-            /* most places of a register window are quiet: no call for them */
-            if ((st->quiet && pl->quiet) || all_before(pl, base)) continue;
-            dissect_place(st, pl, tree, start, base, last, in_summary);
+            /* most places of a register window are quiet or below it: no call for them */
+            if (place_wanted(st, &places[k], base)) dissect_place(st, &places[k], tree, start, base, last, in_summary);
         }
     } else {
         const dg_place **order = wmem_alloc_array(st->pinfo->pool, const dg_place *, hi - lo);
         guint count = 0;
         for (guint k = lo; k < hi; k++)
-            if (!all_before(&places[k], base)) order[count++] = &places[k];
+            if (place_wanted(st, &places[k], base)) order[count++] = &places[k];
         qsort(order, count, sizeof *order, compare_node_index);
         for (guint k = 0; k < count && !st->stopped; k++) dissect_place(st, order[k], tree, start, base, last, in_summary);
     }
