@@ -362,7 +362,7 @@ private:
     const Protocol& p_;
     std::string source_;
     const EmbeddedTables* extra_;
-    std::map<const Node*, uint64_t> quiet_;  // nodes stepped over when unseen, and their sizes (before l_)
+    std::map<const Node*, uint64_t> quiet_;  // nodes stepped over when unseen, and their sizes; declared before l_, whose layout reads it
     Layout l_;
     std::ostringstream o_;
 };

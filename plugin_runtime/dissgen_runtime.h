@@ -171,7 +171,7 @@ typedef gboolean (*dg_summary_text)(const dg_rt::dg_state *st, dg_rt::dg_text *o
 /* Two cache lines, the first of them what the walk reads of every node it
  * meets (kind, lengths, slots, conditions, quiet size, extra, count, hf):
  * out of line, the walk reads nodes from a table no cache keeps between
- * frames, so one line a node instead of three. */
+ * frames, so that a visit costs one line of it. */
 typedef struct alignas(64) dg_node {
     guint8 kind;        /* dg_kind */
     guint8 length_kind; /* dg_length_kind */
