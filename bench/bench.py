@@ -36,8 +36,8 @@ itself. In one run it
     settles differences that CPU times on a busy machine cannot (summary lines). With
     --corpus, --scale or --capture that capture's first FRAMES frames (editcap -r), else
     FRAMES generated ones. --cache-sim counts under cachegrind instead, with its cache and
-    branch simulation: also first-level data cache misses and mispredicted branches, which
-    tell why equal instruction counts can still cost unequal CPU time.
+    branch simulation: also first-level instruction and data cache misses and mispredicted
+    branches, which tell why equal instruction counts can still cost unequal CPU time.
 
 CPU time is user+sys of the tshark process (os.wait4), peak memory its ru_maxrss.
 As root, tshark runs as uid 65534 (Wireshark ignores per-user plugins for root), see
@@ -326,15 +326,15 @@ def bench_decode(envs, capture, runs, modes, configs):
 
 
 # What valgrind prints of a whole run: "==pid== D1  misses:  38,169,217  (30,064,629 rd ..."
-VALGRIND_COUNTS = {"instructions": r"I\s+refs:\s+([\d,]+)", "d1_misses": r"D1\s+misses:\s+([\d,]+)",
-                   "mispredicts": r"Mispredicts:\s+([\d,]+)"}
+VALGRIND_COUNTS = {"instructions": r"I\s+refs:\s+([\d,]+)", "i1_misses": r"I1\s+misses:\s+([\d,]+)",
+                   "d1_misses": r"D1\s+misses:\s+([\d,]+)", "mispredicts": r"Mispredicts:\s+([\d,]+)"}
 
 
 def bench_instructions(envs, capture, modes, configs, cache_sim=False):
     """Instructions of one tshark run per configuration and mode under callgrind: no noise
     from other load, so small differences (summary lines) show. With cache_sim, under
-    cachegrind's cache and branch simulation: also the first-level data cache misses and
-    mispredicted branches, {mode: {config: {count: n}}} as the second result."""
+    cachegrind's cache and branch simulation: also the first-level instruction and data
+    cache misses and mispredicted branches, {mode: {config: {count: n}}} as the second result."""
     results = {m: {} for m in modes}
     locality = {m: {} for m in modes} if cache_sim else {}
     tool = (["--tool=cachegrind", "--cache-sim=yes", "--branch-sim=yes", "--cachegrind-out-file=/dev/null"]
@@ -398,6 +398,21 @@ def table(rows, header):
     return "\n".join([line(header), line(["-" * w for w in widths])] + [line(r) for r in rows])
 
 
+def paired_net_ratios(decode):
+    """{mode: [net ours/ws of run 1, of run 2, ...]}: each run's ours, Wireshark's and floor
+    ran one after the other, so a machine that is slower for a while (a shared host) slows
+    all three. The medians of the cells come from different runs and do not cancel that."""
+    paired = {}
+    for mode, per in decode.items():
+        if not all(k in per for k in ("ours", "wireshark", "floor")):
+            continue
+        v = [net_ratio(o["cpu"], w["cpu"], f["cpu"]) for o, w, f in zip(per["ours"], per["wireshark"], per["floor"])]
+        v = [x for x in v if x == x]
+        if v:
+            paired[mode] = v
+    return paired
+
+
 def report(info, decode, startup, install, runs, instr=None, locality=None):
     out = []
     cap = info["capture"]
@@ -435,6 +450,10 @@ def report(info, decode, startup, install, runs, instr=None, locality=None):
                 v = [s["cpu"] for s in per[k]]
                 spread.append("%s/%s %.2f-%.2f" % (mode, k, min(v), max(v)))
         out.append("CPU min-max: " + "; ".join(spread))
+        paired = paired_net_ratios(decode)
+        if paired:
+            out.append("net ours/ws of each run (its three runs back to back), median [min-max]: " + "; ".join(
+                "%s %.2f [%.2f-%.2f]" % (mode, statistics.median(v), min(v), max(v)) for mode, v in paired.items()))
         wall = []
         for mode, per in decode.items():
             wall.append("%s " % mode + " ".join("%s %.2f" % (k, med(per[k], "wall")) for k in configs))
@@ -456,15 +475,17 @@ def report(info, decode, startup, install, runs, instr=None, locality=None):
         rows = []
         for mode, c in locality.items():
             row = [mode]
-            for count in ("d1_misses", "mispredicts"):
+            for count in ("i1_misses", "d1_misses", "mispredicts"):
                 v = {k: c[k][count] for k in c}
                 row += [fmt(v.get(k, float("nan")) / 1e6, ".2f") for k in ("ours", "wireshark", "floor")]
                 row.append(fmt(net_ratio(v["ours"], v.get("wireshark", float("nan")), v.get("floor", float("nan"))),
                                ".2f"))
             rows.append(row)
         out.append("")
-        out.append("Data cache misses (first level) and mispredicted branches, millions (cachegrind, same runs)")
-        out.append(table(rows, ["mode", "D1 ours", "D1 ws", "D1 floor", "D1 net ours/ws",
+        out.append("Instruction and data cache misses (first level) and mispredicted branches, millions"
+                   " (cachegrind, same runs)")
+        out.append(table(rows, ["mode", "I1 ours", "I1 ws", "I1 floor", "I1 net ours/ws",
+                                "D1 ours", "D1 ws", "D1 floor", "D1 net ours/ws",
                                 "mispred ours", "mispred ws", "mispred floor", "mispred net ours/ws"]))
     if startup:
         base = med(startup["none"], "cpu")
@@ -558,7 +579,8 @@ def main(argv=None):
                          "per cell, e.g. 3000 (about 3 minutes); default 0: off")
     ap.add_argument("--cache-sim", action="store_true",
                     help="with --instructions: count under cachegrind's cache and branch simulation, which also "
-                         "gives first-level data cache misses and mispredicted branches (about twice as slow)")
+                         "gives first-level instruction and data cache misses and mispredicted branches (about twice "
+                         "as slow)")
     ap.add_argument("--json", help="write every sample here")
     ap.add_argument("--keep", action="store_true", help="keep the temporary folders (printed)")
     a = ap.parse_args(argv)
