@@ -305,7 +305,8 @@ static inline __attribute__((always_inline)) gboolean selected(const dg_state *s
 /* A numeric leaf's item from its bytes already read (a bit group's
  * whole value: Wireshark masks and shifts it by the field's bitmask), which
  * costs Wireshark about a third less than proto_tree_add_item() reading them
- * again. Unsigned displays only; the others are added from the bytes. */
+ * again. Unsigned and boolean displays only; the others are added from the
+ * bytes. */
 static inline proto_item *add_numeric_item(const dg_state *st, const dg_node *n, proto_tree *tree, gint offset,
                                            gint length, guint64 raw)
 {
@@ -313,6 +314,9 @@ static inline proto_item *add_numeric_item(const dg_state *st, const dg_node *n,
     case DG_SHOW_HEX: case DG_SHOW_DEC: case DG_SHOW_ENUM:
         return length <= 4 ? proto_tree_add_uint(tree, *n->hf, st->tvb, offset, length, (guint32)raw)
                            : proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, length, raw);
+    case DG_SHOW_BOOL: /* Wireshark's boolean API takes 32 bits */
+        if (length <= 4) return proto_tree_add_boolean(tree, *n->hf, st->tvb, offset, length, (guint32)raw);
+        return proto_tree_add_item(tree, *n->hf, st->tvb, offset, length, encoding_of(n));
     default:
         return proto_tree_add_item(tree, *n->hf, st->tvb, offset, length, encoding_of(n));
     }

@@ -9,6 +9,7 @@
  * read is checked against the bytes left first, so no tvb_ or proto_ call
  * can throw: malformed packets end in an expert info instead.
  */
+#include "dissgen_label.h"
 #include "dissgen_state.h"
 
 #include <epan/proto_data.h>
@@ -228,9 +229,15 @@ gboolean container_length(dg_state *st, const dg_node *n, proto_tree *tree, gint
     return TRUE;
 }
 
+/* Whether the container's item gets its summary once its children are
+ * decoded (show_summary), and with it its whole label. */
+gboolean labelled_later(const dg_state *st, const dg_node *n) { return n->summary_count > 0 && st->want_text; }
+
 /* The container's item and subtree (NULL without a tree). Length 0 now, the
  * real length once the children are decoded: a length of -1 would throw when
- * the container starts at the end of the packet. */
+ * the container starts at the end of the packet. An unnamed container
+ * (filter="") is the text item proto_tree_add_subtree() would add, labelled
+ * without printf (dg_set_label): now, or with its summary at the end. */
 proto_tree *open_container(const dg_state *st, const dg_node *n, proto_tree *tree, gint start, proto_item **item)
 {
     if (!tree) return NULL; /* nothing to add to */
@@ -238,7 +245,24 @@ proto_tree *open_container(const dg_state *st, const dg_node *n, proto_tree *tre
         *item = proto_tree_add_item(tree, *n->hf, st->tvb, start, 0, ENC_NA);
         return proto_item_add_subtree(*item, *n->ett);
     }
-    return proto_tree_add_subtree(tree, st->tvb, start, 0, *n->ett, item, n->name);
+    /* Where no label is shown proto_tree_add_subtree() is as cheap; past the
+     * captured bytes proto_tree_add_item() would throw, the text item not. */
+    if (!PTREE_DATA(tree)->visible || start > st->packet_end)
+        return proto_tree_add_subtree(tree, st->tvb, start, 0, *n->ett, item, n->name);
+    *item = proto_tree_add_item(tree, hf_text_only, st->tvb, start, 0, ENC_NA);
+    if (!labelled_later(st, n)) dg_set_label(*item, n->name, NULL);
+    return proto_item_add_subtree(*item, *n->ett);
+}
+
+/* "Name: summary" on the container's item, in one go where it has no label
+ * yet (a named container shows its field's name, an unnamed one nothing). */
+void label_container(const dg_node *n, proto_item *item, const char *summary)
+{
+    field_info *fi = PITEM_FINFO(item);
+    if (fi && !fi->rep)
+        dg_set_label(item, n->hf ? fi->hfinfo->name : n->name, summary);
+    else
+        proto_item_append_text(item, ": %s", summary);
 }
 
 /* The bytes between the end of a container's fields (at) and the end its
@@ -275,7 +299,7 @@ void show_summary(dg_state *st, const dg_node *n, proto_item *item, gboolean in_
 {
     const char *text = summary_text(st, n);
     gsize text_len = st->text->len;
-    if (item) proto_item_append_text(item, ": %s", text);
+    if (item) label_container(n, item, text);
     if (in_summary || !st->want_info) return;
     if (sink) {
         if (sink->count++) text_append(&sink->text, ", ", 2);

@@ -242,6 +242,55 @@ class SummaryParts(unittest.TestCase):
         self.assertIn("Message: write 0x0010.2 value 0x1234 0", tree)
 
 
+class ContainerLabels(unittest.TestCase):
+    """tests/rules_ok/container_labels.xml: each container's label, "Name" or
+    "Name: summary", on unnamed (filter="") and named containers, cut where
+    Wireshark cuts a label (239 bytes and the NUL); booleans whole and in a bit
+    group. Everything against the bytes written, in tshark's PDML."""
+
+    LABEL = 239  # ITEM_LABEL_LENGTH less the NUL
+
+    @classmethod
+    def setUpClass(cls):
+        cls.env = TsharkEnv()
+        cls.env.install_plugin(ARGS.dissgen, os.path.join(ARGS.source_dir, "tests", "rules_ok", "container_labels.xml"))
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.env.cleanup()
+
+    def expected(self, flag, bits, text, words):
+        cut = lambda label: label[:self.LABEL]  # noqa: E731
+        return [("", "Pair: %d/%d" % (len(text), len(words))), ("", "Plain"),
+                ("clab.flag", "1" if flag else "0"), ("clab.bits.low", str(bits >> 7)),
+                ("clab.bits.high", str(bits & 0x7F)),
+                ("clab.named", cut("Named: " + text)), ("", cut("Unnamed: " + words))]
+
+    def test_labels_whole_and_cut_where_wireshark_cuts(self):
+        import xml.etree.ElementTree as ET
+        cases = [(1, 0x83, "hello", "abc"),
+                 (0, 0x02, "y" * 232, "z" * 230),  # 239 bytes: whole
+                 (2, 0x01, "x" * 233, "w" * 231),  # 240: cut
+                 (0, 0xFE, "".join(chr(0x41 + i % 26) for i in range(250)), "v" * 236)]
+        frames = [ethernet(struct.pack("!BBBB", len(t), len(w), f, b) + t.encode() + w.encode(), ethertype=0x88B7)
+                  for f, b, t, w in cases]
+        cap = self.env.add_file("labels.pcap", pcap(frames))
+        for extra in ([], ["-2"]):
+            root = ET.fromstring(self.env.tshark(["-r", cap, "-T", "pdml"] + extra).stdout)
+            packets = root.findall("packet")
+            self.assertEqual(len(packets), len(cases))
+            for packet, case in zip(packets, cases):
+                proto = packet.find("proto[@name='clab']")
+                seen = []
+                for field in proto.iter("field"):
+                    name = field.get("name")
+                    if name in ("", "clab.named"):
+                        seen.append((name, field.get("show") if name == "" else field.get("showname")))
+                    elif name in ("clab.flag", "clab.bits.low", "clab.bits.high"):
+                        seen.append((name, field.get("show")))
+                self.assertEqual(seen, self.expected(*case))
+
+
 if __name__ == "__main__":
     ARGS, status = run_unittests()
     if status == 0 and not os.path.isdir(corpus_dir()):
