@@ -30,13 +30,17 @@ const BinaryOp kBinary[] = {
 
 // Deep nesting is refused before it can exhaust the stack.
 constexpr int kMaxDepth = 64;
+// A chain (a + b + c ...) is read in a loop, but its tree deepens by one per
+// operator, and the validator and the emitters recurse over the tree.
+constexpr int kMaxChain = 1024;
 
 class ExprParser {
 public:
     explicit ExprParser(const std::string& text) : s_(text) {}
 
     bool parse(Expr& out, std::string& error) {
-        bool ok = binary(out, 1, 0);
+        int height = 0;
+        bool ok = binary(out, 1, 0, height);
         skip_space();
         if (ok && pos_ < s_.size()) ok = fail("unexpected '" + s_.substr(pos_, 1) + "'");
         if (ok && s_.find_first_not_of(" \t\r\n") == std::string::npos) ok = fail("empty expression");
@@ -66,12 +70,17 @@ private:
     }
 
     // Operands joined by operators of at least `min_precedence`, left to right.
-    bool binary(Expr& out, int min_precedence, int depth) {
-        if (!unary(out, depth)) return false;
+    // `height`: the levels of operators in the tree read.
+    bool binary(Expr& out, int min_precedence, int depth, int& height) {
+        if (!unary(out, depth, height)) return false;
         for (const BinaryOp* b = peek_binary(); b && b->precedence >= min_precedence; b = peek_binary()) {
             pos_ += std::char_traits<char>::length(b->text);
             Expr rhs;
-            if (!binary(rhs, b->precedence + 1, depth + 1)) return false;
+            int rhs_height = 0;
+            if (!binary(rhs, b->precedence + 1, depth + 1, rhs_height)) return false;
+            height = std::max(height, rhs_height) + 1;
+            if (height > kMaxChain)
+                return fail("expression too long (more than " + std::to_string(kMaxChain) + " operators deep)");
             Expr joined;
             joined.op = b->op;
             joined.args.push_back(std::move(out));
@@ -81,26 +90,28 @@ private:
         return true;
     }
 
-    bool unary(Expr& out, int depth) {
+    bool unary(Expr& out, int depth, int& height) {
         if (depth > kMaxDepth) return fail("expression nested too deeply");
         skip_space();
         const char c = pos_ < s_.size() ? s_[pos_] : '\0';
         if (c == '-' || c == '!' || c == '~') {
             ++pos_;
             Expr operand;
-            if (!unary(operand, depth + 1)) return false;
+            if (!unary(operand, depth + 1, height)) return false;
+            ++height;
             out.op = c == '-' ? ExprOp::Neg : c == '!' ? ExprOp::Not : ExprOp::BitNot;
             out.args.push_back(std::move(operand));
             return true;
         }
         if (c == '(') {
             ++pos_;
-            if (!binary(out, 1, depth + 1)) return false;
+            if (!binary(out, 1, depth + 1, height)) return false;
             skip_space();
             if (pos_ >= s_.size() || s_[pos_] != ')') return fail("missing ')'");
             ++pos_;
             return true;
         }
+        height = 0;
         return operand(out);
     }
 

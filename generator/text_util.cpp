@@ -20,6 +20,13 @@ std::string hex(uint64_t v, int digits) {
     return buf;
 }
 
+std::string excerpt(const std::string& s, size_t limit) {
+    if (s.size() <= limit) return s;
+    size_t cut = limit;
+    while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;  // not inside a UTF-8 character
+    return s.substr(0, cut) + "... (" + std::to_string(s.size()) + " characters)";
+}
+
 static size_t edit_distance(const std::string& a, const std::string& b) {
     std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
     for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;

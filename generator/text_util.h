@@ -16,6 +16,10 @@ std::string closest_match(const std::string& word, const std::vector<std::string
 // "0x1f", or with at least `digits` hex digits "0x001f".
 std::string hex(uint64_t v, int digits = 0);
 
+// s itself, or when longer than `limit` its start and how long it is
+// ("1 + 1 + 1... (80000 characters)"): what a diagnostic quotes stays readable.
+std::string excerpt(const std::string& s, size_t limit = 80);
+
 // "a, b, c"
 std::string join(const std::vector<std::string>& items, const std::string& sep);
 

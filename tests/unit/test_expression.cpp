@@ -72,8 +72,12 @@ TEST(Expression, DeepNestingIsRefusedNotOverflowed) {
     EXPECT_EQ(parsed(std::string(100000, '(') + "1" + std::string(100000, ')')).rfind("error: expression nested too deeply", 0), 0u);
     EXPECT_EQ(parsed(std::string(100000, '-') + "1").rfind("error: expression nested too deeply", 0), 0u);
     std::string long_sum = "1";
+    for (int i = 0; i < 1024; ++i) long_sum += "+1";
+    EXPECT_EQ(parsed(long_sum).rfind("(+ (+", 0), 0u);  // long but flat: fine up to 1024 operators
+    // Longer, its tree would be as deep as its operators are many: refused
+    // before the validator and the emitters recurse down it.
     for (int i = 0; i < 20000; ++i) long_sum += "+1";
-    EXPECT_EQ(parsed(long_sum).rfind("(+ (+", 0), 0u);  // long but flat: fine
+    EXPECT_EQ(parsed(long_sum).rfind("error: expression too long (more than 1024 operators deep)", 0), 0u);
 }
 
 const char* const kHead =
