@@ -116,8 +116,8 @@ bool load_bus(BusInput& bus) {
     if (!bus.esi.empty() && !load_catalogue(bus.esi, bus.catalogue, std::cerr)) return false;
     if (bus.network_file.empty()) return true;
     Diagnostics diags;
-    std::string text;
-    if (!read_whole_file(bus.network_file, text)) diags.error(0, "cannot read the network file");
+    std::string text, why;
+    if (!read_whole_file(bus.network_file, text, why)) diags.error(0, "cannot read the network file: " + why);
     else read_network(text, bus.network_file, bus.catalogue, bus.network, diags);
     print(diags, bus.network_file);
     return !diags.has_errors();

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "text_util.h"
+#include "xml_input.h"
 
 namespace dissgen {
 
@@ -288,7 +289,10 @@ private:
     std::map<const xmlNode*, Node*> by_xml_;
     std::vector<PendingRef> pending_;
     int next_doc_index_ = 1;
+    bool xpath_limit_hit_ = false;
 };
+
+constexpr unsigned long kXPathStepLimit = 20000000;
 
 std::map<std::string, std::string> Parser::attributes(xmlNode* el,
                                                       const std::vector<std::string>& allowed) {
@@ -700,7 +704,7 @@ void Parser::parse_value(const std::string& text, int line, Node& node) {
     Expr expr;
     std::string error;
     if (!parse_expression(text, expr, error)) {
-        diags_.error(line, "bad value expression '" + text + "': " + error);
+        diags_.error(line, "bad value expression '" + excerpt(text) + "': " + error);
         return;
     }
     node.value = std::move(expr);
@@ -834,7 +838,12 @@ bool Parser::parse_enum_range(const std::string& text, EnumItem& item) {
 }
 
 void Parser::resolve_all() {
-    for (const PendingRef& p : pending_) p.ref->target = resolve(p);
+    for (const PendingRef& p : pending_) {
+        p.ref->target = resolve(p);
+        // One path past the limit is reported; evaluating the others could
+        // cost as much each, and the file is refused already.
+        if (xpath_limit_hit_) break;
+    }
 }
 
 // X in the first "@name='X'" (or "@name = \"X\"") of an XPath, "" if none.
@@ -875,16 +884,23 @@ std::string Parser::nothing_selected_hint(const PendingRef& p) const {
 }
 
 Node* Parser::resolve(const PendingRef& p) {
-    const std::string where = "XPath '" + p.ref->xpath + "' in '" + p.attribute + "'";
+    const std::string where = "XPath '" + excerpt(p.ref->xpath, 120) + "' in '" + p.attribute + "'";
     xmlXPathContextPtr ctx = xmlXPathNewContext(doc_);
     ctx->node = p.context;
     ctx->error = ignore_xml_error;
     Node* result = nullptr;
     xmlSetStructuredErrorFunc(nullptr, ignore_xml_error);
     xmlXPathCompExprPtr comp = xmlXPathCtxtCompile(ctx, BAD_CAST p.ref->xpath.c_str());
+    // A path's cost can grow exponentially with its nesting ("//node[//node[...]]"):
+    // libxml2 stops it after this many steps, far more than any real reference takes.
+    ctx->opLimit = kXPathStepLimit;
     xmlXPathObjectPtr obj = comp ? xmlXPathCompiledEval(comp, ctx) : nullptr;
     xmlSetStructuredErrorFunc(nullptr, nullptr);
-    if (!comp || !obj) {
+    if (comp && !obj && ctx->opCount >= ctx->opLimit) {
+        xpath_limit_hit_ = true;
+        diags_.error(p.line, where + " takes too long to evaluate (over " + std::to_string(kXPathStepLimit) +
+                                 " steps); select the node by a simpler path, such as ../node[@name='X']");
+    } else if (!comp || !obj) {
         diags_.error(p.line, "invalid " + where +
                                  (p.attribute == "length"
                                       ? "; a length is 'Nbyte', 'Nbit', an XPath, 'rest' or nothing"
@@ -968,7 +984,8 @@ std::unique_ptr<Protocol> parse_rules(const std::string& text, Diagnostics& diag
             diags.error(line, "XML is not well-formed: an attribute name cannot start with a digit; "
                               "enum items are written <enum value=\"0x0a\" name=\"LRD 读数据\"/>, one element per item");
         } else {
-            diags.error(sink.line, "XML is not well-formed: " + (sink.seen ? sink.message : "cannot parse"));
+            diags.error(xml_error_line(sink.line, sink.message, text),
+                        "XML is not well-formed: " + (sink.seen ? sink.message : "cannot parse"));
         }
         xmlFreeDoc(doc);
         return nullptr;
@@ -988,14 +1005,12 @@ std::unique_ptr<Protocol> parse_rules(const std::string& text, Diagnostics& diag
 }
 
 std::unique_ptr<Protocol> parse_rule_file(const std::string& path, Diagnostics& diags) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        diags.error(0, "cannot read the rule file");
+    std::string text, why;
+    if (!read_whole_file(path, text, why, kMaxRuleFileBytes)) {
+        diags.error(0, "cannot read the rule file: " + why);
         return nullptr;
     }
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return parse_rules(ss.str(), diags);
+    return parse_rules(text, diags);
 }
 
 }  // namespace dissgen

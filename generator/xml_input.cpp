@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -71,20 +72,52 @@ XmlDocPtr read_untrusted_xml(const std::string& text, const std::string& kind, D
     xmlFreeParserCtxt(ctxt);
     XmlDocPtr owned(doc);
     if (!doc || first.seen) {
-        diags.error(first.seen ? std::max(first.line, 1) : 1,
+        diags.error(xml_error_line(first.seen ? first.line : 1, first.message, text),
                     "XML is not well-formed: " + (first.seen ? first.message : std::string("cannot parse")));
         return nullptr;
     }
     return owned;
 }
 
-bool read_whole_file(const std::string& path, std::string& text) {
+bool read_whole_file(const std::string& path, std::string& text, std::string& why, size_t max_bytes) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (ec) {
+        why = ec.message();
+        return false;
+    }
+    if (std::filesystem::is_directory(status)) {
+        why = "it is a directory";
+        return false;
+    }
+    if (!std::filesystem::is_regular_file(status)) {
+        why = "it is not a regular file";
+        return false;
+    }
     std::ifstream in(path, std::ios::binary);
-    if (!in) return false;
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    text = ss.str();
-    return static_cast<bool>(in) || in.eof();
+    if (!in) {
+        why = "cannot open it";
+        return false;
+    }
+    text.assign(max_bytes + 1, '\0');
+    in.read(&text[0], static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<size_t>(in.gcount()));
+    if (in.bad()) {
+        why = "read error";
+        return false;
+    }
+    return true;
+}
+
+int xml_error_line(int reported, const std::string& message, const std::string& text) {
+    if (message.find("Comment not terminated") != std::string::npos) {
+        size_t open = text.rfind("<!--");
+        if (open != std::string::npos && text.find("-->", open + 4) == std::string::npos)
+            return 1 + static_cast<int>(std::count(text.begin(), text.begin() + open, '\n'));
+    }
+    int lines = static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+    if (!text.empty() && text.back() != '\n') ++lines;
+    return std::clamp(reported, 1, std::max(lines, 1));
 }
 
 int xml_line(const xmlNode* el) { return static_cast<int>(xmlGetLineNo(el)); }

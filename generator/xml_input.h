@@ -27,8 +27,16 @@ using XmlDocPtr = std::unique_ptr<xmlDoc, XmlDocFree>;
 // nullptr after adding an error to `diags`.
 XmlDocPtr read_untrusted_xml(const std::string& text, const std::string& kind, Diagnostics& diags);
 
-// Whole file into `text`; false when it cannot be read.
-bool read_whole_file(const std::string& path, std::string& text);
+// Whole file into `text`, at most max_bytes + 1 bytes of it (the caller's size
+// check then refuses it); false when it cannot be read, with `why` ("it is a
+// directory"): a device such as /dev/zero is never read without end.
+bool read_whole_file(const std::string& path, std::string& text, std::string& why,
+                     size_t max_bytes = kMaxInputXmlBytes);
+
+// The line to report for libxml2's error at `reported` in text: libxml2 counts
+// one line past the end for what it finds missing there, and 0 for what it
+// cannot place; an unclosed comment is reported where it opens.
+int xml_error_line(int reported, const std::string& message, const std::string& text);
 
 int xml_line(const xmlNode* el);
 std::string xml_name(const xmlNode* el);

@@ -298,9 +298,9 @@ bool load_catalogue(const std::vector<std::string>& paths, Catalogue& out, std::
     Catalogue all;
     for (const std::string& path : paths) {
         for (const std::string& file : esi_files_of(path, err, ok)) {
-            std::string text;
+            std::string text, why;
             Diagnostics diags;
-            if (!read_whole_file(file, text)) diags.error(0, "cannot read the ESI file");
+            if (!read_whole_file(file, text, why)) diags.error(0, "cannot read the ESI file: " + why);
             else read_esi(text, file, all, diags);
             err << diags.format(file);
             ok = ok && !diags.has_errors();

@@ -107,9 +107,26 @@ bool DesignReader::resolve_type(const xmlNode* el, const std::string& type, NetS
     return true;
 }
 
+// Text that is not only whitespace: a design's elements hold none.
+static bool stray_text(const xmlNode* c) {
+    if (c->type != XML_TEXT_NODE && c->type != XML_CDATA_SECTION_NODE) return false;
+    for (const xmlChar* p = c->content; p && *p; ++p)
+        if (!std::isspace(*p)) return true;
+    return false;
+}
+
 bool DesignReader::read(const xmlNode* root, Network& net) {
     bool ok = true;
+    for (const xmlAttr* a = root->properties; a; a = a->next) {
+        diags_.error(xml_line(root), "unknown attribute '" + std::string(reinterpret_cast<const char*>(a->name)) +
+                                         "' on <network>: it takes none, only <slave> elements");
+        ok = false;
+    }
     for (const xmlNode* c = root->children; c; c = c->next) {
+        if (stray_text(c)) {
+            diags_.error(xml_line(c), "<network> holds <slave> elements only, not text");
+            ok = false;
+        }
         if (c->type != XML_ELEMENT_NODE) continue;
         if (xml_name(c) != "slave") {
             diags_.error(xml_line(c), "<network> holds <slave> elements in bus order, not <" + xml_name(c) + ">");
@@ -123,6 +140,15 @@ bool DesignReader::read(const xmlNode* root, Network& net) {
             diags_.error(xml_line(c), "unknown attribute '" + n + "' on <slave>" +
                                           (near.empty() ? "" : " (did you mean '" + near + "'?)"));
             ok = false;
+        }
+        for (const xmlNode* inner = c->children; inner; inner = inner->next) {
+            if (inner->type == XML_ELEMENT_NODE || stray_text(inner)) {
+                const std::string what = inner->type == XML_ELEMENT_NODE ? "<" + xml_name(inner) + ">" : "text";
+                diags_.error(xml_line(inner), "<slave> holds nothing: a slave is described by its attributes, not by " +
+                                                  what);
+                ok = false;
+                break;
+            }
         }
         NetSlave s;
         s.position = static_cast<int>(net.slaves.size());

@@ -234,10 +234,11 @@ std::string series_json(const std::vector<TimedValue>& series, size_t buckets) {
 }
 
 std::string write_report_html(const TimingModel& m, const std::string& tool_version, std::ostream& out) {
-    std::string js, css;
+    std::string js, css, why;
     std::string dir = dygraphs_dir();
-    if (!read_whole_file(dir + "/dygraph.min.js", js) || !read_whole_file(dir + "/dygraph.min.css", css))
-        return "cannot read dygraphs from " + dir + " (install Debian's libjs-dygraphs, or set DISSGEN_DYGRAPHS_DIR)";
+    if (!read_whole_file(dir + "/dygraph.min.js", js, why) || !read_whole_file(dir + "/dygraph.min.css", css, why))
+        return "cannot read dygraphs from " + dir + " (" + why +
+               "; install Debian's libjs-dygraphs, or set DISSGEN_DYGRAPHS_DIR)";
 
     out << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>EtherCAT timing: "
         << escape_html(capture_name(m.capture)) << "</title>\n<style>" << css << "</style>\n<style>" << kStyle

@@ -304,6 +304,14 @@ TEST(EsiLoad, BrokenFileInAFolderLoadsNothing) {
     EXPECT_TRUE(cat.devices.empty());
 }
 
+// ESI, ENI and design files share the reader: a file cut short is reported on
+// its last line, not on the line after it that libxml2 counts.
+TEST(EsiLoad, CutShortReportedOnItsLastLine) {
+    Diagnostics d;
+    EXPECT_EQ(read_untrusted_xml("<EtherCATInfo>\n  <Vendor>\n", "ESI files", d), nullptr);
+    EXPECT_EQ(d.format("e.xml"), "e.xml:2: error: XML is not well-formed: Premature end of data in tag Vendor line 2\n");
+}
+
 TEST(EsiLoad, MissingFileAndEmptyFolder) {
     Catalogue cat;
     std::ostringstream err;

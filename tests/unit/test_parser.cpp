@@ -624,7 +624,31 @@ TEST(Structure, MissingRuleFile) {
     Diagnostics d;
     EXPECT_EQ(parse_rule_file("/nonexistent/rules.xml", d), nullptr);
     EXPECT_TRUE(d.has_errors());
-    EXPECT_EQ(d.format("x.xml"), "x.xml: error: cannot read the rule file\n");
+    EXPECT_EQ(d.format("x.xml"), "x.xml: error: cannot read the rule file: No such file or directory\n");
+}
+
+// A folder or a device is refused before it is read: /dev/zero never ends.
+TEST(Structure, RuleFileThatIsNoFile) {
+    Diagnostics folder, device;
+    EXPECT_EQ(parse_rule_file("/tmp", folder), nullptr);
+    EXPECT_EQ(folder.format("x.xml"), "x.xml: error: cannot read the rule file: it is a directory\n");
+    EXPECT_EQ(parse_rule_file("/dev/zero", device), nullptr);
+    EXPECT_EQ(device.format("x.xml"), "x.xml: error: cannot read the rule file: it is not a regular file\n");
+}
+
+// What libxml2 finds missing at the end it places one line past it; the
+// diagnostic names a line of the file, and an unclosed comment where it opens.
+TEST(Structure, ErrorsAtTheEndNameALineOfTheFile) {
+    EXPECT_NE(parse("<root name=\"T\" abbreviation=\"T\" ethertype=\"1\">\n"
+                    "<!-- never closed\n<node name=\"A\" length=\"1byte\"/>\n</root>\n")
+                  .messages()
+                  .find("rules.xml:2: error: XML is not well-formed: Comment not terminated"),
+              std::string::npos);
+    EXPECT_NE(parse("<root name=\"T\" abbreviation=\"T\" ethertype=\"1\">\n<node name=\"A\"/>\n")
+                  .messages()
+                  .find("rules.xml:2: error: XML is not well-formed: Premature end of data in tag root line 1"),
+              std::string::npos);
+    EXPECT_NE(parse("\n\n").messages().find("rules.xml:2: error: XML is not well-formed"), std::string::npos);
 }
 
 }  // namespace
