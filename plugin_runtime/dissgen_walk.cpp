@@ -537,6 +537,42 @@ guint8 direction_of(const packet_info *pinfo)
     return DG_DIR_ANY;
 }
 
+/* Whether the protocol below this message is Ethernet's type field (the
+ * layer before ours, which is the last). */
+gboolean carried_by_ethertype(const packet_info *pinfo)
+{
+    static int ethertype = -2;
+    if (ethertype == -2) ethertype = proto_get_id_by_filter_name("ethertype");
+    wmem_list_frame_t *ours = wmem_list_tail(pinfo->layers);
+    wmem_list_frame_t *below = ours ? wmem_list_frame_prev(ours) : NULL;
+    return below && ethertype >= 0 && GPOINTER_TO_INT(wmem_list_frame_data(below)) == ethertype;
+}
+
+/* The bytes after the message's last field, when its walk ended normally.
+ * Carried by an Ethernet type, the message ends at its fields and the rest is
+ * the link layer's: zeros are Ethernet's padding, shown by nobody (as
+ * Wireshark's own EtherCAT plugin leaves them), anything else is given back to
+ * Ethernet (set_actual_length, as IP does), which shows it as its trailer.
+ * Otherwise the message is all its transport gave (a UDP payload, a pdulength
+ * PDU): as in a container of known length, zeros are padding and other bytes
+ * are not decoded, a warning. */
+void show_message_tail(dg_state *st, proto_tree *tree, gint offset)
+{
+    if (st->stopped || offset <= 0 || offset >= st->packet_end) return;
+    gint rest = st->packet_end - offset;
+    gboolean zero = all_zero(st, offset, rest);
+    if (carried_by_ethertype(st->pinfo)) {
+        if (!zero) set_actual_length(st->tvb, (guint)offset);
+        return;
+    }
+    if (zero) {
+        if (tree) proto_tree_add_item(tree, hf_padding, st->tvb, offset, rest, ENC_NA);
+        return;
+    }
+    proto_tree_add_expert_format(tree, st->pinfo, &st->p->ei->unused, st->tvb, offset, rest,
+                                 "%d bytes after the message's last field are not decoded", rest);
+}
+
 /* Key of the per-packet count of messages decoded (p_add_proto_data). */
 #define DG_MESSAGES_KEY 0x6d736773u
 
@@ -652,6 +688,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     gint offset = 0;
     if (p->request_context) request_begin(&st, *messages - 1);
     walk_list(&st, p->top_walk, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
+    show_message_tail(&st, subtree, offset);
     proto_item_set_len(root, offset);
     if (p->pairing) {
         if (st.request_pending) request_walked(&st);

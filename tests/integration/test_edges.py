@@ -96,6 +96,51 @@ def handoff_checks(check, dissgen, source_dir):
                 what, "" if got == want else "\n       got  %s\n       want %s" % (got, want)))
 
 
+# ----------------------------------------------------------------------------- message tail
+
+def ethertype_frame(payload):
+    return b"\x02\x11\x11\x11\x11\x11\x02\x22\x22\x22\x22\x22\x88\xb5" + payload
+
+
+def message_tail_checks(check, dissgen, source_dir):
+    print("\n== the bytes after a message's last field")
+    message = b"\x07\x12\x34"
+    junk = b"\xde\xad\xbe\xef"
+    # (frame, what, tail.padding length, tail.expert.unused, eth.padding, eth.trailer)
+    cases = [
+        (ethertype_frame(message + bytes(43)), "Ethernet type, zeros to 60 bytes", None, False, None, None),
+        (ethertype_frame(message + junk + bytes(39)), "Ethernet type, bytes that are not zero", None, False, None,
+         (junk + bytes(39)).hex()),
+        (ethertype_frame(message), "Ethernet type, nothing after", None, False, None, None),
+        (pcapgen.udp_ethernet_frame(message + bytes(5), 47493), "UDP, zeros", 5, False, None, None),
+        (pcapgen.udp_ethernet_frame(message + junk, 47493), "UDP, bytes that are not zero", None, True, None,
+         None),
+        (pcapgen.udp_ethernet_frame(message, 47493), "UDP, nothing after", None, False, None, None),
+    ]
+    names = ["tail.word", "tail.padding", "tail.expert.unused", "eth.padding", "eth.trailer", "_ws.expert.message"]
+    with TsharkEnv() as env:
+        env.install_plugin(dissgen, os.path.join(source_dir, "tests", "rules", "message_tail.xml"))
+        env.assert_plugin_loaded("tail")
+        path = env.add_file("tail.pcap", pcapgen.raw_pcap_bytes([c[0] for c in cases]))
+        for extra in ([], ["-2"]):
+            rows, err = env.field_rows(path, ["frame.number"] + names, two_pass=bool(extra), aggregator="|",
+                                       with_stderr=True)
+            check(not err.strip(), "tshark %s wrote nothing to stderr: %s" % (extra, err.strip()[:300]))
+            for (frame, what, padding, unused, eth_padding, eth_trailer), r in zip(cases, rows.values()):
+                got = {"word": r["tail.word"], "padding bytes": len(r["tail.padding"][0]) // 2 if r["tail.padding"]
+                       else None, "unused": bool(r["tail.expert.unused"]), "eth.trailer": r["eth.trailer"][0]
+                       if r["eth.trailer"] else None, "eth.padding": r["eth.padding"][0] if r["eth.padding"]
+                       else None}
+                want = {"word": ["0x1234"], "padding bytes": padding, "unused": unused, "eth.trailer": eth_trailer,
+                        "eth.padding": eth_padding}
+                check(got == want, "%s %s: %s%s" % (what, extra, "the message, then what the bytes after it are",
+                                                    "" if got == want else "\n       got  %s\n       want %s" %
+                                                    (got, want)))
+                if unused:
+                    check(r["_ws.expert.message"] == ["4 bytes after the message's last field are not decoded"],
+                          "%s: the warning says how many bytes (%s)" % (what, r["_ws.expert.message"]))
+
+
 # ----------------------------------------------------------------------------- peek
 
 MAX_WIDTH = 62
@@ -267,6 +312,10 @@ class TestEdges(TsharkTestCase, unittest.TestCase):
     def test_peek_at_shifted_bit_group_members(self):
         with self.checks() as check:
             peek_checks(check, ARGS.dissgen, ARGS.source_dir)
+
+    def test_bytes_after_the_message(self):
+        with self.checks() as check:
+            message_tail_checks(check, ARGS.dissgen, ARGS.source_dir)
 
     def test_offsets_from_enclosing_containers(self):
         with self.checks() as check:
