@@ -29,6 +29,9 @@ struct dg_claim {
     const char *table;
     guint32 value;
     dissector_handle_t handle;
+    int proto;
+    dissector_handle_t displaced; /* the other registrant of the value (Wireshark's plugin), or NULL */
+    dissector_handle_t placed;    /* what this plugin last put in the table */
 };
 
 GArray *claims; /* of dg_claim: table entries this plugin must own */
@@ -40,9 +43,31 @@ GArray *claims; /* of dg_claim: table entries this plugin must own */
 void claim_tables(void)
 {
     for (guint i = 0; claims && i < claims->len; i++) {
-        const dg_claim *c = &g_array_index(claims, dg_claim, i);
-        if (dissector_get_uint_handle(find_dissector_table(c->table), c->value) != c->handle)
+        dg_claim *c = &g_array_index(claims, dg_claim, i);
+        dissector_handle_t now = dissector_get_uint_handle(find_dissector_table(c->table), c->value);
+        if (now != c->handle) {
+            if (now) c->displaced = now;
             dissector_add_uint(c->table, c->value, c->handle);
+        }
+        c->placed = c->handle;
+    }
+}
+
+/* Before each capture is read, once the enabled protocols are known (tshark
+ * --disable-protocol, the GUI's Enabled Protocols): with our protocol
+ * disabled the value goes back to the dissector it displaced, so that
+ * disabling ours selects Wireshark's, and to ours again once it is enabled.
+ * A Decode As choice (anything we did not place) is left alone. */
+void follow_enabled_protocols(void)
+{
+    for (guint i = 0; claims && i < claims->len; i++) {
+        dg_claim *c = &g_array_index(claims, dg_claim, i);
+        if (!c->displaced || !c->placed) continue;
+        if (dissector_get_uint_handle(find_dissector_table(c->table), c->value) != c->placed) continue;
+        dissector_handle_t want = proto_is_protocol_enabled(find_protocol_by_id(c->proto)) ? c->handle : c->displaced;
+        if (want == c->placed) continue;
+        dissector_add_uint(c->table, c->value, want);
+        c->placed = want;
     }
 }
 
@@ -200,6 +225,7 @@ void dg_handoff(const dg_protocol *p)
     if (!claims) {
         claims = g_array_new(FALSE, FALSE, sizeof(dg_claim));
         register_final_registration_routine(claim_tables);
+        register_init_routine(follow_enabled_protocols);
     }
     find_handoff_dissectors(p);
     for (guint i = 0; i < p->hook_count; i++) {
@@ -211,7 +237,7 @@ void dg_handoff(const dg_protocol *p)
         }
         dissector_handle_t h_handle = (stream && strcmp(h->table, "tcp.port") == 0) ? stream : handle;
         dissector_add_uint(h->table, h->value, h_handle);
-        dg_claim c = {h->table, h->value, h_handle};
+        dg_claim c = {h->table, h->value, h_handle, *p->proto, NULL, NULL};
         g_array_append_val(claims, c);
     }
 }

@@ -126,6 +126,27 @@ class PluginLoading(unittest.TestCase):
         for name in ("\tecatf\n", "\tecat\n", "\tecatr\n"):
             self.assertIn(name, protocols)
 
+    def test_disabling_ours_selects_wiresharks(self):
+        """Enabled Protocols: with ecatr disabled Wireshark's plugin decodes the frames (two on
+        the Ethernet type, one on UDP port 34980); disabled too, nothing does; a Decode As
+        choice still wins."""
+        self.env.install_plugin(ARGS.dissgen, self.rules)
+        cases = ((["--disable-protocol", "ecatr"], ["ECAT", "ECAT", "ECAT"]),
+                 (["--disable-protocol", "ecatr", "--disable-protocol", "ecatf"], ["0x88a4", "0x88a4", None]),
+                 (["--disable-protocol", "ecatf"], ["ECATR", "ECATR", "ECATR"]),
+                 (["-d", "ethertype==0x88a4,ecatf"], ["ECAT", "ECAT", "ECATR"]))
+        for args, protocols in cases:
+            with self.subTest(args=args):
+                for passes in ([], ["-2"]):
+                    rows, stderr = fields(self.env, self.capture, ["_ws.col.Protocol"], args + passes)
+                    got = [r[0] for r in rows]
+                    self.assertEqual(len(got), 3, stderr)
+                    for frame, (seen, wanted) in enumerate(zip(got, protocols), 1):
+                        if wanted:
+                            self.assertEqual(seen, wanted, "frame %d: %s" % (frame, stderr))
+                        else:  # UDP with both off: whatever else Wireshark makes of it
+                            self.assertNotIn(seen, ("ECAT", "ECATR"), "frame %d" % frame)
+
     def test_rules_win_whatever_the_load_order(self):
         """Both plugins in one folder under names that sort either way round."""
         if not os.path.exists(SYSTEM_ETHERCAT):
