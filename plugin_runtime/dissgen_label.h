@@ -44,23 +44,18 @@ static inline void dg_label_int(dg_label *l, gint64 v, gboolean plus)
 
 /* Sets item's label to "name" or, with a summary, "name: summary": what
  * proto_item_set_text() with "%s" or "%s: %s" would write, without its
- * g_vsnprintf (about 900 instructions, for most of a container's cost in -V).
- * As there, nothing is written in a tree nobody sees, nor on a hidden item. A
- * label too long for ITEM_LABEL_LENGTH goes through Wireshark, which cuts it:
- * the name with set_text, the summary with append_text, as before. */
-static inline void dg_set_label(proto_item *item, const char *name, const char *summary)
+ * g_vsnprintf (about 900 instructions, most of a container's cost in -V).
+ * As there, nothing is written in a tree nobody sees, nor on a hidden item.
+ * FALSE when the label does not fit ITEM_LABEL_LENGTH: the caller then asks
+ * Wireshark, which cuts it its own way. */
+static inline gboolean dg_set_label(proto_item *item, const char *name, const char *summary)
 {
-    if (!item || !PTREE_DATA(item)->visible || proto_item_is_hidden(item)) return;
+    if (!item || !PTREE_DATA(item)->visible || proto_item_is_hidden(item)) return TRUE;
     field_info *fi = PITEM_FINFO(item);
-    if (!fi) return;
+    if (!fi) return TRUE;
     gsize name_len = strlen(name);
     gsize summary_len = summary ? strlen(summary) : 0;
-    if (name_len + (summary ? 2 + summary_len : 0) >= ITEM_LABEL_LENGTH) {
-        if (name_len >= ITEM_LABEL_LENGTH) proto_item_set_text(item, "%s", name);
-        else dg_set_label(item, name, NULL);
-        if (summary) proto_item_append_text(item, ": %s", summary);
-        return;
-    }
+    if (name_len + (summary ? 2 + summary_len : 0) >= ITEM_LABEL_LENGTH) return FALSE;
     item_label_t *rep = fi->rep;
     if (!rep) {
         rep = wmem_new(PNODE_POOL(item), item_label_t);
@@ -79,4 +74,5 @@ static inline void dg_set_label(proto_item *item, const char *name, const char *
     }
     *at = '\0';
     fi->rep = rep;
+    return TRUE;
 }

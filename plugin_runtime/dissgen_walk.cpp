@@ -229,15 +229,12 @@ gboolean container_length(dg_state *st, const dg_node *n, proto_tree *tree, gint
     return TRUE;
 }
 
-/* Whether the container's item gets its summary once its children are
- * decoded (show_summary), and with it its whole label. */
-gboolean labelled_later(const dg_state *st, const dg_node *n) { return n->summary_count > 0 && st->want_text; }
-
 /* The container's item and subtree (NULL without a tree). Length 0 now, the
  * real length once the children are decoded: a length of -1 would throw when
  * the container starts at the end of the packet. An unnamed container
  * (filter="") is the text item proto_tree_add_subtree() would add, labelled
- * without printf (dg_set_label): now, or with its summary at the end. */
+ * without printf (dg_set_label); its name is there at once, should decoding
+ * end in an exception before its summary. */
 proto_tree *open_container(const dg_state *st, const dg_node *n, proto_tree *tree, gint start, proto_item **item)
 {
     if (!tree) return NULL; /* nothing to add to */
@@ -250,19 +247,19 @@ proto_tree *open_container(const dg_state *st, const dg_node *n, proto_tree *tre
     if (!PTREE_DATA(tree)->visible || start > st->packet_end)
         return proto_tree_add_subtree(tree, st->tvb, start, 0, *n->ett, item, n->name);
     *item = proto_tree_add_item(tree, hf_text_only, st->tvb, start, 0, ENC_NA);
-    if (!labelled_later(st, n)) dg_set_label(*item, n->name, NULL);
+    if (!dg_set_label(*item, n->name, NULL)) proto_item_set_text(*item, "%s", n->name);
     return proto_item_add_subtree(*item, *n->ett);
 }
 
-/* "Name: summary" on the container's item, in one go where it has no label
- * yet (a named container shows its field's name, an unnamed one nothing). */
+/* "Name: summary" on the container's item, written whole where the label is
+ * still just the name (an unnamed container's, or a named one's field name
+ * while it has no text); otherwise, or when it does not fit, appended by
+ * Wireshark as before. */
 void label_container(const dg_node *n, proto_item *item, const char *summary)
 {
     field_info *fi = PITEM_FINFO(item);
-    if (fi && !fi->rep)
-        dg_set_label(item, n->hf ? fi->hfinfo->name : n->name, summary);
-    else
-        proto_item_append_text(item, ": %s", summary);
+    const char *name = !n->hf ? n->name : fi && !fi->rep ? fi->hfinfo->name : NULL;
+    if (!name || !dg_set_label(item, name, summary)) proto_item_append_text(item, ": %s", summary);
 }
 
 /* The bytes between the end of a container's fields (at) and the end its
