@@ -245,6 +245,10 @@ void use_start_lines(xmlDoc* doc, const std::string& text) {
     }
 }
 
+// libxml2 steps one XPath evaluation, and all of a file's, may take.
+constexpr unsigned long kXPathStepLimit = 20000000;
+constexpr unsigned long kXPathFileStepLimit = 100000000;
+
 class Parser {
 public:
     Parser(xmlDoc* doc, Diagnostics& diags) : doc_(doc), diags_(diags) {}
@@ -290,9 +294,8 @@ private:
     std::vector<PendingRef> pending_;
     int next_doc_index_ = 1;
     bool xpath_limit_hit_ = false;
+    unsigned long xpath_steps_left_ = kXPathFileStepLimit;
 };
-
-constexpr unsigned long kXPathStepLimit = 20000000;
 
 std::map<std::string, std::string> Parser::attributes(xmlNode* el,
                                                       const std::vector<std::string>& allowed) {
@@ -891,15 +894,21 @@ Node* Parser::resolve(const PendingRef& p) {
     Node* result = nullptr;
     xmlSetStructuredErrorFunc(nullptr, ignore_xml_error);
     xmlXPathCompExprPtr comp = xmlXPathCtxtCompile(ctx, BAD_CAST p.ref->xpath.c_str());
-    // A path's cost can grow exponentially with its nesting ("//node[//node[...]]"):
-    // libxml2 stops it after this many steps, far more than any real reference takes.
-    ctx->opLimit = kXPathStepLimit;
+    // A path's cost can grow exponentially with its nesting ("//node[//node[...]]"),
+    // and many costly paths add up: libxml2 stops an evaluation after its
+    // share of the file's budget, far more than real references take.
+    ctx->opLimit = std::min(kXPathStepLimit, xpath_steps_left_);
     xmlXPathObjectPtr obj = comp ? xmlXPathCompiledEval(comp, ctx) : nullptr;
     xmlSetStructuredErrorFunc(nullptr, nullptr);
+    xpath_steps_left_ -= std::min(xpath_steps_left_, ctx->opCount);
     if (comp && !obj && ctx->opCount >= ctx->opLimit) {
         xpath_limit_hit_ = true;
-        diags_.error(p.line, where + " takes too long to evaluate (over " + std::to_string(kXPathStepLimit) +
-                                 " steps); select the node by a simpler path, such as ../node[@name='X']");
+        diags_.error(p.line, where + (ctx->opLimit < kXPathStepLimit
+                                          ? " is where the file's XPaths take too long to evaluate (over " +
+                                                std::to_string(kXPathFileStepLimit) + " steps in all)"
+                                          : " takes too long to evaluate (over " + std::to_string(kXPathStepLimit) +
+                                                " steps)") +
+                                 "; select the node by a simpler path, such as ../node[@name='X']");
     } else if (!comp || !obj) {
         diags_.error(p.line, "invalid " + where +
                                  (p.attribute == "length"

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -81,27 +82,22 @@ XmlDocPtr read_untrusted_xml(const std::string& text, const std::string& kind, D
 
 bool read_whole_file(const std::string& path, std::string& text, std::string& why, size_t max_bytes) {
     std::error_code ec;
-    const auto status = std::filesystem::status(path, ec);
-    if (ec) {
-        why = ec.message();
-        return false;
-    }
-    if (std::filesystem::is_directory(status)) {
+    if (std::filesystem::is_directory(path, ec)) {
         why = "it is a directory";
-        return false;
-    }
-    if (!std::filesystem::is_regular_file(status)) {
-        why = "it is not a regular file";
         return false;
     }
     std::ifstream in(path, std::ios::binary);
     if (!in) {
-        why = "cannot open it";
+        why = std::filesystem::exists(path, ec) ? "cannot open it" : "No such file or directory";
         return false;
     }
-    text.assign(max_bytes + 1, '\0');
-    in.read(&text[0], static_cast<std::streamsize>(text.size()));
-    text.resize(static_cast<size_t>(in.gcount()));
+    // In pieces, and no further than one byte past the limit: a pipe or
+    // /dev/stdin is read as a file is, and /dev/zero ends as too large.
+    text.clear();
+    char piece[65536];
+    while (text.size() <= max_bytes && in.read(piece, sizeof piece).gcount() > 0)
+        text.append(piece, static_cast<size_t>(in.gcount()));
+    if (text.size() > max_bytes) text.resize(max_bytes + 1);
     if (in.bad()) {
         why = "read error";
         return false;
@@ -109,7 +105,29 @@ bool read_whole_file(const std::string& path, std::string& text, std::string& wh
     return true;
 }
 
+namespace {
+
+// The line of the bytes an encoding error names ("... input error, bytes
+// 0xA4 0xA2 0xA4 0xEA"), 0 when they are not named or not found.
+int line_of_named_bytes(const std::string& message, const std::string& text) {
+    size_t at = message.find("bytes 0x");
+    if (at == std::string::npos) return 0;
+    std::string bytes;
+    for (at += 6; at + 3 < message.size() + 1 && message.compare(at, 2, "0x") == 0; at += 5) {
+        char* end = nullptr;
+        long v = std::strtol(message.substr(at + 2, 2).c_str(), &end, 16);
+        if (!end || *end) break;
+        bytes += static_cast<char>(v);
+    }
+    size_t found = bytes.empty() ? std::string::npos : text.find(bytes);
+    return found == std::string::npos ? 0 : 1 + static_cast<int>(std::count(text.begin(), text.begin() + found, '\n'));
+}
+
+}  // namespace
+
 int xml_error_line(int reported, const std::string& message, const std::string& text) {
+    if (reported <= 0)
+        if (int line = line_of_named_bytes(message, text)) return line;
     if (message.find("Comment not terminated") != std::string::npos) {
         size_t open = text.rfind("<!--");
         if (open != std::string::npos && text.find("-->", open + 4) == std::string::npos)

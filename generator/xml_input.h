@@ -28,8 +28,9 @@ using XmlDocPtr = std::unique_ptr<xmlDoc, XmlDocFree>;
 XmlDocPtr read_untrusted_xml(const std::string& text, const std::string& kind, Diagnostics& diags);
 
 // Whole file into `text`, at most max_bytes + 1 bytes of it (the caller's size
-// check then refuses it); false when it cannot be read, with `why` ("it is a
-// directory"): a device such as /dev/zero is never read without end.
+// check then refuses it), so that a device such as /dev/zero is not read
+// without end; pipes are read as files are. False when it cannot be read,
+// with `why` ("it is a directory").
 bool read_whole_file(const std::string& path, std::string& text, std::string& why,
                      size_t max_bytes = kMaxInputXmlBytes);
 

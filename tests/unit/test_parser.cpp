@@ -3,6 +3,8 @@
 // arithmetic tails, XPath resolution relative to the node, line numbers.
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include "test_support.h"
 
 namespace dissgen::testing {
@@ -627,13 +629,32 @@ TEST(Structure, MissingRuleFile) {
     EXPECT_EQ(d.format("x.xml"), "x.xml: error: cannot read the rule file: No such file or directory\n");
 }
 
-// A folder or a device is refused before it is read: /dev/zero never ends.
+// A folder is refused before it is read; a device that never ends is read
+// one byte past the size limit and refused as too large.
 TEST(Structure, RuleFileThatIsNoFile) {
     Diagnostics folder, device;
     EXPECT_EQ(parse_rule_file("/tmp", folder), nullptr);
     EXPECT_EQ(folder.format("x.xml"), "x.xml: error: cannot read the rule file: it is a directory\n");
     EXPECT_EQ(parse_rule_file("/dev/zero", device), nullptr);
-    EXPECT_EQ(device.format("x.xml"), "x.xml: error: cannot read the rule file: it is not a regular file\n");
+    EXPECT_EQ(device.format("x.xml"), "x.xml: error: rule file is larger than 16 MiB\n");
+}
+
+// Costly XPaths add up: each stays under the limit of one evaluation, but
+// the file's budget ends them, on the line of the one that spent it.
+TEST(Structure, ManyCostlyXPathsAreStopped) {
+    std::string xml = "<root name=\"T\" abbreviation=\"T\" ethertype=\"1\">\n  <node name=\"Body\" length=\"50byte\">\n";
+    for (int i = 0; i < 50; ++i) xml += "    <node name=\"F" + std::to_string(i) + "\" length=\"1byte\"/>\n";
+    xml += "  </node>\n";
+    for (int i = 0; i < 800; ++i)
+        xml += "  <node name=\"O" + std::to_string(i) + "\" length=\"//node[//node[//node]]\"/>\n";
+    xml += "</root>\n";
+    const auto start = std::chrono::steady_clock::now();
+    Parsed p = parse(xml);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_NE(p.messages().find("is where the file's XPaths take too long to evaluate (over 100000000 steps in all)"),
+              std::string::npos)
+        << p.messages().substr(0, 400);
+    EXPECT_LT(seconds, 20.0);  // about 2.5 s; unbounded, about 90 s
 }
 
 // What libxml2 finds missing at the end it places one line past it; the
@@ -649,6 +670,12 @@ TEST(Structure, ErrorsAtTheEndNameALineOfTheFile) {
                   .find("rules.xml:2: error: XML is not well-formed: Premature end of data in tag root line 1"),
               std::string::npos);
     EXPECT_NE(parse("\n\n").messages().find("rules.xml:2: error: XML is not well-formed"), std::string::npos);
+    // An encoding error libxml2 gives no line: the line of the bytes it names.
+    const std::string eucjp = parse("<?xml version=\"1.0\" encoding=\"EUC-JP\"?>\n"
+                                    "<root name=\"E\" abbreviation=\"E\" ethertype=\"1\">\n"
+                                    "<node name=\"\xff\xfe\" length=\"1byte\"/>\n</root>\n").messages();
+    EXPECT_NE(eucjp.find("rules.xml:3: error: XML is not well-formed: input conversion failed"), std::string::npos)
+        << eucjp;
 }
 
 }  // namespace
