@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "validator.h"
 
+#include "expression.h"
+
 #include "runtime_names.h"
 #include "text_util.h"
 
@@ -71,6 +73,7 @@ private:
     void assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, const std::string& prefix);
     void mark_slot(Node* n) { if (n) needs_slot_[n] = true; }
     void assign_slots();
+    void check_table_sizes();
     // display types, range enums, repeat="rest", direction, hand-off, reassembly
     void check_display_direction_handoff(Node& n);
     void check_unit(const Node& n);
@@ -121,6 +124,31 @@ void Validator::run() {
     runtime_names_ = name_groups_of(proto_);
     assign_filter_names(proto_.nodes, proto_.filter);
     assign_slots();
+    if (!diags_.has_errors()) check_table_sizes();  // expressions compile only once every name resolved
+}
+
+// The plugin's tables index their rows with 16 bits (plugin_runtime's
+// dg_node, dg_extra, dg_when): a rule file whose tables outgrow them would be
+// miscompiled, so it is refused, on the line of the node that goes past.
+void Validator::check_table_sizes() {
+    const size_t max_rows = 65535;
+    size_t nodes = 0, ranges = 0, operations = 0;
+    bool reported = false;
+    auto over = [&](const Node& n, size_t count, size_t limit, const std::string& what) {
+        if (reported || count <= limit) return;
+        reported = true;
+        diags_.error(n.line, "the rule file is too large for the plugin's tables: more than " +
+                                 std::to_string(limit) + " " + what + " in all");
+    };
+    for_each_node(proto_.nodes, [&](Node& n) {
+        over(n, ++nodes, max_rows, "nodes");
+        ranges += n.in_list.size() + n.hook_list.size() + n.valid_list.size();
+        for (const When& w : n.whens) ranges += w.in_list.size();
+        over(n, ranges, max_rows, "values in 'in', 'ifhook', 'valid' and <when> lists");
+        if (n.is_computed()) operations += compile_expression(*n.value, n.display == Display::Float).size();
+        over(n, operations, max_rows, "operations in computed values");
+        if (n.slot >= 0) over(n, static_cast<size_t>(n.slot) + 1, 32767, "fields whose values are read");
+    });
 }
 
 void Validator::check_root() {

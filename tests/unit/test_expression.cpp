@@ -85,6 +85,22 @@ const char* const kHead =
     "  <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
     "  <node name=\"Raw\" length=\"2byte\" displaytype=\"int\"/>\n";
 
+// The plugin numbers a computed value's operations with 16 bits: a file
+// with more in all is refused on the node that goes past, not miscompiled.
+TEST(Expression, MoreOperationsThanThePluginCanNumberAreRefused) {
+    std::string chain = "{Count}";
+    for (int i = 0; i < 1000; ++i) chain += " + {Count}";  // 2 001 operations
+    std::string body = "  <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\"/>\n";
+    for (int i = 0; i < 32; ++i)
+        body += "  <node name=\"V" + std::to_string(i) + "\" value=\"" + chain + "\"/>\n";
+    EXPECT_TRUE(front_end(rules(body)).ok());  // 32 x 2 001 = 64 032 operations fit
+    Front f = front_end(rules(body + "  <node name=\"Last\" value=\"" + chain + "\"/>\n"));
+    EXPECT_NE(f.messages().find("rules.xml:35: error: the rule file is too large for the plugin's tables: more than "
+                                "65535 operations in computed values in all"),
+              std::string::npos)
+        << f.messages().substr(0, 300);
+}
+
 TEST(Expression, RequestOperand) {
     EXPECT_EQ(parsed("request{Reference} + index"), "(+ request{Reference} #)");
     EXPECT_EQ(parsed("request{A}*{B}"), "(* request{A} {B})");
