@@ -27,7 +27,7 @@
 #define DG_RUNTIME_EXPERTS(X)                                                                              \
     X(truncated, "expert.truncated", PI_MALFORMED, PI_ERROR, "The packet ends inside a field")             \
     X(past_end, "expert.past_end", PI_MALFORMED, PI_ERROR, "A length field points past the end of its data") \
-    X(more_no_data, "expert.more_no_data", PI_MALFORMED, PI_ERROR,                                         \
+    X(more_no_data, "expert.more_no_data", PI_MALFORMED, PI_WARN, /* RULES-SPEC: "an expert warning" */      \
       "The repeat flag says more follow, but no data is left")                                           \
     X(count_short, "expert.count_short", PI_MALFORMED, PI_ERROR, "Fewer instances than the count field says") \
     X(bad_length, "expert.bad_length", PI_MALFORMED, PI_ERROR, "A length or count is missing or negative")   \

@@ -286,7 +286,7 @@ class Item:
 
 EXPERTS = {  # expert field -> (severity, group) as -V shows them
     "truncated": ("Error", "Malformed"), "past_end": ("Error", "Malformed"),
-    "more_no_data": ("Error", "Malformed"), "count_short": ("Error", "Malformed"),
+    "more_no_data": ("Warning", "Malformed"), "count_short": ("Error", "Malformed"),
     "bad_length": ("Error", "Malformed"), "unused": ("Warning", "Protocol"),
 }
 # Registered by every protocol, raised by constructs everything.xml does not use
