@@ -465,7 +465,7 @@ void Validator::check_validity() {
         }
         if (!n.is_numeric()) {
             diags_.error(n.line, "'valid' field " + quote(n) + " is not numeric: it must be a leaf of 1-64 bits shown as "
-                                 "numberhex, numberdec, bool, enum or nondisplay");
+                                 "numberhex, numberdec, int, time, bool, enum or nondisplay");
             return;
         }
         uint64_t offset = 0;
