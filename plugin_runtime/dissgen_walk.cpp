@@ -534,14 +534,16 @@ guint8 direction_of(const packet_info *pinfo)
     return DG_DIR_ANY;
 }
 
-/* Whether the protocol below this message is Ethernet's type field (the
- * layer before ours, which is the last). */
-gboolean carried_by_ethertype(const packet_info *pinfo)
+/* Whether the protocol below this message is Ethernet's type field. Asked
+ * before the walk: then the last layer is ours and the one before it is what
+ * called us (the walk's hand-offs add layers after ours). */
+gboolean carried_by_ethertype(const dg_protocol *p, const packet_info *pinfo)
 {
     static int ethertype = -2;
     if (ethertype == -2) ethertype = proto_get_id_by_filter_name("ethertype");
     wmem_list_frame_t *ours = wmem_list_tail(pinfo->layers);
-    wmem_list_frame_t *below = ours ? wmem_list_frame_prev(ours) : NULL;
+    if (!ours || GPOINTER_TO_INT(wmem_list_frame_data(ours)) != *p->proto) return FALSE;
+    wmem_list_frame_t *below = wmem_list_frame_prev(ours);
     return below && ethertype >= 0 && GPOINTER_TO_INT(wmem_list_frame_data(below)) == ethertype;
 }
 
@@ -553,12 +555,12 @@ gboolean carried_by_ethertype(const packet_info *pinfo)
  * Otherwise the message is all its transport gave (a UDP payload, a pdulength
  * PDU): as in a container of known length, zeros are padding and other bytes
  * are not decoded, a warning. */
-void show_message_tail(dg_state *st, proto_tree *tree, gint offset)
+void show_message_tail(dg_state *st, proto_tree *tree, gint offset, gboolean on_ethertype)
 {
     if (st->stopped || offset <= 0 || offset >= st->packet_end) return;
     gint rest = st->packet_end - offset;
     gboolean zero = all_zero(st, offset, rest);
-    if (carried_by_ethertype(st->pinfo)) {
+    if (on_ethertype) {
         if (!zero) set_actual_length(st->tvb, (guint)offset);
         return;
     }
@@ -573,17 +575,20 @@ void show_message_tail(dg_state *st, proto_tree *tree, gint offset)
 /* Key of the per-packet count of messages decoded (p_add_proto_data). */
 #define DG_MESSAGES_KEY 0x6d736773u
 
-/* How many messages of this protocol the packet had before this one (a TCP
- * segment may hold several); counts this one. */
-guint *count_message(const dg_protocol *p, packet_info *pinfo)
+/* How many messages of this protocol the packet has had, this one included.
+ * Wireshark counts the calls of a protocol in a packet (curr_proto_layer_num:
+ * a message in a message, EtherCAT in EoE); the messages of one TCP segment
+ * (pdulength, tcp_dissect_pdus) come in one call, so a protocol with a
+ * pdulength counts them itself. */
+guint count_message(const dg_protocol *p, packet_info *pinfo)
 {
+    if (p->pdu_node < 0 && pinfo->curr_proto_layer_num > 0) return pinfo->curr_proto_layer_num;
     guint *messages = (guint *)p_get_proto_data(pinfo->pool, pinfo, *p->proto, DG_MESSAGES_KEY);
     if (!messages) {
         messages = wmem_new0(pinfo->pool, guint);
         p_add_proto_data(pinfo->pool, pinfo, *p->proto, DG_MESSAGES_KEY, messages);
     }
-    (*messages)++;
-    return messages;
+    return ++*messages;
 }
 
 /* The buffers one message's state starts in, on dg_dissect's stack. The
@@ -672,8 +677,9 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
 {
     col_set_str(pinfo->cinfo, COL_PROTOCOL, p->short_name);
     /* Several messages in one packet (a TCP segment): each adds its Info text. */
-    guint *messages = count_message(p, pinfo);
-    gboolean first_message = *messages == 1;
+    const guint messages = count_message(p, pinfo);
+    const gboolean on_ethertype = carried_by_ethertype(p, pinfo);
+    gboolean first_message = messages == 1;
     if (first_message) col_clear(pinfo->cinfo, COL_INFO);
 
     dg_state st;
@@ -683,14 +689,14 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     proto_item *root = tree ? proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA) : NULL;
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
     gint offset = 0;
-    if (p->request_context) request_begin(&st, *messages - 1);
+    if (p->request_context) request_begin(&st, messages - 1);
     walk_list(&st, p->top_walk, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
-    show_message_tail(&st, subtree, offset);
+    show_message_tail(&st, subtree, offset, on_ethertype);
     proto_item_set_len(root, offset);
     if (p->pairing) {
         if (st.request_pending) request_walked(&st);
         const dg_frame_pairing *fp =
-            dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, *messages - 1, st.direction);
+            dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, messages - 1, st.direction);
         if (st.tap) st.tap->pairing = fp;
         if (p->request_context) request_end(&st, fp, subtree);
     }

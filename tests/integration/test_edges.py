@@ -104,13 +104,13 @@ def ethertype_frame(payload):
 
 def message_tail_checks(check, dissgen, source_dir):
     print("\n== the bytes after a message's last field")
-    message = b"\x07\x12\x34"
+    message = b"\x07\x12\x34\xab\xcd"
     junk = b"\xde\xad\xbe\xef"
     # (frame, what, tail.padding length, tail.expert.unused, eth.padding, eth.trailer)
     cases = [
-        (ethertype_frame(message + bytes(43)), "Ethernet type, zeros to 60 bytes", None, False, None, None),
-        (ethertype_frame(message + junk + bytes(39)), "Ethernet type, bytes that are not zero", None, False, None,
-         (junk + bytes(39)).hex()),
+        (ethertype_frame(message + bytes(41)), "Ethernet type, zeros to 60 bytes", None, False, None, None),
+        (ethertype_frame(message + junk + bytes(37)), "Ethernet type, bytes that are not zero", None, False, None,
+         (junk + bytes(37)).hex()),
         (ethertype_frame(message), "Ethernet type, nothing after", None, False, None, None),
         (pcapgen.udp_ethernet_frame(message + bytes(5), 47493), "UDP, zeros", 5, False, None, None),
         (pcapgen.udp_ethernet_frame(message + junk, 47493), "UDP, bytes that are not zero", None, True, None,

@@ -101,6 +101,7 @@ TESTS = {
     "edges_handoff": integration("test_edges.py", "TestEdges.test_handoff_gives_the_other_dissector_the_leaf_only"),
     "edges_peek": integration("test_edges.py", "TestEdges.test_peek_at_shifted_bit_group_members"),
     "edges_offsets": integration("test_edges.py", "TestEdges.test_offsets_from_enclosing_containers"),
+    "edges_message_tail": integration("test_edges.py", "TestEdges.test_bytes_after_the_message"),
     "malformed_skip": integration("test_malformed_skip.py"),
     "quiet": integration("test_quiet.py"),
     "live_capture": integration("test_live_capture.py"),
