@@ -298,6 +298,21 @@ def overlays_frames():
     return [m.HEADER + data for _m, data in (m.message(rng) for _ in range(60))]
 
 
+def message_tail_frames():
+    """tests/rules/message_tail.xml: messages with bytes after them, zero or not, on the
+    Ethernet type and on UDP."""
+    import test_edges as m
+    rng = random.Random(7)
+    out = []
+    for n in (0, 1, 4, 41):
+        for zero in (True, False):
+            rest = bytes(n) if zero else bytes(rng.getrandbits(8) | 1 for _ in range(n))
+            message = bytes(rng.getrandbits(8) for _ in range(5))
+            out.append(m.ethertype_frame(message + rest))
+            out.append(udp_frame(47493, message + rest))
+    return out
+
+
 # Rule file (relative to the source folder) -> the captures that exercise it.
 CAPTURES = {
     "tests/rules/widths.xml": widths_frames,
@@ -315,6 +330,7 @@ CAPTURES = {
     "tests/rules/request_context.xml": request_context_frames,
     "tests/rules/request_context_decoded_keys.xml": request_context_decoded_keys_frames,
     "tests/rules/request_by_position.xml": request_by_position_frames,
+    "tests/rules/message_tail.xml": message_tail_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,
