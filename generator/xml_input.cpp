@@ -113,10 +113,11 @@ int line_of_named_bytes(const std::string& message, const std::string& text) {
     size_t at = message.find("bytes 0x");
     if (at == std::string::npos) return 0;
     std::string bytes;
-    for (at += 6; at + 3 < message.size() + 1 && message.compare(at, 2, "0x") == 0; at += 5) {
+    for (at += 6; at + 4 <= message.size() && message.compare(at, 2, "0x") == 0; at += 5) {
+        const std::string digits = message.substr(at + 2, 2);
         char* end = nullptr;
-        long v = std::strtol(message.substr(at + 2, 2).c_str(), &end, 16);
-        if (!end || *end) break;
+        long v = std::strtol(digits.c_str(), &end, 16);
+        if (end != digits.c_str() + digits.size()) break;
         bytes += static_cast<char>(v);
     }
     size_t found = bytes.empty() ? std::string::npos : text.find(bytes);

@@ -73,6 +73,7 @@ struct dg_state {
     dg_table *tables;     /* offset tables: per slot, allocated at the first offset leaf */
     gint packet_end;      /* captured bytes */
     gboolean stopped;     /* a malformed spot was reported: decode nothing more */
+    gboolean faulted;     /* a malformed spot was reported in this message, even if decoding went on */
     gboolean want_text;   /* summaries are shown: a visible tree, or columns */
     gboolean want_info;   /* the Info column is shown (pinfo->cinfo) */
     gboolean quiet;       /* no tree, no tap listener: step over quiet nodes (dg_node.quiet_size) */

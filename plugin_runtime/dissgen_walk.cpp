@@ -24,6 +24,7 @@ void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint 
     if (offset > st->packet_end) offset = st->packet_end;
     if (length < 0 || offset + length > st->packet_end) length = st->packet_end - offset;
     st->stopped = TRUE;
+    st->faulted = TRUE;
     if (st->quiet) {
         /* No tree and no tap listener: nobody reads the text, but the
          * severity still goes to the Expert column and the capture's highest
@@ -547,7 +548,9 @@ gboolean carried_by_ethertype(const dg_protocol *p, const packet_info *pinfo)
     return below && ethertype >= 0 && GPOINTER_TO_INT(wmem_list_frame_data(below)) == ethertype;
 }
 
-/* The bytes after the message's last field, when its walk ended normally.
+/* The bytes after the message's last field, when its walk ended normally
+ * and reported nothing malformed (then that report explains them: a header
+ * whose length leaves the last datagram out, say).
  * Carried by an Ethernet type, the message ends at its fields and the rest is
  * the link layer's: zeros are Ethernet's padding, shown by nobody (as
  * Wireshark's own EtherCAT plugin leaves them), anything else is given back to
@@ -557,7 +560,7 @@ gboolean carried_by_ethertype(const dg_protocol *p, const packet_info *pinfo)
  * are not decoded, a warning. */
 void show_message_tail(dg_state *st, proto_tree *tree, gint offset, gboolean on_ethertype)
 {
-    if (st->stopped || offset <= 0 || offset >= st->packet_end) return;
+    if (st->faulted || offset <= 0 || offset >= st->packet_end) return;
     gint rest = st->packet_end - offset;
     gboolean zero = all_zero(st, offset, rest);
     if (on_ethertype) {
