@@ -548,9 +548,10 @@ gboolean carried_by_ethertype(const dg_protocol *p, const packet_info *pinfo)
     return below && ethertype >= 0 && GPOINTER_TO_INT(wmem_list_frame_data(below)) == ethertype;
 }
 
-/* The bytes after the message's last field, when its walk ended normally
- * and reported nothing malformed (then that report explains them: a header
- * whose length leaves the last datagram out, say).
+/* The bytes after the message's last field, when its walk went to its end
+ * (not stopped: by a malformed spot, or by a value from a request not
+ * captured) and reported nothing malformed on the way (then that report
+ * explains them: a header whose length leaves the last datagram out, say).
  * Carried by an Ethernet type, the message ends at its fields and the rest is
  * the link layer's: zeros are Ethernet's padding, shown by nobody (as
  * Wireshark's own EtherCAT plugin leaves them), anything else is given back to
@@ -560,7 +561,7 @@ gboolean carried_by_ethertype(const dg_protocol *p, const packet_info *pinfo)
  * are not decoded, a warning. */
 void show_message_tail(dg_state *st, proto_tree *tree, gint offset, gboolean on_ethertype)
 {
-    if (st->faulted || offset <= 0 || offset >= st->packet_end) return;
+    if (st->stopped || st->faulted || offset <= 0 || offset >= st->packet_end) return;
     gint rest = st->packet_end - offset;
     gboolean zero = all_zero(st, offset, rest);
     if (on_ethertype) {
