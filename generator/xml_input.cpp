@@ -107,6 +107,11 @@ bool read_whole_file(const std::string& path, std::string& text, std::string& wh
 
 namespace {
 
+// The line (from 1) of the byte at `pos` in text.
+int line_at(const std::string& text, size_t pos) {
+    return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(pos), '\n'));
+}
+
 // The line of the bytes an encoding error names ("... input error, bytes
 // 0xA4 0xA2 0xA4 0xEA"), 0 when they are not named or not found.
 int line_of_named_bytes(const std::string& message, const std::string& text) {
@@ -121,7 +126,7 @@ int line_of_named_bytes(const std::string& message, const std::string& text) {
         bytes += static_cast<char>(v);
     }
     size_t found = bytes.empty() ? std::string::npos : text.find(bytes);
-    return found == std::string::npos ? 0 : 1 + static_cast<int>(std::count(text.begin(), text.begin() + found, '\n'));
+    return found == std::string::npos ? 0 : line_at(text, found);
 }
 
 }  // namespace
@@ -132,7 +137,7 @@ int xml_error_line(int reported, const std::string& message, const std::string& 
     if (message.find("Comment not terminated") != std::string::npos) {
         size_t open = text.rfind("<!--");
         if (open != std::string::npos && text.find("-->", open + 4) == std::string::npos)
-            return 1 + static_cast<int>(std::count(text.begin(), text.begin() + open, '\n'));
+            return line_at(text, open);
     }
     int lines = static_cast<int>(std::count(text.begin(), text.end(), '\n'));
     if (!text.empty() && text.back() != '\n') ++lines;
