@@ -28,8 +28,9 @@
 #include "ethercat/network_reader.h"
 #include "parser.h"
 #include "report/capture_stream.h"
-#include "report/report_html.h"
-#include "report/timing_model.h"
+#include "report/ethercat/report_page.h"
+#include "report/ethercat/timing_model.h"
+#include "runtime_names.h"
 #include "validator.h"
 #include "wireshark_env.h"
 #include "xml_input.h"
@@ -358,17 +359,18 @@ int cmd_report(const std::string& capture, const std::string& out_path, std::str
     } cleanup{plugin_root};
 
     std::vector<std::string> known = known_fields(stream);
-    std::vector<std::string> fields = TimingModelBuilder::timing_fields(known);
-    if (std::find(fields.begin(), fields.end(), "ecatr.time") == fields.end()) {
-        std::cerr << "dissgen: report: " << stream.tshark << " has no EtherCAT plugin of dissgen (no field ecatr.time): "
-                     "install it first, e.g. dissgen install rules/ethercat.xml\n";
+    std::string protocol = ethercat_protocol(known);
+    if (protocol.empty()) {
+        std::cerr << "dissgen: report: " << stream.tshark << " has no EtherCAT plugin of dissgen (no protocol with "
+                     "the " DG_ANALYSIS_ETHERCAT_ESC " analysis's fields): install it first, e.g. dissgen install "
+                     "rules/ethercat.xml\n";
         return 1;
     }
-    stream.fields = fields;
-    stream.extra_args = TimingModelBuilder::statistics_args(known);
+    stream.fields = TimingModelBuilder::fields(protocol, known);
+    stream.extra_args = TimingModelBuilder::statistics_args(protocol, known);
     TimingModel model;
     model.capture = capture;
-    TimingModelBuilder builder(fields, model);
+    TimingModelBuilder builder(protocol, stream.fields, model);
     stream.on_other_line = [&](std::string_view line) { builder.add_statistics_line(line); };
     std::string error = read_capture(stream, capture, [&](const FieldRow& row) { builder.add(row); });
     if (!error.empty()) {

@@ -101,4 +101,15 @@ std::string NameClash::description(const std::string& protocol_filter) const {
     return what;
 }
 
+std::string runtime_filter_name(const std::string& protocol_filter, const char* name) {
+    return protocol_filter + "." + name;
+}
+
+std::string runtime_expert_summary(const char* name) {
+    for (const NameGroup& g : runtime_name_groups())
+        for (const RuntimeName& n : g.names)
+            if (n.kind == RuntimeName::Kind::Expert && std::string(n.name) == name) return n.label;
+    return name;
+}
+
 }  // namespace dissgen

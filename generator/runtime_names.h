@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "model.h"
+#include "../plugin_runtime/dissgen_names.h"
 
 namespace dissgen {
 
@@ -53,5 +54,34 @@ struct NameClash {
 };
 std::optional<NameClash> runtime_name_clash(const std::vector<const NameGroup*>& groups,
                                             const std::string& protocol_filter, const std::string& filter_name);
+
+// Each runtime name as a constant named by its row's identifier
+// (runtime_field::period is "cycle.period"): code that reads a plugin's fields
+// (dissgen report) names them through the one list, so that a rename reaches
+// it and a removed row no longer compiles, instead of silently emptying it.
+#define DISSGEN_NAME_CONSTANT(id, name, ...) inline constexpr const char id[] = name;
+namespace runtime_field {
+DG_RUNTIME_FIELDS(DISSGEN_NAME_CONSTANT)
+DG_FRAGMENT_FIELDS(DISSGEN_NAME_CONSTANT)
+DG_PAIRING_FIELDS(DISSGEN_NAME_CONSTANT)
+DG_ESC_FIELDS(DISSGEN_NAME_CONSTANT)
+DG_BUS_FIELDS(DISSGEN_NAME_CONSTANT)
+DG_CYCLE_FIELDS(DISSGEN_NAME_CONSTANT)
+DG_DC_FIELDS(DISSGEN_NAME_CONSTANT)
+}  // namespace runtime_field
+namespace runtime_expert {
+DG_RUNTIME_EXPERTS(DISSGEN_NAME_CONSTANT)
+DG_PAIRING_EXPERTS(DISSGEN_NAME_CONSTANT)
+DG_REQUEST_CONTEXT_EXPERTS(DISSGEN_NAME_CONSTANT)
+DG_ESC_EXPERTS(DISSGEN_NAME_CONSTANT)
+DG_BUS_EXPERTS(DISSGEN_NAME_CONSTANT)
+}  // namespace runtime_expert
+#undef DISSGEN_NAME_CONSTANT
+
+// "P.NAME": a runtime name under a protocol's filter name.
+std::string runtime_filter_name(const std::string& protocol_filter, const char* name);
+
+// The expert info's summary, as the plugin labels it (its row in the list).
+std::string runtime_expert_summary(const char* name);
 
 }  // namespace dissgen

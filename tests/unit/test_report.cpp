@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// dissgen report's model: tshark's text parsed exactly, figures by nearest
-// rank, rows folded into cycles, returns, losses and slave states.
+// dissgen report's model: tshark's text parsed exactly, the cycles' figures
+// taken from -z P,cycles as printed, rows folded into series, returns,
+// losses and slave states, field names from the runtime's list.
 #include <gtest/gtest.h>
 
 #include <sstream>
 
-#include "report/report_html.h"
-#include "report/timing_model.h"
+#include "report/charts.h"
+#include "report/ethercat/report_page.h"
+#include "report/ethercat/timing_model.h"
 
 using namespace dissgen;
 
@@ -29,78 +31,100 @@ TEST(ReportParse, RelativeTimesToTheNanosecond) {
     EXPECT_FALSE(parse_seconds_ns("--1.0", ns));
 }
 
-TEST(ReportParse, NamesOfCommandsAndStates) {
-    EXPECT_EQ(ethercat_command_name(12), "LRW");
-    EXPECT_EQ(ethercat_command_name(14), "FRMW");
-    EXPECT_EQ(ethercat_command_name(0), "NOP");
-    EXPECT_EQ(ethercat_command_name(15), "cmd 0x0f");
+TEST(ReportParse, NamesOfStates) {
     EXPECT_EQ(al_state_name(0x0008), "OP");
     EXPECT_EQ(al_state_name(0x0014), "SAFEOP");  // the error bit is not the state
     EXPECT_EQ(al_state_name(0x0003), "BOOT");
     EXPECT_EQ(al_state_name(0x0005), "0x5");
 }
 
-TEST(ReportSpread, NearestRankAndPopulationDeviation) {
-    std::vector<int64_t> v;
-    for (int64_t i = 1; i <= 200; ++i) v.push_back(i);
-    Spread s = spread_of(v);
-    EXPECT_EQ(s.count, 200u);
-    EXPECT_EQ(s.min, 1);
-    EXPECT_EQ(s.median, 100);  // the lower of the two middle values
-    EXPECT_EQ(s.p99, 198);     // rank ceil(0.99 * 200) = 198
-    EXPECT_EQ(s.max, 200);
-    Spread one = spread_of({7});
-    EXPECT_EQ(one.median, 7);
-    EXPECT_EQ(one.p99, 7);
-    EXPECT_DOUBLE_EQ(one.stddev, 0);
-    EXPECT_EQ(spread_of({1, 2, 3}).median, 2);
-    std::vector<int64_t> hundred;
-    for (int64_t i = 1; i <= 100; ++i) hundred.push_back(i);
-    EXPECT_EQ(spread_of(hundred).p99, 99);  // rank 99, not 100 (0.99 * 100 is not exact in binary)
-    Spread pair = spread_of({-3, 3});
-    EXPECT_EQ(pair.median, -3);
-    EXPECT_DOUBLE_EQ(pair.stddev, 3);
-    EXPECT_EQ(spread_of({}).count, 0u);
-}
+// Every field the report can ask for, as `tshark -G fields` would list them.
+const std::vector<std::string> kKnown = {
+    "frame.number",       "frame.time_epoch",      "ecatr.cycle",         "ecatr.cycle.period",
+    "ecatr.cycle.jitter", "ecatr.time",            "ecatr.request_in",    "ecatr.no_response_to",
+    "ecatr.expert.wkc",   "ecatr.slave.position",  "ecatr.slave.name",    "ecatr.datagram.reg.alstatus.status",
+    "ecatr.esc.wkc_added", "ecatr.datagram.cmd",   "other.time"};
 
-// Rows as tshark writes them for TimingModelBuilder::timing_fields().
+// Rows as tshark writes them for TimingModelBuilder::fields().
 struct Rows {
-    std::vector<std::string> fields = TimingModelBuilder::timing_fields(
-        {"frame.number", "frame.time_epoch", "ecatr.cycle", "ecatr.cycle.period", "ecatr.cycle.jitter",
-         "ecatr.datagram.cmd", "ecatr.datagram.adp", "ecatr.datagram.ado", "ecatr.datagram.lad",
-         "ecatr.datagram.len", "ecatr.datagram.wkc", "ecatr.esc.wkc_added", "ecatr.time", "ecatr.request_in",
-         "ecatr.no_response_to", "ecatr.expert.wkc", "ecatr.slave.position", "ecatr.slave.name",
-         "ecatr.datagram.reg.alstatus.status"});
+    std::vector<std::string> fields = TimingModelBuilder::fields("ecatr", kKnown);
     std::vector<std::vector<std::string>> text;
+    std::vector<std::string> statistics;
     void add(std::initializer_list<std::pair<const char*, std::string>> values) {
         std::vector<std::string> row(fields.size());
-        for (auto& [name, value] : values)
+        for (auto& [name, value] : values) {
+            bool asked = false;
             for (size_t i = 0; i < fields.size(); ++i)
-                if (fields[i] == name) row[i] = value;
+                if (fields[i] == name) row[i] = value, asked = true;
+            EXPECT_TRUE(asked) << name << " is not asked for";
+        }
         text.push_back(row);
     }
     void feed(TimingModel& m) {
-        TimingModelBuilder b(fields, m);
+        TimingModelBuilder b("ecatr", fields, m);
         for (auto& r : text) {
             FieldRow row(r.begin(), r.end());
             b.add(row);
         }
+        for (auto& line : statistics) b.add_statistics_line(line);
     }
 };
 
-TEST(ReportModel, CyclesReturnsLossesAndStates) {
-    const std::string sep(1, kValueSeparator);
+TEST(ReportFields, NamedFromTheRuntimeListUnderTheProtocol) {
+    EXPECT_EQ(ethercat_protocol(kKnown), "ecatr");
+    EXPECT_EQ(ethercat_protocol({"ecatr.time", "ecatr.cycle"}), "") << "no ethercat-esc analysis field";
+    std::vector<std::string> renamed = {"ecx.esc.wkc_added", "ecx.time", "ecx.cycle"};
+    EXPECT_EQ(ethercat_protocol(renamed), "ecx");
+    EXPECT_EQ(TimingModelBuilder::fields("ecx", renamed), (std::vector<std::string>{"ecx.cycle", "ecx.time"}));
+    std::vector<std::string> fields = TimingModelBuilder::fields("ecatr", kKnown);
+    EXPECT_EQ(fields.size(), 12u);  // what tshark knows, without the ones the report does not read
+    EXPECT_EQ(std::count(fields.begin(), fields.end(), "ecatr.esc.wkc_added"), 0);
+    EXPECT_EQ(std::count(fields.begin(), fields.end(), "ecatr.datagram.cmd"), 0);
+    EXPECT_EQ(TimingModelBuilder::statistics_args("ecatr", kKnown), (std::vector<std::string>{"-z", "ecatr,cycles"}));
+}
+
+TEST(ReportModel, FiguresAreThePluginStatistics) {
     Rows r;
-    EXPECT_EQ(r.fields.size(), 19u);  // only the fields tshark knows are asked for
-    r.add({{"frame.number", "1"}, {"frame.time_epoch", "100.000000000"}, {"ecatr.cycle", "1"},
-           {"ecatr.datagram.cmd", "0x0c" + sep + "0x0e"}, {"ecatr.datagram.adp", "0x1001"},
-           {"ecatr.datagram.ado", "0x0910"}, {"ecatr.datagram.lad", "0x00010000"},
-           {"ecatr.datagram.len", "4" + sep + "8"}});
-    r.add({{"frame.number", "2"}, {"frame.time_epoch", "100.000050000"}, {"ecatr.time", "0.000050000"},
-           {"ecatr.request_in", "1"}, {"ecatr.expert.wkc", "1"}, {"ecatr.datagram.wkc", "3" + sep + "1"},
-           {"ecatr.esc.wkc_added", "3" + sep + "0"}});
+    r.add({{"frame.number", "1"}, {"frame.time_epoch", "100.000000000"}, {"ecatr.cycle", "1"}});
     r.add({{"frame.number", "3"}, {"frame.time_epoch", "100.001002000"}, {"ecatr.cycle", "1"},
            {"ecatr.cycle.period", "0.001002000"}, {"ecatr.cycle.jitter", "0.000002000"}});
+    r.statistics = {"===================================================================",
+                    "EtherCAT cycles (ecatr)",
+                    "Cycle 1: LRW 0x00010000 (4 bytes), FRMW 0x1001:0x0910 (8 bytes)",
+                    "  frames: 600",
+                    "  nominal period (ns): 1000000",
+                    "  period min/median/p99/max (ns): 995000 1000000 1005000 1005000",
+                    "  jitter std dev (ns): 2160.2",
+                    "  round trip: none",
+                    "  frames returned: 599",
+                    "  frames lost: 1",
+                    "  working counter errors: 7",
+                    "==================================================================="};
+    TimingModel m;
+    r.feed(m);
+    ASSERT_EQ(m.cycles.size(), 1u);
+    const Cycle& c = m.cycles.at(1);
+    EXPECT_EQ(c.signature, "LRW 0x00010000 (4 bytes), FRMW 0x1001:0x0910 (8 bytes)");
+    EXPECT_EQ(c.figures.frames, 600u) << "the plugin's count, not the two rows seen";
+    EXPECT_EQ(c.figures.nominal, 1000000);
+    EXPECT_EQ(c.figures.period.min, 995000);
+    EXPECT_EQ(c.figures.period.p99, 1005000);
+    EXPECT_DOUBLE_EQ(c.figures.jitter_sd, 2160.2);
+    EXPECT_EQ(c.figures.round_trip.max, 0);
+    EXPECT_EQ(c.figures.returned, 599u);
+    EXPECT_EQ(c.figures.lost, 1u);
+    EXPECT_EQ(c.figures.wkc_errors, 7u);
+    ASSERT_EQ(c.period.size(), 1u);  // the chart's series, from the fields
+    EXPECT_EQ(c.period[0].ns, 1002000);
+    EXPECT_EQ(c.jitter[0].ns, 2000);
+    EXPECT_TRUE(m.network.empty()) << "the cycles' lines are not network findings";
+}
+
+TEST(ReportModel, ReturnsLossesAndStates) {
+    const std::string sep(1, kValueSeparator);
+    Rows r;
+    r.add({{"frame.number", "2"}, {"frame.time_epoch", "100.000050000"}, {"ecatr.time", "0.000050000"},
+           {"ecatr.request_in", "1"}, {"ecatr.expert.wkc", "1"}});
     r.add({{"frame.number", "4"}, {"frame.time_epoch", "100.200000000"}, {"ecatr.no_response_to", "3"},
            {"ecatr.request_in", "9"}, {"ecatr.slave.position", "0" + sep + "1"},
            {"ecatr.slave.name", "EK1100" + sep + "EL1004"},
@@ -109,38 +133,19 @@ TEST(ReportModel, CyclesReturnsLossesAndStates) {
            {"ecatr.slave.position", "1"}, {"ecatr.datagram.reg.alstatus.status", "0x0008"}});
     TimingModel m;
     r.feed(m);
-    EXPECT_EQ(m.frames, 5u);
-    EXPECT_NEAR(m.duration, 0.3, 1e-9);
-    ASSERT_EQ(m.cycles.size(), 1u);
-    const Cycle& c = m.cycles.at(1);
-    EXPECT_EQ(c.signature, "LRW 0x00010000 (4 bytes), FRMW 0x1001:0x0910 (8 bytes)");
-    EXPECT_EQ(c.frames, 2u);
-    ASSERT_EQ(c.period.size(), 1u);
-    EXPECT_EQ(c.period[0].ns, 1002000);
-    EXPECT_EQ(c.jitter[0].ns, 2000);
-    ASSERT_EQ(c.round_trip.size(), 1u);
-    EXPECT_EQ(c.round_trip[0].ns, 50000);
-    EXPECT_EQ(c.wkc_errors, 1u);  // the FRMW's counter was not raised
-    EXPECT_EQ(c.nominal, 1000000);
-    EXPECT_EQ(c.returned, 1u);
-    EXPECT_EQ(c.lost(), 0u);  // frame 3 may still be in flight: no later frame came back
+    EXPECT_EQ(m.frames, 3u);
+    EXPECT_NEAR(m.duration, 0.29995, 1e-9);
+    ASSERT_EQ(m.round_trip.size(), 1u);
+    EXPECT_EQ(m.round_trip[0].ns, 50000);
+    ASSERT_EQ(m.wkc_differs.size(), 1u);
+    EXPECT_EQ(m.wkc_differs[0].frame, 1u);
     ASSERT_EQ(m.lost.size(), 1u);
     EXPECT_EQ(m.lost[0].frame, 3u);
-    EXPECT_EQ(m.lost[0].cycle, 1u);
     ASSERT_EQ(m.slaves.size(), 2u);
     EXPECT_EQ(m.slaves.at(0).name, "EK1100");
     EXPECT_EQ(m.slaves.at(1).name, "EL1004");
     ASSERT_EQ(m.slaves.at(1).states.size(), 1u);  // OP twice: one state, no change
     EXPECT_EQ(m.slaves.at(1).states[0].second, 8u);
-}
-
-TEST(ReportModel, LostAreUnansweredBeforeTheLatestAnswered) {
-    Cycle c;
-    c.sent = {10, 20, 30, 40, 50};
-    c.answered = {10, 40, 20};  // 30 lost; 50 in flight
-    EXPECT_EQ(c.lost(), 1u);
-    c.answered = {};
-    EXPECT_EQ(c.lost(), 0u);
 }
 
 TEST(ReportModel, StatusesNotMatchingTheSlavesAreNotGuessed) {
@@ -188,7 +193,8 @@ TEST(ReportPage, SelfContainedAndEscaped) {
     Cycle& c = m.cycles[1];
     c.number = 1;
     c.signature = "LRW 0x1 + </script>";
-    c.frames = 3;
+    c.figures.frames = 3;
+    c.figures.period.max = 1000000;
     c.period = {{0.001, 1000000}, {0.002, 1000000}};
     std::ostringstream out;
     std::string error = write_report_html(m, "test", out);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-#include "report_html.h"
+#include "report_page.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "../xml_input.h"
+#include "../../runtime_names.h"
 
 namespace dissgen {
 
@@ -16,53 +16,6 @@ namespace {
 
 constexpr size_t kPlotBuckets = 4000;     // points per curve, at most
 constexpr size_t kMarkerLimit = 4000;     // lost / working-counter markers drawn, at most
-constexpr size_t kHistogramBins = 80;
-
-std::string escape_html(const std::string& text) {
-    std::string out;
-    for (char c : text) {
-        switch (c) {
-        case '&': out += "&amp;"; break;
-        case '<': out += "&lt;"; break;
-        case '>': out += "&gt;"; break;
-        case '"': out += "&quot;"; break;
-        default: out += c;
-        }
-    }
-    return out;
-}
-
-// A JSON string literal, safe inside <script> (no "</").
-std::string json_string(const std::string& text) {
-    std::string out = "\"";
-    for (unsigned char c : text) {
-        if (c == '"' || c == '\\') out += '\\', out += static_cast<char>(c);
-        else if (c == '<') out += "\\u003c";
-        else if (c < 0x20) {
-            char buf[8];
-            std::snprintf(buf, sizeof buf, "\\u%04x", c);
-            out += buf;
-        } else out += static_cast<char>(c);
-    }
-    return out + "\"";
-}
-
-std::string num(double v, int decimals = 3) {
-    if (!std::isfinite(v)) return "null";
-    char buf[40];
-    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-    return buf;
-}
-
-// ns -> "1000.250" µs, as the tables print them.
-std::string us(int64_t ns) { return num(static_cast<double>(ns) / 1000.0, 3); }
-
-std::vector<int64_t> values_of(const std::vector<TimedValue>& series) {
-    std::vector<int64_t> v;
-    v.reserve(series.size());
-    for (const TimedValue& p : series) v.push_back(p.ns);
-    return v;
-}
 
 std::string events_json(const std::vector<Event>& events) {
     std::string out = "[";
@@ -87,21 +40,22 @@ std::string slaves_json(const TimingModel& m) {
     return out + "]";
 }
 
-// One figure per cell; times in µs with 3 decimals (exact: they are whole ns).
+// One figure per cell, as -z P,cycles prints it; times in µs with 3 decimals
+// (exact: they are whole ns).
 void cycle_table(const TimingModel& m, std::ostream& out) {
     out << "<table id=\"cycles\"><thead><tr><th>Cycle</th><th>Signature</th><th>Frames</th>"
            "<th>Nominal period (µs)</th><th>Period min</th><th>median</th><th>p99</th><th>max</th>"
            "<th>Jitter std dev (µs)</th><th>Round trip min</th><th>median</th><th>p99</th><th>max</th>"
-           "<th>Returned</th><th>Lost</th><th>WKC errors</th></tr></thead><tbody>\n";
+           "<th>Returned</th><th>Lost</th><th>Working counter errors</th></tr></thead><tbody>\n";
     for (const auto& [number, c] : m.cycles) {
-        Spread period = spread_of(values_of(c.period)), jitter = spread_of(values_of(c.jitter)),
-               rtt = spread_of(values_of(c.round_trip));
+        const CycleFigures& f = c.figures;
         out << "<tr data-cycle=\"" << number << "\"><td>" << number << "</td><td>" << escape_html(c.signature)
-            << "</td><td>" << c.frames << "</td><td>" << us(c.nominal) << "</td>";
-        for (int64_t v : {period.min, period.median, period.p99, period.max}) out << "<td>" << us(v) << "</td>";
-        out << "<td>" << num(jitter.stddev / 1000.0) << "</td>";
-        for (int64_t v : {rtt.min, rtt.median, rtt.p99, rtt.max}) out << "<td>" << us(v) << "</td>";
-        out << "<td>" << c.returned << "</td><td>" << c.lost() << "</td><td>" << c.wkc_errors << "</td></tr>\n";
+            << "</td><td>" << f.frames << "</td><td>" << us(f.nominal) << "</td>";
+        for (int64_t v : {f.period.min, f.period.median, f.period.p99, f.period.max}) out << "<td>" << us(v) << "</td>";
+        out << "<td>" << num(f.jitter_sd / 1000.0) << "</td>";
+        for (int64_t v : {f.round_trip.min, f.round_trip.median, f.round_trip.p99, f.round_trip.max})
+            out << "<td>" << us(v) << "</td>";
+        out << "<td>" << f.returned << "</td><td>" << f.lost << "</td><td>" << f.wkc_errors << "</td></tr>\n";
     }
     out << "</tbody></table>\n";
 }
@@ -140,10 +94,10 @@ const char kScript[] = R"JS(
   data.lost.forEach(e => rows.push([e[0], null, [top, top, top], null]));
   data.wkc_errors.forEach(e => rows.push([e[0], null, null, [top * 0.95, top * 0.95, top * 0.95]]));
   rows.sort((a, b) => a[0] - b[0]);
-  chart('round-trip', rows, Object.assign({labels: ['t', 'Round trip (µs)', 'Lost frame', 'WKC error'],
+  chart('round-trip', rows, Object.assign({labels: ['t', 'Round trip (µs)', 'Lost frame', 'WKC differs'],
       ylabel: 'Round trip (µs)', title: 'Round trip over time',
       series: {'Lost frame': {strokeWidth: 0, drawPoints: true, pointSize: 4, color: '#d62728'},
-               'WKC error': {strokeWidth: 0, drawPoints: true, pointSize: 4, color: '#ff7f0e'}}}, common));
+               'WKC differs': {strokeWidth: 0, drawPoints: true, pointSize: 4, color: '#ff7f0e'}}}, common));
   // AL states: one step line per slave.
   if (data.slaves.length) {
     const times = new Set([data.duration]);
@@ -176,84 +130,27 @@ td:nth-child(2), th:nth-child(2) { text-align: left; }
 
 }  // namespace
 
-std::string dygraphs_dir() {
-    const char* env = std::getenv("DISSGEN_DYGRAPHS_DIR");
-    return env && *env ? env : "/usr/share/javascript/dygraphs";
-}
-
-std::string histogram_json(const std::vector<TimedValue>& series) {
-    if (series.empty()) return "[]";
-    int64_t lo = series.front().ns, hi = lo;
-    for (const TimedValue& p : series) lo = std::min(lo, p.ns), hi = std::max(hi, p.ns);
-    int64_t width = std::max<int64_t>(1, (hi - lo) / static_cast<int64_t>(kHistogramBins) + 1);
-    std::vector<uint64_t> counts(static_cast<size_t>((hi - lo) / width + 1));
-    for (const TimedValue& p : series) counts[static_cast<size_t>((p.ns - lo) / width)]++;
-    // A step plot draws a bin from its x to the next one's: each bin at its
-    // lower edge, and an empty one after the last to close it.
-    std::string out = "[";
-    for (size_t i = 0; i <= counts.size(); ++i) {
-        double edge = static_cast<double>(lo + static_cast<int64_t>(i) * width);
-        out += (i ? "," : "") + std::string("[") + num(edge / 1000.0) + "," +
-               std::to_string(i < counts.size() ? counts[i] : 0) + "]";
-    }
-    return out + "]";
-}
-
-std::string series_json(const std::vector<TimedValue>& series, size_t buckets) {
-    std::string out = "[";
-    if (series.empty()) return out + "]";
-    double t0 = series.front().t, t1 = series.back().t;
-    size_t per = series.size() <= buckets ? 1 : 0;
-    double width = per ? 0 : (t1 - t0) / static_cast<double>(buckets);
-    bool first = true;
-    auto emit = [&](double t, int64_t lo, double mean, int64_t hi) {
-        out += std::string(first ? "" : ",") + "[" + num(t, 6) + ",[" + us(lo) + "," + num(mean / 1000.0) + "," +
-               us(hi) + "]]";
-        first = false;
-    };
-    if (per) {
-        for (const TimedValue& p : series) emit(p.t, p.ns, static_cast<double>(p.ns), p.ns);
-        return out + "]";
-    }
-    size_t i = 0;
-    while (i < series.size()) {
-        size_t bucket = static_cast<size_t>((series[i].t - t0) / width);
-        double end = t0 + static_cast<double>(bucket + 1) * width;
-        int64_t lo = series[i].ns, hi = lo;
-        double sum = 0;
-        size_t n = 0;
-        double t = series[i].t;
-        for (; i < series.size() && (series[i].t < end || bucket + 1 >= buckets); ++i, ++n) {
-            lo = std::min(lo, series[i].ns);
-            hi = std::max(hi, series[i].ns);
-            sum += static_cast<double>(series[i].ns);
-        }
-        emit(t, lo, sum / static_cast<double>(n), hi);
-    }
-    return out + "]";
-}
-
 std::string write_report_html(const TimingModel& m, const std::string& tool_version, std::ostream& out) {
-    std::string js, css, why;
-    std::string dir = dygraphs_dir();
-    if (!read_whole_file(dir + "/dygraph.min.js", js, why) || !read_whole_file(dir + "/dygraph.min.css", css, why))
-        return "cannot read dygraphs from " + dir + " (" + why +
-               "; install Debian's libjs-dygraphs, or set DISSGEN_DYGRAPHS_DIR)";
+    std::string js, css, error = read_dygraphs(js, css);
+    if (!error.empty()) return error;
 
     out << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>EtherCAT timing: "
         << escape_html(capture_name(m.capture)) << "</title>\n<style>" << css << "</style>\n<style>" << kStyle
         << "</style>\n<script>" << js << "</script>\n</head><body>\n";
+    // The headline's working-counter count is the expert info's kind (differs
+    // from the expected), not the cycle table's: it says so in the expert's words.
     out << "<h1>EtherCAT timing: " << escape_html(capture_name(m.capture)) << "</h1>\n<p class=\"note\">"
         << m.frames << " frames, " << num(m.duration, 3) << " s; " << m.cycles.size() << " cycle"
         << (m.cycles.size() == 1 ? "" : "s") << ", " << m.lost.size() << " lost frame"
-        << (m.lost.size() == 1 ? "" : "s") << ", " << m.wkc_errors.size() << " working-counter error"
-        << (m.wkc_errors.size() == 1 ? "" : "s") << ". Generated by dissgen " << tool_version
-        << " from the fields of the installed plugin.</p>\n";
+        << (m.lost.size() == 1 ? "" : "s") << ", " << m.wkc_differs.size() << " with “"
+        << escape_html(runtime_expert_summary(runtime_expert::wkc)) << "”. Generated by dissgen " << tool_version
+        << " from the fields and statistics of the installed plugin.</p>\n";
 
     out << "<h2>Cycles</h2>\n";
     if (!m.has_cycle_fields)
-        out << "<p class=\"note\">The installed plugin shows no cycle fields (ecatr.cycle): regenerate it with this "
-               "dissgen.</p>\n";
+        out << "<p class=\"note\">The installed plugin shows no cycle fields ("
+            << escape_html(runtime_filter_name(m.protocol, runtime_field::cycle))
+            << "): regenerate it with this dissgen.</p>\n";
     else if (m.cycles.empty())
         out << "<p class=\"note\">No cyclic traffic in this capture.</p>\n";
     else cycle_table(m, out);
@@ -302,7 +199,7 @@ std::string write_report_html(const TimingModel& m, const std::string& tool_vers
         first = false;
     }
     out << "],\"round_trip\":" << series_json(m.round_trip, kPlotBuckets) << ",\"lost\":" << events_json(m.lost)
-        << ",\"wkc_errors\":" << events_json(m.wkc_errors) << ",\"slaves\":" << slaves_json(m) << "}</script>\n";
+        << ",\"wkc_errors\":" << events_json(m.wkc_differs) << ",\"slaves\":" << slaves_json(m) << "}</script>\n";
     out << "<script>" << kScript << "</script>\n</body></html>\n";
     return out ? "" : "cannot write the report";
 }
