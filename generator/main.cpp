@@ -7,7 +7,7 @@
 //   dissgen install FILE.xml [--dir DIR | --system]
 //                                          generate, build and install the plugin
 //   dissgen esi PATH...                    list the device catalogue of ESI files
-//   dissgen report CAPTURE -o FILE.html    timing report of an EtherCAT capture
+//   dissgen report CAPTURE... -o FILE.html timing report of an EtherCAT capture
 // check, generate, fields and install take --esi PATH (repeatable),
 // --network FILE and --compact: the catalogue and the designed network are
 // embedded into the plugin.
@@ -48,7 +48,7 @@ const char kUsage[] =
     "       dissgen fields FILE.xml\n"
     "       dissgen install FILE.xml [--dir DIR | --system]\n"
     "       dissgen esi PATH...\n"
-    "       dissgen report CAPTURE -o FILE.html [--rules FILE.xml]\n"
+    "       dissgen report CAPTURE... -o FILE.html [--rules FILE.xml]\n"
     "       dissgen --help | --version\n"
     "  check, generate, fields, install and report also take [--esi PATH]... [--network FILE] [--compact]\n"
     "\n"
@@ -64,7 +64,8 @@ const char kUsage[] =
     "  report    decode an EtherCAT capture with the installed plugin (with --esi or --network:\n"
     "            with a plugin built from the rules and those for this run) and write one\n"
     "            self-contained HTML page: cycles, periods, jitter, round trips, lost frames,\n"
-    "            working-counter errors, the slaves' AL states, the network check\n"
+    "            working-counter errors, the slaves' AL states, the network check; several\n"
+    "            captures (a ring-buffer file set of dumpcap, in order) report as one\n"
     "\n"
     "options:\n"
     "  -o DIR          generate: the folder to write into; report: the HTML file\n"
@@ -332,7 +333,7 @@ std::string build_report_plugin(const std::string& rules, BusInput& bus, const s
     return root;
 }
 
-int cmd_report(const std::string& capture, const std::string& out_path, std::string rules, BusInput& bus,
+int cmd_report(const std::vector<std::string>& captures, const std::string& out_path, std::string rules, BusInput& bus,
                const std::string& argv0) {
     CaptureStream stream;
     if (const char* t = std::getenv("DISSGEN_TSHARK"); t && *t) stream.tshark = t;
@@ -369,10 +370,10 @@ int cmd_report(const std::string& capture, const std::string& out_path, std::str
     stream.fields = TimingModelBuilder::fields(protocol, known);
     stream.extra_args = TimingModelBuilder::statistics_args(protocol, known);
     TimingModel model;
-    model.capture = capture;
+    model.captures = captures;
     TimingModelBuilder builder(protocol, stream.fields, model);
     stream.on_other_line = [&](std::string_view line) { builder.add_statistics_line(line); };
-    std::string error = read_capture(stream, capture, [&](const FieldRow& row) { builder.add(row); });
+    std::string error = read_capture(stream, captures, [&](const FieldRow& row) { builder.add(row); });
     if (!error.empty()) {
         std::cerr << "dissgen: report: " << error << "\n";
         return 1;
@@ -439,11 +440,12 @@ int main(int argc, char** argv) {
         return cmd_esi(files);
     }
     if (command == "report") {
-        if (files.size() != 1 || out_dir.empty()) {
-            std::cerr << "dissgen: report takes one capture and -o FILE.html\n" << kUsage;
+        if (files.empty() || out_dir.empty()) {
+            std::cerr << "dissgen: report takes captures (one, or a ring-buffer set in order) and -o FILE.html\n"
+                      << kUsage;
             return 2;
         }
-        return cmd_report(files[0], out_dir, rules, bus, argv[0]);
+        return cmd_report(files, out_dir, rules, bus, argv[0]);
     }
     if (!rules.empty()) {
         std::cerr << "dissgen: --rules is an option of report\n";

@@ -21,8 +21,9 @@ struct Child {
     int err = -1;  // tshark's stderr
 };
 
-// fork + exec without a shell: arguments pass through untouched.
-Child spawn(const std::vector<std::string>& argv, const CaptureStream& stream) {
+// fork + exec without a shell: arguments pass through untouched. `in`: the
+// child's stdin when not -1 (closed here once the child has it).
+Child spawn(const std::vector<std::string>& argv, const CaptureStream& stream, int in = -1) {
     int out[2], err[2];
     if (pipe(out) != 0) return {};
     if (pipe(err) != 0) {
@@ -32,6 +33,7 @@ Child spawn(const std::vector<std::string>& argv, const CaptureStream& stream) {
     }
     pid_t pid = fork();
     if (pid == 0) {
+        if (in >= 0) dup2(in, 0), close(in);
         dup2(out[1], 1);
         dup2(err[1], 2);
         close(out[0]);
@@ -48,6 +50,7 @@ Child spawn(const std::vector<std::string>& argv, const CaptureStream& stream) {
     }
     close(out[1]);
     close(err[1]);
+    if (in >= 0) close(in);
     if (pid < 0) {
         close(out[0]);
         close(err[0]);
@@ -149,18 +152,49 @@ std::vector<std::string> known_fields(const CaptureStream& stream) {
     return names;
 }
 
-std::string read_capture(const CaptureStream& stream, const std::string& capture,
+namespace {
+
+// mergecap writing `captures` one after the other to a pipe, which is the
+// returned child's `out`.
+Child concatenate(const CaptureStream& stream, const std::vector<std::string>& captures) {
+    std::vector<std::string> argv{stream.mergecap, "-a", "-w", "-"};
+    argv.insert(argv.end(), captures.begin(), captures.end());
+    return spawn(argv, stream);
+}
+
+// What a child wrote to stderr, once it is done, trimmed.
+std::string rest_of_stderr(int fd, std::string err) {
+    fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+    drain(fd, err);
+    close(fd);
+    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+    return err;
+}
+
+std::string joined(const std::vector<std::string>& captures) {
+    std::string names;
+    for (const std::string& c : captures) names += (names.empty() ? "" : " + ") + c;
+    return names;
+}
+
+}  // namespace
+
+std::string read_capture(const CaptureStream& stream, const std::vector<std::string>& captures,
                          const std::function<void(const FieldRow&)>& on_row) {
+    Child merger;
+    if (captures.size() > 1 && (merger = concatenate(stream, captures)).pid < 0)
+        return "cannot start " + stream.mergecap + ": " + std::strerror(errno);
+    const std::string capture = captures.size() == 1 ? captures[0] : "-";
     // One custom column per field, unresolved ("0x0130", not its name), every occurrence.
     std::string columns;
     for (size_t i = 0; i < stream.fields.size(); ++i)
         columns += (i ? "," : "") + std::string("\"f") + std::to_string(i) + "\",\"%Cus:" + stream.fields[i] + ":0:U\"";
     std::vector<std::string> argv{stream.tshark, "-n", "-r", capture, "-T", "tabs", "-o", "gui.column.format:" + columns};
     argv.insert(argv.end(), stream.extra_args.begin(), stream.extra_args.end());
-    Child child = spawn(argv, stream);
+    Child child = spawn(argv, stream, merger.out);
     if (child.pid < 0) return "cannot start " + stream.tshark + ": " + std::strerror(errno);
     FILE* in = fdopen(child.out, "r");
-    Progress progress("decoding " + capture);
+    Progress progress("decoding " + joined(captures));
     std::string err;
     FieldRow row;
     char* line = nullptr;
@@ -181,14 +215,19 @@ std::string read_capture(const CaptureStream& stream, const std::string& capture
     free(line);
     fclose(in);
     progress.done();
-    fcntl(child.err, F_SETFL, fcntl(child.err, F_GETFL) & ~O_NONBLOCK);
-    drain(child.err, err);
-    close(child.err);
-    int status = 0;
+    err = rest_of_stderr(child.err, err);
+    int status = 0, merged = 0;
     waitpid(child.pid, &status, 0);
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
-    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
-    return stream.tshark + " failed on " + capture + (err.empty() ? "" : ": " + err);
+    std::string merge_err;
+    if (merger.pid > 0) {
+        merge_err = rest_of_stderr(merger.err, "");
+        waitpid(merger.pid, &merged, 0);
+    }
+    bool merge_ok = merger.pid <= 0 || (WIFEXITED(merged) && WEXITSTATUS(merged) == 0);
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && merge_ok) return "";
+    if (!merge_ok)
+        return stream.mergecap + " could not join " + joined(captures) + (merge_err.empty() ? "" : ": " + merge_err);
+    return stream.tshark + " failed on " + joined(captures) + (err.empty() ? "" : ": " + err);
 }
 
 }  // namespace dissgen

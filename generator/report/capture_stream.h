@@ -23,17 +23,20 @@ using FieldRow = std::vector<std::string_view>;
 
 struct CaptureStream {
     std::string tshark = "tshark";       // $DISSGEN_TSHARK, else from PATH
+    std::string mergecap = "mergecap";   // joins several files; beside tshark (wireshark-common)
     std::vector<std::string> fields;     // display-filter names
     std::vector<std::string> extra_args; // e.g. -z statistics, printed after the rows
     std::function<void(std::string_view)> on_other_line;  // lines that are not rows (statistics)
     std::vector<std::pair<std::string, std::string>> environment;  // added to tshark's environment
 };
 
-// Runs tshark on `capture` and calls `on_row` for every frame. Progress goes
-// to stderr (a line every few seconds, or one updated line on a terminal).
-// Returns "" on success, else a message for the user (tshark's own error text
-// when it failed).
-std::string read_capture(const CaptureStream& stream, const std::string& capture,
+// Runs tshark on `captures` and calls `on_row` for every frame. Several files
+// (a ring-buffer set from `dumpcap -b`, in order) are read as one capture:
+// mergecap concatenates them into tshark's input, so frame numbers and the
+// plugin's state run on from one file into the next. Progress goes to stderr
+// (a line every few seconds, or one updated line on a terminal). Returns "" on
+// success, else a message for the user (tshark's own error text when it failed).
+std::string read_capture(const CaptureStream& stream, const std::vector<std::string>& captures,
                          const std::function<void(const FieldRow&)>& on_row);
 
 // The display-filter field names the installed tshark knows (`tshark -G fields`).

@@ -13,6 +13,9 @@ user with the plugin installed per user, and:
   ecatr.no_response_to, ecatr.expert.wkc): frames, period min/median/p99/max (nearest rank),
   jitter standard deviation, round trip min/median/p99/max, lost, working-counter errors;
 - the same table equals `tshark -z ecatr,cycles` where the plugin has that statistic;
+- AL status read by station address from slaves of unknown position shows by station;
+  identical out and back timestamps are said, not drawn; a ring-buffer file set reports as
+  one capture;
 - the page embeds everything it needs (no http:, no src= outside the page) and Debian's
   chromium, headless, draws a canvas in every chart; its screenshot is written to
   --screenshots (default: the system's temporary folder) and must not be blank.
@@ -65,6 +68,37 @@ def two_task_capture():
             packets.append(pr.Packet(ecat_frame(MASTER, mbx), t + 500_000))
             packets.append(pr.Packet(returned(MASTER, mbx, 1), t + 560_000))
     packets.sort(key=lambda p: p.ts)
+    return packets
+
+
+def run_mode_capture():
+    """A capture started after the scan (TwinCAT in run mode): LRW every millisecond, and every
+    10 ms the AL status (0x0130) of stations 0x1001 and 0x1002 read by FPRD, one datagram each.
+    No position was ever learned.  0x1001 stays in OP; 0x1002 is in SAFEOP, then OP from t = 0.1 s."""
+    packets, t0 = [], 1_700_000_000 * 10**9
+    for n in range(200):
+        t = t0 + n * 1_000_000
+        dgs = [(12, 0x10, 0x0000, 0x0001, bytes([n & 0xFF, 0, 0, 0]), 0)]
+        packets.append(pr.Packet(ecat_frame(MASTER, dgs), t))
+        packets.append(pr.Packet(returned(MASTER, dgs, 3), t + 40_000))
+        if n % 10 == 5:
+            reads = [(4, 0x40 + n % 64, 0x1001, 0x0130, b"\0\0", 0), (4, 0x40 + n % 64, 0x1002, 0x0130, b"\0\0", 0)]
+            states = [b"\x08\x00", b"\x04\x00" if n < 100 else b"\x08\x00"]
+            back = [(c, i, a, o, state, w + 1) for (c, i, a, o, _d, w), state in zip(reads, states)]
+            packets.append(pr.Packet(ecat_frame(MASTER, reads), t + 300_000))
+            packets.append(pr.Packet(ecat_frame(bytes([MASTER[0] | 0x02]) + MASTER[1:], back), t + 360_000))
+    return packets
+
+
+def same_stamp_capture():
+    """The two-task capture as some capture drivers stamp it: every return at its request's time."""
+    packets, last_out = [], 0
+    for p in two_task_capture():
+        if p.data[6] & 0x02:
+            p = pr.Packet(p.data, last_out)
+        else:
+            last_out = p.ts
+        packets.append(p)
     return packets
 
 
@@ -263,7 +297,10 @@ class TestReport(TsharkTestCase, unittest.TestCase):
         took = time.monotonic() - started
         if check and p.returncode != 0:
             self.fail("dissgen report %s: exit %d\n%s%s" % (name, p.returncode, p.stdout, p.stderr))
-        page = open(out, encoding="utf-8").read() if p.returncode == 0 else ""
+        page = ""
+        if p.returncode == 0:
+            with open(out, encoding="utf-8") as fh:
+                page = fh.read()
         return p, page, took
 
     def table_checks(self, check, capture, name):
@@ -307,6 +344,57 @@ class TestReport(TsharkTestCase, unittest.TestCase):
                       "period min/max from the injected jitter of -3..+3 us (got %s/%s)" % (fast[4], fast[7]))
             check(not re.search(r"<(script|link|img|iframe)\b[^>]*\b(src|href)=", page, re.I),
                   "the page loads nothing from outside (no src= or href= on a script, link, image or frame)")
+
+    def test_al_status_by_station_address(self):
+        """Slaves whose position was never learned still show, by the station address their AL
+        status was read from (FPRD of 0x0130)."""
+        capture = self.env.path("run-mode.pcap")
+        generated(capture, run_mode_capture())
+        os.chmod(capture, 0o644)
+        _p, page, _took = self.report(capture, "run-mode")
+        reader = TableReader("slaves")
+        reader.feed(page)
+        rows = {r[0]: r for r in reader.rows if r}
+        with self.checks() as check:
+            check(sorted(rows) == ["station 0x1001", "station 0x1002"],
+                  "the two stations read by FPRD are the Slaves section's rows: %s" % sorted(rows))
+            if len(rows) == 2:
+                check(rows["station 0x1001"][2] == "OP (0.005 s)", "0x1001 in OP: %s" % rows["station 0x1001"][2])
+                check(rows["station 0x1002"][2] == "SAFEOP (0.005 s) → OP (0.105 s)",
+                      "0x1002 from SAFEOP to OP: %s" % rows["station 0x1002"][2])
+
+    def test_identical_out_and_back_timestamps(self):
+        """A capture whose returns carry their requests' timestamps says so instead of drawing
+        the round trip as a flat line at 0."""
+        capture = self.env.path("same-stamp.pcap")
+        generated(capture, same_stamp_capture())
+        os.chmod(capture, 0o644)
+        _p, page, _took = self.report(capture, "same-stamp")
+        _p, clean, _took = self.report(self.capture, "stamped")
+        with self.checks() as check:
+            check('id="round-trip"' not in page, "no round-trip chart when every round trip is 0")
+            check('id="round-trip-same-stamp"' in page and "same timestamp" in page,
+                  "the page says the out and back timestamps are identical")
+            check('id="round-trip"' in clean and 'id="round-trip-same-stamp"' not in clean,
+                  "a capture with real round trips still draws them, without the note")
+
+    def test_ring_buffer_files_are_one_capture(self):
+        """Files of a `dumpcap -b` set, given in order, report as the one capture they split."""
+        packets = two_task_capture()
+        parts = []
+        for k, (a, b) in enumerate(((0, 700), (700, 1400), (1400, len(packets)))):
+            parts.append(self.env.path("ring_%05d.pcap" % (k + 1)))
+            generated(parts[-1], packets[a:b])
+            os.chmod(parts[-1], 0o644)
+        p, page, _took = self.report(parts[0], "ring", extra=parts[1:])
+        _p, whole, _took = self.report(self.capture, "whole")
+        with self.checks() as check:
+            check(report_table(page) == report_table(whole) and len(report_table(page)) == 2,
+                  "the three files' cycle table is the whole capture's")
+            frames = re.search(r'<p class="note">(\d+) frames', page)
+            check(frames is not None and int(frames.group(1)) == len(packets),
+                  "all %d frames of the three files counted (%s)" % (len(packets), frames and frames.group(1)))
+            check("ring_00001.pcap" in page and "ring_00003.pcap" in page, "the page names the files")
 
     def test_browser_draws_every_chart(self):
         chromium = shutil.which("chromium") or shutil.which("chromium-browser")

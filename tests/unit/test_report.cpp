@@ -43,7 +43,8 @@ const std::vector<std::string> kKnown = {
     "frame.number",       "frame.time_epoch",      "ecatr.cycle",         "ecatr.cycle.period",
     "ecatr.cycle.jitter", "ecatr.time",            "ecatr.request_in",    "ecatr.no_response_to",
     "ecatr.expert.wkc",   "ecatr.slave.position",  "ecatr.slave.name",    "ecatr.datagram.reg.alstatus.status",
-    "ecatr.esc.wkc_added", "ecatr.datagram.cmd",   "other.time"};
+    "ecatr.esc.wkc_added", "ecatr.datagram.cmd",   "ecatr.datagram.adp",  "ecatr.datagram.ado",
+    "other.time"};
 
 // Rows as tshark writes them for TimingModelBuilder::fields().
 struct Rows {
@@ -77,9 +78,8 @@ TEST(ReportFields, NamedFromTheRuntimeListUnderTheProtocol) {
     EXPECT_EQ(ethercat_protocol(renamed), "ecx");
     EXPECT_EQ(TimingModelBuilder::fields("ecx", renamed), (std::vector<std::string>{"ecx.cycle", "ecx.time"}));
     std::vector<std::string> fields = TimingModelBuilder::fields("ecatr", kKnown);
-    EXPECT_EQ(fields.size(), 12u);  // what tshark knows, without the ones the report does not read
+    EXPECT_EQ(fields.size(), 15u);  // what tshark knows, without the ones the report does not read
     EXPECT_EQ(std::count(fields.begin(), fields.end(), "ecatr.esc.wkc_added"), 0);
-    EXPECT_EQ(std::count(fields.begin(), fields.end(), "ecatr.datagram.cmd"), 0);
     EXPECT_EQ(TimingModelBuilder::statistics_args("ecatr", kKnown), (std::vector<std::string>{"-z", "ecatr,cycles"}));
 }
 
@@ -148,6 +148,35 @@ TEST(ReportModel, ReturnsLossesAndStates) {
     EXPECT_EQ(m.slaves.at(1).states[0].second, 8u);
 }
 
+// A capture started after the scan: no position known, the AL status read by
+// FPRD of 0x0130 names the slave by its station address.
+TEST(ReportModel, StatusesByStationWhenNoPositionIsKnown) {
+    const std::string sep(1, kValueSeparator);
+    Rows r;
+    // LRW, FPRD 0x1001:0x0130, FPRD 0x1002:0x0130 (adp/ado only for the last two).
+    auto reads = [&](const char* time, const char* second) {
+        r.add({{"frame.number", "7"}, {"frame.time_epoch", time}, {"ecatr.request_in", "6"},
+               {"ecatr.datagram.cmd", "0x0c" + sep + "0x04" + sep + "0x04"},
+               {"ecatr.datagram.adp", "0x1001" + sep + "0x1002"}, {"ecatr.datagram.ado", "0x0130" + sep + "0x0130"},
+               {"ecatr.datagram.reg.alstatus.status", "0x0008" + sep + second}});
+    };
+    reads("1.0", "0x0004");
+    reads("2.0", "0x0008");
+    // A BRD of 0x0130 is every slave's at once: not one slave's state.
+    r.add({{"frame.number", "9"}, {"frame.time_epoch", "3.0"}, {"ecatr.request_in", "8"},
+           {"ecatr.datagram.cmd", "0x07"}, {"ecatr.datagram.adp", "0x0000"}, {"ecatr.datagram.ado", "0x0130"},
+           {"ecatr.datagram.reg.alstatus.status", "0x0002"}});
+    TimingModel m;
+    r.feed(m);
+    EXPECT_TRUE(m.slaves.empty());
+    ASSERT_EQ(m.stations.size(), 2u);
+    EXPECT_EQ(m.stations.at(0x1001).states.size(), 1u);
+    ASSERT_EQ(m.stations.at(0x1002).states.size(), 2u);
+    EXPECT_EQ(m.stations.at(0x1002).states[0].second, 4u);
+    EXPECT_EQ(m.stations.at(0x1002).states[1].second, 8u);
+    EXPECT_EQ(m.stations.at(0x1001).states[0].second, 8u) << "the BRD's PREOP is nobody's";
+}
+
 TEST(ReportModel, StatusesNotMatchingTheSlavesAreNotGuessed) {
     const std::string sep(1, kValueSeparator);
     Rows r;
@@ -188,7 +217,7 @@ TEST(ReportChart, HistogramBinsSpanTheValues) {
 
 TEST(ReportPage, SelfContainedAndEscaped) {
     TimingModel m;
-    m.capture = "/x/<evil>.pcap";
+    m.captures = {"/x/<evil>.pcap"};
     m.has_cycle_fields = true;
     Cycle& c = m.cycles[1];
     c.number = 1;

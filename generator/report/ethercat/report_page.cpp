@@ -25,11 +25,30 @@ std::string events_json(const std::vector<Event>& events) {
     return out + "]";
 }
 
-std::string slaves_json(const TimingModel& m) {
+// The Slaves section's rows: by position, then by station address those
+// whose position the capture never showed.
+struct SlaveRow {
+    std::string key;  // "3", "station 0x1001"
+    const SlaveTimeline* timeline;
+};
+
+std::vector<SlaveRow> slave_rows(const TimingModel& m) {
+    std::vector<SlaveRow> rows;
+    for (const auto& [position, s] : m.slaves) rows.push_back({std::to_string(position), &s});
+    for (const auto& [station, s] : m.stations) {
+        char key[24];
+        std::snprintf(key, sizeof key, "station 0x%04x", station);
+        rows.push_back({key, &s});
+    }
+    return rows;
+}
+
+std::string slaves_json(const std::vector<SlaveRow>& rows) {
     std::string out = "[";
     bool first = true;
-    for (const auto& [position, s] : m.slaves) {
-        std::string label = std::to_string(position) + (s.name.empty() ? "" : ": " + s.name);
+    for (const SlaveRow& row : rows) {
+        const SlaveTimeline& s = *row.timeline;
+        std::string label = row.key + (s.name.empty() ? "" : ": " + s.name);
         out += std::string(first ? "" : ",") + "{\"label\":" + json_string(label) + ",\"states\":[";
         first = false;
         for (size_t i = 0; i < s.states.size(); ++i)
@@ -38,6 +57,43 @@ std::string slaves_json(const TimingModel& m) {
         out += "]}";
     }
     return out + "]";
+}
+
+void slaves_section(const std::vector<SlaveRow>& rows, std::ostream& out) {
+    out << "<h2>Slaves</h2>\n";
+    if (rows.empty()) {
+        out << "<p class=\"note\">No AL status read from a single slave in this capture.</p>\n";
+        return;
+    }
+    out << "<table id=\"slaves\"><thead><tr><th>Position or station</th><th>Slave</th><th>AL states</th></tr>"
+           "</thead><tbody>\n";
+    for (const SlaveRow& row : rows) {
+        std::string states;
+        for (const auto& [t, state] : row.timeline->states)
+            states += (states.empty() ? "" : " → ") + al_state_name(state) + " (" + num(t, 3) + " s)";
+        out << "<tr><td>" << escape_html(row.key) << "</td><td>" << escape_html(row.timeline->name) << "</td><td>"
+            << escape_html(states) << "</td></tr>\n";
+    }
+    out << "</tbody></table>\n<div class=\"chart wide\" id=\"al-states\"></div>\n";
+}
+
+// Some capture drivers stamp a frame's return with its sending time: every
+// round trip is then 0, which a chart would draw as a flat line.
+bool stamps_out_and_back_alike(const TimingModel& m) {
+    if (m.round_trip.empty()) return false;
+    for (const TimedValue& v : m.round_trip)
+        if (v.ns != 0) return false;
+    return true;
+}
+
+void round_trip_section(const TimingModel& m, std::ostream& out) {
+    out << "<h2>Round trip</h2>\n";
+    if (stamps_out_and_back_alike(m))
+        out << "<p class=\"note\" id=\"round-trip-same-stamp\">Every one of the " << m.round_trip.size()
+            << " returns has the same timestamp as its frame sent: the capture driver stamps out and back "
+               "alike, so this capture cannot tell round trips.</p>\n";
+    else
+        out << "<div class=\"chart wide\" id=\"round-trip\"></div>\n";
 }
 
 // One figure per cell, as -z P,cycles prints it; times in µs with 3 decimals
@@ -60,9 +116,16 @@ void cycle_table(const TimingModel& m, std::ostream& out) {
     out << "</tbody></table>\n";
 }
 
-std::string capture_name(const std::string& path) {
+std::string file_name(const std::string& path) {
     size_t slash = path.find_last_of('/');
     return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// "bus.pcapng", or "ring_00001.pcap + ring_00002.pcap" for a file set.
+std::string capture_name(const std::vector<std::string>& paths) {
+    std::string name;
+    for (const std::string& p : paths) name += (name.empty() ? "" : " + ") + file_name(p);
+    return name;
 }
 
 // The page's script: draws the charts from the embedded data.
@@ -135,11 +198,11 @@ std::string write_report_html(const TimingModel& m, const std::string& tool_vers
     if (!error.empty()) return error;
 
     out << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>EtherCAT timing: "
-        << escape_html(capture_name(m.capture)) << "</title>\n<style>" << css << "</style>\n<style>" << kStyle
+        << escape_html(capture_name(m.captures)) << "</title>\n<style>" << css << "</style>\n<style>" << kStyle
         << "</style>\n<script>" << js << "</script>\n</head><body>\n";
     // The headline's working-counter count is the expert info's kind (differs
     // from the expected), not the cycle table's: it says so in the expert's words.
-    out << "<h1>EtherCAT timing: " << escape_html(capture_name(m.capture)) << "</h1>\n<p class=\"note\">"
+    out << "<h1>EtherCAT timing: " << escape_html(capture_name(m.captures)) << "</h1>\n<p class=\"note\">"
         << m.frames << " frames, " << num(m.duration, 3) << " s; " << m.cycles.size() << " cycle"
         << (m.cycles.size() == 1 ? "" : "s") << ", " << m.lost.size() << " lost frame"
         << (m.lost.size() == 1 ? "" : "s") << ", " << m.wkc_differs.size() << " with “"
@@ -158,22 +221,9 @@ std::string write_report_html(const TimingModel& m, const std::string& tool_vers
         out << "<div class=\"pair\"><div class=\"chart\" id=\"period-" << number
             << "\"></div><div class=\"chart\" id=\"jitter-" << number << "\"></div></div>\n";
 
-    out << "<h2>Round trip</h2>\n<div class=\"chart wide\" id=\"round-trip\"></div>\n";
-
-    out << "<h2>Slaves</h2>\n";
-    if (m.slaves.empty())
-        out << "<p class=\"note\">No AL status read from a single slave in this capture.</p>\n";
-    else {
-        out << "<table id=\"slaves\"><thead><tr><th>Position</th><th>Slave</th><th>AL states</th></tr></thead><tbody>\n";
-        for (const auto& [position, s] : m.slaves) {
-            std::string states;
-            for (const auto& [t, state] : s.states)
-                states += (states.empty() ? "" : " → ") + al_state_name(state) + " (" + num(t, 3) + " s)";
-            out << "<tr><td>" << position << "</td><td>" << escape_html(s.name) << "</td><td>"
-                << escape_html(states) << "</td></tr>\n";
-        }
-        out << "</tbody></table>\n<div class=\"chart wide\" id=\"al-states\"></div>\n";
-    }
+    round_trip_section(m, out);
+    std::vector<SlaveRow> slaves = slave_rows(m);
+    slaves_section(slaves, out);
 
     out << "<h2>Network check</h2>\n";
     if (m.network.empty())
@@ -199,7 +249,7 @@ std::string write_report_html(const TimingModel& m, const std::string& tool_vers
         first = false;
     }
     out << "],\"round_trip\":" << series_json(m.round_trip, kPlotBuckets) << ",\"lost\":" << events_json(m.lost)
-        << ",\"wkc_errors\":" << events_json(m.wkc_differs) << ",\"slaves\":" << slaves_json(m) << "}</script>\n";
+        << ",\"wkc_errors\":" << events_json(m.wkc_differs) << ",\"slaves\":" << slaves_json(slaves) << "}</script>\n";
     out << "<script>" << kScript << "</script>\n</body></html>\n";
     return out ? "" : "cannot write the report";
 }

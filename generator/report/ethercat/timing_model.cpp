@@ -12,8 +12,17 @@ namespace dissgen {
 namespace {
 
 // The rule file's names of what the report reads beyond the runtime's
-// (rules/ethercat.xml): an AL status read (register 0x0130).
+// (rules/ethercat.xml): an AL status read (register 0x0130), and the
+// addressing of the datagrams, which names the slave read when the plugin
+// never learned its position. P.datagram.adp and .ado are shown for the
+// datagrams that are not logical (LRD/LWR/LRW) only.
 const char kAlStatusField[] = "datagram.reg.alstatus.status";
+const char kCommandField[] = "datagram.cmd";
+const char kAddressField[] = "datagram.adp";
+const char kOffsetField[] = "datagram.ado";
+const char* const kRuleFields[] = {kAlStatusField, kCommandField, kAddressField, kOffsetField};
+constexpr uint64_t kFprd = 4, kFirstLogical = 10, kLastLogical = 12;
+constexpr uint64_t kAlStatusRegister = 0x0130;
 
 // The runtime's fields the report reads (runtime_names.h), each optional:
 // asked for only when the installed plugin has it.
@@ -95,7 +104,8 @@ std::string ethercat_protocol(const std::vector<std::string>& known) {
 }
 
 std::vector<std::string> TimingModelBuilder::fields(const std::string& filter, const std::vector<std::string>& known) {
-    std::vector<std::string> names{"frame.number", "frame.time_epoch", runtime_filter_name(filter, kAlStatusField)};
+    std::vector<std::string> names{"frame.number", "frame.time_epoch"};
+    for (const char* f : kRuleFields) names.push_back(runtime_filter_name(filter, f));
     for (const char* f : kRuntimeFields) names.push_back(runtime_filter_name(filter, f));
     for (const char* e : kRuntimeExperts) names.push_back(runtime_filter_name(filter, e));
     std::vector<std::string> asked;
@@ -249,13 +259,20 @@ void TimingModelBuilder::add_return(const FieldRow& row, double t) {
     for (size_t i = 0; i < differs; ++i) model_.wkc_differs.push_back({t, static_cast<uint32_t>(request)});
 }
 
+void SlaveTimeline::observe(double t, unsigned status) {
+    unsigned state = status & 0x0f;
+    if (states.empty() || states.back().second != state) states.push_back({t, state});
+}
+
 // A return's AL status reads, paired with the slaves they address when the
-// frame names as many slaves as it has reads (one datagram each).
+// frame names as many slaves as it has reads (one datagram each); when it
+// names none, by the station addresses they were read from.
 void TimingModelBuilder::add_slave_states(const FieldRow& row, double t) {
     if (value(row, runtime_column(runtime_field::request_in)).empty()) return;
     auto statuses = split_values(value(row, column(runtime_filter_name(filter_, kAlStatusField))));
     if (statuses.empty()) return;
     auto positions = split_values(value(row, runtime_column(runtime_field::position)));
+    if (positions.empty()) return add_station_states(row, statuses, t);
     if (positions.size() != statuses.size()) return;
     auto names = split_values(value(row, runtime_column(runtime_field::name)));
     for (size_t i = 0; i < positions.size(); ++i) {
@@ -263,8 +280,35 @@ void TimingModelBuilder::add_slave_states(const FieldRow& row, double t) {
         if (!parse_uint(positions[i], position) || !parse_uint(statuses[i], status)) continue;
         SlaveTimeline& s = model_.slaves[static_cast<unsigned>(position)];
         if (names.size() == positions.size()) s.name = std::string(names[i]);
-        unsigned state = static_cast<unsigned>(status & 0x0f);
-        if (s.states.empty() || s.states.back().second != state) s.states.push_back({t, state});
+        s.observe(t, static_cast<unsigned>(status));
+    }
+}
+
+// The statuses of a frame whose every AL status read is an FPRD starting at
+// register 0x0130 (one per slave, as masters poll it), by station address.
+// Anything else (a broadcast, a read that starts below 0x0130) is not guessed.
+void TimingModelBuilder::add_station_states(const FieldRow& row, const std::vector<std::string_view>& statuses,
+                                            double t) {
+    auto commands = split_values(value(row, column(runtime_filter_name(filter_, kCommandField))));
+    auto addresses = split_values(value(row, column(runtime_filter_name(filter_, kAddressField))));
+    auto offsets = split_values(value(row, column(runtime_filter_name(filter_, kOffsetField))));
+    std::vector<unsigned> stations;
+    size_t addressed = 0;  // adp/ado are listed for the datagrams that are not logical
+    for (std::string_view text : commands) {
+        uint64_t cmd = 0, station = 0, offset = 0;
+        if (!parse_uint(text, cmd)) return;
+        if (cmd >= kFirstLogical && cmd <= kLastLogical) continue;
+        if (addressed >= addresses.size() || addressed >= offsets.size()) return;
+        if (!parse_uint(addresses[addressed], station) || !parse_uint(offsets[addressed], offset)) return;
+        addressed++;
+        if (offset != kAlStatusRegister) continue;
+        if (cmd != kFprd) return;
+        stations.push_back(static_cast<unsigned>(station));
+    }
+    if (stations.size() != statuses.size()) return;
+    for (size_t i = 0; i < stations.size(); ++i) {
+        uint64_t status = 0;
+        if (parse_uint(statuses[i], status)) model_.stations[stations[i]].observe(t, static_cast<unsigned>(status));
     }
 }
 

@@ -52,10 +52,11 @@ struct Event {
 struct SlaveTimeline {
     std::string name;                                 // the model's name from the ESI ("EL2004"), or ""
     std::vector<std::pair<double, unsigned>> states;  // (t, AL state), when it changed
+    void observe(double t, unsigned status);          // an AL status read at t
 };
 
 struct TimingModel {
-    std::string capture;
+    std::vector<std::string> captures;  // the files read, in order, as one capture
     std::string protocol;           // the plugin's filter name ("ecatr")
     uint64_t frames = 0;
     double duration = 0;            // seconds, first to last frame
@@ -63,7 +64,9 @@ struct TimingModel {
     std::vector<TimedValue> round_trip;  // every return, cycle or not (P.time)
     std::vector<Event> lost;             // P.no_response_to
     std::vector<Event> wkc_differs;      // P.expert.wkc: differs from the expected (designed) one
-    std::map<unsigned, SlaveTimeline> slaves;  // by position
+    std::map<unsigned, SlaveTimeline> slaves;    // by position
+    std::map<unsigned, SlaveTimeline> stations;  // by configured station address, whose position
+                                                 // was never learned (a capture started after the scan)
     std::vector<std::string> network;          // the network check's findings (the expert infos' texts)
     std::vector<uint32_t> network_frames;      // the frames that carry them
     bool has_cycle_fields = false;             // the plugin shows P.cycle
@@ -96,6 +99,7 @@ private:
     void add_cycle_frame(const FieldRow& row, double t, unsigned cycle);
     void add_return(const FieldRow& row, double t);
     void add_slave_states(const FieldRow& row, double t);
+    void add_station_states(const FieldRow& row, const std::vector<std::string_view>& statuses, double t);
     bool add_cycle_statistics_line(std::string_view line);
     void add_network_line(std::string_view line);
 
