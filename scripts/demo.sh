@@ -7,7 +7,9 @@
 #                                    the bus scan, CoE mailbox exchanges (SDO
 #                                    uploads, one aborted), repeated DC frames
 #   samples/ethercat-demo.pcap       generated frames with cyclic process data (LRW)
-# (samples/README says where they come from.)
+# (samples/README says where they come from.) Then it writes the timing
+# report of the real capture (dissgen report) into the build folder and says
+# where it is: it opens offline in any browser (none is installed).
 #
 # The plugin goes into a throw-away HOME so your own Wireshark set-up is left
 # alone (for yourself, run: build/bin/dissgen install rules/ethercat.xml).
@@ -28,13 +30,14 @@ build/bin/dissgen install rules/ethercat.xml --dir "$demo_home/.local/lib/wiresh
 cp samples/replay-sdo-error.pcapng samples/ethercat-demo.pcap "$demo_home/"
 chmod -R a+rX "$demo_home"
 
-tshark_as_user() {
+as_user() {
   if [ "$(id -u)" -eq 0 ]; then
-    setpriv --reuid=65534 --regid=65534 --clear-groups env HOME="$demo_home" tshark "$@"
+    setpriv --reuid=65534 --regid=65534 --clear-groups env HOME="$demo_home" "$@"
   else
-    HOME="$demo_home" tshark "$@"
+    HOME="$demo_home" "$@"
   fi
 }
+tshark_as_user() { as_user tshark "$@"; }
 section() { echo; echo "== $1"; }
 real="$demo_home/replay-sdo-error.pcapng"
 generated="$demo_home/ethercat-demo.pcap"
@@ -80,3 +83,14 @@ tshark_as_user -r "$generated" -Y "ecatr.datagram.cmd == 0x0c" -T fields -e fram
   -e ecatr.datagram.lad -e ecatr.datagram.len -e ecatr.datagram.data -e ecatr.datagram.wkc \
   -E occurrence=a -E aggregator=, |
   awk -F'\t' 'NR <= 5 {printf "%5s  %-16s %-8s %-6s %s\n", $1, $2, $3, $5, $4}'
+
+# dissgen report runs tshark itself, so it runs as that user too, from a copy
+# that user can read, writing where that user may.
+report="build/demo-report.html"
+cp build/bin/dissgen "$demo_home/dissgen"
+mkdir "$demo_home/report"
+[ "$(id -u)" -ne 0 ] || chown 65534:65534 "$demo_home/report"
+section "the timing report of samples/replay-sdo-error.pcapng (dissgen report: round trips, the slave's AL states)"
+as_user "$demo_home/dissgen" report "$real" -o "$demo_home/report/demo-report.html"
+cp "$demo_home/report/demo-report.html" "$report"
+echo "report: $(pwd)/$report (one page, opens offline in any browser)"

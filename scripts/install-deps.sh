@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-2.0-or-later
-# Installs the Debian packages dissgen needs to build, run and test, if any
-# are missing. Uses sudo when not root.
+# Installs the Debian packages dissgen needs to build and run (the demo), and
+# with --tests those the tests add, if any are missing. Uses sudo when not root.
 set -euo pipefail
 packages=(cmake g++ make pkg-config libwireshark-dev tshark libglib2.0-dev libxml2-dev
-          libgtest-dev python3 util-linux clang libclang-rt-14-dev libjs-dygraphs chromium)
+          libgtest-dev python3 util-linux libjs-dygraphs)
+# The fuzz test's compiler and runtime, the browser that checks the report's page.
+test_packages=(clang libclang-rt-14-dev chromium)
+[ "${1:-}" = "--tests" ] && packages+=("${test_packages[@]}")
 missing=()
 for p in "${packages[@]}"; do
   # (No `| grep -q`: under pipefail its early exit could fail the query and

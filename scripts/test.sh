@@ -5,7 +5,7 @@
 # Extra arguments go to ctest (e.g. -R test_enip).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
+bash scripts/install-deps.sh --tests
 bash scripts/build.sh
 cd build
 rm -f ctest-junit.xml

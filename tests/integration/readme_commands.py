@@ -114,6 +114,7 @@ DEMO_LINES = [
      r"^ +Abort code: Object does not exist in the object dictionary \(0x06020000\)$"),
     ("the returned DC frames counted", r"^== repeated frames: .*, 100 returned$"),
     ("the first DC frame", r"^ +106  0\.044131 s  0x0910  0 +FRMW 0x1000:0x0910 len 8$"),
+    ("the real capture's timing report written", r"^wrote .*/demo-report\.html: 556 frames, 0 cycles$"),
 ]
 LRW_ROW = r"^ +\d+  0x00010000 +[\d,]+ +[\d,]+ +[0-9a-f]{2}( [0-9a-f]{2})*$"
 LRW_ROWS = 5
@@ -277,10 +278,19 @@ def check_demo(check, status, output, demo_script):
         check(any(p.startswith(fixed) for p in printed), "the demo prints the heading '== %s'" % h)
     for what, pattern in DEMO_LINES:
         check(re.search(pattern, output, re.M), "the demo shows %s" % what)
-    last = output.rsplit("\n== ", 1)[-1]
-    rows = re.findall(LRW_ROW, last, re.M)
-    check(last.startswith("cyclic process data (LRW") and len(rows) == LRW_ROWS,
-          "the demo's last section shows %d LRW rows (found %d)" % (LRW_ROWS, len(rows)))
+    sections = output.split("\n== ")
+    lrw = next((s for s in sections if s.startswith("cyclic process data (LRW")), "")
+    rows = re.findall(LRW_ROW, lrw, re.M)
+    check(len(rows) == LRW_ROWS, "the demo's LRW section shows %d LRW rows (found %d)" % (LRW_ROWS, len(rows)))
+    report = re.search(r"^report: (/\S+\.html) ", sections[-1], re.M)
+    page = ""
+    if report and os.path.isfile(report.group(1)):
+        with open(report.group(1), encoding="utf-8") as fh:
+            page = fh.read()
+    check(sections[-1].startswith("the timing report of samples/replay-sdo-error.pcapng") and
+          '<table id="slaves">' in page and 'id="round-trip"' in page,
+          "the demo's last section writes the real capture's timing report (its slave, its round trips) "
+          "and says where")
 
 
 def keep_option(parser):
