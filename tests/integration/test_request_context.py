@@ -243,6 +243,41 @@ class TestRequestContextDecodedKeys(TestRequestContext):
     CLIENT = staticmethod(client_name)
 
 
+class TestRequestByPath(TsharkTestCase, unittest.TestCase):
+    """request{Container/Name} (tests/rules/request_path.xml): both read functions have their
+    own request layout with a Reference and a Quantity, and each response reads its own
+    function's by path; the registers' numbers of function 3 come from Read registers'
+    Reference although Read coils' comes first in the file."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "request_path.xml"), "rqp")
+        cls.txns = transactions(47507, 60)
+        cls.order = schedule(cls.txns, 2)
+        cls.path = cls.env.add_file("paths.pcap", pcapgen.raw_pcap_bytes(
+            [frame(d, modbus(d, cls.txns[k])) for d, k in cls.order]))
+
+    def test_each_response_reads_its_own_layouts_field(self):
+        fields = [f.replace("rqc.", "rqp.") for f in FIELDS if f != "rqc.first_register"]
+        functions = {f for _, _, f, _, _, _ in self.txns}
+        with self.checks() as check:
+            check(functions == {1, 3}, "both read functions are in the capture")
+            for two_pass in (False, True):
+                rows = self.env.field_rows(self.path, fields, two_pass)
+                wrong = []
+                for n, (d, k) in enumerate(self.order, 1):
+                    if d != "response":
+                        continue
+                    want = {f.replace("rqc.", "rqp."): v for f, v in expected(self.txns[k], True).items()
+                            if f != "rqc.first_register"}
+                    got = {f: ",".join(rows[n][f]) for f in want}
+                    if got != want:
+                        wrong.append((n, got, want))
+                check(not wrong, "%s: every response's register and coil numbers (and coil count) from its own "
+                      "function's request layout%s" % ("-2" if two_pass else "one pass",
+                                                       "" if not wrong else " (wrong: %s)" % wrong[:2]))
+
+
 # --- request{Name} by position (tests/rules/request_by_position.xml, UDP 47505) -------------
 
 BATCH_PORT = 47505
