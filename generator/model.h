@@ -56,6 +56,7 @@ struct EnumItem {
 
 struct ValueRange {
     uint64_t low = 0, high = 0;
+    std::string text;  // as written ("0-300", "0x10"), for messages that echo it
 };
 
 // One piece of a summary template: literal text, the shown value of a leaf,

@@ -735,6 +735,7 @@ bool Parser::parse_value_list(const std::string& text, int line, const std::stri
                       ? parse_number(item, r.low)
                       : parse_number(item.substr(0, dash), r.low) && parse_number(item.substr(dash + 1), r.high);
         if (dash == std::string::npos) r.high = r.low;
+        r.text = item;
         if (!ok || r.high < r.low) {
             diags_.error(line, bad);
             return false;

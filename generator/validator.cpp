@@ -514,10 +514,13 @@ void Validator::check_list_fits(int line, const std::vector<ValueRange>& list, c
     const uint64_t max = (uint64_t{1} << t->fixed_bits) - 1;
     for (const ValueRange& r : list) {
         if (r.high <= max) continue;
-        const std::string values = r.low == r.high ? hex(r.low) : hex(r.low) + "-" + hex(r.high);
+        // echoed as written, the field's maximum in the same base: valid="0-300" is not "0x0-0x12c"
+        const bool written_hex = r.text.find("0x") != std::string::npos || r.text.find("0X") != std::string::npos;
+        const std::string values = !r.text.empty() ? r.text : r.low == r.high ? hex(r.low) : hex(r.low) + "-" + hex(r.high);
+        const std::string highest = written_hex ? hex(max) : std::to_string(max);
         diags_.warning(line, "'" + std::string(attribute) + "' value " + values + " does not fit the " + std::to_string(t->fixed_bits) +
                                  "-bit field " + quote(*t) + at_line(*t) + ": " +
-                                 (r.low > max ? "it never matches" : "values above " + hex(max) + " never match"));
+                                 (r.low > max ? "it never matches" : "values above " + highest + " never match"));
     }
 }
 
