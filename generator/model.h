@@ -243,6 +243,7 @@ struct Protocol {
     std::vector<Heuristic> heuristics;
     std::optional<FieldRef> pdulength;
     int64_t pdulengthadd = 0;
+    bool no_padding = false;  // padding="none": zero bytes a length leaves over raise P.expert.unused too
     int line = 0;
     std::vector<std::unique_ptr<Node>> nodes;
     // request/response pairing, when the file declares it
