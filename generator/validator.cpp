@@ -60,6 +60,7 @@ private:
     bool check_expr(Node& n, Expr& e);
     bool check_request_field(Node& n, Expr& e);
     const Node* request_field_target(const Node& n, const std::string& text, const std::string& what);
+    bool check_defined(const Node& n, Expr& e);
     void check_request_keys();
     const Node* fixed_offset_blocker(const Node& n, uint64_t& offset) const;
     const Node* find_earlier(const Node& n, const std::string& name);
@@ -702,6 +703,7 @@ bool Validator::check_expr(Node& n, Expr& e) {
         diags_.error(n.line, "'index'" + in + ": it is not inside a repeated node, so there is no instance to count");
         return false;
     case ExprOp::RequestField: return check_request_field(n, e);
+    case ExprOp::Defined: return check_defined(n, e);
     case ExprOp::Field: {
         const Node* t = find_earlier(n, e.name);
         if (!t) {
@@ -895,6 +897,25 @@ bool Validator::check_request_field(Node& n, Expr& e) {
     if (it == kept.end()) kept.push_back(t);
     mark_slot(e.target);
     if (repeat) e.target->keeps_instances = true;
+    return true;
+}
+
+// defined(X) asks about one value that may be missing: a field ({Name}, not
+// decoded under a condition) or a field of the request (request{Name}, the
+// request not captured). A number or index is always defined, and an
+// expression is undefined exactly when a field in it is: ask about that.
+bool Validator::check_defined(const Node& n, Expr& e) {
+    const Expr& x = e.args[0];
+    if (x.op != ExprOp::Field && x.op != ExprOp::RequestField) {
+        diags_.error(n.line, "defined(...) in the value of " + quote(n) +
+                                 " asks about one field, {Name} or request{Name}: " +
+                                 (x.op == ExprOp::Int || x.op == ExprOp::Float || x.op == ExprOp::Index
+                                      ? "a number or index is always defined"
+                                      : "an expression is undefined exactly when a field it reads is; ask about that "
+                                        "field"));
+        return false;
+    }
+    e.is_float = false;
     return true;
 }
 
