@@ -677,6 +677,7 @@ std::string Emitter::protocol_row() const {
     table("windows", l_.windows);
     table("places", l_.places);
     if (!l_.exprs.empty()) set.push_back("exprs(" + f + "_exprs)");
+    if (p_.no_padding) set.push_back("no_padding()");
     if (p_.pairing) set.push_back("pairing(&" + f + "_pairing)");
     if (p_.pairing && !p_.request_fields.empty()) set.push_back("request_context(&" + f + "_request_context)");
     if (extra_ && !extra_->analysis_data.empty()) set.push_back("analysis_data(&" + extra_->analysis_data + ")");

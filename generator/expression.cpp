@@ -103,6 +103,7 @@ private:
             out.args.push_back(std::move(operand));
             return true;
         }
+        if (s_.compare(pos_, 7, "defined") == 0) return defined(out, depth, height);
         if (c == '(') {
             ++pos_;
             if (!binary(out, 1, depth + 1, height)) return false;
@@ -113,6 +114,23 @@ private:
         }
         height = 0;
         return operand(out);
+    }
+
+    // defined(X): whatever X is here; the validator allows a field only.
+    bool defined(Expr& out, int depth, int& height) {
+        pos_ += 7;
+        skip_space();
+        if (pos_ >= s_.size() || s_[pos_] != '(') return fail("expected '(' after 'defined'");
+        ++pos_;
+        Expr inner;
+        if (!binary(inner, 1, depth + 1, height)) return false;
+        skip_space();
+        if (pos_ >= s_.size() || s_[pos_] != ')') return fail("missing ')'");
+        ++pos_;
+        ++height;
+        out.op = ExprOp::Defined;
+        out.args.push_back(std::move(inner));
+        return true;
     }
 
     bool operand(Expr& out) {
@@ -191,6 +209,7 @@ const char* expr_op_text(ExprOp op) {
     case ExprOp::Neg: return "-";
     case ExprOp::Not: return "!";
     case ExprOp::BitNot: return "~";
+    case ExprOp::Defined: return "defined";
     default: return "";
     }
 }
@@ -212,6 +231,7 @@ const char* integer_code(ExprOp op) {
     case ExprOp::Neg: return "DG_OP_NEG";
     case ExprOp::Not: return "DG_OP_NOT";
     case ExprOp::BitNot: return "DG_OP_BITNOT";
+    case ExprOp::Defined: return "DG_OP_DEFINED";
     case ExprOp::Mul: return "DG_OP_MUL";
     case ExprOp::Div: return "DG_OP_DIV";
     case ExprOp::Mod: return "DG_OP_MOD";
@@ -259,6 +279,11 @@ void compile_into(const Expr& e, bool as_float, std::vector<ExprRow>& out) {
         return;
     case ExprOp::Index:
         out.push_back({"DG_OP_INDEX"});
+        if (as_float) out.push_back({"DG_OP_TO_FLOAT"});
+        return;
+    case ExprOp::Defined:  // of a value of any type, giving an integer
+        compile_into(e.args[0], e.args[0].is_float, out);
+        out.push_back({"DG_OP_DEFINED"});
         if (as_float) out.push_back({"DG_OP_TO_FLOAT"});
         return;
     case ExprOp::Field:

@@ -8,7 +8,9 @@
 // Operands: integers (decimal, 0x hex), decimals with a point (1.5),
 // {Name} (the value of an earlier numeric field), index (the instance number
 // of the innermost repeated node, from 0), request{Name} (the value of a
-// field of the paired request message, in a protocol with <pairing>).
+// field of the paired request message, in a protocol with <pairing>),
+// defined({Name}) / defined(request{Name}) (1 when that value is defined:
+// the field was decoded, the request was captured; else 0).
 // Operators as in C, with C's
 // precedence: unary - ! ~; * / %; + -; << >>; < <= > >=; == !=; &; ^; |;
 // &&; ||; and parentheses.
@@ -25,7 +27,7 @@ struct Node;
 
 enum class ExprOp {
     Int, Float, Field, Index, RequestField,    // operands
-    Neg, Not, BitNot,                          // unary
+    Neg, Not, BitNot, Defined,                 // unary; Defined: defined(X), 1 when X is, else 0
     Mul, Div, Mod, Add, Sub, Shl, Shr,         // binary, arithmetic
     Lt, Le, Gt, Ge, Eq, Ne,                    // binary, comparisons (0 or 1)
     BitAnd, BitXor, BitOr, And, Or,            // binary, logic

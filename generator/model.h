@@ -56,6 +56,7 @@ struct EnumItem {
 
 struct ValueRange {
     uint64_t low = 0, high = 0;
+    std::string text;  // as written ("0-300", "0x10"), for messages that echo it
 };
 
 // One piece of a summary template: literal text, the shown value of a leaf,
@@ -242,6 +243,7 @@ struct Protocol {
     std::vector<Heuristic> heuristics;
     std::optional<FieldRef> pdulength;
     int64_t pdulengthadd = 0;
+    bool no_padding = false;  // padding="none": zero bytes a length leaves over raise P.expert.unused too
     int line = 0;
     std::vector<std::unique_ptr<Node>> nodes;
     // request/response pairing, when the file declares it

@@ -29,7 +29,7 @@ std::string significant_digits(const std::string& digits) {
 }
 
 const std::vector<std::string> kRootAttributes = {"name",   "abbreviation", "ethertype", "filter",
-                                                  "byteorder", "pdulength", "pdulengthadd"};
+                                                  "byteorder", "pdulength", "pdulengthadd", "padding"};
 const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displaytype", "repeat",
                                                   "count",  "filter",    "byteorder",   "description",
                                                   "if",     "in",        "summary",     "ifhook",
@@ -392,6 +392,15 @@ std::unique_ptr<Protocol> Parser::parse_root(xmlNode* root) {
             diags_.error(proto->line, "'pdulengthadd' needs a 'pdulength' field");
     }
 
+    if (attrs.count("padding")) {
+        const std::string padding = trim(attrs["padding"]);
+        if (padding == "none")
+            proto->no_padding = true;
+        else if (padding != "zeros")
+            diags_.error(proto->line, "bad padding '" + attrs["padding"] +
+                                          "': expected 'zeros' (zero bytes a length leaves over are padding, the "
+                                          "default) or 'none' (the protocol never pads: they are not decoded either)");
+    }
     for (xmlNode* c = root->children; c; c = c->next) {
         if (c->type == XML_ELEMENT_NODE && element_name(c) == "node")
             proto->nodes.push_back(parse_node(c, nullptr, 1));
@@ -735,6 +744,7 @@ bool Parser::parse_value_list(const std::string& text, int line, const std::stri
                       ? parse_number(item, r.low)
                       : parse_number(item.substr(0, dash), r.low) && parse_number(item.substr(dash + 1), r.high);
         if (dash == std::string::npos) r.high = r.low;
+        r.text = item;
         if (!ok || r.high < r.low) {
             diags_.error(line, bad);
             return false;

@@ -59,6 +59,8 @@ private:
     void check_computed(Node& n);
     bool check_expr(Node& n, Expr& e);
     bool check_request_field(Node& n, Expr& e);
+    const Node* request_field_target(const Node& n, const std::string& text, const std::string& what);
+    bool check_defined(const Node& n, Expr& e);
     void check_request_keys();
     const Node* fixed_offset_blocker(const Node& n, uint64_t& offset) const;
     const Node* find_earlier(const Node& n, const std::string& name);
@@ -513,10 +515,13 @@ void Validator::check_list_fits(int line, const std::vector<ValueRange>& list, c
     const uint64_t max = (uint64_t{1} << t->fixed_bits) - 1;
     for (const ValueRange& r : list) {
         if (r.high <= max) continue;
-        const std::string values = r.low == r.high ? hex(r.low) : hex(r.low) + "-" + hex(r.high);
+        // echoed as written, the field's maximum in the same base: valid="0-300" is not "0x0-0x12c"
+        const bool written_hex = r.text.find("0x") != std::string::npos || r.text.find("0X") != std::string::npos;
+        const std::string values = !r.text.empty() ? r.text : r.low == r.high ? hex(r.low) : hex(r.low) + "-" + hex(r.high);
+        const std::string highest = written_hex ? hex(max) : std::to_string(max);
         diags_.warning(line, "'" + std::string(attribute) + "' value " + values + " does not fit the " + std::to_string(t->fixed_bits) +
                                  "-bit field " + quote(*t) + at_line(*t) + ": " +
-                                 (r.low > max ? "it never matches" : "values above " + hex(max) + " never match"));
+                                 (r.low > max ? "it never matches" : "values above " + highest + " never match"));
     }
 }
 
@@ -698,6 +703,7 @@ bool Validator::check_expr(Node& n, Expr& e) {
         diags_.error(n.line, "'index'" + in + ": it is not inside a repeated node, so there is no instance to count");
         return false;
     case ExprOp::RequestField: return check_request_field(n, e);
+    case ExprOp::Defined: return check_defined(n, e);
     case ExprOp::Field: {
         const Node* t = find_earlier(n, e.name);
         if (!t) {
@@ -749,11 +755,91 @@ bool Validator::check_expr(Node& n, Expr& e) {
     return true;
 }
 
-// request{Name}: a field of the paired request. Of the nodes named Name,
-// the first one decoded only in requests (it or a container of it has
-// direction="request"), else the first one in the file. Numeric, outside
-// every repeat (a request keeps one value of it), and in a protocol whose
-// messages are paired.
+namespace {
+
+bool decoded_only_in(const Node& c, Direction d) {
+    for (const Node* a = &c; a; a = a->parent)
+        if (a->direction == d) return true;
+    return false;
+}
+
+// "Read registers/Reference": a node's name preceded by those of its nearest
+// containers, as many as segments given.
+bool matches_path(const Node& c, const std::vector<std::string>& segments) {
+    const Node* a = &c;
+    for (auto s = segments.rbegin(); s != segments.rend(); ++s, a = a->parent)
+        if (!a || a->name != *s) return false;
+    return true;
+}
+
+std::vector<std::string> path_segments(const std::string& path) {
+    std::vector<std::string> out;
+    size_t start = 0;
+    for (size_t slash; (slash = path.find('/', start)) != std::string::npos; start = slash + 1)
+        out.push_back(path.substr(start, slash - start));
+    out.push_back(path.substr(start));
+    return out;
+}
+
+// The shortest path (name, then its containers') that tells c from the
+// other candidates, for a message that lists them.
+std::string telling_path(const Node& c, const std::vector<const Node*>& candidates) {
+    std::vector<std::string> segments;
+    for (const Node* a = &c; a; a = a->parent) {
+        segments.insert(segments.begin(), a->name);
+        int alike = 0;
+        for (const Node* o : candidates) alike += matches_path(*o, segments);
+        if (alike == 1) break;
+    }
+    std::string path;
+    for (const std::string& s : segments) path += (path.empty() ? "" : "/") + s;
+    return path;
+}
+
+}  // namespace
+
+// The node request{TEXT} reads: TEXT is a node's name, or a path "A/B/Name"
+// of names (Name inside B inside A) when no node has TEXT as its name. Of the
+// nodes it fits that a request decodes, those decoded only in requests (it
+// or a container of it has direction="request") if any: exactly one, since
+// reading the first of several would silently pick a layout. NULL after an
+// error; a node decoded only in responses when no other fits.
+const Node* Validator::request_field_target(const Node& n, const std::string& text, const std::string& what) {
+    bool whole_name = false;
+    for_each_node(proto_.nodes, [&](Node& c) { whole_name = whole_name || c.name == text; });
+    const std::vector<std::string> segments = whole_name ? std::vector<std::string>{text} : path_segments(text);
+    std::vector<const Node*> fits, requests, responses;
+    for_each_node(proto_.nodes, [&](Node& c) {
+        if (!matches_path(c, segments)) return;
+        (decoded_only_in(c, Direction::Response) ? responses : fits).push_back(&c);
+        if (decoded_only_in(c, Direction::Request)) requests.push_back(&c);
+    });
+    if (!requests.empty()) fits = requests;
+    if (fits.size() > 1) {
+        std::string list;
+        for (const Node* c : fits) list += std::string(list.empty() ? "" : ", ") + "'" + telling_path(*c, fits) + "'" + at_line(*c);
+        diags_.error(n.line, what + " is ambiguous: " + std::to_string(fits.size()) +
+                                 " fields a request decodes fit it: " + list + "; name one by its path, e.g. request{" +
+                                 telling_path(*fits.front(), fits) + "}");
+        return nullptr;
+    }
+    if (!fits.empty()) return fits.front();
+    if (!responses.empty()) return responses.front();
+    std::vector<std::string> names;
+    std::vector<const Node*> named;  // a path that is wrong above a right name: suggest the right path
+    for_each_node(proto_.nodes, [&](Node& c) {
+        names.push_back(c.name);
+        if (c.name == segments.back()) named.push_back(&c);
+    });
+    const std::string near = named.empty() ? closest_match(segments.back(), names) : telling_path(*named[0], named);
+    diags_.error(n.line, what + (segments.size() > 1 ? ": no node has that path" : ": no node has that name") +
+                             (near.empty() ? "" : " (did you mean request{" + near + "}?)"));
+    return nullptr;
+}
+
+// request{Name}: a field of the paired request (request_field_target).
+// Numeric, inside one repeat at the most (read by position), and in a
+// protocol whose messages are paired.
 bool Validator::check_request_field(Node& n, Expr& e) {
     const std::string what = "request{" + e.name + "} in the value of " + quote(n);
     if (!proto_.pairing) {
@@ -761,24 +847,8 @@ bool Validator::check_request_field(Node& n, Expr& e) {
                                     "<pairing> with the key fields a response repeats from its request");
         return false;
     }
-    auto only_in = [](const Node& c, Direction d) {
-        for (const Node* a = &c; a; a = a->parent)
-            if (a->direction == d) return true;
-        return false;
-    };
-    const Node* t = nullptr;
-    for_each_node(proto_.nodes, [&](Node& c) {
-        if (c.name != e.name) return;
-        if (!t || (only_in(c, Direction::Request) && !only_in(*t, Direction::Request))) t = &c;
-    });
-    if (!t) {
-        std::vector<std::string> names;
-        for_each_node(proto_.nodes, [&](Node& c) { names.push_back(c.name); });
-        const std::string near = closest_match(e.name, names);
-        diags_.error(n.line, what + ": no node has that name" +
-                                 (near.empty() ? "" : " (did you mean request{" + near + "}?)"));
-        return false;
-    }
+    const Node* t = request_field_target(n, e.name, what);
+    if (!t) return false;
     if (!t->is_numeric() && !t->is_computed()) {
         diags_.error(n.line, what + " is " + quote(*t) + at_line(*t) +
                                  ", which is not numeric: it must be a leaf of 1-64 bits shown as a number, "
@@ -811,7 +881,7 @@ bool Validator::check_request_field(Node& n, Expr& e) {
             return false;
         }
     }
-    if (only_in(*t, Direction::Response)) {
+    if (decoded_only_in(*t, Direction::Response)) {
         diags_.error(n.line, what + " is " + quote(*t) + at_line(*t) +
                                  ", which is decoded only in responses (direction=\"response\"): a request never "
                                  "has it");
@@ -827,6 +897,25 @@ bool Validator::check_request_field(Node& n, Expr& e) {
     if (it == kept.end()) kept.push_back(t);
     mark_slot(e.target);
     if (repeat) e.target->keeps_instances = true;
+    return true;
+}
+
+// defined(X) asks about one value that may be missing: a field ({Name}, not
+// decoded under a condition) or a field of the request (request{Name}, the
+// request not captured). A number or index is always defined, and an
+// expression is undefined exactly when a field in it is: ask about that.
+bool Validator::check_defined(const Node& n, Expr& e) {
+    const Expr& x = e.args[0];
+    if (x.op != ExprOp::Field && x.op != ExprOp::RequestField) {
+        diags_.error(n.line, "defined(...) in the value of " + quote(n) +
+                                 " asks about one field, {Name} or request{Name}: " +
+                                 (x.op == ExprOp::Int || x.op == ExprOp::Float || x.op == ExprOp::Index
+                                      ? "a number or index is always defined"
+                                      : "an expression is undefined exactly when a field it reads is; ask about that "
+                                        "field"));
+        return false;
+    }
+    e.is_float = false;
     return true;
 }
 

@@ -39,6 +39,7 @@ dg_expr_value operand(const dg_expr_op *op, dg_slot_reader read, dg_slot_reader 
 }
 
 dg_expr_value unary(guint8 code, dg_expr_value a) {
+    if (code == DG_OP_DEFINED) return integer_value(a.defined);
     if (!a.defined) return a;
     switch (code) {
     case DG_OP_TO_FLOAT: return real_value((gdouble)a.integer);
@@ -120,7 +121,7 @@ dg_expr_value dg_expr_eval(const dg_expr_op *ops, guint count, dg_slot_reader re
         if (code <= DG_OP_INDEX) {
             if (depth == DG_EXPR_STACK) return undefined_value();
             stack[depth++] = operand(&ops[k], read, read_request, context, index);
-        } else if (code <= DG_OP_FNOT) {
+        } else if (code <= DG_OP_DEFINED) {
             if (depth < 1) return undefined_value();
             stack[depth - 1] = unary(code, stack[depth - 1]);
         } else {

@@ -11,6 +11,7 @@
  * undefined when a field it reads was not decoded in this message, or it
  * divides an integer by zero; && and || give a defined answer when their
  * left side decides, as in C, so "{n} != 0 && {x} / {n} > 2" is safe.
+ * defined(X) asks: 1 when X is defined, 0 when not, never undefined.
  */
 #pragma once
 
@@ -30,6 +31,7 @@ enum dg_expr_code {
     DG_OP_TO_FLOAT,     /* the integer on top becomes a double */
     /* unary, on integers (F: on doubles) */
     DG_OP_NEG, DG_OP_NOT, DG_OP_BITNOT, DG_OP_FNEG, DG_OP_FNOT,
+    DG_OP_DEFINED,      /* 1 when the value on top is defined, else 0: itself always defined */
     /* binary, on integers */
     DG_OP_MUL, DG_OP_DIV, DG_OP_MOD, DG_OP_ADD, DG_OP_SUB, DG_OP_SHL, DG_OP_SHR,
     DG_OP_LT, DG_OP_LE, DG_OP_GT, DG_OP_GE, DG_OP_EQ, DG_OP_NE,

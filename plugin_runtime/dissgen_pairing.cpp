@@ -179,6 +179,7 @@ void recycle(recycled **list, void *p)
 const dg_protocol *protocol;
 const dg_analysis *analysis;
 const char *key_name = "key"; /* the first key field's name, for texts */
+const dg_node *key_node;      /* the first key field, whose display base the texts follow */
 capture_state *capture; /* NULL between captures */
 
 int hf_response_in = -1, hf_request_in = -1, hf_time = -1, hf_no_response_to = -1, hf_no_request = -1;
@@ -959,6 +960,21 @@ gboolean known_lost(const dg_transaction *t)
     return nstime_to_sec(&waited) > protocol->pairing->timeout;
 }
 
+/* The first key's value as its field shows it: decimal for a decimal field
+ * (signed for a signed one), hex padded to the field's width otherwise, so
+ * that the note names the request the way its tree does. */
+const char *key_text(packet_info *pinfo, guint64 key)
+{
+    if (key_node && key_node->show == DG_SHOW_DEC)
+        return wmem_strdup_printf(pinfo->pool, "%" G_GINT64_MODIFIER "u", key);
+    guint bits = key_node ? key_node->bits : 64;
+    if (key_node && key_node->show == DG_SHOW_INT) {
+        gint64 value = bits > 0 && bits < 64 && (key >> (bits - 1)) & 1 ? (gint64)(key | (~G_GUINT64_CONSTANT(0) << bits)) : (gint64)key;
+        return wmem_strdup_printf(pinfo->pool, "%" G_GINT64_MODIFIER "d", value);
+    }
+    return wmem_strdup_printf(pinfo->pool, "0x%0*" G_GINT64_MODIFIER "x", (int)((bits + 3) / 4), key);
+}
+
 /* The requests this message proved lost, each linked. The expert info goes
  * here in the first pass (one pass, a live capture), where nothing later can
  * be shown; once the capture has been read (tshark -2, the GUI) it sits on
@@ -973,8 +989,8 @@ void show_lost(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, pr
         nstime_t since;
         nstime_delta(&since, &pinfo->abs_ts, &l->txn->request_time);
         proto_tree_add_expert_format(tree, pinfo, &ei_no_response, tvb, 0, 0,
-                                     "No response to frame %u (%s 0x%" G_GINT64_MODIFIER "x), sent %.3f ms before",
-                                     l->txn->request_frame, key_name, l->key, nstime_to_msec(&since));
+                                     "No response to frame %u (%s %s), sent %.3f ms before",
+                                     l->txn->request_frame, key_name, key_text(pinfo, l->key), nstime_to_msec(&since));
     }
 }
 
@@ -1050,6 +1066,7 @@ void dg_pairing_register(const dg_protocol *p)
     for (guint i = 0; i < p->node_count; i++)
         if (p->nodes[i].flags & DG_KEY) {
             key_name = p->nodes[i].name;
+            key_node = &p->nodes[i];
             break;
         }
     proto_register_field_array(*p->proto, hf, (int)G_N_ELEMENTS(hf));

@@ -30,7 +30,7 @@ struct dg_claim {
     guint32 value;
     dissector_handle_t handle;
     int proto;
-    dissector_handle_t displaced; /* the other registrant of the value (Wireshark's plugin), or NULL */
+    dissector_handle_t displaced; /* the other registrant of the value (built in or a plugin), or NULL */
     dissector_handle_t placed;    /* what this plugin last put in the table */
 };
 
@@ -236,8 +236,13 @@ void dg_handoff(const dg_protocol *p)
             continue;
         }
         dissector_handle_t h_handle = (stream && strcmp(h->table, "tcp.port") == 0) ? stream : handle;
+        /* Dissectors built into libwireshark (POWERLINK on 0x88AB) took their
+         * values before any plugin's handoff: recorded now, before ours
+         * replaces them, so that disabling ours gives the value back. Later
+         * plugins' entries are recorded by claim_tables. */
+        dissector_handle_t builtin = dissector_get_uint_handle(find_dissector_table(h->table), h->value);
         dissector_add_uint(h->table, h->value, h_handle);
-        dg_claim c = {h->table, h->value, h_handle, *p->proto, NULL, NULL};
+        dg_claim c = {h->table, h->value, h_handle, *p->proto, builtin, NULL};
         g_array_append_val(claims, c);
     }
 }

@@ -147,6 +147,7 @@ struct dg_protocol_row {
     constexpr dg_protocol_row &exprs(const dg_expr_op *v) { p.exprs = v; return *this; }
     constexpr dg_protocol_row &request_context(const dg_request_context *v) { p.request_context = v; return *this; }
     constexpr dg_protocol_row &top_walk(dg_list_walk fn) { p.top_walk = fn; return *this; }
+    constexpr dg_protocol_row &no_padding() { p.no_padding = 1; return *this; }
 };
 
 /* Operations of computed values: dg_op(CODE) for operators and index, and

@@ -307,6 +307,9 @@ typedef struct dg_protocol {
      * code gives it only for protocols that use it. */
     const dg_request_context *request_context = nullptr;
     dg_list_walk top_walk = nullptr; /* the top-level nodes, compiled (NULL: the table walk) */
+    /* padding="none": zero bytes a length leaves over are not padding but
+     * P.expert.unused, like any others. Generated code gives it only when set. */
+    guint8 no_padding = 0;
 } dg_protocol;
 
 /* The entry points generated code calls. C linkage: plain symbol

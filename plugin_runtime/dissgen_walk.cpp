@@ -268,7 +268,7 @@ void label_container(const dg_node *n, proto_item *item, const char *summary)
 void show_trailing_bytes(dg_state *st, const dg_node *n, proto_tree *subtree, gint start, gint at, gint inner_end,
                          gint64 length)
 {
-    if (all_zero(st, at, inner_end - at)) {
+    if (!st->p->no_padding && all_zero(st, at, inner_end - at)) {
         /* Zero bytes up to the length: padding, which senders may add (to
          * a minimum length, or a length rounded up). Nothing is wrong. */
         if (subtree) proto_tree_add_item(subtree, hf_padding, st->tvb, at, inner_end - at, ENC_NA);
@@ -564,11 +564,11 @@ void show_message_tail(dg_state *st, proto_tree *tree, gint offset, gboolean on_
     if (st->stopped || st->faulted || offset <= 0 || offset >= st->packet_end) return;
     gint rest = st->packet_end - offset;
     gboolean zero = all_zero(st, offset, rest);
-    if (on_ethertype) {
+    if (on_ethertype) { /* Ethernet's own padding to 60 bytes, whatever the protocol says */
         if (!zero) set_actual_length(st->tvb, (guint)offset);
         return;
     }
-    if (zero) {
+    if (zero && !st->p->no_padding) {
         if (tree) proto_tree_add_item(tree, hf_padding, st->tvb, offset, rest, ENC_NA);
         return;
     }

@@ -141,6 +141,49 @@ def message_tail_checks(check, dissgen, source_dir):
                           "%s: the warning says how many bytes (%s)" % (what, r["_ws.expert.message"]))
 
 
+def no_padding_checks(check, dissgen, source_dir):
+    """padding="none" (tests/rules/no_padding.xml): zeros a length leaves over raise
+    nopad.expert.unused exactly where they are, and nothing on clean messages; the same
+    rules without the attribute show them as nopad.padding and raise nothing."""
+    print("\n== padding=\"none\": zeros a length leaves over are not padding")
+    word = b"\x12\x34"
+    udp = lambda payload: pcapgen.udp_ethernet_frame(payload, 47494)
+    eth = lambda payload: b"\x02\x11\x11\x11\x11\x11\x02\x22\x22\x22\x22\x22\x88\xb6" + payload + bytes(43)
+    # (frame, what, the warning without padding="none" shown as padding, the warning's text or None)
+    cases = [
+        (udp(b"\x02" + word), "UDP, clean", None),
+        (eth(b"\x02" + word), "Ethernet type, clean (Ethernet's padding after it)", None),
+        (udp(b"\x04" + word + bytes(2)), "UDP, two zeros inside Body's length",
+         "'Body' is 4 bytes, but its fields end after 2: 2 bytes are not decoded"),
+        (eth(b"\x05" + word + bytes(3)), "Ethernet type, three zeros inside Body's length",
+         "'Body' is 5 bytes, but its fields end after 2: 3 bytes are not decoded"),
+        (udp(b"\x02" + word + bytes(3)), "UDP, three zeros after the message",
+         "3 bytes after the message's last field are not decoded"),
+    ]
+    rules = os.path.join(source_dir, "tests", "rules", "no_padding.xml")
+    with open(rules, encoding="utf-8") as f:
+        text = f.read()
+    for none in (True, False):
+        with TsharkEnv() as env:
+            variant = env.add_file("no_padding.xml", (text if none else text.replace(' padding="none"', "")).encode())
+            env.install_plugin(dissgen, variant)
+            env.assert_plugin_loaded("nopad")
+            path = env.add_file("nopad.pcap", pcapgen.raw_pcap_bytes([c[0] for c in cases]))
+            for extra in ([], ["-2"]):
+                rows = env.field_rows(path, ["frame.number", "nopad.body.word", "nopad.expert.unused",
+                                             "nopad.padding", "_ws.expert.message"], two_pass=bool(extra),
+                                      aggregator="|")
+                for (_, what, warning), r in zip(cases, rows.values()):
+                    want = {"word": ["0x1234"], "warning": [warning] if warning and none else [],
+                            "padding": bool(warning) and not none}
+                    got = {"word": r["nopad.body.word"], "warning": r["_ws.expert.message"],
+                           "padding": bool(r["nopad.padding"])}
+                    check(got == want, "%s %s %s: %s%s" % (
+                        'padding="none"' if none else "default", what, extra,
+                        "unused exactly there" if none else "zeros are padding, no expert",
+                        "" if got == want else "\n       got  %s\n       want %s" % (got, want)))
+
+
 # ----------------------------------------------------------------------------- peek
 
 MAX_WIDTH = 62
@@ -316,6 +359,10 @@ class TestEdges(TsharkTestCase, unittest.TestCase):
     def test_bytes_after_the_message(self):
         with self.checks() as check:
             message_tail_checks(check, ARGS.dissgen, ARGS.source_dir)
+
+    def test_protocol_without_padding(self):
+        with self.checks() as check:
+            no_padding_checks(check, ARGS.dissgen, ARGS.source_dir)
 
     def test_offsets_from_enclosing_containers(self):
         with self.checks() as check:

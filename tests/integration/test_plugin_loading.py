@@ -147,6 +147,45 @@ class PluginLoading(unittest.TestCase):
                         else:  # UDP with both off: whatever else Wireshark makes of it
                             self.assertNotIn(seen, ("ECAT", "ECATR"), "frame %d" % frame)
 
+    def test_disabling_ours_gives_values_back_to_built_in_dissectors(self):
+        """POWERLINK (epl, 0x88AB) and SERCOS III (siii, 0x88CD) are built into libwireshark and
+        hold their values before any plugin: with ours disabled (on the command line, or in the
+        profile as the Enabled Protocols dialog saves it) they decode the frames again; enabled
+        again (the profile's entry removed), or with theirs disabled, ours does. One pass and -2."""
+        self.env.install_plugin(ARGS.dissgen, os.path.join(ARGS.source_dir, "tests", "rules",
+                                                           "builtin_ethertypes.xml"))
+        ethernet = b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01"
+        # an EPL SoC (message type 1) to broadcast, and a SERCOS III MDT telegram
+        epl = ethernet + b"\x88\xab" + b"\x01\xff\xf0" + bytes(43)
+        siii = ethernet + b"\x88\xcd" + b"\x00\x00\x00\x00\x00\x00" + bytes(40)
+        capture = self.env.add_file("builtin.pcap", pcapgen.raw_pcap_bytes([epl, siii]))
+        profile = os.path.join(self.env.home, ".config", "wireshark")
+        disabled_protos = os.path.join(profile, "disabled_protos")
+        names = ["_ws.col.Protocol", "bltn.kind", "epl.mtyp", "siii"]
+        ours, theirs = ["BLTN", "BLTN"], ["POWERLINK", "SIII MDT"]
+        # (command-line options, the profile's disabled protocols or None, protocols of the two frames)
+        cases = (([], None, ours),
+                 (["--disable-protocol", "bltn"], None, theirs),
+                 ([], "bltn", theirs),
+                 ([], None, ours),  # enabled again
+                 (["--disable-protocol", "epl", "--disable-protocol", "siii"], None, ours))
+        for args, disabled, protocols in cases:
+            if disabled:
+                os.makedirs(profile, exist_ok=True)
+                with open(disabled_protos, "w", encoding="utf-8") as f:
+                    f.write(disabled + "\n")
+                subprocess.run(["chmod", "-R", "a+rX", os.path.join(self.env.home, ".config")], check=True)
+            elif os.path.exists(disabled_protos):
+                os.remove(disabled_protos)
+            with self.subTest(args=args, profile_disables=disabled):
+                for passes in ([], ["-2"]):
+                    rows, stderr = fields(self.env, capture, names, args + passes)
+                    self.assertEqual([r[0] for r in rows], protocols, stderr)
+                    decoded_by_us = protocols == ours
+                    self.assertEqual([r[1] for r in rows], ["0x01", "0x00"] if decoded_by_us else ["", ""])
+                    self.assertEqual(rows[0][2], "" if decoded_by_us else "1")
+                    self.assertEqual(rows[1][3] != "", not decoded_by_us)
+
     def test_rules_win_whatever_the_load_order(self):
         """Both plugins in one folder under names that sort either way round."""
         if not os.path.exists(SYSTEM_ETHERCAT):

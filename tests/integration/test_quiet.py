@@ -249,13 +249,18 @@ def computed_frames():
     return [m.ethernet_frame(body) for _, body in m.messages(77, 40)]
 
 
-def request_context_frames():
-    """tests/rules/request_context.xml: read transactions in flight together, then responses
-    without their requests (test_request_context.py's messages)."""
+def read_transaction_frames(seed, order_seed):
+    """Read transactions in flight together, then responses without their requests
+    (test_request_context.py's messages)."""
     import test_request_context as m
-    txns = m.transactions(47502, 30)
-    paired = [m.frame(d, m.payload(d, txns[k])) for d, k in m.schedule(txns, 1)]
-    return paired + [m.frame("response", m.payload("response", t)) for t in txns[:10]]
+    txns = m.transactions(seed, 30)
+    paired = [m.frame(d, m.modbus(d, txns[k])) for d, k in m.schedule(txns, order_seed)]
+    return paired + [m.frame("response", m.modbus("response", t)) for t in txns[:10]]
+
+
+def request_context_frames():
+    """tests/rules/request_context.xml: read transactions (read_transaction_frames)."""
+    return read_transaction_frames(47502, 1)
 
 
 def request_by_position_frames():
@@ -313,6 +318,38 @@ def message_tail_frames():
     return out
 
 
+def builtin_ethertypes_frames():
+    """tests/rules/builtin_ethertypes.xml: frames on POWERLINK's and SERCOS III's ethertypes."""
+    ethernet = b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01"
+    rng = random.Random(8)
+    return [ethernet + ethertype + bytes(rng.getrandbits(8) for _ in range(n))
+            for ethertype in (b"\x88\xab", b"\x88\xcd") for n in (0, 1, 46)]
+
+
+def request_path_frames():
+    """tests/rules/request_path.xml: both read functions, each response reading its own layout."""
+    return read_transaction_frames(47507, 2)
+
+
+def request_defined_frames():
+    """tests/rules/request_defined.xml: coil responses with and without their requests."""
+    return read_transaction_frames(47508, 3)
+
+
+def no_padding_frames():
+    """tests/rules/no_padding.xml: bodies longer than their word, zeros or not, on both carriers."""
+    import test_edges as m
+    rng = random.Random(9)
+    out = []
+    for extra in (0, 1, 3):
+        for zero in (True, False):
+            rest = bytes(extra) if zero else bytes(rng.getrandbits(8) | 1 for _ in range(extra))
+            body = bytes([2 + extra]) + b"\x12\x34" + rest
+            out += [udp_frame(47494, body), udp_frame(47494, body + rest),
+                    m.ethertype_frame(body)[:12] + b"\x88\xb6" + body]
+    return out
+
+
 # Rule file (relative to the source folder) -> the captures that exercise it.
 CAPTURES = {
     "tests/rules/widths.xml": widths_frames,
@@ -331,6 +368,10 @@ CAPTURES = {
     "tests/rules/request_context_decoded_keys.xml": request_context_decoded_keys_frames,
     "tests/rules/request_by_position.xml": request_by_position_frames,
     "tests/rules/message_tail.xml": message_tail_frames,
+    "tests/rules/builtin_ethertypes.xml": builtin_ethertypes_frames,
+    "tests/rules/request_path.xml": request_path_frames,
+    "tests/rules/request_defined.xml": request_defined_frames,
+    "tests/rules/no_padding.xml": no_padding_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,

@@ -243,6 +243,83 @@ class TestRequestContextDecodedKeys(TestRequestContext):
     CLIENT = staticmethod(client_name)
 
 
+class TestRequestByPath(TsharkTestCase, unittest.TestCase):
+    """request{Container/Name} (tests/rules/request_path.xml): both read functions have their
+    own request layout with a Reference and a Quantity, and each response reads its own
+    function's by path; the registers' numbers of function 3 come from Read registers'
+    Reference although Read coils' comes first in the file."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "request_path.xml"), "rqp")
+        cls.txns = transactions(47507, 60)
+        cls.order = schedule(cls.txns, 2)
+        cls.path = cls.env.add_file("paths.pcap", pcapgen.raw_pcap_bytes(
+            [frame(d, modbus(d, cls.txns[k])) for d, k in cls.order]))
+
+    def test_each_response_reads_its_own_layouts_field(self):
+        fields = [f.replace("rqc.", "rqp.") for f in FIELDS if f != "rqc.first_register"]
+        functions = {f for _, _, f, _, _, _ in self.txns}
+        with self.checks() as check:
+            check(functions == {1, 3}, "both read functions are in the capture")
+            for two_pass in (False, True):
+                rows = self.env.field_rows(self.path, fields, two_pass)
+                wrong = []
+                for n, (d, k) in enumerate(self.order, 1):
+                    if d != "response":
+                        continue
+                    want = {f.replace("rqc.", "rqp."): v for f, v in expected(self.txns[k], True).items()
+                            if f != "rqc.first_register"}
+                    got = {f: ",".join(rows[n][f]) for f in want}
+                    if got != want:
+                        wrong.append((n, got, want))
+                check(not wrong, "%s: every response's register and coil numbers (and coil count) from its own "
+                      "function's request layout%s" % ("-2" if two_pass else "one pass",
+                                                       "" if not wrong else " (wrong: %s)" % wrong[:2]))
+
+
+class TestRequestDefined(TsharkTestCase, unittest.TestCase):
+    """defined(request{Quantity}) (tests/rules/request_defined.xml): a coil response whose request
+    was captured says so and has its coils counted and numbered from it; one whose request was
+    not says so too and shows its bytes as raw states, with no coils and no malformed expert."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "request_defined.xml"), "rqk")
+        cls.txns = [t for t in transactions(47508, 80) if t[2] == 1]
+        cls.order = schedule(cls.txns, 3)
+        frames = [frame(d, modbus(d, cls.txns[k])) for d, k in cls.order]
+        cls.orphans = [k for d, k in cls.order if d == "response"][:10]
+        frames += [frame("response", modbus("response", cls.txns[k])) for k in cls.orphans]
+        cls.path = cls.env.add_file("defined.pcap", pcapgen.raw_pcap_bytes(frames))
+
+    def test_responses_say_whether_their_request_is_known(self):
+        fields = ["frame.number", "rqk.coils.request_known", "rqk.coils.raw_states", "rqk.coils.coil.state",
+                  "rqk.coils.coil.number", "rqk.expert.no_request_context", "_ws.malformed", "_ws.expert.severity"]
+        with self.checks() as check:
+            for two_pass in (False, True):
+                mode = "-2" if two_pass else "one pass"
+                rows = {n: {f: ",".join(v) for f, v in r.items()}
+                        for n, r in self.env.field_rows(self.path, fields, two_pass).items()}
+                expect = [(n, k, True) for n, (d, k) in enumerate(self.order, 1) if d == "response"]
+                expect += [(len(self.order) + 1 + i, k, False) for i, k in enumerate(self.orphans)]
+                wrong = []
+                for n, k, known in expect:
+                    _, _, _, reference, quantity, values = self.txns[k]
+                    want = {"rqk.coils.request_known": "1" if known else "0",
+                            "rqk.coils.raw_states": "" if known else " ".join("%02x" % v for v in values),
+                            "rqk.coils.coil.state": ",".join("0x%02x" % v for v in values) if known else "",
+                            "rqk.coils.coil.number": ",".join(str(reference + i) for i in range(quantity))
+                            if known else "",
+                            "rqk.expert.no_request_context": "" if known else "1", "_ws.malformed": ""}
+                    got = {f: rows[n][f] for f in want}
+                    if got != want:
+                        wrong.append((n, got, want))
+                check(not wrong, "%s: %d responses with their request (coils from it), %d without (raw states), "
+                      "each saying which%s" % (mode, len(expect) - len(self.orphans), len(self.orphans),
+                                               "" if not wrong else " (wrong: %s)" % wrong[:2]))
+
+
 # --- request{Name} by position (tests/rules/request_by_position.xml, UDP 47505) -------------
 
 BATCH_PORT = 47505

@@ -78,9 +78,22 @@ def decode(env, path, two_pass):
 
 
 class TestTransactions(TsharkTestCase, unittest.TestCase):
+    KEY_TEXT = "0x%04x"  # the transaction in the no-response note, as its field shows it
+
     @classmethod
     def prepare(cls):
         cls.install(os.path.join("tests", "rules", "transactions.xml"), "txnp")
+
+    def test_no_response_note_names_the_key_as_its_field_shows_it(self):
+        path = self.env.path("notes.pcap")
+        write(path)
+        os.chmod(path, 0o644)
+        rows = self.env.field_rows(path, ["frame.number", "_ws.expert.message"], False, aggregator="|")
+        notes = {n: [m for m in r["_ws.expert.message"] if m.startswith("No response to")] for n, r in rows.items()}
+        want = {proof: ["No response to frame %d (Transaction %s), sent %.3f ms before" % (
+                    lost, self.KEY_TEXT % MESSAGES[lost - 1][2], MESSAGES[proof - 1][0] - MESSAGES[lost - 1][0])]
+                for lost, proof in LOST.items()}
+        self.assertEqual({n: m for n, m in notes.items() if m}, want)
 
     def test_requests_and_responses_paired_by_direction(self):
         env = self.env
@@ -108,6 +121,23 @@ class TestTransactions(TsharkTestCase, unittest.TestCase):
                 times = {n: r["txnp.time"] for n, r in rows.items() if r["txnp.time"]}
                 want = {n: "%.9f" % ((MESSAGES[n - 1][0] - MESSAGES[m - 1][0]) / 1000) for n, m in PAIRS.items()}
                 check(times == want, "%s: round trips are the timestamps' differences (%s)" % (mode, times))
+
+
+class TestTransactionsDecimalKey(TestTransactions):
+    """The same protocol with its transaction shown in decimal: so is it in the note."""
+    KEY_TEXT = "%d"
+
+    @classmethod
+    def prepare(cls):
+        with open(os.path.join(cls.args.source_dir, "tests", "rules", "transactions.xml"), encoding="utf-8") as f:
+            text = f.read()
+        decimal = text.replace('name="Transaction" length="2byte" displaytype="numberhex"',
+                               'name="Transaction" length="2byte" displaytype="numberdec"')
+        assert decimal != text
+        path = cls.env.path("transactions_decimal.xml")
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(decimal)
+        cls.install(path, "txnp")
 
 
 if __name__ == "__main__":

@@ -102,6 +102,7 @@ TESTS = {
     "edges_peek": integration("test_edges.py", "TestEdges.test_peek_at_shifted_bit_group_members"),
     "edges_offsets": integration("test_edges.py", "TestEdges.test_offsets_from_enclosing_containers"),
     "edges_message_tail": integration("test_edges.py", "TestEdges.test_bytes_after_the_message"),
+    "edges_no_padding": integration("test_edges.py", "TestEdges.test_protocol_without_padding"),
     "malformed_skip": integration("test_malformed_skip.py"),
     "quiet": integration("test_quiet.py"),
     "live_capture": integration("test_live_capture.py"),

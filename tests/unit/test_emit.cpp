@@ -24,6 +24,15 @@ void expect_type(const Protocol& proto, const std::string& name, const std::stri
     EXPECT_EQ(t.mask, mask) << name << std::hex << ": 0x" << t.mask;
 }
 
+TEST(Emit, NoPaddingOnlyWhenTheRootSaysSo) {
+    const std::string body = "  <node name=\"Word\" length=\"2byte\" displaytype=\"numberhex\"/>\n</root>\n";
+    Front none = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\" padding=\"none\">\n" + body);
+    Front zeros = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\" padding=\"zeros\">\n" + body);
+    ASSERT_TRUE(none.ok() && zeros.ok()) << none.messages() << zeros.messages();
+    EXPECT_TRUE(contains(emit_cpp(*none.proto, "rules.xml"), ".no_padding()"));
+    EXPECT_FALSE(contains(emit_cpp(*zeros.proto, "rules.xml"), "no_padding"));  // the default emits nothing new
+}
+
 TEST(FieldType, EveryDisplayTypeOnWholeBytes) {
     Front f = front_end(rules("  <node name=\"mac\" length=\"6byte\" displaytype=\"address\"/>\n"
                               "  <node name=\"ip\" length=\"4byte\" displaytype=\"address\"/>\n"

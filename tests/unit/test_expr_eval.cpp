@@ -22,7 +22,7 @@ guint8 code_of(const std::string& name) {
         {"DG_OP_FIELD_SIGNED", DG_OP_FIELD_SIGNED}, {"DG_OP_FIELD_FLOAT", DG_OP_FIELD_FLOAT},
         {"DG_OP_INDEX", DG_OP_INDEX}, {"DG_OP_TO_FLOAT", DG_OP_TO_FLOAT}, {"DG_OP_NEG", DG_OP_NEG},
         {"DG_OP_NOT", DG_OP_NOT}, {"DG_OP_BITNOT", DG_OP_BITNOT}, {"DG_OP_FNEG", DG_OP_FNEG},
-        {"DG_OP_FNOT", DG_OP_FNOT}, {"DG_OP_MUL", DG_OP_MUL}, {"DG_OP_DIV", DG_OP_DIV}, {"DG_OP_MOD", DG_OP_MOD},
+        {"DG_OP_FNOT", DG_OP_FNOT}, {"DG_OP_DEFINED", DG_OP_DEFINED}, {"DG_OP_MUL", DG_OP_MUL}, {"DG_OP_DIV", DG_OP_DIV}, {"DG_OP_MOD", DG_OP_MOD},
         {"DG_OP_ADD", DG_OP_ADD}, {"DG_OP_SUB", DG_OP_SUB}, {"DG_OP_SHL", DG_OP_SHL}, {"DG_OP_SHR", DG_OP_SHR},
         {"DG_OP_LT", DG_OP_LT}, {"DG_OP_LE", DG_OP_LE}, {"DG_OP_GT", DG_OP_GT}, {"DG_OP_GE", DG_OP_GE},
         {"DG_OP_EQ", DG_OP_EQ}, {"DG_OP_NE", DG_OP_NE}, {"DG_OP_BITAND", DG_OP_BITAND},
@@ -174,6 +174,21 @@ TEST(ComputedEval, UndefinedWhenAFieldIsMissingOrIntegerDivisionByZero) {
     EXPECT_EQ(integer("{C} == 3 || {A} > 1", {{C, 3}}), 1);
     EXPECT_TRUE(undefined("{C} == 4 || {A} > 1", {{C, 3}}));
     EXPECT_TRUE(undefined("{A} > 1 || {C} == 3", {{C, 3}}));  // an undefined left decides nothing
+}
+
+TEST(ComputedEval, DefinedAsksWhetherAFieldWasDecoded) {
+    EXPECT_EQ(integer("defined({A})"), 1);
+    EXPECT_EQ(integer("defined({A})", {{C, 3}}), 0);  // A not decoded: 0, itself defined
+    EXPECT_EQ(integer("defined( {F} )"), 1);          // a float value's, an integer answer
+    EXPECT_EQ(integer("!defined({A}) + 2 * defined({C})", {{C, 3}}), 3);
+    EXPECT_EQ(integer("defined({A}) && {A} > 999"), 1);
+    EXPECT_EQ(integer("defined({A}) && {A} / 0", {{C, 3}}), 0);  // the left side decides
+    EXPECT_DOUBLE_EQ(real("defined({A}) * 0.5"), 0.5);
+    // a field only: a number, index or expression is an error, and so is a missing '('
+    EXPECT_NE(evaluate("defined(3)", kFields).error.find("asks about one field, {Name} or request{Name}: a number "
+                                                         "or index is always defined"), std::string::npos);
+    EXPECT_NE(evaluate("defined({A} + 1)", kFields).error.find("ask about that field"), std::string::npos);
+    EXPECT_NE(evaluate("defined {A}", kFields).error.find("expected '(' after 'defined'"), std::string::npos);
 }
 
 TEST(ComputedEval, RealsWhenADecimalTakesPart) {

@@ -153,6 +153,47 @@ TEST(Computed, RequestFieldsAreKeptOnceAndTheKeysPlaced) {
     EXPECT_TRUE(contains(code, "dg_op_field(DG_OP_REQUEST_FIELD_SIGNED, 0, 16)")) << code;
 }
 
+// Two request layouts that both hold a Reference: the bare name is an error
+// naming both; a path (containers' names, then the field's) reads one, also
+// when the first in the file is the other, and a node named with '/' is
+// still found by its name.
+Front paired_layouts(const std::string& reader) {
+    return front_end(
+        "<root name=\"Test\" abbreviation=\"TST\" byteorder=\"big\">\n"
+        "  <hook table=\"udp.port\" value=\"47502\"/>\n"
+        "  <pairing><key field=\"node[@name='Transaction']\"/></pairing>\n"
+        "  <node name=\"Transaction\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+        "  <node name=\"Read coils\" direction=\"request\">\n"
+        "    <node name=\"Reference\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
+        "  </node>\n"
+        "  <node name=\"Read registers\" direction=\"request\">\n"
+        "    <node name=\"Reference\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
+        "    <node name=\"Read/Write\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+        "  </node>\n"
+        "  <node name=\"Number\" value=\"" + reader + "\" direction=\"response\"/>\n"
+        "</root>\n");
+}
+
+TEST(Computed, AmbiguousRequestNamesAreErrorsAndPathsChoose) {
+    Front bare = paired_layouts("request{Reference}");
+    EXPECT_FALSE(bare.ok());
+    EXPECT_TRUE(contains(bare.messages(), "rules.xml:12: error: request{Reference} in the value of 'Number' is "
+                                          "ambiguous: 2 fields a request decodes fit it: 'Read coils/Reference' "
+                                          "(line 6), 'Read registers/Reference' (line 9); name one by its path, "
+                                          "e.g. request{Read coils/Reference}"))
+        << bare.messages();
+    Front path = paired_layouts("request{Read registers/Reference}");
+    ASSERT_TRUE(path.ok()) << path.messages();
+    ASSERT_EQ(path.proto->request_fields.size(), 1u);
+    EXPECT_EQ(path.proto->request_fields[0], path.proto->nodes[2]->children[0].get());
+    Front slash = paired_layouts("request{Read/Write}");
+    ASSERT_TRUE(slash.ok()) << slash.messages();
+    EXPECT_EQ(slash.proto->request_fields[0], slash.proto->nodes[2]->children[1].get());
+    Front wrong = paired_layouts("request{Read coil/Reference}");
+    EXPECT_TRUE(contains(wrong.messages(), "no node has that path (did you mean request{Read coils/Reference}?)"))
+        << wrong.messages();
+}
+
 TEST(Computed, ResolvesTheClosestEarlierFieldAndTypes) {
     Front f = front_end(rules(std::string(kHead) +
                               "  <node name=\"Temperature\" value=\"{Raw} * 0.1 - 40\"/>\n"

@@ -390,7 +390,7 @@ TEST(Conditions, InValuesMustFitTheFieldTheyTest) {
                               "  <node name=\"e\" length=\"1byte\"><when field=\"../node[@name='b']\" in=\"0x100\"/></node>\n"));
     const std::string m = f.messages();
     EXPECT_TRUE(f.ok()) << m;
-    EXPECT_TRUE(contains(m, "rules.xml:7: warning: 'in' value 0x8 does not fit the 3-bit field 'k' (line 2): it never matches")) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:7: warning: 'in' value 8 does not fit the 3-bit field 'k' (line 2): it never matches")) << m;
     EXPECT_TRUE(contains(m, "rules.xml:8: warning: 'in' value 0x100 does not fit the 8-bit field 'b' (line 4): it never matches")) << m;
     EXPECT_EQ(std::count(m.begin(), m.end(), '\n'), 2) << m;
 }

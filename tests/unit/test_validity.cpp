@@ -153,9 +153,14 @@ TEST(Validity, Diagnostics) {
     Front wide = front_end(rules("  <node name=\"Kind\" length=\"4bit\" displaytype=\"numberdec\" valid=\"3,8-20\"/>\n"
                                  "  <node name=\"Rest\" length=\"4bit\" displaytype=\"numberdec\"/>\n"));
     EXPECT_TRUE(wide.ok()) << wide.messages();
-    EXPECT_TRUE(contains(wide.messages(), "rules.xml:2: warning: 'valid' value 0x8-0x14 does not fit the 4-bit field "
-                                          "'Kind' (line 2): values above 0xf never match"))
+    EXPECT_TRUE(contains(wide.messages(), "rules.xml:2: warning: 'valid' value 8-20 does not fit the 4-bit field "
+                                          "'Kind' (line 2): values above 15 never match"))
         << wide.messages();
+    // echoed in the form written, not as 0x0-0x12c
+    Front decimal = front_end(rules("  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\" valid=\"0-300\"/>\n"));
+    EXPECT_TRUE(contains(decimal.messages(), "rules.xml:2: warning: 'valid' value 0-300 does not fit the 8-bit field "
+                                             "'Kind' (line 2): values above 255 never match"))
+        << decimal.messages();
 }
 
 }  // namespace
