@@ -911,6 +911,7 @@ std::string Emitter::extra_row(const Node& n) const {
     if (slot(n.overlay) >= 0) add("overlay", std::to_string(slot(n.overlay)));
     if (n.is_computed())
         add("value", std::to_string(l_.expr_span.at(&n).first) + ", " + std::to_string(l_.expr_span.at(&n).second));
+    if (slot(n.covers) >= 0) add("covers", std::to_string(slot(n.covers)));
     if (!n.findings.empty()) add("findings", std::to_string(l_.finding_first.at(&n)) + ", " + std::to_string(n.findings.size()));
     return named_row("dg_node_extra()", set);
 }

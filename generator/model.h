@@ -180,6 +180,7 @@ struct Node {
     // value="EXPR": a computed leaf, shown as a generated item; takes no bytes
     std::optional<Expr> value;
     std::string value_text;                 // as written, for messages
+    std::optional<FieldRef> covers;         // covers="XPATH": a computed value shown on that node's bytes
     // derived by the validator
     bool keeps_values = false;              // an offsets table: every instance's value is kept
     bool keeps_instances = false;           // request{...} reads it by position: each instance's value is kept

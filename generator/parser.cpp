@@ -45,7 +45,7 @@ const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displa
                                                   // two views of the same bytes
                                                   "overlay",
                                                   // computed values
-                                                  "value",
+                                                  "value", "covers",
                                                   // whose message it is
                                                   "valid"};
 const std::vector<std::string> kEnumAttributes = {"value", "name"};
@@ -550,6 +550,7 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
     }
     parse_length(attrs.count("length") ? attrs["length"] : "", node->line, *node, el);
     if (attrs.count("value")) parse_value(attrs["value"], node->line, *node);
+    if (attrs.count("covers")) node->covers = make_ref(attrs["covers"], node->line, "covers", false);
     parse_text_direction_handoff_attributes(attrs, node->line, *node);
     parse_layout_attributes(attrs, *node);
 
@@ -570,6 +571,7 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
     if (node->offsets) defer(*node->offsets, el, node->line, "offsets");
     if (node->from) defer(*node->from, el, node->line, "from");
     if (node->overlay) defer(*node->overlay, el, node->line, "overlay");
+    if (node->covers) defer(*node->covers, el, node->line, "covers");
     if (node->repeat) defer(*node->repeat, el, node->line, "repeat");
     if (node->count) defer(*node->count, el, node->line, "count");
     if (node->if_field) defer(*node->if_field, el, node->line, "if");

@@ -100,6 +100,7 @@ private:
     void check_peek(Node& n, When& w);
     void check_offsets(Node& n);  // offsets="XPATH" from="XPATH"
     void check_overlay(Node& n);  // overlay="XPATH"
+    void check_covers(Node& n);   // covers="XPATH" on a computed value
     bool known_before(const Node* t, const Node& n) const;
 
     Protocol& proto_;
@@ -127,6 +128,7 @@ void Validator::run() {
         check_layout(n);
         check_offsets(n);
         if (n.is_overlay()) check_overlay(n);
+        if (n.covers) check_covers(n);
         if (n.is_computed()) check_computed(n);
         if (n.unit_given) check_unit(n);  // after check_computed, which settles a computed value's display
         if (!n.findings.empty()) check_findings(n);
@@ -1217,6 +1219,35 @@ void Validator::check_overlay(Node& n) {
             }
         mark_slot(const_cast<Node*>(t));
     }
+}
+
+// covers="XPATH": the bytes of a node decoded before the computed value, in
+// its instance or outside every repeat; the runtime reads where they are
+// from the node's slot.
+void Validator::check_covers(Node& n) {
+    if (!n.is_computed()) {
+        diags_.error(n.line, "'covers' on " + quote(n) + ": only a computed value (value=\"...\") is shown on the "
+                                 "bytes of another node; a field has bytes of its own");
+        return;
+    }
+    const Node* t = n.covers->target;
+    if (!t) return;  // the parser already reported the XPath
+    const std::string what = "'covers' of " + quote(n) + " selects " + quote(*t) + at_line(*t);
+    if (t->doc_index >= n.doc_index || is_ancestor_or_self(t, &n)) {
+        diags_.error(n.line, what + ", which is not decoded before it; select an earlier field");
+        return;
+    }
+    if (t->is_computed()) {
+        diags_.error(n.line, what + ", a computed value: it has no bytes to show the value on");
+        return;
+    }
+    for (const Node* r = t; r; r = r->parent)
+        if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
+            diags_.error(n.line, what + ", inside repeated node " + quote(*r) + at_line(*r) + ", which does not contain " +
+                                     quote(n) + "; select a node of the same instance or one outside every repeat");
+            return;
+        }
+    mark_slot(const_cast<Node*>(t));
 }
 
 // Whether the value of t is known when n starts: decoded earlier, in the same

@@ -87,6 +87,7 @@ struct dg_extra_row {
     constexpr dg_extra_row &unit(const char *label) { e.unit = label; return *this; }
     constexpr dg_extra_row &overlay(gint16 target_slot) { e.overlay_slot = target_slot; return *this; }
     constexpr dg_extra_row &value(guint16 first, guint16 count) { e.expr_first = first; e.expr_count = count; return *this; }
+    constexpr dg_extra_row &covers(gint16 slot) { e.covers_slot = slot; return *this; }
     constexpr dg_extra_row &findings(guint16 first, guint16 count) {
         e.finding_first = first; e.finding_count = count; return *this;
     }

@@ -97,6 +97,9 @@ typedef struct dg_extra {
     gint16 overlay_slot = -1;
     /* value="EXPR": the operations dg_protocol.exprs[expr_first ..] */
     guint16 expr_first = 0, expr_count = 0;
+    /* covers="XPATH": the computed value's item is shown on the bytes of the
+     * node in covers_slot (decoded before it); -1: on none (a zero-length item) */
+    gint16 covers_slot = -1;
     /* <finding> children: dg_protocol.findings[finding_first ..], checked
      * once each instance of the node is decoded */
     guint16 finding_first = 0, finding_count = 0;

@@ -159,15 +159,20 @@ void dissect_computed(dg_state *st, const dg_node *n, proto_tree *tree, gint off
     if (v.is_float) memcpy(&bits, &v.real, sizeof bits);
     store(st, n, bits, offset, 0);
     if (!tree || !n->hf) return;
+    gint length = 0;
+    if (x->covers_slot >= 0 && st->present[x->covers_slot]) { /* on the bytes of the node it covers */
+        offset = st->slots[x->covers_slot].offset;
+        length = st->slots[x->covers_slot].length;
+    }
     proto_item *item;
     switch (n->show) {
     case DG_SHOW_FLOAT:
-        item = proto_tree_add_double(tree, *n->hf, st->tvb, offset, 0, v.real);
+        item = proto_tree_add_double(tree, *n->hf, st->tvb, offset, length, v.real);
         append_unit(n, item);
         break;
-    case DG_SHOW_BOOL: item = proto_tree_add_boolean(tree, *n->hf, st->tvb, offset, 0, v.integer != 0); break;
-    case DG_SHOW_HEX: case DG_SHOW_ENUM: item = proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, 0, bits); break;
-    default: item = proto_tree_add_int64(tree, *n->hf, st->tvb, offset, 0, v.integer); break;
+    case DG_SHOW_BOOL: item = proto_tree_add_boolean(tree, *n->hf, st->tvb, offset, length, v.integer != 0); break;
+    case DG_SHOW_HEX: case DG_SHOW_ENUM: item = proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, length, bits); break;
+    default: item = proto_tree_add_int64(tree, *n->hf, st->tvb, offset, length, v.integer); break;
     }
     proto_item_set_generated(item);
     if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);

@@ -145,3 +145,16 @@ TEST(FindingEmit, NothingOfItWithoutFindings) {
     const std::string code = emit_cpp(*f.proto, "t.xml");
     EXPECT_FALSE(contains(code, "finding")) << code;
 }
+
+// covers="XPATH": a computed value shown on another node's bytes (issue 40, item 4).
+TEST(Covers, KeepsWhereItsNodeIsAndEmitsItsSlot) {
+    Front f = front_end(rules("  <node name=\"Start\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"Value\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"Number\" value=\"{Start} + 1\" covers=\"../node[@name='Value']\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Node* value = find(*f.proto, "Value");
+    ASSERT_GE(value->slot, 0);  // its place is kept for the item
+    EXPECT_EQ(find(*f.proto, "Number")->covers->target, value);
+    const std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_TRUE(contains(code, ".covers(" + std::to_string(value->slot) + ")")) << code;
+}
