@@ -985,6 +985,10 @@ std::string list_fields(const Protocol& proto) {
         if (n.filter_name.empty()) return;
         out << n.filter_name << "\t" << field_type(n).type << "\t" << n.name << "\t" << kRulesSource << "\n";
     });
+    for_each_node(proto.nodes, [&](const Node& n) {  // <finding>s: expert infos, named by their text
+        for (const Finding& f : n.findings)
+            out << f.filter_name << "\tFT_NONE\t" << f.text << "\t" << kRulesSource << "\n";
+    });
     for (const NameGroup* g : name_groups_of(proto))
         for (const RuntimeName& n : g->names)
             if (n.kind == RuntimeName::Kind::Field || n.kind == RuntimeName::Kind::Expert)

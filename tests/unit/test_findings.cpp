@@ -139,6 +139,14 @@ TEST(FindingEmit, RegistersOneExpertPerFindingAndChecksItAfterItsNode) {
     EXPECT_TRUE(contains(code, "dg_op(DG_OP_NE)")) << code;
 }
 
+TEST(FindingEmit, FieldsListsEachFindingAsWiresharkRegistersIt) {
+    Front f = front_end(reply_with(kGood));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_TRUE(contains(list_fields(*f.proto),
+                         "tst.finding.error_status\tFT_NONE\tService {Service} failed: {Status} ({Note})\trules\n"))
+        << list_fields(*f.proto);
+}
+
 TEST(FindingEmit, NothingOfItWithoutFindings) {
     Front f = front_end(reply_with(""));
     ASSERT_TRUE(f.ok()) << f.messages();
