@@ -487,6 +487,30 @@ void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *off
     if (collect) summaries_end(st, n, &summaries);
 }
 
+/* --- findings from the rules ---------------------------------------------- */
+
+/* n's <finding>s, once an instance of it is decoded in [start, stop): each
+ * whose condition holds (defined and not zero: a field it reads that was not
+ * decoded keeps it quiet) is raised on those bytes, beside n's item, with its
+ * text built as a summary is. */
+void raise_findings(dg_state *st, const dg_node *n, proto_tree *tree, gint start, gint stop)
+{
+    const dg_protocol *p = st->p;
+    for (guint i = 0; i < n->extra->finding_count; i++) {
+        const dg_finding *f = &p->findings[n->extra->finding_first + i];
+        dg_expr_value v = dg_expr_eval(&p->exprs[f->expr_first], f->expr_count, read_slot, read_request, st,
+                                       st->instance);
+        if (!v.defined || (v.is_float ? v.real == 0.0 : v.integer == 0)) continue;
+        char buf[256];
+        dg_text text;
+        text_init(&text, st->pinfo->pool, buf, sizeof buf);
+        append_text_pieces(st, &text, f->text_first, f->text_count);
+        gint at = MIN(start, st->packet_end);
+        proto_tree_add_expert_format(tree, st->pinfo, f->ei, st->tvb, at, MAX(0, MIN(stop, st->packet_end) - at),
+                                     "%s", text.data);
+    }
+}
+
 /* --- overlays ------------------------------------------------------------ */
 
 /* overlay="XPATH": the container decodes the bytes of an earlier node,
@@ -500,6 +524,7 @@ void dissect_overlay(dg_state *st, const dg_node *n, proto_tree *tree, gboolean 
     const dg_slot *t = &st->slots[target];
     gint at = t->offset;
     dissect_container(st, n, tree, &at, t->offset + t->length, in_summary, NULL);
+    if (n->extra->finding_count) raise_findings(st, n, tree, t->offset, at);
 }
 
 /* --- lists of siblings --------------------------------------------------- */
@@ -526,30 +551,6 @@ void walk_list(dg_state *st, dg_list_walk walk, guint16 first, guint16 count, pr
         walk(st, tree, offset, end, in_summary);
     else
         dissect_list(st, first, count, tree, offset, end, in_summary);
-}
-
-/* --- findings from the rules ---------------------------------------------- */
-
-/* n's <finding>s, once an instance of it is decoded in [start, stop): each
- * whose condition holds (defined and not zero: a field it reads that was not
- * decoded keeps it quiet) is raised on those bytes, beside n's item, with its
- * text built as a summary is. */
-void raise_findings(dg_state *st, const dg_node *n, proto_tree *tree, gint start, gint stop)
-{
-    const dg_protocol *p = st->p;
-    for (guint i = 0; i < n->extra->finding_count; i++) {
-        const dg_finding *f = &p->findings[n->extra->finding_first + i];
-        dg_expr_value v = dg_expr_eval(&p->exprs[f->expr_first], f->expr_count, read_slot, read_request, st,
-                                       st->instance);
-        if (!v.defined || (v.is_float ? v.real == 0.0 : v.integer == 0)) continue;
-        char buf[256];
-        dg_text text;
-        text_init(&text, st->pinfo->pool, buf, sizeof buf);
-        append_text_pieces(st, &text, f->text_first, f->text_count);
-        gint at = MIN(start, st->packet_end);
-        proto_tree_add_expert_format(tree, st->pinfo, f->ei, st->tvb, at, MAX(0, MIN(stop, st->packet_end) - at),
-                                     "%s", text.data);
-    }
 }
 
 /* --- one message ----------------------------------------------------------- */

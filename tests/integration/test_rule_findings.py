@@ -4,7 +4,8 @@
 
 Random replies on ethertype 0x88b7, the faults put in by the test: a value
 above 1000 in some items, a status other than 0 in some replies, an odd count
-of values with status 0 in others. Each expert info must sit exactly on the
+of values with status 0 in others, the extended status's top bit (read by an
+overlay) in failed ones. Each expert info must sit exactly on the
 frames (and items) where its condition holds, with its text, severity and
 group, and nowhere else: in one pass and with -2, filterable by its name,
 counted by `tshark -z expert`. Needs no corpus.
@@ -50,6 +51,8 @@ def expected(service, values, status, extended):
     """[(finding, severity, group, text)] in tree order."""
     out = [("value_high", "Warning", "Protocol", "Item %d: value %d is above 1000" % (i + 1, v))
            for i, v in enumerate(values) if v > 1000]
+    if status != 0 and extended & 0x8000:  # on the overlay inside the reply, before the reply's own
+        out.append(("retry", "Error", "Sequence", "failed, retry advised"))
     if status != 0:
         name = STATUS_NAMES.get(status, "Unknown (0x%02x)" % status)
         out.append(("error_status", "Note", "Response code",
@@ -103,7 +106,7 @@ class TestRuleFindings(TsharkTestCase, unittest.TestCase):
     def test_each_finding_filters_and_counts(self):
         counts = collections.Counter(f for r in self.replies for f, *_ in expected(*r))
         with self.checks() as check:
-            for name in ("value_high", "error_status", "odd_count"):
+            for name in ("value_high", "error_status", "odd_count", "retry"):
                 for two_pass in (False, True):
                     args = ["-r", self.path, "-Y", "rfind.finding." + name, "-T", "fields", "-e", "frame.number"]
                     frames = self.env.tshark(args + (["-2"] if two_pass else [])).stdout.split()
@@ -111,7 +114,8 @@ class TestRuleFindings(TsharkTestCase, unittest.TestCase):
                     check(frames == want, "%s: -Y rfind.finding.%s keeps the %d frames with that fault" % (
                         "-2" if two_pass else "one pass", name, len(want)))
             out = self.env.tshark(["-r", self.path, "-q", "-z", "expert"]).stdout
-            for name, severity in (("value_high", "Warns"), ("error_status", "Notes"), ("odd_count", "Chats")):
+            for name, severity in (("value_high", "Warns"), ("error_status", "Notes"), ("odd_count", "Chats"),
+                                   ("retry", "Errors")):
                 section = re.search(r"\n%s \((\d+)\)\n" % severity, out)
                 check(section is not None and int(section.group(1)) == counts[name],
                       "-z expert counts %d %s (%s)" % (counts[name], severity, name))
