@@ -21,6 +21,8 @@ machine, so differences of a few percent show.
     pairing    base + <pairing> by transaction (the reference of request)
     request    pairing + request{...}: per register of a response, the number its
                request's start gives (request{Start} + index)
+    finding    base + two <finding>s: one checked on every register (value 0xffff: seldom
+               raised), one on the status word (a note in a quarter of the packets)
 
 Each row gives the instructions per packet that tshark spends in
 epan_dissect_run_with_taps (the dissection of a packet, from the frame through Ethernet,
@@ -61,6 +63,12 @@ def rules(kind):
            '  <node name="Count" length="1byte" displaytype="numberdec"/>\n' % valid]
     if kind == "computed":
         out.append('  <node name="Temperature" value="{Start} * 0.1 - 40" unit="°C"/>\n')
+    if kind == "finding":  # on the status word: raised when its two top bits are set
+        out[-1] = out[-1].replace(
+            '  <node name="Status" length="2byte" displaytype="numberhex"/>\n',
+            '  <node name="Status" length="2byte" displaytype="numberhex">\n'
+            '    <finding name="fault" severity="note" condition="{Status} &gt;= 0xc000" text="status {Status}"/>\n'
+            '  </node>\n')
     if kind == "overlay":
         out.append('  <node name="Status bits" filter="bits" overlay="../node[@name=\'Status\']">\n'
                    '    <node name="Ready" length="1bit" displaytype="bool"/>\n'
@@ -81,6 +89,10 @@ def rules(kind):
                    '  </node>\n')
     out.append('  <node name="Register" count="../node[@name=\'Count\']">\n'
                '    <node name="Value" length="2byte" displaytype="numberhex"/>\n')
+    if kind == "finding":
+        out[-1] = out[-1].replace('displaytype="numberhex"/>\n', 'displaytype="numberhex">\n'
+                                  '      <finding name="saturated" severity="warning" condition="{Value} == 0xffff"'
+                                  ' text="register value {Value}"/>\n    </node>\n')
     if kind == "computed":
         out.append('    <node name="Number" value="{Start} + index"/>\n')
     if kind == "request":
@@ -89,7 +101,7 @@ def rules(kind):
     return "".join(out)
 
 
-KINDS = ["base", "branch", "unused", "validity", "computed", "overlay", "pairing", "request"]
+KINDS = ["base", "branch", "unused", "validity", "computed", "overlay", "pairing", "request", "finding"]
 REFERENCE = {"request": "pairing", "unused": "branch"}
 
 

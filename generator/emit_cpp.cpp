@@ -3,6 +3,7 @@
 
 #include "analyses.h"
 #include "emit_validity.h"
+#include "findings.h"
 #include "quiet.h"
 #include "runtime_names.h"
 #include "text_util.h"
@@ -103,11 +104,15 @@ struct Layout {
     // computed values: each one's operations, in postfix order
     std::map<const Node*, std::pair<int, int>> expr_span;  // first, count
     std::vector<ExprRow> exprs;
+    // <finding>s in document order: their rows, and each node's first
+    std::vector<std::string> findings;
+    std::map<const Node*, int> finding_first;
     bool uses_layout_tables() const { return !whens.empty() || !windows.empty(); }
     bool node_uses_layout_columns(const Node& n) const { return when_first.count(&n) || window_index.count(&n) || n.otherwise; }
 };
 
 void layout_conditions_and_windows(Layout& l, const std::map<const Node*, uint64_t>& quiet);
+void layout_findings(Layout& l, const std::string& filter);
 
 std::string ident_for(const Protocol& proto, const Node& n) {
     std::string base = n.filter_name.empty() ? proto.filter + "_" + (n.segment.empty() ? n.name : n.segment)
@@ -165,7 +170,28 @@ Layout make_layout(const Protocol& proto, const std::map<const Node*, uint64_t>&
         l.expr_span[n] = {static_cast<int>(l.exprs.size()), static_cast<int>(rows.size())};
         l.exprs.insert(l.exprs.end(), rows.begin(), rows.end());
     }
+    layout_findings(l, proto.filter);
     return l;
+}
+
+// Each <finding>: its expert field, condition (after every computed value's
+// operations) and text (after every summary's pieces).
+void layout_findings(Layout& l, const std::string& filter) {
+    for (const Node* n : l.nodes) {
+        if (n->findings.empty()) continue;
+        l.finding_first[n] = static_cast<int>(l.findings.size());
+        for (const Finding& f : n->findings) {
+            std::vector<ExprRow> rows = compile_expression(f.condition, false);
+            const size_t expr_first = l.exprs.size(), text_first = l.pieces.size();
+            l.exprs.insert(l.exprs.end(), rows.begin(), rows.end());
+            for (const SummaryPiece& p : f.text_pieces)
+                l.pieces.push_back({p.text, p.leaf ? p.leaf->slot : -1, 0, -1, p.leaf});
+            l.findings.push_back("/* " + f.name + ", line " + std::to_string(f.line) + " */ { &" + filter +
+                                 "_finding_ei[" + std::to_string(l.findings.size()) + "], " +
+                                 std::to_string(expr_first) + ", " + std::to_string(rows.size()) + ", " +
+                                 std::to_string(text_first) + ", " + std::to_string(f.text_pieces.size()) + " }");
+        }
+    }
 }
 
 // A computed value's operation: its code, then what that code reads.
@@ -340,6 +366,7 @@ private:
     void protocol_struct();
     void register_functions();
     void expert_entries();
+    void finding_entries();
     // typed values, hand-off and reassembly (dg_extra)
     bool uses_reassembly() const;
     void extra_table();
@@ -484,6 +511,10 @@ void Emitter::condition_and_window_tables() {
     std::vector<std::string> exprs;
     for (const ExprRow& r : l_.exprs) exprs.push_back(expr_row(r));
     table("dg_expr_op", "exprs", exprs, "Computed values: their operations in postfix order");
+    if (l_.findings.empty()) return;
+    o_ << "/* <finding>s: expert info, condition (first, count in exprs), text (first, count in summary). */\n"
+       << "static expert_field " << p_.filter << "_finding_ei[" << l_.findings.size() << "];\n";
+    o_ << c_array("static const dg_finding " + p_.filter + "_findings", l_.findings);
 }
 
 void Emitter::node_table() {
@@ -678,6 +709,7 @@ std::string Emitter::protocol_row() const {
     table("places", l_.places);
     if (!l_.exprs.empty()) set.push_back("exprs(" + f + "_exprs)");
     if (p_.no_padding) set.push_back("no_padding()");
+    if (!l_.findings.empty()) set.push_back("findings(" + f + "_findings)");
     if (p_.pairing) set.push_back("pairing(&" + f + "_pairing)");
     if (p_.pairing && !p_.request_fields.empty()) set.push_back("request_context(&" + f + "_request_context)");
     if (extra_ && !extra_->analysis_data.empty()) set.push_back("analysis_data(&" + extra_->analysis_data + ")");
@@ -783,7 +815,23 @@ void Emitter::expert_entries() {
     for (size_t i = 0; i < experts.size(); ++i) {
         const RuntimeName& e = *experts[i];
         o_ << "        { &ei_" << f << "." << e.id << ", { " << c_string(f + "." + e.name) << ", " << e.group << ", "
-           << e.severity << ", " << c_string(e.label) << ", EXPFILL } }" << (i + 1 < experts.size() ? ",\n" : "\n");
+           << e.severity << ", " << c_string(e.label) << ", EXPFILL } }"
+           << (i + 1 < experts.size() || !l_.findings.empty() ? ",\n" : "\n");
+    }
+    finding_entries();
+}
+
+// The rule file's <finding>s, after the runtime's expert infos; the summary
+// is the text as written.
+void Emitter::finding_entries() {
+    std::vector<const Finding*> all;
+    for (const Node* n : l_.nodes)
+        for (const Finding& f : n->findings) all.push_back(&f);
+    for (size_t i = 0; i < all.size(); ++i) {
+        const Finding& f = *all[i];
+        o_ << "        { &" << p_.filter << "_finding_ei[" << i << "], { " << c_string(f.filter_name) << ", "
+           << group_constant(f.group) << ", " << severity_constant(f.severity) << ", " << c_string(f.text)
+           << ", EXPFILL } }" << (i + 1 < all.size() ? ",\n" : "\n");
     }
 }
 
@@ -822,7 +870,8 @@ bool needs_extra(const Node& n) {
     return (n.is_leaf() && (n.display == Display::String || n.display == Display::StringZ ||
                             n.display == Display::Time)) ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
-           n.keeps_values || n.keeps_instances || n.is_computed() || n.has_unit_label() || n.is_overlay();
+           n.keeps_values || n.keeps_instances || n.is_computed() || n.has_unit_label() || n.is_overlay() ||
+           !n.findings.empty();
 }
 
 void Emitter::extra_table() {
@@ -863,6 +912,8 @@ std::string Emitter::extra_row(const Node& n) const {
     if (slot(n.overlay) >= 0) add("overlay", std::to_string(slot(n.overlay)));
     if (n.is_computed())
         add("value", std::to_string(l_.expr_span.at(&n).first) + ", " + std::to_string(l_.expr_span.at(&n).second));
+    if (slot(n.covers) >= 0) add("covers", std::to_string(slot(n.covers)));
+    if (!n.findings.empty()) add("findings", std::to_string(l_.finding_first.at(&n)) + ", " + std::to_string(n.findings.size()));
     return named_row("dg_node_extra()", set);
 }
 
@@ -934,6 +985,10 @@ std::string list_fields(const Protocol& proto) {
     for_each_node(proto.nodes, [&](const Node& n) {
         if (n.filter_name.empty()) return;
         out << n.filter_name << "\t" << field_type(n).type << "\t" << n.name << "\t" << kRulesSource << "\n";
+    });
+    for_each_node(proto.nodes, [&](const Node& n) {  // <finding>s: expert infos, named by their text
+        for (const Finding& f : n.findings)
+            out << f.filter_name << "\tFT_NONE\t" << f.text << "\t" << kRulesSource << "\n";
     });
     for (const NameGroup* g : name_groups_of(proto))
         for (const RuntimeName& n : g->names)

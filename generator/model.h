@@ -83,6 +83,22 @@ struct When {
     unsigned target_up = 0;  // the target is a child of the node's k-th container (0: a sibling)
 };
 
+// <finding name="..." severity="..." group="..." condition="EXPR" text="..."/>
+// inside a node: an expert info raised on the node's bytes, once an instance
+// of it is decoded, when the condition holds (defined and not zero).
+struct Finding {
+    std::string name;        // segment of its filter name, P.finding.NAME
+    std::string severity;    // chat, note, warning, error (as written)
+    std::string group;       // protocol, malformed, sequence, ... (as written; default protocol)
+    Expr condition;
+    std::string condition_text;
+    std::string text;        // {Name}: the shown value of a field decoded before
+    int line = 0;
+    // derived by the validator
+    std::vector<SummaryPiece> text_pieces;
+    std::string filter_name;
+};
+
 struct Node {
     // --- as written ---
     std::string name;
@@ -147,6 +163,7 @@ struct Node {
     }
     // --- alternatives, multi-field conditions, look-ahead, register maps ---
     std::vector<When> whens;                // <when field|peek="XPATH" in="LIST"/> children, ANDed
+    std::vector<Finding> findings;          // <finding> children: expert infos the rules raise
     bool otherwise = false;                 // otherwise="true": member of the previous sibling's chain
     bool skip_malformed = false;            // malformed="skip": a malformed spot inside spoils only this container
     std::optional<FieldRef> base;           // base="XPATH [+-* N]": this container is a window
@@ -164,6 +181,7 @@ struct Node {
     // value="EXPR": a computed leaf, shown as a generated item; takes no bytes
     std::optional<Expr> value;
     std::string value_text;                 // as written, for messages
+    std::optional<FieldRef> covers;         // covers="XPATH": a computed value shown on that node's bytes
     // derived by the validator
     bool keeps_values = false;              // an offsets table: every instance's value is kept
     bool keeps_instances = false;           // request{...} reads it by position: each instance's value is kept

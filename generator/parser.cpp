@@ -45,13 +45,14 @@ const std::vector<std::string> kNodeAttributes = {"name",   "length",    "displa
                                                   // two views of the same bytes
                                                   "overlay",
                                                   // computed values
-                                                  "value",
+                                                  "value", "covers",
                                                   // whose message it is
                                                   "valid"};
 const std::vector<std::string> kEnumAttributes = {"value", "name"};
 const std::vector<std::string> kHookAttributes = {"table", "value"};
 const std::vector<std::string> kHeuristicAttributes = {"table", "enabled"};
 const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};
+const std::vector<std::string> kFindingAttributes = {"name", "severity", "group", "condition", "text"};
 const std::vector<std::string> kPairingAttributes = {"timeout", "analysis", "order"};
 const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
@@ -272,6 +273,7 @@ private:
     void defer_reassembly_refs(Node& node, xmlNode* el);
     bool parse_enum_range(const std::string& text, EnumItem& item);
     void parse_when(xmlNode* el, Node& node, xmlNode* node_el);
+    void parse_finding(xmlNode* el, Node& node);
     void parse_layout_attributes(std::map<std::string, std::string>& attrs, Node& node);
     void parse_pairing(xmlNode* el, Protocol& proto);
     void parse_length(const std::string& text, int line, Node& node, xmlNode* el);
@@ -557,6 +559,7 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
     }
     parse_length(attrs.count("length") ? attrs["length"] : "", node->line, *node, el);
     if (attrs.count("value")) parse_value(attrs["value"], node->line, *node);
+    if (attrs.count("covers")) node->covers = make_ref(attrs["covers"], node->line, "covers", false);
     parse_text_direction_handoff_attributes(attrs, node->line, *node);
     parse_layout_attributes(attrs, *node);
 
@@ -567,14 +570,17 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
             parse_enum(c, *node);
         else if (c->type == XML_ELEMENT_NODE && element_name(c) == "when")
             parse_when(c, *node, el);
+        else if (c->type == XML_ELEMENT_NODE && element_name(c) == "finding")
+            parse_finding(c, *node);
         else
-            unexpected_child(c, "node", {"node", "enum", "when"});
+            unexpected_child(c, "node", {"node", "enum", "when", "finding"});
     }
     for (When& w : node->whens) defer(w.ref, el, w.line, w.peek ? "peek" : "field");
     if (node->base) defer(*node->base, el, node->line, "base");
     if (node->offsets) defer(*node->offsets, el, node->line, "offsets");
     if (node->from) defer(*node->from, el, node->line, "from");
     if (node->overlay) defer(*node->overlay, el, node->line, "overlay");
+    if (node->covers) defer(*node->covers, el, node->line, "covers");
     if (node->repeat) defer(*node->repeat, el, node->line, "repeat");
     if (node->count) defer(*node->count, el, node->line, "count");
     if (node->if_field) defer(*node->if_field, el, node->line, "if");
@@ -623,6 +629,31 @@ void Parser::parse_when(xmlNode* el, Node& node, xmlNode*) {
     w.ref = make_ref(attrs[peek ? "peek" : "field"], w.line, peek ? "peek" : "field", false);
     if (!parse_value_list(attrs["in"], w.line, "in", w.in_list)) return;
     node.whens.push_back(std::move(w));
+}
+
+// <finding name="..." severity="..." [group="..."] condition="EXPR" text="..."/>;
+// the validator checks the words and the names the condition and text read.
+void Parser::parse_finding(xmlNode* el, Node& node) {
+    Finding f;
+    f.line = line_of(el);
+    auto attrs = attributes(el, kFindingAttributes);
+    for (xmlNode* c = el->children; c; c = c->next) unexpected_child(c, "finding", {});
+    for (const char* required : {"name", "severity", "condition", "text"})
+        if (!attrs.count(required)) {
+            diags_.error(f.line, std::string("<finding> needs a '") + required + "' attribute");
+            return;
+        }
+    f.name = attrs["name"];
+    f.severity = trim(attrs["severity"]);
+    f.group = attrs.count("group") ? trim(attrs["group"]) : "protocol";
+    f.condition_text = attrs["condition"];
+    std::string error;
+    if (!parse_expression(f.condition_text, f.condition, error)) {
+        diags_.error(f.line, "bad condition of finding '" + f.name + "' '" + excerpt(f.condition_text) + "': " + error);
+        return;
+    }
+    f.text = attrs["text"];
+    node.findings.push_back(std::move(f));
 }
 
 // Alternatives and register windows: otherwise="true", base="XPATH [op N]", at="ADDR", stride="N", instances="M".

@@ -11,6 +11,7 @@ namespace {
 // Whether decoding n matters to anything but its own (unseen) items.
 bool feeds_others(const Node& n, const std::function<bool(const Node&)>& is_key) {
     if (n.slot >= 0 || !n.summary_pieces.empty() || n.dissector || n.reassembles() || is_key(n)) return true;
+    if (!n.findings.empty()) return true;  // raises its expert infos
     for (const auto& c : n.children)
         if (feeds_others(*c, is_key)) return true;
     return false;

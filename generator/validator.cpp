@@ -2,6 +2,7 @@
 #include "validator.h"
 
 #include "expression.h"
+#include "findings.h"
 
 #include "runtime_names.h"
 #include "text_util.h"
@@ -57,13 +58,25 @@ private:
     void check_reference(Node& n, const FieldRef& ref, const std::string& what);
     void check_pdulength();
     void check_computed(Node& n);
+    // Where an expression is read: the node it belongs to, the fields it may
+    // read (doc_index below reach), the line and words of its messages.
+    struct ExprSite {
+        int reach;
+        int line;
+        std::string in;
+    };
     bool check_expr(Node& n, Expr& e);
+    bool check_expr(Node& n, Expr& e, const ExprSite& at);
+    const Node* find_before(int reach, const std::string& name);
+    // <finding>s: their words, names, condition and text (findings.h)
+    void check_findings(Node& n);
+    void parse_finding_text(Node& n, Finding& f, const ExprSite& at);
+    void name_findings();
     bool check_request_field(Node& n, Expr& e);
     const Node* request_field_target(const Node& n, const std::string& text, const std::string& what);
     bool check_defined(const Node& n, Expr& e);
     void check_request_keys();
     const Node* fixed_offset_blocker(const Node& n, uint64_t& offset) const;
-    const Node* find_earlier(const Node& n, const std::string& name);
     void check_validity();  // valid="LIST" fields and <heuristic>
     void check_pairing();
     void check_hook_list(const Node& n);
@@ -89,6 +102,7 @@ private:
     void check_peek(Node& n, When& w);
     void check_offsets(Node& n);  // offsets="XPATH" from="XPATH"
     void check_overlay(Node& n);  // overlay="XPATH"
+    void check_covers(Node& n);   // covers="XPATH" on a computed value
     bool known_before(const Node* t, const Node& n) const;
 
     Protocol& proto_;
@@ -116,8 +130,10 @@ void Validator::run() {
         check_layout(n);
         check_offsets(n);
         if (n.is_overlay()) check_overlay(n);
+        if (n.covers) check_covers(n);
         if (n.is_computed()) check_computed(n);
         if (n.unit_given) check_unit(n);  // after check_computed, which settles a computed value's display
+        if (!n.findings.empty()) check_findings(n);
     });
     check_pdulength();
     check_validity();
@@ -125,6 +141,7 @@ void Validator::run() {
     check_request_keys();
     runtime_names_ = name_groups_of(proto_);
     assign_filter_names(proto_.nodes, proto_.filter);
+    name_findings();
     assign_slots();
     if (!diags_.has_errors()) check_table_sizes();  // expressions compile only once every name resolved
 }
@@ -148,6 +165,7 @@ void Validator::check_table_sizes() {
         for (const When& w : n.whens) ranges += w.in_list.size();
         over(n, ranges, max_rows, "values in 'in', 'ifhook', 'valid' and <when> lists");
         if (n.is_computed()) operations += compile_expression(*n.value, n.display == Display::Float).size();
+        for (const Finding& f : n.findings) operations += compile_expression(f.condition, false).size();
         over(n, operations, max_rows, "operations in computed values");
         if (n.slot >= 0) over(n, static_cast<size_t>(n.slot) + 1, 32767, "fields whose values are read");
     });
@@ -653,12 +671,11 @@ void Validator::assign_slots() {
 
 // --- computed values ---------------------------------------------------------
 
-// The node named `name` closest above n in the file (the last one decoded
-// before it), or nullptr.
-const Node* Validator::find_earlier(const Node& n, const std::string& name) {
+// The node named `name` last in document order among the first reach - 1, or nullptr.
+const Node* Validator::find_before(int reach, const std::string& name) {
     const Node* found = nullptr;
     for_each_node(proto_.nodes, [&](Node& c) {
-        if (c.name == name && c.doc_index < n.doc_index) found = &c;
+        if (c.name == name && c.doc_index < reach) found = &c;
     });
     return found;
 }
@@ -690,46 +707,50 @@ void Validator::check_computed(Node& n) {
 // count, and types it: an operand that is a decimal or a float field makes
 // its operator work in double (comparisons and logic give 0 or 1).
 bool Validator::check_expr(Node& n, Expr& e) {
+    return check_expr(n, e, ExprSite{n.doc_index, n.line, " in the value of " + quote(n)});
+}
+
+bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
     bool ok = true;
-    for (Expr& a : e.args) ok = check_expr(n, a) && ok;
+    for (Expr& a : e.args) ok = check_expr(n, a, at) && ok;
     if (!ok) return false;
-    const std::string in = " in the value of " + quote(n);
+    const std::string& in = at.in;
     switch (e.op) {
     case ExprOp::Int: return true;
     case ExprOp::Float: e.is_float = true; return true;
     case ExprOp::Index:
         for (const Node* r = &n; r; r = r->parent)
             if (r->is_repeated()) return true;
-        diags_.error(n.line, "'index'" + in + ": it is not inside a repeated node, so there is no instance to count");
+        diags_.error(at.line, "'index'" + in + ": it is not inside a repeated node, so there is no instance to count");
         return false;
     case ExprOp::RequestField: return check_request_field(n, e);
     case ExprOp::Defined: return check_defined(n, e);
     case ExprOp::Field: {
-        const Node* t = find_earlier(n, e.name);
+        const Node* t = find_before(at.reach, e.name);
         if (!t) {
             const Node* later = nullptr;
             for_each_node(proto_.nodes, [&](Node& c) { if (!later && c.name == e.name) later = &c; });
             if (later) {
-                diags_.error(n.line, "{" + e.name + "}" + in + " is " + quote(*later) + at_line(*later) +
+                diags_.error(at.line, "{" + e.name + "}" + in + " is " + quote(*later) + at_line(*later) +
                                          ", which comes after it; a value reads fields decoded before it");
                 return false;
             }
             std::vector<std::string> names;
-            for_each_node(proto_.nodes, [&](Node& c) { if (c.doc_index < n.doc_index) names.push_back(c.name); });
+            for_each_node(proto_.nodes, [&](Node& c) { if (c.doc_index < at.reach) names.push_back(c.name); });
             const std::string near = closest_match(e.name, names);
-            diags_.error(n.line, "{" + e.name + "}" + in + ": no node of that name comes before it" +
+            diags_.error(at.line, "{" + e.name + "}" + in + ": no node of that name comes before it" +
                                      (near.empty() ? "" : " (did you mean {" + near + "}?)"));
             return false;
         }
         if (!t->is_numeric() && !(t->is_computed() && t->display == Display::Float)) {
-            diags_.error(n.line, "{" + e.name + "}" + in + " is " + quote(*t) + at_line(*t) +
+            diags_.error(at.line, "{" + e.name + "}" + in + " is " + quote(*t) + at_line(*t) +
                                      ", which is not numeric: it must be a leaf of 1-64 bits shown as a number, "
                                      "or a computed value");
             return false;
         }
         for (const Node* r = t; r; r = r->parent)
             if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
-                diags_.error(n.line, "{" + e.name + "}" + in + " is inside repeated node " + quote(*r) + at_line(*r) +
+                diags_.error(at.line, "{" + e.name + "}" + in + " is inside repeated node " + quote(*r) + at_line(*r) +
                                          ", which does not contain " + quote(n) +
                                          "; use a field of the same instance or one outside every repeat");
                 return false;
@@ -745,7 +766,7 @@ bool Validator::check_expr(Node& n, Expr& e) {
     bool any_float = false;
     for (const Expr& a : e.args) any_float = any_float || a.is_float;
     if (any_float && expr_op_needs_integers(e.op)) {
-        diags_.error(n.line, std::string("operator '") + expr_op_text(e.op) + "'" + in +
+        diags_.error(at.line, std::string("operator '") + expr_op_text(e.op) + "'" + in +
                                  " needs integers; an operand is a decimal or a float field");
         return false;
     }
@@ -1289,6 +1310,35 @@ void Validator::check_overlay(Node& n) {
     }
 }
 
+// covers="XPATH": the bytes of a node decoded before the computed value, in
+// its instance or outside every repeat; the runtime reads where they are
+// from the node's slot.
+void Validator::check_covers(Node& n) {
+    if (!n.is_computed()) {
+        diags_.error(n.line, "'covers' on " + quote(n) + ": only a computed value (value=\"...\") is shown on the "
+                                 "bytes of another node; a field has bytes of its own");
+        return;
+    }
+    const Node* t = n.covers->target;
+    if (!t) return;  // the parser already reported the XPath
+    const std::string what = "'covers' of " + quote(n) + " selects " + quote(*t) + at_line(*t);
+    if (t->doc_index >= n.doc_index || is_ancestor_or_self(t, &n)) {
+        diags_.error(n.line, what + ", which is not decoded before it; select an earlier field");
+        return;
+    }
+    if (t->is_computed()) {
+        diags_.error(n.line, what + ", a computed value: it has no bytes to show the value on");
+        return;
+    }
+    for (const Node* r = t; r; r = r->parent)
+        if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
+            diags_.error(n.line, what + ", inside repeated node " + quote(*r) + at_line(*r) + ", which does not contain " +
+                                     quote(n) + "; select a node of the same instance or one outside every repeat");
+            return;
+        }
+    mark_slot(const_cast<Node*>(t));
+}
+
 // Whether the value of t is known when n starts: decoded earlier, in the same
 // repeat instance or outside every repeat.
 bool Validator::known_before(const Node* t, const Node& n) const {
@@ -1444,6 +1494,91 @@ bool is_valid_filter_segment(const std::string& s) {
 bool validate(Protocol& proto, Diagnostics& diags) {
     Validator(proto, diags).run();
     return !diags.has_errors();
+}
+
+// --- findings from the rules -------------------------------------------------
+
+// A finding is checked once its node is decoded: its condition and text read
+// the node itself, what is inside it and what comes before it.
+void Validator::check_findings(Node& n) {
+    int reach = n.doc_index + 1;
+    for_each_node(n.children, [&](Node& c) { reach = std::max(reach, c.doc_index + 1); });
+    for (Finding& f : n.findings) {
+        const std::string what = "finding '" + f.name + "'";
+        if (severity_constant(f.severity).empty()) {
+            const std::string near = closest_match(f.severity, severity_names());
+            diags_.error(f.line, "unknown severity '" + f.severity + "' of " + what + "; use chat, note, warning or error" +
+                                     (near.empty() ? "" : " (did you mean '" + near + "'?)"));
+        }
+        if (group_constant(f.group).empty()) {
+            std::string all;
+            for (const std::string& g : group_names()) all += (all.empty() ? "" : ", ") + g;
+            const std::string near = closest_match(f.group, group_names());
+            diags_.error(f.line, "unknown group '" + f.group + "' of " + what + "; use one of " + all +
+                                     (near.empty() ? "" : " (did you mean '" + near + "'?)"));
+        }
+        const ExprSite at{reach, f.line, " in the condition of " + what};
+        if (check_expr(n, f.condition, at) && f.condition.is_float)
+            diags_.error(f.line, "the condition of " + what + " is a real number; compare it (" + f.condition_text +
+                                     " != 0) to say when the finding holds");
+        parse_finding_text(n, f, ExprSite{reach, f.line, " in the text of " + what});
+    }
+}
+
+// The text: literal pieces and {Name}, the shown value of the field Name as
+// a value reads it (the last one of that name the finding can see).
+void Validator::parse_finding_text(Node& n, Finding& f, const ExprSite& at) {
+    const std::string& s = f.text;
+    for (size_t i = 0; i < s.size();) {
+        size_t open = s.find('{', i);
+        if (open == std::string::npos) {
+            f.text_pieces.push_back({s.substr(i), nullptr});
+            return;
+        }
+        if (open > i) f.text_pieces.push_back({s.substr(i, open - i), nullptr});
+        size_t close = s.find('}', open);
+        if (close == std::string::npos) {
+            diags_.error(at.line, "'{' without '}'" + at.in);
+            return;
+        }
+        const std::string name = s.substr(open + 1, close - open - 1);
+        const Node* t = find_before(at.reach, name);
+        if (!t || t->is_container()) {
+            diags_.error(at.line, "{" + name + "}" + at.in + ": no field of that name is decoded before it");
+            return;
+        }
+        for (const Node* r = t; r; r = r->parent)
+            if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
+                diags_.error(at.line, "{" + name + "}" + at.in + " is inside repeated node " + quote(*r) + at_line(*r) +
+                                          ", which does not contain " + quote(n));
+                return;
+            }
+        f.text_pieces.push_back({"", const_cast<Node*>(t)});
+        mark_slot(const_cast<Node*>(t));
+        i = close + 1;
+    }
+}
+
+// Filter names P.finding.NAME: a lowercase segment, each once, and no field's.
+void Validator::name_findings() {
+    std::map<std::string, int> seen;
+    for_each_node(proto_.nodes, [&](Node& n) {
+        for (Finding& f : n.findings) {
+            if (f.name.empty() || !std::islower(static_cast<unsigned char>(f.name[0])) ||
+                f.name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") != std::string::npos) {
+                diags_.error(f.line, "bad finding name '" + f.name + "': it is a filter-name segment, [a-z][a-z0-9_]*");
+                continue;
+            }
+            f.filter_name = proto_.filter + ".finding." + f.name;
+            auto [it, inserted] = seen.emplace(f.name, f.line);
+            if (!inserted)
+                diags_.error(f.line, "duplicate finding name '" + f.name + "' (also line " + std::to_string(it->second) +
+                                         ")");
+            else if (auto owner = filter_owner_.find(f.filter_name); owner != filter_owner_.end())
+                diags_.error(f.line, "finding '" + f.name + "' is filtered as '" + f.filter_name + "', the name of " +
+                                         quote(*owner->second) + at_line(*owner->second) + "; rename one of them");
+        }
+    });
 }
 
 }  // namespace dissgen

@@ -87,6 +87,10 @@ struct dg_extra_row {
     constexpr dg_extra_row &unit(const char *label) { e.unit = label; return *this; }
     constexpr dg_extra_row &overlay(gint16 target_slot) { e.overlay_slot = target_slot; return *this; }
     constexpr dg_extra_row &value(guint16 first, guint16 count) { e.expr_first = first; e.expr_count = count; return *this; }
+    constexpr dg_extra_row &covers(gint16 slot) { e.covers_slot = slot; return *this; }
+    constexpr dg_extra_row &findings(guint16 first, guint16 count) {
+        e.finding_first = first; e.finding_count = count; return *this;
+    }
 };
 
 /* UTF-8 strings, times in nanoseconds, no reassembly. */
@@ -146,6 +150,7 @@ struct dg_protocol_row {
     constexpr dg_protocol_row &analysis_data(const void *v) { p.analysis_data = v; return *this; }
     constexpr dg_protocol_row &exprs(const dg_expr_op *v) { p.exprs = v; return *this; }
     constexpr dg_protocol_row &request_context(const dg_request_context *v) { p.request_context = v; return *this; }
+    constexpr dg_protocol_row &findings(const dg_finding *v) { p.findings = v; return *this; }
     constexpr dg_protocol_row &top_walk(dg_list_walk fn) { p.top_walk = fn; return *this; }
     constexpr dg_protocol_row &no_padding() { p.no_padding = 1; return *this; }
 };

@@ -97,7 +97,22 @@ typedef struct dg_extra {
     gint16 overlay_slot = -1;
     /* value="EXPR": the operations dg_protocol.exprs[expr_first ..] */
     guint16 expr_first = 0, expr_count = 0;
+    /* covers="XPATH": the computed value's item is shown on the bytes of the
+     * node in covers_slot (decoded before it); -1: on none (a zero-length item) */
+    gint16 covers_slot = -1;
+    /* <finding> children: dg_protocol.findings[finding_first ..], checked
+     * once each instance of the node is decoded */
+    guint16 finding_first = 0, finding_count = 0;
 } dg_extra;
+
+/* A <finding>: the expert info `ei` is raised on the node's bytes when the
+ * condition dg_protocol.exprs[expr_first ..] is defined and not zero; its
+ * text is the summary pieces dg_protocol.pieces[text_first ..]. */
+typedef struct dg_finding {
+    expert_field *ei;
+    guint16 expr_first, expr_count;
+    guint16 text_first, text_count;
+} dg_finding;
 
 /* The most entries an offset table may have; longer ones are malformed. */
 #define DG_MAX_TABLE 1024
@@ -306,6 +321,8 @@ typedef struct dg_protocol {
     /* request{...}: NULL when no value reads the paired request. Generated
      * code gives it only for protocols that use it. */
     const dg_request_context *request_context = nullptr;
+    /* <finding>s, addressed by dg_extra.finding_first/count; NULL when none */
+    const dg_finding *findings = nullptr;
     dg_list_walk top_walk = nullptr; /* the top-level nodes, compiled (NULL: the table walk) */
     /* padding="none": zero bytes a length leaves over are not padding but
      * P.expert.unused, like any others. Generated code gives it only when set. */

@@ -160,6 +160,8 @@ const char *summary_text(const dg_state *st, const dg_node *n);
 /* Appends a leaf's value as its tree item shows it, with its unit label (a
  * compiled summary's value). */
 void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s);
+/* Appends the summary pieces [first, first + count): a <finding>'s text. */
+void append_text_pieces(const dg_state *st, dg_text *out, guint first, guint count);
 
 void info_append(dg_state *st, const char *text, gsize len);
 

@@ -206,6 +206,12 @@ void info_separate(dg_state *st)
 
 namespace dg_rt {
 
+/* A <finding>'s text (dg_finding.text_first/count): the pieces as a summary has them. */
+void append_text_pieces(const dg_state *st, dg_text *out, guint first, guint count)
+{
+    append_pieces(st, out, first, count);
+}
+
 void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s)
 {
     append_bare_value(st, out, s);

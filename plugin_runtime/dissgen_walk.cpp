@@ -159,15 +159,20 @@ void dissect_computed(dg_state *st, const dg_node *n, proto_tree *tree, gint off
     if (v.is_float) memcpy(&bits, &v.real, sizeof bits);
     store(st, n, bits, offset, 0);
     if (!tree || !n->hf) return;
+    gint length = 0;
+    if (x->covers_slot >= 0 && st->present[x->covers_slot]) { /* on the bytes of the node it covers */
+        offset = st->slots[x->covers_slot].offset;
+        length = st->slots[x->covers_slot].length;
+    }
     proto_item *item;
     switch (n->show) {
     case DG_SHOW_FLOAT:
-        item = proto_tree_add_double(tree, *n->hf, st->tvb, offset, 0, v.real);
+        item = proto_tree_add_double(tree, *n->hf, st->tvb, offset, length, v.real);
         append_unit(n, item);
         break;
-    case DG_SHOW_BOOL: item = proto_tree_add_boolean(tree, *n->hf, st->tvb, offset, 0, v.integer != 0); break;
-    case DG_SHOW_HEX: case DG_SHOW_ENUM: item = proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, 0, bits); break;
-    default: item = proto_tree_add_int64(tree, *n->hf, st->tvb, offset, 0, v.integer); break;
+    case DG_SHOW_BOOL: item = proto_tree_add_boolean(tree, *n->hf, st->tvb, offset, length, v.integer != 0); break;
+    case DG_SHOW_HEX: case DG_SHOW_ENUM: item = proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, length, bits); break;
+    default: item = proto_tree_add_int64(tree, *n->hf, st->tvb, offset, length, v.integer); break;
     }
     proto_item_set_generated(item);
     if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
@@ -482,6 +487,30 @@ void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *off
     if (collect) summaries_end(st, n, &summaries);
 }
 
+/* --- findings from the rules ---------------------------------------------- */
+
+/* n's <finding>s, once an instance of it is decoded in [start, stop): each
+ * whose condition holds (defined and not zero: a field it reads that was not
+ * decoded keeps it quiet) is raised on those bytes, beside n's item, with its
+ * text built as a summary is. */
+void raise_findings(dg_state *st, const dg_node *n, proto_tree *tree, gint start, gint stop)
+{
+    const dg_protocol *p = st->p;
+    for (guint i = 0; i < n->extra->finding_count; i++) {
+        const dg_finding *f = &p->findings[n->extra->finding_first + i];
+        dg_expr_value v = dg_expr_eval(&p->exprs[f->expr_first], f->expr_count, read_slot, read_request, st,
+                                       st->instance);
+        if (!v.defined || (v.is_float ? v.real == 0.0 : v.integer == 0)) continue;
+        char buf[256];
+        dg_text text;
+        text_init(&text, st->pinfo->pool, buf, sizeof buf);
+        append_text_pieces(st, &text, f->text_first, f->text_count);
+        gint at = MIN(start, st->packet_end);
+        proto_tree_add_expert_format(tree, st->pinfo, f->ei, st->tvb, at, MAX(0, MIN(stop, st->packet_end) - at),
+                                     "%s", text.data);
+    }
+}
+
 /* --- overlays ------------------------------------------------------------ */
 
 /* overlay="XPATH": the container decodes the bytes of an earlier node,
@@ -495,6 +524,7 @@ void dissect_overlay(dg_state *st, const dg_node *n, proto_tree *tree, gboolean 
     const dg_slot *t = &st->slots[target];
     gint at = t->offset;
     dissect_container(st, n, tree, &at, t->offset + t->length, in_summary, NULL);
+    if (n->extra->finding_count) raise_findings(st, n, tree, t->offset, at);
 }
 
 /* --- lists of siblings --------------------------------------------------- */
@@ -669,10 +699,12 @@ void dissect_node(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
 void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
                       gboolean in_summary, dg_summaries *sink)
 {
+    const gint start = *offset;
     if (n->kind == DG_LEAF)
         dissect_leaf(st, n, tree, offset, end);
     else
         dissect_container(st, n, tree, offset, end, in_summary, sink);
+    if (n->extra && n->extra->finding_count) raise_findings(st, n, tree, start, *offset);
 }
 
 } // namespace dg_rt

@@ -131,6 +131,21 @@ class TestComputed(TsharkTestCase, unittest.TestCase):
                     if f[1] != 2 and c_div(f[0], f[1] - 2) == 0]
             check(filtered == want, "computed fields filter like any field (%d frames)" % len(want))
 
+    def test_covers_shows_a_value_on_the_bytes_it_names(self):
+        """Register (covers="../node[@name='Value']") sits on its register's two bytes;
+        a value without covers takes none."""
+        pdml = self.env.tshark(["-r", self.path, "-T", "pdml", "-c", "30"]).stdout
+        places = re.findall(r'<field name="(calc\.registers\.(?:value|register)|calc\.ratio)"[^>]*? size="(\d+)" pos="(\d+)"',
+                            pdml)
+        pairs = [(places[i], places[i + 1]) for i in range(len(places) - 1)
+                 if places[i][0] == "calc.registers.value" and places[i + 1][0] == "calc.registers.register"]
+        with self.checks() as check:
+            check(len(pairs) >= 20, "%d registers in the first 30 frames" % len(pairs))
+            check(all(v[1:] == r[1:] == ("2", v[2]) for v, r in pairs),
+                  "every [Register] has its Value's position and 2 bytes")
+            check(all(size == "0" for name, size, _ in places if name == "calc.ratio"),
+                  "a value without covers is zero-length")
+
 
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])

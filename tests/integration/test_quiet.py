@@ -296,6 +296,12 @@ def quiet_bits_frames():
     return out
 
 
+def rule_findings_frames():
+    """tests/rules/findings.xml: test_rule_findings.py's replies, faulty and clean."""
+    import test_rule_findings as m
+    return [m.ethernet_frame(m.body(*r)) for r in m.replies(41, 40)]
+
+
 def overlays_frames():
     """tests/rules/overlays.xml: test_overlays.py's messages, well-formed and malformed."""
     import test_overlays as m
@@ -372,6 +378,7 @@ CAPTURES = {
     "tests/rules/request_path.xml": request_path_frames,
     "tests/rules/request_defined.xml": request_defined_frames,
     "tests/rules/no_padding.xml": no_padding_frames,
+    "tests/rules/findings.xml": rule_findings_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,

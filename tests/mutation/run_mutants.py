@@ -111,6 +111,7 @@ TESTS = {
     "corpus_differential": corpus_differential,
     "transactions": integration("test_transactions.py"),
     "computed": integration("test_computed.py"),
+    "rule_findings": integration("test_rule_findings.py"),
     "overlays": integration("test_overlays.py"),
     "request_context": integration("test_request_context.py"),
     "request_by_position": integration("test_request_context.py", "TestRequestByPosition"),
