@@ -1,15 +1,12 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "analyses.h"
 
+#include "runtime_list.h"
+
 namespace dissgen {
 
 const std::vector<Analysis>& analyses() {
-    static const std::vector<Analysis> list = {
-        // What an EtherCAT slave controller does to a frame, and the bus model
-        // (plugin_runtime/ethercat/).
-        {"ethercat-esc", "dg_ethercat_esc", {"ethercat/ethercat_esc.cpp", "ethercat/ethercat_bus.cpp", "ethercat/ethercat_cycles.cpp"}},
-    };
-    return list;
+    return runtime_list().analyses;
 }
 
 const Analysis* find_analysis(const std::string& name) {
@@ -18,8 +15,12 @@ const Analysis* find_analysis(const std::string& name) {
     return nullptr;
 }
 
+const Analysis* analysis_of(const Protocol& proto) {
+    return proto.pairing ? find_analysis(proto.pairing->analysis) : nullptr;
+}
+
 std::vector<std::string> analysis_runtime_sources(const Protocol& proto) {
-    const Analysis* a = proto.pairing ? find_analysis(proto.pairing->analysis) : nullptr;
+    const Analysis* a = analysis_of(proto);
     return a ? a->runtime_sources : std::vector<std::string>{};
 }
 

@@ -2,7 +2,8 @@
 // The protocol analyses a rule file can name with <pairing analysis="...">.
 // Each lives in its own folder of plugin_runtime/ (its dg_analysis object and
 // the sources that define it) and, when it reads more input than the rule
-// file, of generator/. Adding one: its folders and one entry in analyses.cpp.
+// file, of generator/. Adding one: its folders and its entry in
+// plugin_runtime/runtime.list (runtime_list.h), which lists the analyses.
 #pragma once
 
 #include <string>
@@ -16,13 +17,17 @@ struct Analysis {
     std::string name;                          // the rule file's <pairing analysis="...">
     std::string symbol;                        // its dg_analysis object in the runtime
     std::vector<std::string> runtime_sources;  // relative to the runtime folder
+    std::vector<std::string> runtime_headers;  // likewise
 };
 
-// Every analysis, in registration order.
+// Every analysis, in the order of plugin_runtime/runtime.list.
 const std::vector<Analysis>& analyses();
 
 // The analysis called `name`, or nullptr.
 const Analysis* find_analysis(const std::string& name);
+
+// The analysis `proto`'s pairing names, or nullptr.
+const Analysis* analysis_of(const Protocol& proto);
 
 // The runtime sources a plugin of `proto` compiles beyond the generic runtime:
 // those of the analysis its pairing names, none without one.

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "runtime_list.h"
 #include "wireshark_env.h"
 
 namespace fs = std::filesystem;
@@ -25,15 +26,11 @@ std::vector<std::string> split_words(const std::string& s) {
     return words;
 }
 
-// The generic runtime's sources, compiled into every plugin; an analysis's
-// own come from the request (BuildRequest::analysis_sources).
-const char* const kRuntimeSources[] = {"dissgen_walk.cpp",    "dissgen_conditions.cpp", "dissgen_text.cpp",
-                                       "dissgen_handoff.cpp", "dissgen_register.cpp",   "dissgen_pairing.cpp",
-                                       "dissgen_expr.cpp", "dissgen_validity.cpp", "dissgen_request.cpp"};
-
+// The generic runtime's sources (runtime.list) are compiled into every plugin;
+// an analysis's own come from the request (BuildRequest::analysis_sources).
 bool has_runtime(const fs::path& dir) {
     std::error_code ec;
-    for (const char* source : kRuntimeSources)
+    for (const std::string& source : runtime_list().sources)
         if (!fs::exists(dir / source, ec)) return false;
     return fs::exists(dir / "dissgen_runtime.h", ec);
 }
@@ -94,16 +91,16 @@ std::string build_and_install(const BuildRequest& req, std::string& installed_pa
         return "pkg-config cannot find Wireshark's development files: install libwireshark-dev";
 
     const char* cxx = std::getenv("CXX");
-    // -fno-plt: the walk calls Wireshark's API for every field; through the GOT
-    // that is one indirect call instead of a call and an indirect jump.
-    std::vector<std::string> cmd = {cxx && *cxx ? cxx : "c++", "-std=c++17", "-O2", "-fPIC", "-fno-plt", "-shared",
-                                    "-DWS_BUILD_DLL", "-Werror=attributes", "-I" + req.runtime_dir};
+    std::vector<std::string> cmd = {cxx && *cxx ? cxx : "c++", "-std=c++17", "-O2", "-fPIC", "-shared"};
+    const RuntimeList& runtime = runtime_list();
+    cmd.insert(cmd.end(), runtime.flags.begin(), runtime.flags.end());
+    cmd.push_back("-I" + req.runtime_dir);
     for (const std::string& w : split_words(cflags)) cmd.push_back(w);
     // Extra flags, e.g. -fsanitize=address,undefined for the sanitizer test runs.
     if (const char* extra = std::getenv("DISSGEN_CXXFLAGS"))
         for (const std::string& w : split_words(extra)) cmd.push_back(w);
     cmd.push_back(source.string());
-    for (const char* runtime_source : kRuntimeSources) cmd.push_back(req.runtime_dir + "/" + runtime_source);
+    for (const std::string& runtime_source : runtime.sources) cmd.push_back(req.runtime_dir + "/" + runtime_source);
     for (const std::string& extra : req.analysis_sources) cmd.push_back(req.runtime_dir + "/" + extra);
     cmd.push_back("-o");
     cmd.push_back(output.string());

@@ -8,6 +8,7 @@
 //                                          generate, build and install the plugin
 //   dissgen esi PATH...                    list the device catalogue of ESI files
 //   dissgen report CAPTURE... -o FILE.html timing report of an EtherCAT capture
+//   dissgen sources [FILE.xml]             the runtime files and compile options of a plugin
 // check, generate, fields and install take --esi PATH (repeatable),
 // --network FILE and --compact: the catalogue and the designed network are
 // embedded into the plugin.
@@ -30,6 +31,7 @@
 #include "report/capture_stream.h"
 #include "report/ethercat/report_page.h"
 #include "report/ethercat/timing_model.h"
+#include "runtime_list.h"
 #include "runtime_names.h"
 #include "validator.h"
 #include "wireshark_env.h"
@@ -49,6 +51,7 @@ const char kUsage[] =
     "       dissgen install FILE.xml [--dir DIR | --system]\n"
     "       dissgen esi PATH...\n"
     "       dissgen report CAPTURE... -o FILE.html [--rules FILE.xml]\n"
+    "       dissgen sources [FILE.xml]\n"
     "       dissgen --help | --version\n"
     "  check, generate, fields, install and report also take [--esi PATH]... [--network FILE] [--compact]\n"
     "\n"
@@ -66,6 +69,9 @@ const char kUsage[] =
     "            self-contained HTML page: cycles, periods, jitter, round trips, lost frames,\n"
     "            working-counter errors, the slaves' AL states, the network check; several\n"
     "            captures (a ring-buffer file set of dumpcap, in order) report as one\n"
+    "  sources   what a plugin of the rule file (without one: of any rule file) is built\n"
+    "            from: a line 'flags OPTION...', then 'source PATH' and 'header PATH' lines,\n"
+    "            paths relative to the runtime folder (share/dissgen/runtime)\n"
     "\n"
     "options:\n"
     "  -o DIR          generate: the folder to write into; report: the HTML file\n"
@@ -333,6 +339,23 @@ std::string build_report_plugin(const std::string& rules, BusInput& bus, const s
     return root;
 }
 
+// The runtime files and compile options of a plugin of `path` ("" for every
+// analysis): plugin_runtime/runtime.list, as dissgen compiles it.
+int cmd_sources(const std::string& path) {
+    std::vector<const Analysis*> wanted;
+    if (path.empty()) {
+        for (const Analysis& a : analyses()) wanted.push_back(&a);
+    } else {
+        Diagnostics diags;
+        Loaded l = load(path, diags);
+        print(diags, path);
+        if (!l.ok) return 1;
+        if (const Analysis* a = analysis_of(*l.proto)) wanted.push_back(a);
+    }
+    std::cout << runtime_files_text(runtime_list(), wanted);
+    return 0;
+}
+
 int cmd_report(const std::vector<std::string>& captures, const std::string& out_path, std::string rules, BusInput& bus,
                const std::string& argv0) {
     CaptureStream stream;
@@ -446,6 +469,14 @@ int main(int argc, char** argv) {
             return 2;
         }
         return cmd_report(files, out_dir, rules, bus, argv[0]);
+    }
+    if (command == "sources") {
+        if (files.size() > 1 || bus.given() || bus.compact || !out_dir.empty() || !dir.empty() || system ||
+            !rules.empty()) {
+            std::cerr << "dissgen: sources takes at most one rule file\n" << kUsage;
+            return 2;
+        }
+        return cmd_sources(files.empty() ? "" : files[0]);
     }
     if (!rules.empty()) {
         std::cerr << "dissgen: --rules is an option of report\n";

@@ -2,7 +2,9 @@
 """A plugin carries only the runtime its rules use.
 
 `dissgen install` compiles an analysis's runtime (plugin_runtime/<folder>/)
-only into the plugins whose <pairing analysis="..."> names it:
+only into the plugins whose <pairing analysis="..."> names it, and CMake's
+plugins (build/plugins/, linked with every analysis library) get it only
+where the generated code names it:
 
 - the EtherNet/IP plugin (rules/enip.xml, no analysis) defines no symbol of
   the EtherCAT analysis or its bus model;
@@ -45,26 +47,33 @@ class PluginContents(unittest.TestCase):
         if shutil.which("nm") is None:
             raise unittest.SkipTest("nm (binutils) is not installed")
         cls.dir = tempfile.mkdtemp(prefix="dissgen-contents-")
+        # {stem: {builder: symbols}}: `dissgen install`'s plugin and CMake's, built beside dissgen.
         cls.plugins = {}
+        cmake_dir = os.path.join(os.path.dirname(os.path.abspath(ARGS.dissgen)), "..", "plugins")
         for stem in ("enip", "ethercat"):
             rules = os.path.join(ARGS.source_dir, "rules", stem + ".xml")
             r = subprocess.run([ARGS.dissgen, "install", rules, "--dir", cls.dir], capture_output=True, text=True)
             assert r.returncode == 0, r.stdout + r.stderr
-            cls.plugins[stem] = defined_symbols(os.path.join(cls.dir, "dissgen_" + stem + ".so"))
+            built = {"dissgen install": os.path.join(cls.dir, "dissgen_" + stem + ".so"),
+                     "CMake": os.path.join(cmake_dir, "dissgen_" + stem + ".so")}
+            assert os.path.exists(built["CMake"]), "no CMake-built plugin at " + built["CMake"]
+            cls.plugins[stem] = {builder: defined_symbols(path) for builder, path in built.items()}
 
     @classmethod
     def tearDownClass(cls):
         shutil.rmtree(cls.dir, ignore_errors=True)
 
     def test_enip_plugin_has_no_ethercat_code(self):
-        symbols = self.plugins["enip"]
-        self.assertIn("dg_pairing_register", symbols, "the generic pairing runtime is there")
-        self.assertEqual(sorted(s for s in symbols if ETHERCAT_SYMBOL.search(s)), [])
+        for builder, symbols in self.plugins["enip"].items():
+            with self.subTest(builder=builder):
+                self.assertIn("dg_pairing_register", symbols, "the generic pairing runtime is there")
+                self.assertEqual(sorted(s for s in symbols if ETHERCAT_SYMBOL.search(s)), [])
 
     def test_ethercat_plugin_has_its_analysis(self):
-        symbols = self.plugins["ethercat"]
-        self.assertIn("dg_ethercat_esc", symbols)
-        self.assertTrue(any(s.startswith("dg_ecat::bus_") for s in symbols), "the bus model is compiled in")
+        for builder, symbols in self.plugins["ethercat"].items():
+            with self.subTest(builder=builder):
+                self.assertIn("dg_ethercat_esc", symbols)
+                self.assertTrue(any(s.startswith("dg_ecat::bus_") for s in symbols), "the bus model is compiled in")
 
 
 if __name__ == "__main__":

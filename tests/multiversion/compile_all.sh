@@ -42,11 +42,20 @@ fi
 cxx="${CXX:-c++}"
 suites="${DISSGEN_MULTIVERSION_SUITES:-trixie sid}"
 packages=(libwireshark-dev libwsutil-dev libwiretap-dev)
-# The flags a plugin is built with (CMakeLists.txt, generator/build_plugin.cpp)
-# plus -Wall -Wextra -Werror: a deprecation is an error here.
-# The runtime's sources: the generic ones and every analysis's (each is compiled here).
-runtime_sources=(plugin_runtime/dissgen_walk.cpp plugin_runtime/dissgen_conditions.cpp plugin_runtime/dissgen_text.cpp plugin_runtime/dissgen_handoff.cpp plugin_runtime/dissgen_register.cpp plugin_runtime/dissgen_pairing.cpp plugin_runtime/dissgen_expr.cpp plugin_runtime/dissgen_validity.cpp plugin_runtime/dissgen_request.cpp plugin_runtime/ethercat/ethercat_esc.cpp plugin_runtime/ethercat/ethercat_bus.cpp plugin_runtime/ethercat/ethercat_cycles.cpp)
-flags=(-std=c++17 -O2 -fPIC -DWS_BUILD_DLL -Wall -Wextra -Werror -Werror=attributes -I"$root/plugin_runtime")
+# The runtime's sources (the generic ones and every analysis's: each is
+# compiled here) and the options of plugin code, from the one list
+# (plugin_runtime/runtime.list) as dissgen reads it, plus -Wall -Wextra -Werror:
+# a deprecation is an error here.
+if ! listing=$("$dissgen" sources); then
+  echo "compile_all.sh: $dissgen sources failed" >&2
+  exit 2
+fi
+runtime_sources=()
+while read -r kind path; do
+  [ "$kind" = source ] && runtime_sources+=("plugin_runtime/$path")
+done <<<"$listing"
+read -ra plugin_flags <<<"$(sed -n 's/^flags//p' <<<"$listing")"
+flags=(-std=c++17 -O2 -fPIC "${plugin_flags[@]}" -Wall -Wextra -Werror -I"$root/plugin_runtime")
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/dissgen-multiversion-XXXXXX")
 cleanup() { if [ "$keep" = 1 ]; then echo "kept $work"; else rm -rf "$work"; fi; }

@@ -46,7 +46,8 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 EQUIVALENT = os.path.join(HERE, "equivalent.txt")
-FOLDERS = ("plugin_runtime", "generator")
+RUNTIME_LIST = os.path.join("plugin_runtime", "runtime.list")   # the runtime's files, listed once
+GENERATOR = "generator"                                          # every .cpp and .h under it
 SMALL = 64   # integer literals up to this value are constants that get +1 and -1
 
 # Source file (or folder prefix, the longest match wins) -> the runner's test names
@@ -395,15 +396,35 @@ def sites_of(rel, text):
     return out
 
 
-def source_files(source_dir):
+def runtime_files(source_dir):
+    """The plugin runtime's sources and headers, generic and every analysis's, as
+    plugin_runtime/runtime.list names them (its 'source' and 'header' lines): the files
+    CMake builds and installs and `dissgen install` compiles."""
     out = []
-    for folder in FOLDERS:
-        for root, dirs, files in os.walk(os.path.join(source_dir, folder)):
-            dirs.sort()
-            for f in sorted(files):
-                if f.endswith((".cpp", ".h")):
-                    out.append(os.path.relpath(os.path.join(root, f), source_dir).replace(os.sep, "/"))
+    with open(os.path.join(source_dir, RUNTIME_LIST), encoding="utf-8") as fh:
+        for line in fh:
+            words = line.split()
+            if words and words[0] in ("source", "header"):
+                out += ["plugin_runtime/" + w for w in words[1:]]
+    return out
+
+
+def source_files(source_dir):
+    out = runtime_files(source_dir)
+    for root, dirs, files in os.walk(os.path.join(source_dir, GENERATOR)):
+        dirs.sort()
+        for f in sorted(files):
+            if f.endswith((".cpp", ".h")):
+                out.append(os.path.relpath(os.path.join(root, f), source_dir).replace(os.sep, "/"))
     return sorted(out)
+
+
+def unlisted_test_keys(source_dir):
+    """TESTS_BY_FILE keys under plugin_runtime/ that name no listed file or folder: tests
+    that no mutant would run after a rename."""
+    files = runtime_files(source_dir)
+    return sorted(k for k in TESTS_BY_FILE if k.startswith("plugin_runtime/") and
+                  not any(f == k or (k.endswith("/") and f.startswith(k)) for f in files))
 
 
 def all_sites(source_dir):
@@ -480,7 +501,17 @@ def main(argv=None):
     ap.add_argument("--show", nargs="*", help="these ids: place, change, line")
     ap.add_argument("--check-equivalent", action="store_true",
                     help="every id of equivalent.txt is still a site (exit 1 otherwise)")
+    ap.add_argument("--files", action="store_true",
+                    help="the files mutated: the runtime's from plugin_runtime/runtime.list, then generator/")
     args = ap.parse_args(argv)
+    stale_keys = unlisted_test_keys(args.source_dir)
+    if stale_keys:
+        print("systematic.py: TESTS_BY_FILE names files %s does not list: %s" % (RUNTIME_LIST, " ".join(stale_keys)),
+              file=sys.stderr)
+        return 2
+    if args.files:
+        print("\n".join(source_files(args.source_dir)))
+        return 0
     sites = all_sites(args.source_dir)
     eq = equivalent_ids()
     if args.check_equivalent:

@@ -102,21 +102,25 @@ for dep in "libwireshark-dev (>= $abi)" "libwireshark-dev (<< $next_abi)" libxml
            libglib2.0-dev "g++ | c++-compiler" pkg-config; do
   check "Depends on $dep" grep -qF "$dep" <<<"$depends"
 done
-for f in /usr/bin/dissgen /usr/share/dissgen/runtime/dissgen_runtime.h \
-         /usr/share/dissgen/runtime/dissgen_walk.cpp /usr/share/dissgen/runtime/dissgen_state.h \
-         /usr/share/dissgen/runtime/dissgen_compat.h \
-         /usr/share/dissgen/runtime/dissgen_rows.h \
-         /usr/share/dissgen/runtime/dissgen_pairing.cpp /usr/share/dissgen/runtime/dissgen_validity.cpp \
-         /usr/share/dissgen/runtime/ethercat/ethercat_esc.cpp \
-         /usr/share/dissgen/runtime/ethercat/ethercat_bus.cpp \
+mkdir "$work/x"
+dpkg-deb -x "$deb" "$work/x"
+# The runtime files: every one the packaged dissgen compiles plugins from
+# (`dissgen sources`, which reads plugin_runtime/runtime.list).
+runtime_files=()
+if listing=$("$work/x/usr/bin/dissgen" sources) && grep -q "^source " <<<"$listing"; then
+  while read -r kind path; do
+    [ "$kind" = source ] || [ "$kind" = header ] && runtime_files+=("/usr/share/dissgen/runtime/$path")
+  done <<<"$listing"
+else
+  not_ok "the packaged dissgen lists the runtime it compiles plugins from (dissgen sources)"
+fi
+for f in /usr/bin/dissgen "${runtime_files[@]}" \
          /usr/share/dissgen/rules/ethercat.xml "$packaged_plugin" /usr/share/man/man1/dissgen.1.gz \
          /usr/share/doc/dissgen/copyright; do
   check "contains $f" grep -qx "$f" "$work/contents"
 done
 check "everything is under /usr, nothing in /usr/local" \
   bash -c '! grep -v "^/usr/" "$1" | grep -q . && ! grep -q "^/usr/local" "$1"' _ "$work/contents"
-mkdir "$work/x"
-dpkg-deb -x "$deb" "$work/x"
 leaks=$(grep -rlF -e "$source_dir" -e "$build_dir" -e /usr/local "$work/x" 2>/dev/null)
 check "no build or /usr/local path inside any file${leaks:+ (found in: $leaks)}" test -z "$leaks"
 copyright="$work/x/usr/share/doc/dissgen/copyright"
