@@ -306,7 +306,7 @@ class Emitter {
 public:
     Emitter(const Protocol& p, const std::string& source, const EmbeddedTables* extra)
         : p_(p), source_(source), extra_(extra),
-          quiet_(quiet_sizes(p, [this](const Node& n) { return is_pairing_key(n); })), l_(make_layout(p, quiet_)) {}
+          quiet_(quiet_sizes(p, [this](const Node& n) { return is_pairing_key(n) || n.analysis_input >= 0; })), l_(make_layout(p, quiet_)) {}
     std::string run();
 
 private:
@@ -821,7 +821,8 @@ bool needs_extra(const Node& n) {
     return (n.is_leaf() && (n.display == Display::String || n.display == Display::StringZ ||
                             n.display == Display::Time)) ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
-           n.keeps_values || n.keeps_instances || n.is_computed() || n.has_unit_label() || n.is_overlay();
+           n.keeps_values || n.keeps_instances || n.is_computed() || n.has_unit_label() || n.is_overlay() ||
+           n.analysis_input >= 0;
 }
 
 void Emitter::extra_table() {
@@ -862,6 +863,7 @@ std::string Emitter::extra_row(const Node& n) const {
     if (slot(n.overlay) >= 0) add("overlay", std::to_string(slot(n.overlay)));
     if (n.is_computed())
         add("value", std::to_string(l_.expr_span.at(&n).first) + ", " + std::to_string(l_.expr_span.at(&n).second));
+    if (n.analysis_input >= 0) add("input", std::to_string(n.analysis_input));
     return named_row("dg_node_extra()", set);
 }
 

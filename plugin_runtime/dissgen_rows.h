@@ -87,6 +87,7 @@ struct dg_extra_row {
     constexpr dg_extra_row &unit(const char *label) { e.unit = label; return *this; }
     constexpr dg_extra_row &overlay(gint16 target_slot) { e.overlay_slot = target_slot; return *this; }
     constexpr dg_extra_row &value(guint16 first, guint16 count) { e.expr_first = first; e.expr_count = count; return *this; }
+    constexpr dg_extra_row &input(gint8 number) { e.input = number; return *this; }
 };
 
 /* UTF-8 strings, times in nanoseconds, no reassembly. */

@@ -97,6 +97,9 @@ typedef struct dg_extra {
     gint16 overlay_slot = -1;
     /* value="EXPR": the operations dg_protocol.exprs[expr_first ..] */
     guint16 expr_first = 0, expr_count = 0;
+    /* <pairing><input>: the number of the pairing analysis' input this leaf
+     * is (its value goes to the message's dg_view); -1: none */
+    gint8 input = -1;
 } dg_extra;
 
 /* The most entries an offset table may have; longer ones are malformed. */
