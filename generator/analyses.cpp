@@ -2,11 +2,30 @@
 #include "analyses.h"
 
 #include "runtime_list.h"
+#include "../plugin_runtime/ethercat/ethercat_inputs.h"
 
 namespace dissgen {
+namespace {
+
+// What the analysis called `name` reads from each message, in its dg_view's order.
+std::vector<AnalysisInputSpec> inputs_of(const std::string& name) {
+#define DG_INPUT_SPEC(id, input, per_instance) {input, per_instance != 0},
+    if (name == "ethercat-esc") return {DG_ESC_INPUTS(DG_INPUT_SPEC)};
+#undef DG_INPUT_SPEC
+    return {};
+}
+
+}  // namespace
 
 const std::vector<Analysis>& analyses() {
-    return runtime_list().analyses;
+    // runtime.list names each analysis and its files; what it reads from each
+    // message is its runtime's own list (e.g. ethercat_inputs.h).
+    static const std::vector<Analysis> list = [] {
+        std::vector<Analysis> out = runtime_list().analyses;
+        for (Analysis& a : out) a.inputs = inputs_of(a.name);
+        return out;
+    }();
+    return list;
 }
 
 const Analysis* find_analysis(const std::string& name) {

@@ -13,11 +13,21 @@
 
 namespace dissgen {
 
+// One input an analysis reads from each message (<pairing><input name="...">):
+// one value per message, or one per instance of a repeated node.
+struct AnalysisInputSpec {
+    std::string name;
+    bool per_instance = false;
+};
+
 struct Analysis {
     std::string name;                          // the rule file's <pairing analysis="...">
     std::string symbol;                        // its dg_analysis object in the runtime
     std::vector<std::string> runtime_sources;  // relative to the runtime folder
     std::vector<std::string> runtime_headers;  // likewise
+    // what it reads from each message, every one required, in the order of
+    // its dg_view (the runtime's list, e.g. ethercat_inputs.h)
+    std::vector<AnalysisInputSpec> inputs;
 };
 
 // Every analysis, in the order of plugin_runtime/runtime.list.

@@ -332,7 +332,7 @@ class Emitter {
 public:
     Emitter(const Protocol& p, const std::string& source, const EmbeddedTables* extra)
         : p_(p), source_(source), extra_(extra),
-          quiet_(quiet_sizes(p, [this](const Node& n) { return is_pairing_key(n); })), l_(make_layout(p, quiet_)) {}
+          quiet_(quiet_sizes(p, [this](const Node& n) { return is_pairing_key(n) || n.analysis_input >= 0; })), l_(make_layout(p, quiet_)) {}
     std::string run();
 
 private:
@@ -871,7 +871,7 @@ bool needs_extra(const Node& n) {
                             n.display == Display::Time)) ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
            n.keeps_values || n.keeps_instances || n.is_computed() || n.has_unit_label() || n.is_overlay() ||
-           !n.findings.empty();
+           !n.findings.empty() || n.analysis_input >= 0;
 }
 
 void Emitter::extra_table() {
@@ -914,6 +914,7 @@ std::string Emitter::extra_row(const Node& n) const {
         add("value", std::to_string(l_.expr_span.at(&n).first) + ", " + std::to_string(l_.expr_span.at(&n).second));
     if (slot(n.covers) >= 0) add("covers", std::to_string(slot(n.covers)));
     if (!n.findings.empty()) add("findings", std::to_string(l_.finding_first.at(&n)) + ", " + std::to_string(n.findings.size()));
+    if (n.analysis_input >= 0) add("input", std::to_string(n.analysis_input));
     return named_row("dg_node_extra()", set);
 }
 

@@ -193,6 +193,10 @@ struct Node {
     bool is_overlay() const { return overlay.has_value(); }
     // derived by the validator: a valid field's byte offset (its bit group's) from the message start
     uint64_t valid_offset = 0;
+    // derived by the validator: the pairing analysis reads this leaf as its
+    // input number analysis_input (-1: none), per instance of its repeated node or not
+    int analysis_input = -1;
+    bool analysis_input_per_instance = false;
 
     bool is_computed() const { return value.has_value(); }
     bool is_container() const { return !children.empty(); }
@@ -235,9 +239,18 @@ struct PairingKey {
     uint64_t offset = 0;
 };
 
+// <input name="..." field="XPATH"/> in <pairing>: a field the pairing's
+// analysis reads from each message (generator/analysis_inputs.h).
+struct AnalysisInput {
+    std::string name;
+    FieldRef field;
+    int line = 0;
+};
+
 struct Pairing {
     int line = 0;
     std::vector<PairingKey> keys;
+    std::vector<AnalysisInput> inputs;
     double timeout = 1.0;   // seconds a request waits for its response
     // order="request" (true): responses come back in the order of their
     // requests (per connection); order="any": in any order, so none is out

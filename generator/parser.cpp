@@ -55,6 +55,7 @@ const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};
 const std::vector<std::string> kFindingAttributes = {"name", "severity", "group", "condition", "text"};
 const std::vector<std::string> kPairingAttributes = {"timeout", "analysis", "order"};
 const std::vector<std::string> kKeyAttributes = {"field"};
+const std::vector<std::string> kInputAttributes = {"name", "field"};
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
                                                 "origin",  "enum",      "nondisplay",
                                                 // typed values shown as text
@@ -494,12 +495,28 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
         if (!find_analysis(pairing.analysis))
             diags_.error(line, "unknown analysis '" + attrs["analysis"] + "'; valid: " + join(known, ", "));
     }
-    std::vector<xmlNode*> key_elements;
+    std::vector<xmlNode*> key_elements, input_elements;
     for (xmlNode* c = el->children; c; c = c->next) {
         if (c->type == XML_ELEMENT_NODE && element_name(c) == "key")
             key_elements.push_back(c);
+        else if (c->type == XML_ELEMENT_NODE && element_name(c) == "input")
+            input_elements.push_back(c);
         else
-            unexpected_child(c, "pairing", {"key"});
+            unexpected_child(c, "pairing", {"key", "input"});
+    }
+    // What the analysis reads: checked against its list by analysis_inputs.cpp.
+    for (xmlNode* c : input_elements) {
+        AnalysisInput input;
+        input.line = line_of(c);
+        auto iattrs = attributes(c, kInputAttributes);
+        input.name = trim(iattrs["name"]);
+        if (input.name.empty() || !iattrs.count("field") || trim(iattrs["field"]).empty())
+            diags_.error(input.line, "<input> needs 'name' (what the analysis reads) and 'field' (an XPath to a "
+                                     "numeric field, from <root>)");
+        else
+            input.field = make_ref(iattrs["field"], input.line, "field", false);
+        for (xmlNode* k = c->children; k; k = k->next) unexpected_child(k, "input", {});
+        pairing.inputs.push_back(input);
     }
     // All keys first, then their references: defer() keeps pointers into the vector.
     for (xmlNode* c : key_elements) {
@@ -518,6 +535,8 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
                            "from its request");
     for (size_t i = 0; i < pairing.keys.size(); ++i)
         defer(pairing.keys[i].field, el->parent, pairing.keys[i].line, "field");
+    for (AnalysisInput& input : pairing.inputs)
+        defer(input.field, el->parent, input.line, "field");
 }
 
 std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {

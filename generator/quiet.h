@@ -17,7 +17,7 @@ namespace dissgen {
 // reads, a hand-off (another dissector's side effects), or a malformed spot
 // that would stop the walk. A node with none of these, whose size is fixed
 // and whose fields cannot be malformed within that size, is stepped over.
-// is_key tells which leaves are <pairing> keys.
+// is_key tells which leaves the pairing reads: its keys and its analysis' inputs.
 std::map<const Node*, uint64_t> quiet_sizes(const Protocol& proto,
                                            const std::function<bool(const Node&)>& is_key);
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "validator.h"
 
+#include "analysis_inputs.h"
 #include "expression.h"
 #include "findings.h"
 
@@ -658,7 +659,7 @@ void Validator::check_pairing() {
         if (!inserted)
             diags_.error(key.line, "key field " + quote(*t) + " is already a key (line " + std::to_string(it->second) +
                                        ")");
-    }
+    }    check_analysis_inputs(proto_, diags_);
 }
 
 void Validator::assign_slots() {

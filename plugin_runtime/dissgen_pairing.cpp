@@ -80,8 +80,9 @@ struct pending {
     dg_transaction *txn;
     address src;
     guint8 src_bytes[16];  /* src's data when it fits (kept_address) */
-    guint8 *bytes;  /* the request's bytes, kept for the analysis until answered */
+    guint8 *bytes;  /* the request's bytes and view, kept for the analysis until answered */
     guint length;
+    guint view_count; /* values of its view (kept_view) */
     guint capacity; /* of bytes (a buffer used again: capture_state.spare) */
     guint64 key;    /* its first key value (dg_lost) */
     kept *record;              /* the request's record */
@@ -102,8 +103,9 @@ struct key_entry {
     kept *last_record;           /* its record (adopt_orphan) */
     address last_src;
     guint8 last_src_bytes[16];
-    guint8 *last_bytes;
+    guint8 *last_bytes;          /* and, with an analysis, its view (kept_view) */
     guint last_length;
+    guint last_view_count;
     guint last_capacity;         /* of last_bytes, which each message of the key fills again */
     nstime_t last_request_time;  /* this key's last request */
     nstime_t request_period;     /* between its last two requests; 0 until there are two */
@@ -128,6 +130,7 @@ struct capture_state {
     nstime_t clock;              /* what forgetting goes by (forget_clock) */
     nstime_t previous_time;      /* the last message's time */
     gboolean clock_set;
+    const dg_view *view;         /* the analysis inputs of the message being paired (first pass) */
     wmem_array_t *table;         /* the frame table: chunks of table_chunk kept records */
     wmem_map_t *lost_lists;      /* kept record -> the dg_lost it proved (kept.lost_count) */
     wmem_map_t *long_trips;      /* kept record -> its round trip in ns (gint64), beyond a gint32 */
@@ -397,16 +400,31 @@ void unlink_entry(capture_state *c, key_entry *e)
     e->older = e->newer = NULL;
 }
 
-/* *buffer (of *capacity bytes) holds the first `length` bytes of tvb, in a
- * larger buffer only when they do not fit. */
-void fill_buffer(guint8 **buffer, guint *capacity, tvbuff_t *tvb, guint length)
+/* Where a kept message's view starts in its buffer: after its bytes, aligned
+ * for the values (one allocation for both). */
+guint view_start(guint length) { return (length + 7u) & ~7u; }
+
+/* *buffer (of *capacity bytes) holds the first `length` bytes of tvb and
+ * then the values of `view` (NULL: none), in a larger buffer only when they
+ * do not fit. */
+void fill_buffer(guint8 **buffer, guint *capacity, tvbuff_t *tvb, guint length, const dg_view *view)
 {
-    if (length > *capacity || !*buffer) {
+    guint values = view ? view->count : 0;
+    guint size = values ? view_start(length) + values * (guint)sizeof(dg_view_value) : length;
+    if (size > *capacity || !*buffer) {
         wmem_free(wmem_file_scope(), *buffer);
-        *buffer = length ? (guint8 *)wmem_alloc(wmem_file_scope(), length) : NULL;
-        *capacity = length;
+        *buffer = size ? (guint8 *)wmem_alloc(wmem_file_scope(), size) : NULL;
+        *capacity = size;
     }
     if (length) tvb_memcpy(tvb, *buffer, 0, length);
+    if (values) memcpy(*buffer + view_start(length), view->values, values * sizeof(dg_view_value));
+}
+
+/* The view kept after a message's `length` bytes by fill_buffer(). */
+dg_view kept_view(const guint8 *buffer, guint length, guint count)
+{
+    dg_view v = {count ? (const dg_view_value *)(const void *)(buffer + view_start(length)) : NULL, count};
+    return v;
 }
 
 void remember_last(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length, guint8 role)
@@ -427,8 +445,9 @@ void remember_last(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *p
         drop_address(&e->last_src, e->last_src_bytes);
         keep_address(&e->last_src, e->last_src_bytes, &pinfo->src);
     }
-    fill_buffer(&e->last_bytes, &e->last_capacity, tvb, length);
+    fill_buffer(&e->last_bytes, &e->last_capacity, tvb, length, c->view);
     e->last_length = length;
+    e->last_view_count = c->view ? c->view->count : 0;
 }
 
 /* Answered or given up: what it kept goes now, the rest once both queues let go. */
@@ -537,7 +556,7 @@ pending *take_answered(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_inf
  * for the key, it is that one's. (With several waiting, a capture that missed
  * frames could not be told from one whose keys changed; a response to another
  * request, whose own request was not captured, is an orphan.) */
-pending *take_oldest(capture_state *c, tvbuff_t *tvb, packet_info *pinfo)
+pending *take_oldest(capture_state *c, packet_info *pinfo)
 {
     /* Before the first pair, a response is far likelier one whose request
      * was sent before the capture started. */
@@ -546,10 +565,8 @@ pending *take_oldest(capture_state *c, tvbuff_t *tvb, packet_info *pinfo)
     if (!q || c->waiting != 1 || !analysis || !analysis->is_response || analysis->is_response(c->analysis, &q->src, &pinfo->src) != 1)
         return NULL;
     if (analysis->key_changed && q->bytes) {
-        tvbuff_t *request = tvb_new_real_data(q->bytes, q->length, (gint)q->length);
-        gboolean same = analysis->key_changed(request, tvb);
-        tvb_free(request);
-        if (!same) return NULL;
+        const dg_view request = kept_view(q->bytes, q->length, q->view_count);
+        if (!analysis->key_changed(&request, c->view)) return NULL;
     }
     return q;
 }
@@ -677,7 +694,7 @@ void orphan_guessed_from(capture_state *c, const packet_info *pinfo)
  * oldest whose source says it is answered (the analysis' is_response), else
  * the oldest it does not rule out; else the one request waiting if its key
  * came back changed (take_oldest); NULL: an orphan. */
-pending *take_response(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pinfo)
+pending *take_response(capture_state *c, key_entry *e, packet_info *pinfo)
 {
     oldest_waiting(c, &e->waiting, TRUE, pinfo); /* gives up the expired ones */
     pending *maybe = NULL;
@@ -690,7 +707,7 @@ pending *take_response(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_inf
         }
         if (verdict < 0 && !maybe) maybe = q;
     }
-    return maybe ? maybe : take_oldest(c, tvb, pinfo);
+    return maybe ? maybe : take_oldest(c, pinfo);
 }
 
 /* A message its own bytes cannot place (the analysis has a direction()):
@@ -701,7 +718,8 @@ pending *take_unchanged(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_in
     pending *q = oldest_waiting(c, &e->waiting, TRUE, pinfo);
     if (!q || !q->bytes || !within_copy_window(e, &q->txn->request_time, pinfo)) return NULL;
     tvbuff_t *request = tvb_new_real_data(q->bytes, q->length, (gint)q->length);
-    gboolean same = analysis->unchanged ? analysis->unchanged(request, tvb, length)
+    const dg_view request_view = kept_view(q->bytes, q->length, q->view_count);
+    gboolean same = analysis->unchanged ? analysis->unchanged(request, &request_view, tvb, length)
                                         : q->length == length && tvb_memeql(tvb, 0, q->bytes, length) == 0;
     tvb_free(request);
     /* Lets the analysis learn from the two sources (a marked return). */
@@ -714,7 +732,7 @@ pending *take_unchanged(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_in
 guint8 direction_of(capture_state *c, tvbuff_t *tvb, packet_info *pinfo, guint8 transport)
 {
     if (transport != DG_DIR_ANY || !analysis || !analysis->direction) return transport;
-    return analysis->direction(c->analysis, tvb, pinfo);
+    return analysis->direction(c->analysis, tvb, c->view, pinfo);
 }
 
 /* The requests this message proved lost go with its record (rare: a map
@@ -727,9 +745,9 @@ void with_lost(capture_state *c, kept *k)
 }
 
 /* This message, k, answers transaction t, whose request's record and bytes
- * are given. The transaction is freed: the two records say what it did. */
+ * (and view) are given. The transaction is freed: the two records say what it did. */
 void response_to(capture_state *c, dg_transaction *t, kept *request, const guint8 *request_bytes,
-                 guint request_length, kept *k, tvbuff_t *tvb, packet_info *pinfo)
+                 guint request_length, guint request_view_count, kept *k, tvbuff_t *tvb, packet_info *pinfo)
 {
     k->role = DG_ROLE_RESPONSE;
     t->response_frame = pinfo->num;
@@ -749,7 +767,8 @@ void response_to(capture_state *c, dg_transaction *t, kept *request, const guint
     if (t->seq > c->answered_max) c->answered_max = t->seq;
     if (analysis && analysis->compare && request_bytes) {
         tvbuff_t *bytes = tvb_new_real_data(request_bytes, request_length, (gint)request_length);
-        k->analysis = analysis->compare(c->analysis, bytes, tvb, t, pinfo);
+        const dg_view request_view = kept_view(request_bytes, request_length, request_view_count);
+        k->analysis = analysis->compare(c->analysis, bytes, &request_view, tvb, c->view, t, pinfo);
         tvb_free(bytes);
     }
     request->partner = pinfo->num;
@@ -759,7 +778,7 @@ void response_to(capture_state *c, dg_transaction *t, kept *request, const guint
 
 void answer(capture_state *c, pending *q, kept *k, tvbuff_t *tvb, packet_info *pinfo)
 {
-    response_to(c, q->txn, q->record, q->bytes, q->length, k, tvb, pinfo);
+    response_to(c, q->txn, q->record, q->bytes, q->length, q->view_count, k, tvb, pinfo);
     q->txn = NULL; /* freed: a retired request is never looked at again */
     retire(c, q);
 }
@@ -786,7 +805,7 @@ gboolean adopt_orphan(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, pa
     t->order_scope = order_scope_of(c, pinfo);
     kept *request = e->last_record;
     request->role = DG_ROLE_REQUEST;
-    response_to(c, t, request, e->last_bytes, e->last_length, k, tvb, pinfo);
+    response_to(c, t, request, e->last_bytes, e->last_length, e->last_view_count, k, tvb, pinfo);
     return TRUE;
 }
 
@@ -795,7 +814,7 @@ gboolean adopt_orphan(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, pa
 dg_transaction *new_request(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, packet_info *pinfo, guint length,
                  guint64 key, gboolean guessed)
 {
-    if (analysis && analysis->sent) k->analysis = analysis->sent(c->analysis, tvb, pinfo);
+    if (analysis && analysis->sent) k->analysis = analysis->sent(c->analysis, tvb, c->view, pinfo);
     /* Kept until it is answered (response_to frees it), or for good when it is not. */
     dg_transaction *t = new_recycled<dg_transaction>(&c->free_transactions);
     t->request_frame = pinfo->num;
@@ -820,8 +839,9 @@ dg_transaction *new_request(capture_state *c, key_entry *e, kept *k, tvbuff_t *t
             n->capacity = c->spare_capacity;
             c->spare = NULL;
         }
-        fill_buffer(&n->bytes, &n->capacity, tvb, length);
+        fill_buffer(&n->bytes, &n->capacity, tvb, length, c->view);
         n->length = length;
+        n->view_count = c->view ? c->view->count : 0;
     }
     enqueue(&e->waiting, n, TRUE);
     enqueue(&c->sent, n, FALSE);
@@ -837,7 +857,7 @@ pending *classify(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pi
     *orphan = FALSE;
     pending *q = NULL;
     if (direction == DG_DIR_RESPONSE) {
-        q = take_response(c, e, tvb, pinfo);
+        q = take_response(c, e, pinfo);
         *orphan = !q;
     } else if (direction == DG_DIR_REQUEST) {
         give_up_sent_again(c, e, pinfo);
@@ -848,7 +868,7 @@ pending *classify(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pi
         /* Neither the transport nor an analysis can tell: the order decides. */
         q = take_answered(c, e, tvb, pinfo, length, unchanged);
         if (!q && analysis && analysis->is_returned && analysis->is_returned(c->analysis, &pinfo->src)) {
-            q = take_oldest(c, tvb, pinfo);
+            q = take_oldest(c, pinfo);
             *orphan = !q;
         }
     }
@@ -858,14 +878,15 @@ pending *classify(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pi
 /* Pairs message k on the first pass and fills its record. Returns the
  * transaction of a new request (capture_state.unanswered has it too), else NULL. */
 dg_transaction *first_pass(capture_state *c, kept *k, tvbuff_t *tvb, packet_info *pinfo, const guint64 *keys, guint key_count,
-                guint length, guint8 transport_direction)
+                const dg_view *view, guint length, guint8 transport_direction)
 {
     c->frame = pinfo->num;
+    c->view = view;
     c->lost_count = 0;
     forget_clock(c, pinfo);
     forget_requests(c);
     forget_keys(c);
-    if (analysis && analysis->see) analysis->see(c->analysis, tvb, pinfo);
+    if (analysis && analysis->see) analysis->see(c->analysis, tvb, view, pinfo);
     guint8 verdict = direction_of(c, tvb, pinfo, transport_direction);
     guint8 direction = verdict & ~DG_DIR_FROM_SOURCE;
     if (verdict == (DG_DIR_RESPONSE | DG_DIR_FROM_SOURCE) && c->guessed) orphan_guessed_from(c, pinfo);
@@ -1084,8 +1105,8 @@ void dg_pairing_register(const dg_protocol *p)
 }
 
 const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
-                                           const guint64 *keys, guint key_count, gint length, guint message,
-                                           guint8 direction)
+                                           const guint64 *keys, guint key_count, const dg_view *view, gint length,
+                                           guint message, guint8 direction)
 {
     /* A message cut short before its first key field answers and asks nothing. */
     if (key_count == 0) return NULL;
@@ -1096,7 +1117,7 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *, tvbuff_t *tvb, p
         guint len = length > 0 ? (guint)length : tvb_captured_length(tvb);
         capture_state *c = current_capture();
         k = record_of(c, pinfo, message, TRUE);
-        fresh = first_pass(c, k, tvb, pinfo, keys, key_count, len, direction);
+        fresh = first_pass(c, k, tvb, pinfo, keys, key_count, view, len, direction);
     }
     const dg_frame_pairing *fp = view_of(capture, k, pinfo, fresh);
     show(fp, tvb, pinfo, tree);

@@ -86,8 +86,30 @@ typedef struct dg_frame_pairing {
     const dg_lost *lost;     /* lost_count of them, or NULL */
 } dg_frame_pairing;
 
+/* What an analysis reads from a message, as the walk decoded it: the
+ * fields the rule file binds to the analysis's inputs (<pairing><input
+ * name="..." field="..."/>), one value each in decoding order. The analysis
+ * names its inputs by number (its list, e.g. ethercat/ethercat_inputs.h),
+ * so it reads nothing from the bytes that the rules describe. Flat (no
+ * pointers inside), so that the pairing keeps a request's view with its
+ * bytes. */
+typedef struct dg_view_value {
+    guint64 value;
+    gint32 offset;      /* of the field's bytes (its bit group's) in the message */
+    guint16 length;     /* those bytes */
+    guint8 input;       /* the analysis's input number */
+    guint32 instance;   /* the instance of its repeated node (0 for a message's own input) */
+} dg_view_value;
+
+typedef struct dg_view {
+    const dg_view_value *values;
+    guint count;
+} dg_view;
+
 /* What one protocol knows about its requests and responses. Every callback
- * may be NULL. */
+ * may be NULL. Those given a dg_view get the message's (and the request's);
+ * its bytes come as a tvb for what the rules do not describe (e.g. whether
+ * data came back unchanged). */
 typedef struct dg_analysis {
     const char *name;        /* the rule file's <pairing analysis="..."> */
     /* Registers the analysis's own fields and expert infos (once, at start-up). */
@@ -96,7 +118,7 @@ typedef struct dg_analysis {
      * slave model, which reads p->analysis_data), or NULL. */
     void *(*capture_new)(const dg_protocol *p);
     /* First pass, every message in capture order, before pairing. */
-    void (*see)(void *capture, tvbuff_t *tvb, packet_info *pinfo);
+    void (*see)(void *capture, tvbuff_t *tvb, const dg_view *view, packet_info *pinfo);
     /* Whether a message from `src` can be the response to a pending request
      * from `request_src`: 1 yes, 0 no (it is a new request), -1 cannot tell. */
     int (*is_response)(void *capture, const address *request_src, const address *src);
@@ -108,8 +130,8 @@ typedef struct dg_analysis {
      * analysis gives its result (kept in wmem_file_scope; 0: none): the
      * pairing keeps 4 bytes a message for it. `request` holds the request's
      * bytes, `txn` the pair (its request frame, its round trip). */
-    guint32 (*compare)(void *capture, tvbuff_t *request, tvbuff_t *response, const dg_transaction *txn,
-                       packet_info *pinfo);
+    guint32 (*compare)(void *capture, tvbuff_t *request, const dg_view *request_view, tvbuff_t *response,
+                       const dg_view *response_view, const dg_transaction *txn, packet_info *pinfo);
     /* Every pass: shows a compare() result on the response. */
     void (*show)(guint32 result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
     /* Statistics (tshark -z FILTER,tree): nodes under the pairing's own. */
@@ -117,22 +139,22 @@ typedef struct dg_analysis {
     void (*stats_response)(stats_tree *st, int parent, guint32 result);
     /* First pass, a request: the number of the analysis's result for it (as
      * compare's), or 0. */
-    guint32 (*sent)(void *capture, tvbuff_t *tvb, packet_info *pinfo);
+    guint32 (*sent)(void *capture, tvbuff_t *tvb, const dg_view *view, packet_info *pinfo);
     /* Every pass: shows a sent() result. */
     void (*show_sent)(guint32 result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
     /* First pass, before pairing: what the message's own bytes and source say
      * it is, DG_DIR_REQUEST or DG_DIR_RESPONSE, or DG_DIR_ANY when they cannot
      * tell. With this callback a message that cannot tell is a request unless
      * it is its key's waiting request come back unchanged (unchanged()). */
-    guint8 (*direction)(void *capture, tvbuff_t *tvb, packet_info *pinfo);
+    guint8 (*direction)(void *capture, tvbuff_t *tvb, const dg_view *view, packet_info *pinfo);
     /* Whether `message` (its first `length` bytes, the message the rules
      * decoded) can be `request` come back untouched by the other side (a
      * frame no station processed); NULL: the same bytes. */
-    gboolean (*unchanged)(tvbuff_t *request, tvbuff_t *message, guint length);
+    gboolean (*unchanged)(tvbuff_t *request, const dg_view *request_view, tvbuff_t *message, guint length);
     /* Whether `message`, a response whose key matches no waiting request, is
      * `request` come back with its key changed (the same request otherwise);
      * NULL: it may be. */
-    gboolean (*key_changed)(tvbuff_t *request, tvbuff_t *message);
+    gboolean (*key_changed)(const dg_view *request, const dg_view *message);
 } dg_analysis;
 
 /* C linkage like dissgen_runtime.h's entry points: plain symbol names. */
@@ -144,14 +166,15 @@ void dg_pairing_register(const dg_protocol *p);
 
 /* After a message was decoded: pairs it on the first pass, then shows the
  * pairing in `tree`. `keys` are the values of the DG_KEY fields in decoding
- * order; `length` the bytes the message took; `message` its number within the
+ * order; `view` the analysis inputs the walk decoded (first pass; NULL
+ * without an analysis or on later passes); `length` the bytes the message took; `message` its number within the
  * frame (0 for the first); `direction` what the transport says (dg_direction:
  * to the hooked port a request, from it a response). Without a tree only the expert infos are raised
  * (their severity reaches the Expert column). Returns what was found, for
  * the statistics. */
 const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
-                                           const guint64 *keys, guint key_count, gint length, guint message,
-                                           guint8 direction);
+                                           const guint64 *keys, guint key_count, const dg_view *view, gint length,
+                                           guint message, guint8 direction);
 
 /* First pass, before a message is decoded: the transaction of the request
  * with these key values that the message would answer (its key's oldest

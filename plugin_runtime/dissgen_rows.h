@@ -91,6 +91,7 @@ struct dg_extra_row {
     constexpr dg_extra_row &findings(guint16 first, guint16 count) {
         e.finding_first = first; e.finding_count = count; return *this;
     }
+    constexpr dg_extra_row &input(gint8 number) { e.input = number; return *this; }
 };
 
 /* UTF-8 strings, times in nanoseconds, no reassembly. */

@@ -103,6 +103,9 @@ typedef struct dg_extra {
     /* <finding> children: dg_protocol.findings[finding_first ..], checked
      * once each instance of the node is decoded */
     guint16 finding_first = 0, finding_count = 0;
+    /* <pairing><input>: the number of the pairing analysis' input this leaf
+     * is (its value goes to the message's dg_view); -1: none */
+    gint8 input = -1;
 } dg_extra;
 
 /* A <finding>: the expert info `ei` is raised on the node's bytes when the

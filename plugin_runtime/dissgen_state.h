@@ -88,6 +88,11 @@ struct dg_state {
     /* the values of the <pairing> key fields (DG_KEY), in decoding order */
     guint64 *keys;
     guint key_count, key_capacity;
+    /* what the pairing analysis reads (dg_view): the values of the input
+     * leaves (dg_extra.input), first pass only; views NULL otherwise */
+    dg_view_value *views;
+    guint view_count, view_capacity;
+    gboolean wants_view;
     /* request{...}: what the paired request kept, NULL when it is not known */
     mutable const dg_request_values *request;
     mutable gboolean request_missed; /* a value read the request, and it is not known */
@@ -209,6 +214,28 @@ static inline void key_append(dg_state *st, guint64 value)
     st->keys[st->key_count++] = value;
 }
 
+/* An input of the pairing analysis: where the walk found it and its value. */
+static inline void view_append(dg_state *st, const dg_node *n, guint64 value, gint offset, gint length)
+{
+    if (st->view_count == st->view_capacity) {
+        st->view_capacity = st->view_capacity ? 2 * st->view_capacity : 32;
+        st->views = (dg_view_value *)wmem_realloc(st->pinfo->pool, st->views,
+                                                  st->view_capacity * sizeof(dg_view_value));
+    }
+    dg_view_value *v = &st->views[st->view_count++];
+    v->value = value;
+    v->offset = offset;
+    v->length = (guint16)length;
+    v->input = (guint8)n->extra->input;
+    v->instance = st->instance;
+}
+
+/* Whether the pairing analysis reads this leaf, in this pass. */
+static inline __attribute__((always_inline)) gboolean is_view_input(const dg_state *st, const dg_node *n)
+{
+    return st->wants_view && n->extra && n->extra->input >= 0;
+}
+
 static inline void tap_record(dg_state *st, const dg_node *n, guint64 value)
 {
     dg_tap_data *t = st->tap;
@@ -228,6 +255,7 @@ static inline __attribute__((always_inline)) void store(dg_state *st, const dg_n
 {
     if (st->tap && n->show == DG_SHOW_ENUM) tap_record(st, n, value);
     if (n->flags & DG_KEY) key_append(st, value);
+    if (is_view_input(st, n)) view_append(st, n, value, offset, length);
     if (n->slot < 0) return;
     if (n->extra && n->extra->keep_values) table_append(st, n, value);
     if (n->extra && n->extra->keep_instances) table_put(st, n, value);
@@ -243,7 +271,7 @@ static inline __attribute__((always_inline)) void store(dg_state *st, const dg_n
  * stats tree counts it. Otherwise the walk need not read it from the tvb. */
 static inline __attribute__((always_inline)) gboolean value_wanted(const dg_state *st, const dg_node *n)
 {
-    return n->slot >= 0 || (st->tap && n->show == DG_SHOW_ENUM) || (n->flags & DG_KEY);
+    return n->slot >= 0 || (st->tap && n->show == DG_SHOW_ENUM) || (n->flags & DG_KEY) || is_view_input(st, n);
 }
 
 /* A new instance: the values of the previous one's subtree are gone. */

@@ -654,6 +654,8 @@ void begin_message(dg_state *st, dg_message_buffers *b, const dg_protocol *p, tv
     st->packet_end = (gint)tvb_captured_length(tvb);
     st->hook_value = pinfo->match_uint;
     st->direction = direction_of(pinfo);
+    /* The analysis reads its inputs on the first pass only (dissgen_pairing.h). */
+    st->wants_view = p->pairing && p->pairing->analysis && !PINFO_FD_VISITED(pinfo);
     /* Summaries are text for the Info column and for container items; build
      * them only when someone sees them: tshark -T fields and -V have a visible
      * tree and no columns, summary lines have columns and no tree, and a
@@ -731,8 +733,10 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     proto_item_set_len(root, offset);
     if (p->pairing) {
         if (st.request_pending) request_walked(&st);
-        const dg_frame_pairing *fp =
-            dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, offset, messages - 1, st.direction);
+        const dg_view view = {st.views, st.view_count};
+        const dg_frame_pairing *fp = dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count,
+                                                        st.wants_view ? &view : NULL, offset, messages - 1,
+                                                        st.direction);
         if (st.tap) st.tap->pairing = fp;
         if (p->request_context) request_end(&st, fp, subtree);
     }

@@ -1113,39 +1113,40 @@ void show_process_data(const bus_model *m, const datagram *d, gboolean returned,
 
 const char *command_name(guint8 cmd) { return cmd < G_N_ELEMENTS(command_names) ? command_names[cmd] : "unknown"; }
 
-/* A little-endian 16-bit value of a header copied out of the tvb (pint.h's
- * names changed in Wireshark 4.6). */
-static guint16 little16(const guint8 *p) { return (guint16)(p[0] | p[1] << 8); }
-
-guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max)
+/* One value of the view into its datagram. */
+static void place_input(datagram *d, const dg_view_value *x)
 {
-    gint end = (gint)tvb_captured_length(tvb);
+    switch (x->input) {
+    case ESC_IN_COMMAND: d->cmd = (guint8)x->value; d->offset = x->offset; break;
+    case ESC_IN_INDEX: d->idx = (guint8)x->value; break;
+    case ESC_IN_ADP: d->adp = (guint16)x->value; d->address_offset = x->offset; break;
+    case ESC_IN_ADO: d->ado = (guint16)x->value; break;
+    case ESC_IN_LOGICAL: /* the same 32 bits as ADP (low half) and ADO */
+        d->adp = (guint16)x->value;
+        d->ado = (guint16)(x->value >> 16);
+        d->address_offset = x->offset;
+        break;
+    case ESC_IN_LENGTH: d->length = (guint16)x->value; break;
+    case ESC_IN_WKC: d->wkc = (guint16)x->value; d->wkc_at = x->offset; break;
+    default: break;
+    }
+}
+
+guint frame_datagrams(const dg_view *view, guint *header_length, datagram *out, guint max)
+{
     *header_length = 0;
-    if (end < 2) return 0;
-    guint16 header = dg_tvb_get_uint16(tvb, 0, ENC_LITTLE_ENDIAN);
-    *header_length = header & 0x7ff;
-    if ((header >> 12) != 1) return 0;
-    if ((gint)(2 + *header_length) < end) end = 2 + (gint)*header_length;
-    guint n = 0;
-    gint offset = 2;
-    while (n < max && offset + datagram_header + datagram_wkc <= end) {
-        /* One bounds-checked copy of the datagram header instead of five tvb
-         * reads: this runs on every frame of the first pass. */
-        guint8 h[datagram_header];
-        tvb_memcpy(tvb, h, offset, sizeof h);
-        datagram *d = &out[n];
-        d->offset = offset;
-        d->cmd = h[0];
-        d->idx = h[1];
-        d->adp = little16(h + 2);
-        d->ado = little16(h + 4);
-        guint16 flags = little16(h + 6);
-        d->length = flags & 0x7ff;
-        if (offset + datagram_span(d) > end) break;
-        d->wkc = dg_tvb_get_uint16(tvb, wkc_offset(d), ENC_LITTLE_ENDIAN);
-        n++;
-        offset += datagram_span(d);
-        if (!(flags & 0x8000)) break;
+    guint n = 0, cleared = 0;
+    for (guint i = 0; view && i < view->count; i++) {
+        const dg_view_value *x = &view->values[i];
+        if (x->input == ESC_IN_FRAME_LENGTH) {
+            *header_length = (guint)x->value;
+            continue;
+        }
+        if (x->instance >= max) continue;
+        while (cleared <= x->instance) memset(&out[cleared++], 0, sizeof *out);
+        place_input(&out[x->instance], x);
+        /* The working counter, last on the wire, makes the datagram whole. */
+        if (x->input == ESC_IN_WKC) n = x->instance + 1;
     }
     return n;
 }
@@ -1155,6 +1156,8 @@ datagram kept_datagram(const datagram *d, gboolean index)
     datagram k;
     memset(&k, 0, sizeof k);
     k.offset = d->offset;
+    k.address_offset = d->address_offset;
+    k.wkc_at = d->wkc_at;
     k.cmd = d->cmd;
     k.idx = index ? d->idx : 0;
     k.adp = d->adp;

@@ -7,31 +7,42 @@
 #pragma once
 
 #include "ethercat_design.h"
+#include "ethercat_inputs.h"
 #include "dissgen_pairing.h"
 
 namespace dg_ecat {
 
-/* One datagram as read from a frame. */
+/* The inputs of a frame's dg_view, by number (ethercat_inputs.h). */
+enum esc_input {
+#define DG_ESC_INPUT_ID(id, name, per_instance) id,
+    DG_ESC_INPUTS(DG_ESC_INPUT_ID)
+#undef DG_ESC_INPUT_ID
+};
+
+/* One datagram as the walk decoded it (the frame's dg_view). */
 struct datagram {
-    gint offset;        /* of the datagram in its tvb */
+    gint offset;         /* of the datagram (its command) in its tvb */
+    gint address_offset; /* of its address (the ADP, or the logical address) */
+    gint wkc_at;         /* of its working counter, which follows its data */
     guint8 cmd, idx;
-    guint16 adp, ado;   /* the 32-bit address: ADP low half, ADO high half */
-    guint16 length;     /* of the data */
+    guint16 adp, ado;    /* the 32-bit address: ADP low half, ADO high half */
+    guint16 length;      /* of the data */
     guint16 wkc;
 };
 
-/* A datagram on the wire: a 10-byte header, its data, a 2-byte working counter. */
-const gint datagram_header = 10, datagram_wkc = 2;
-inline gint data_offset(const datagram *d) { return d->offset + datagram_header; }
-inline gint wkc_offset(const datagram *d) { return data_offset(d) + d->length; }
-inline gint datagram_span(const datagram *d) { return datagram_header + d->length + datagram_wkc; }
+/* A datagram ends with its data and a 2-byte working counter. */
+const gint datagram_wkc = 2;
+inline gint wkc_offset(const datagram *d) { return d->wkc_at; }
+inline gint data_offset(const datagram *d) { return d->wkc_at - d->length; }
+inline gint datagram_span(const datagram *d) { return d->wkc_at + datagram_wkc - d->offset; }
 
 /* At most this many datagrams per frame: 1500 bytes hold at most 124. */
 const guint max_datagrams = 128;
 
-/* The frame's header length, and its datagrams (up to `max`); every read is
- * checked against the bytes there are. */
-guint read_frame(tvbuff_t *tvb, guint *header_length, datagram *out, guint max);
+/* The frame's header length, and its datagrams (up to `max`), from the
+ * values the walk decoded (`view`, NULL: none): a datagram counts when its
+ * working counter was decoded, so only whole datagrams do. */
+guint frame_datagrams(const dg_view *view, guint *header_length, datagram *out, guint max);
 
 const char *command_name(guint8 cmd);
 
@@ -61,11 +72,11 @@ struct bus_frame {
 
 bus_model *bus_new(const dg_bus *design);
 /* First pass. A frame as sent (a request, or one whose response is not paired),
- * its n datagrams as read_frame() read them: which slave each one addresses, in *f. */
+ * its n datagrams as frame_datagrams() gives them: which slave each one addresses, in *f. */
 void bus_sent(bus_model *m, const datagram *d, guint n, bus_frame *f);
 /* First pass. A returned frame with the frame as sent: what it teaches about
  * the bus, and which slave each datagram addresses, in *f. s and b are their
- * first n datagrams as read_frame() read them. */
+ * first n datagrams as frame_datagrams() gives them. */
 void bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
                   packet_info *pinfo, bus_frame *f);
 /* A sent frame's cycle (ethercat_cycles.h), kept with its slaves. */

@@ -314,7 +314,7 @@ int esc_is_response(void *capture, const address *request_src, const address *sr
  * the frame (a master sends every working counter as 0): returned, whether
  * or not the capture marks returns and whether or not its request was
  * captured. A frame with every working counter 0 cannot tell by itself. */
-guint8 esc_direction(void *capture, tvbuff_t *tvb, packet_info *pinfo)
+guint8 esc_direction(void *capture, tvbuff_t *, const dg_view *view, packet_info *pinfo)
 {
     const capture_hints *h = (const capture_hints *)capture;
     const address *src = &pinfo->src;
@@ -327,7 +327,7 @@ guint8 esc_direction(void *capture, tvbuff_t *tvb, packet_info *pinfo)
     }
     datagram d[max_datagrams];
     guint header_length;
-    guint n = read_frame(tvb, &header_length, d, max_datagrams);
+    guint n = frame_datagrams(view, &header_length, d, max_datagrams);
     for (guint i = 0; i < n; i++)
         if (d[i].wkc != 0) return DG_DIR_RESPONSE;
     return DG_DIR_ANY;
@@ -336,18 +336,18 @@ guint8 esc_direction(void *capture, tvbuff_t *tvb, packet_info *pinfo)
 /* A frame that no slave processed comes back as it was sent, except for the
  * auto-increment address of auto-increment and broadcast datagrams, which
  * every slave it passes advances. */
-gboolean esc_unchanged(tvbuff_t *request, tvbuff_t *message, guint message_length)
+gboolean esc_unchanged(tvbuff_t *request, const dg_view *request_view, tvbuff_t *message, guint message_length)
 {
     guint length = tvb_captured_length(request);
     if (message_length != length || tvb_captured_length(message) < length) return FALSE;
     datagram d[max_datagrams];
     guint header_length;
-    guint n = read_frame(request, &header_length, d, max_datagrams);
+    guint n = frame_datagrams(request_view, &header_length, d, max_datagrams);
     const guint8 *sent = (const guint8 *)tvb_get_ptr(request, 0, (gint)length);
     guint from = 0; /* bytes before `from` are compared */
     for (guint i = 0; i < n; i++) {
         if (!advances_adp(d[i].cmd)) continue;
-        guint adp = (guint)d[i].offset + 2;
+        guint adp = (guint)d[i].address_offset;
         if (tvb_memeql(message, (gint)from, sent + from, adp - from) != 0) return FALSE;
         from = adp + 2;
     }
@@ -357,12 +357,12 @@ gboolean esc_unchanged(tvbuff_t *request, tvbuff_t *message, guint message_lengt
 /* A returned frame whose index matches no frame sent is the one frame
  * waiting only if its datagrams are that frame's but for the index (the same
  * commands and addresses): otherwise it answers a frame not captured. */
-gboolean esc_key_changed(tvbuff_t *request, tvbuff_t *message)
+gboolean esc_key_changed(const dg_view *request, const dg_view *message)
 {
     datagram s[max_datagrams], b[max_datagrams];
     guint sent_length, back_length;
-    guint n = read_frame(request, &sent_length, s, max_datagrams);
-    if (read_frame(message, &back_length, b, max_datagrams) != n) return FALSE;
+    guint n = frame_datagrams(request, &sent_length, s, max_datagrams);
+    if (frame_datagrams(message, &back_length, b, max_datagrams) != n) return FALSE;
     for (guint i = 0; i < n; i++)
         if (s[i].cmd != b[i].cmd || s[i].ado != b[i].ado || (!advances_adp(s[i].cmd) && s[i].adp != b[i].adp))
             return FALSE;
@@ -370,12 +370,13 @@ gboolean esc_key_changed(tvbuff_t *request, tvbuff_t *message)
 }
 
 
-guint32 esc_compare(void *capture, tvbuff_t *request, tvbuff_t *response, const dg_transaction *txn, packet_info *pinfo)
+guint32 esc_compare(void *capture, tvbuff_t *request, const dg_view *request_view, tvbuff_t *response,
+                    const dg_view *response_view, const dg_transaction *txn, packet_info *pinfo)
 {
     datagram sent[max_datagrams], back[max_datagrams];
     guint sent_length, back_length;
-    guint sent_count = read_frame(request, &sent_length, sent, max_datagrams);
-    guint back_count = read_frame(response, &back_length, back, max_datagrams);
+    guint sent_count = frame_datagrams(request_view, &sent_length, sent, max_datagrams);
+    guint back_count = frame_datagrams(response_view, &back_length, back, max_datagrams);
     guint count = MIN(sent_count, back_count);
     compared d[max_datagrams];
     memset(d, 0, count * sizeof(compared));
@@ -422,7 +423,7 @@ proto_tree *show_datagram_items(const compared *c, guint i, tvbuff_t *tvb, proto
     proto_item *it = proto_tree_add_int(sub, hf_wkc_added, tvb, wkc_offset(&c->back), datagram_wkc, wkc_added(c));
     proto_item_set_generated(it);
     if (c->has_advance) {
-        it = proto_tree_add_uint(sub, hf_slaves_passed, tvb, c->back.offset + 2, 2, c->advance);
+        it = proto_tree_add_uint(sub, hf_slaves_passed, tvb, c->back.address_offset, 2, c->advance);
         proto_item_set_generated(it);
     }
     it = proto_tree_add_boolean(sub, hf_data_changed, tvb, data_offset(&c->back), c->back.length, c->data_changed);
@@ -456,7 +457,7 @@ void show_datagram_experts(const compared *c, guint i, tvbuff_t *tvb, packet_inf
                                      "Datagram %u (%s): working counter went down from %u to %u", i + 1, cmd,
                                      c->sent.wkc, c->back.wkc);
     if (c->forwarding)
-        proto_tree_add_expert_format(tree, pinfo, &ei_forwarding, tvb, c->back.offset + 2, 2,
+        proto_tree_add_expert_format(tree, pinfo, &ei_forwarding, tvb, c->back.address_offset, 2,
                                      "Datagram %u (%s): auto-increment address advanced by %u, the frame's other "
                                      "datagrams by %u",
                                      i + 1, cmd, c->advance, c->majority);
@@ -524,12 +525,12 @@ void esc_show(guint32 data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 }
 
 /* A frame as sent: its slaves and its cycle. */
-guint32 esc_sent(void *capture, tvbuff_t *tvb, packet_info *pinfo)
+guint32 esc_sent(void *capture, tvbuff_t *, const dg_view *view, packet_info *pinfo)
 {
     capture_hints *h = (capture_hints *)capture;
     datagram d[max_datagrams];
     guint header_length;
-    guint n = read_frame(tvb, &header_length, d, max_datagrams);
+    guint n = frame_datagrams(view, &header_length, d, max_datagrams);
     bus_frame f = {};
     bus_sent(h->bus, d, n, &f);
     cycle_mark c = cycles_sent(h->cycles, d, n, pinfo);

@@ -55,7 +55,7 @@ class ReservedNames(unittest.TestCase):
 
     def test_a_field_named_like_the_bus_model_is_refused(self):
         rules = src("tests", "rules_err", "pairing_esc_reserved_bus_field_name.xml")
-        expected = ("%s:7: error: filter name 'tst.slave' is reserved for the ethercat-esc analysis (its field "
+        expected = ("%s:15: error: filter name 'tst.slave' is reserved for the ethercat-esc analysis (its field "
                     "'Slave')" % rules)
         check = dissgen("check", rules)
         self.assertEqual(check.returncode, 1)

@@ -421,9 +421,10 @@ TEST(Emit, ExpertInfosAreExactlyTheRuntimesList) {
 // <pairing> marks its key fields DG_KEY (every instance of a
 // repeated one) and gives the protocol a dg_pairing; without it nothing changes.
 TEST(Pairing, KeysAreFlaggedAndThePairingIsEmitted) {
+    const AnalysisScaffold inputs = analysis_scaffold("ethercat-esc");
     Front f = front_end(rules("  <pairing timeout=\"0.25\" analysis=\"ethercat-esc\">\n"
-                              "    <key field=\"node[@name='Item']/node[@name='Id']\"/>\n"
-                              "  </pairing>\n"
+                              "    <key field=\"node[@name='Item']/node[@name='Id']\"/>\n" +
+                              lines_of(inputs.inputs) + "  </pairing>\n" + lines_of(inputs.nodes) +
                               "  <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
                               "  <node name=\"Item\" count=\"../node[@name='Count']\">\n"
                               "    <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
@@ -441,6 +442,29 @@ TEST(Pairing, KeysAreFlaggedAndThePairingIsEmitted) {
     EXPECT_TRUE(contains(code, ".pairing(&tst_pairing);")) << code;
     EXPECT_TRUE(contains(code, ".show(DG_SHOW_HEX).flags(DG_NUMERIC|DG_KEY)")) << code;
     EXPECT_EQ(code.find(".show(DG_SHOW_DEC).flags(DG_NUMERIC|DG_KEY)"), std::string::npos) << "only the key is flagged";
+}
+
+// <input> binds a leaf to the analysis's input number: its dg_extra says so,
+// and the walk never steps over it unseen (quiet), as nobody else reads it.
+TEST(Pairing, InputsAreNumberedInTheirExtraAndNeverQuiet) {
+    const AnalysisScaffold inputs = analysis_scaffold("ethercat-esc");
+    Front f = front_end(rules("  <pairing analysis=\"ethercat-esc\">\n"
+                              "    <key field=\"node[@name='Input count']\"/>\n" +
+                              lines_of(inputs.inputs) + "  </pairing>\n" + lines_of(inputs.nodes)));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Analysis* esc = find_analysis("ethercat-esc");
+    ASSERT_TRUE(esc);
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    for (size_t i = 0; i < esc->inputs.size(); ++i) {
+        const Node* leaf = find(*f.proto, "Input " + std::to_string(i));
+        ASSERT_TRUE(leaf);
+        EXPECT_EQ(leaf->analysis_input, static_cast<int>(i));
+        EXPECT_EQ(leaf->analysis_input_per_instance, esc->inputs[i].per_instance);
+        EXPECT_TRUE(contains(code, "/* " + std::to_string(leaf->doc_index - 1) + ": Input " + std::to_string(i) +
+                                       " */\n    dg_node_extra().input(" + std::to_string(i) + ")"))
+            << code;
+    }
+    EXPECT_FALSE(contains(code, ".quiet_size(")) << "an input is never stepped over:\n" << code;
 }
 
 TEST(Pairing, AbsentMeansNoPairingCode) {

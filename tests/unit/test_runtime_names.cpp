@@ -59,8 +59,14 @@ Scaffold scaffold_for(const NameGroup& g) {
         case When::Pairing: return {{"  <pairing>", key, "  </pairing>", id}, {}};
         case When::RequestContext:
             return {{"  <pairing>", key, "  </pairing>", id}, {"  <node name=\"Again\" value=\"request{Id}\"/>"}};
-        case When::Analysis:
-            return {{"  <pairing analysis=\"" + std::string(g.analysis) + "\">", key, "  </pairing>", id}, {}};
+        case When::Analysis: {
+            const AnalysisScaffold inputs = analysis_scaffold(g.analysis);
+            Scaffold s{{"  <pairing analysis=\"" + std::string(g.analysis) + "\">", key}, inputs.nodes};
+            s.before.insert(s.before.end(), inputs.inputs.begin(), inputs.inputs.end());
+            s.before.push_back("  </pairing>");
+            s.before.push_back(id);
+            return s;
+        }
     }
     return {};
 }

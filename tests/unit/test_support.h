@@ -7,7 +7,9 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <vector>
 
+#include "analyses.h"
 #include "diagnostics.h"
 #include "model.h"
 #include "parser.h"
@@ -55,6 +57,42 @@ inline const Node* find(const Protocol& proto, const std::string& name) {
 
 inline bool contains(const std::string& haystack, const std::string& needle) {
     return haystack.find(needle) != std::string::npos;
+}
+
+// What <pairing analysis="NAME"> needs in a small test file: the <input>
+// lines inside <pairing>, and the nodes they name (from <root>): a leaf per
+// input of the message, and, in a repeated node, one per input of each
+// instance. One line each.
+struct AnalysisScaffold {
+    std::vector<std::string> inputs, nodes;
+};
+
+inline AnalysisScaffold analysis_scaffold(const std::string& name) {
+    AnalysisScaffold s;
+    const Analysis* a = find_analysis(name);
+    if (!a) return s;
+    std::vector<std::string> own, repeated;
+    for (size_t i = 0; i < a->inputs.size(); ++i) {
+        const std::string leaf = "Input " + std::to_string(i);
+        const std::string path = a->inputs[i].per_instance ? "node[@name='Inputs']/node[@name='" + leaf + "']"
+                                                           : "node[@name='" + leaf + "']";
+        s.inputs.push_back("    <input name=\"" + a->inputs[i].name + "\" field=\"" + path + "\"/>");
+        (a->inputs[i].per_instance ? repeated : own)
+            .push_back("<node name=\"" + leaf + "\" length=\"1byte\" displaytype=\"numberdec\"/>");
+    }
+    s.nodes.push_back("  <node name=\"Input count\" length=\"1byte\" displaytype=\"numberdec\"/>");
+    for (const std::string& n : own) s.nodes.push_back("  " + n);
+    s.nodes.push_back("  <node name=\"Inputs\" count=\"../node[@name='Input count']\">");
+    for (const std::string& n : repeated) s.nodes.push_back("    " + n);
+    s.nodes.push_back("  </node>");
+    return s;
+}
+
+// The lines joined, each ended by a newline.
+inline std::string lines_of(const std::vector<std::string>& lines) {
+    std::string out;
+    for (const std::string& l : lines) out += l + "\n";
+    return out;
 }
 
 }  // namespace dissgen::testing
