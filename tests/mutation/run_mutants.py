@@ -33,6 +33,8 @@ Exit status: 0 when every mutant is killed, 1 otherwise, 77 (skip) without tshar
 import argparse
 import fnmatch
 import glob
+import hashlib
+import json
 import os
 import re
 import resource
@@ -46,6 +48,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import systematic  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+COVERAGE_MAP = os.path.join(HERE, "coverage.json")   # coverage_map.py writes it
 SKIP_CODE = 77
 TEST_TIMEOUT = 300   # seconds per test run: a mutant that hangs the decoder is killed by it
 TIMEOUT_FACTOR = 3   # ... unless the test's unmutated run took more than a third of it
@@ -457,6 +460,54 @@ def corpus_missing(mutants, source_dir, corpus=None):
     return sorted({t for m in mutants for t in m.tests if needs_corpus(t, source_dir)})
 
 
+def changed_lines(original, mutated):
+    """(first, last) line numbers of original that mutated changes."""
+    p = 0
+    while p < min(len(original), len(mutated)) and original[p] == mutated[p]:
+        p += 1
+    e = 0
+    while e < min(len(original), len(mutated)) - p and original[-1 - e] == mutated[-1 - e]:
+        e += 1
+    first, end = original.count("\n", 0, p) + 1, len(original) - e
+    return first, (original.count("\n", 0, end - 1) + 1 if end > p else first)   # end - 1: the last byte changed
+
+
+def load_coverage(path):
+    """The map coverage_map.py writes (test -> runtime file -> executed lines), or None."""
+    if not os.path.isfile(path):
+        return None
+    with open(path, encoding="utf-8") as fh:
+        return json.load(fh)
+
+
+def tests_running(coverage, file, lines, text):
+    """Names of the tests that the coverage map says execute a line of lines in file
+    (any line of file when its text changed since the map was written: its line numbers
+    may have moved)."""
+    if not coverage or file not in coverage.get("sources", {}):
+        return []
+    moved = coverage["sources"][file] != hashlib.sha256(text.encode("utf-8")).hexdigest()
+    first, last = lines
+    return [t for t, row in coverage.get("tests", {}).items() if t in TESTS and file in row["lines"] and
+            (moved or any(first <= l <= last for l in row["lines"][file]))]
+
+
+def choose_tests(m, coverage, source_dir):
+    """The mutant's own tests and every test the coverage map says executes the mutated
+    lines, cheapest (by the map's seconds) first; tests the map has not timed keep their
+    order, after those."""
+    if getattr(m, "problem", None) or not m.file:
+        return m.tests
+    try:
+        original = open(os.path.join(source_dir, m.file), encoding="utf-8").read()
+        lines = changed_lines(original, m.mutate(original))
+    except (OSError, ValueError):
+        return m.tests   # judge() reports it INVALID
+    chosen = list(dict.fromkeys(m.tests + tests_running(coverage, m.file, lines, original)))
+    timed = coverage.get("tests", {}) if coverage else {}
+    return sorted(chosen, key=lambda t: (timed[t]["seconds"], 0) if t in timed else (float("inf"), chosen.index(t)))
+
+
 def pick_window(spec, count, source_dir):
     """--window K/N: (k, n); K may be 'commit' (the source tree's commit picks it)."""
     m = re.match(r"^(\d+|commit)/(\d+)$", spec)
@@ -485,6 +536,10 @@ def main(argv=None):
                     help="start no mutant after this many seconds (0: run all)")
     ap.add_argument("--without", nargs="*", default=[], metavar="TEST",
                     help="leave these tests out (to measure what the others kill)")
+    ap.add_argument("--coverage", default=COVERAGE_MAP, metavar="FILE",
+                    help="the coverage map that adds the tests executing a mutated line (coverage_map.py)")
+    ap.add_argument("--no-coverage", action="store_true",
+                    help="run only the tests each mutant names (to measure what the map adds)")
     ap.add_argument("--systematic", action="store_true",
                     help="the generated mutants of systematic.py instead of the hand-written ones")
     ap.add_argument("--sample", type=int, default=0, metavar="N", help="a random sample of N of the mutants")
@@ -522,8 +577,9 @@ def main(argv=None):
         generated = systematic.mutants(args.source_dir, include_equivalent=True)
         n = max(1, -(-len(generated) // args.extra_systematic))
         extra = systematic.window(generated, commit_number(args.source_dir) % n, n)[:args.extra_systematic]
+    coverage = None if args.no_coverage else load_coverage(args.coverage)
     for m in mutants + extra:
-        m.tests = [t for t in m.tests if t not in args.without]
+        m.tests = [t for t in choose_tests(m, coverage, args.source_dir) if t not in args.without]
     if args.list:
         for m in mutants + extra:
             print("%-34s %-36s %s" % (m.name, m.path if args.systematic or m in extra else m.file,

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The mutation runner's decisions on fake test outcomes: what a run of a test says
 (classify), how long a test may take (time_limit), the verdict of a mutant from its
-tests' runs (decide), and which tests need the corpus (needs_corpus)."""
+tests' runs (decide), the tests a coverage map adds (choose_tests), when the map is
+stale (coverage_map.stale), and which tests need the corpus (needs_corpus)."""
 
 import os
 import sys
@@ -9,6 +10,7 @@ import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import run_mutants as rm  # noqa: E402
+import coverage_map  # noqa: E402
 
 SOURCE_DIR = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 
@@ -126,6 +128,67 @@ class Decide(unittest.TestCase):
         fake = Fake({"quiet": [(rm.PASS, "")]})
         decide(fake, ["quiet"], {"quiet": 400})
         self.assertEqual(fake.calls, [("mutant", "quiet", 1200)])
+
+
+class ChosenByCoverage(unittest.TestCase):
+    TEXT = "line one\nline two\nline three\nline four\n"
+
+    def coverage(self, text=None):
+        return {"sources": {"plugin_runtime/x.cpp": rm.hashlib.sha256((text or self.TEXT).encode()).hexdigest()},
+                "tests": {"overlays": {"seconds": 90, "lines": {"plugin_runtime/x.cpp": [2]}},
+                          "widths": {"seconds": 20, "lines": {"plugin_runtime/x.cpp": [2, 3]}},
+                          "edges_offsets": {"seconds": 5, "lines": {"plugin_runtime/x.cpp": [4]}}}}
+
+    def test_changed_lines(self):
+        self.assertEqual(rm.changed_lines(self.TEXT, self.TEXT.replace("two", "2")), (2, 2))
+        self.assertEqual(rm.changed_lines(self.TEXT, self.TEXT.replace("two\nline three", "2\nline 3")), (2, 3))
+        self.assertEqual(rm.changed_lines(self.TEXT, self.TEXT.replace("line four\n", "")), (4, 4))
+
+    def test_tests_executing_the_line(self):
+        self.assertEqual(sorted(rm.tests_running(self.coverage(), "plugin_runtime/x.cpp", (2, 2), self.TEXT)),
+                         ["overlays", "widths"])
+        self.assertEqual(rm.tests_running(self.coverage(), "plugin_runtime/x.cpp", (1, 1), self.TEXT), [])
+        self.assertEqual(rm.tests_running(self.coverage(), "generator/y.cpp", (2, 2), self.TEXT), [])
+        self.assertEqual(rm.tests_running(None, "plugin_runtime/x.cpp", (2, 2), self.TEXT), [])
+
+    def test_a_file_changed_since_the_map_takes_every_test_of_it(self):
+        moved = "new first line\n" + self.TEXT
+        self.assertEqual(sorted(rm.tests_running(self.coverage(), "plugin_runtime/x.cpp", (1, 1), moved)),
+                         ["edges_offsets", "overlays", "widths"])
+
+    def test_own_tests_and_covering_ones_cheapest_first(self):
+        class M:
+            problem, file, tests = None, "plugin_runtime/x.cpp", ["everything", "overlays"]
+
+            def mutate(self, text):
+                return text.replace("two", "2")
+        folder = rm.tempfile.mkdtemp()
+        os.makedirs(os.path.join(folder, "plugin_runtime"))
+        with open(os.path.join(folder, "plugin_runtime", "x.cpp"), "w") as fh:
+            fh.write(self.TEXT)
+        self.assertEqual(rm.choose_tests(M(), self.coverage(), folder), ["widths", "overlays", "everything"])
+        self.assertEqual(rm.choose_tests(M(), None, folder), ["everything", "overlays"])
+        rm.shutil.rmtree(folder)
+
+
+class CoverageMapStale(unittest.TestCase):
+    def current(self):
+        sources = {f: "hash" for f in coverage_map.runtime_sources(SOURCE_DIR)}
+        return {"sources": sources, "tests": {"overlays": {"seconds": 1, "lines": {}}},
+                "unmapped": sorted(set(rm.TESTS) - {"overlays"})}
+
+    def test_a_map_that_knows_everything_is_fresh(self):
+        self.assertEqual(coverage_map.stale(SOURCE_DIR, self.current()), [])
+
+    def test_a_test_added_since_is_stale(self):
+        data = self.current()
+        data["unmapped"].remove("widths")
+        self.assertEqual(coverage_map.stale(SOURCE_DIR, data), ["test widths"])
+
+    def test_a_source_added_since_is_stale(self):
+        data = self.current()
+        del data["sources"]["plugin_runtime/dissgen_walk.cpp"]
+        self.assertEqual(coverage_map.stale(SOURCE_DIR, data), ["source plugin_runtime/dissgen_walk.cpp"])
 
 
 class Corpus(unittest.TestCase):
