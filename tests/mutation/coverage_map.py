@@ -7,11 +7,11 @@ the runner reads to choose a mutant's tests by what they run, not by a hand-kept
 
 The runtime runs inside tshark, in a plugin that `dissgen install` compiles from the
 generated code and the plugin_runtime sources.  Each test (a name of run_mutants.TESTS)
-runs with DISSGEN_CXXFLAGS="--coverage -dumpdir DIR/" (build_plugin passes it to the
-compiler, as DISSGEN_SANITIZE's flags): the plugins it builds leave their .gcno notes in
-DIR, and tshark their .gcda counts at exit, one DIR per test; gcov turns them into the
-executed lines of each runtime file.  Tests that build no plugin (the unit tests) map to
-no runtime line.  The generator is not mapped yet: for its files the runner keeps the
+runs with DISSGEN_COVERAGE_DIR=DIR: dissgen (build_plugin) then compiles each plugin with
+"--coverage -dumpdir DIR/<its build folder>/" (every plugin has the runtime's file names,
+and one rule file may make several): its .gcno notes land there, and tshark writes its
+.gcda counts there at exit; gcov turns them into the executed lines of each runtime file.
+Tests that build no plugin (the unit tests) map to no runtime line.  The generator is not mapped yet: for its files the runner keeps the
 mutant's own tests.
 
 The map (coverage.json): for each test its seconds and {runtime file: [executed lines]};
@@ -56,8 +56,9 @@ def sha256(path):
 def gcov_lines(notes_dir, by_basename):
     """{repository path: sorted executed lines} from the .gcda/.gcno pairs in notes_dir."""
     lines = {}
-    for gcda in sorted(glob.glob(os.path.join(notes_dir, "*.gcda"))):
-        p = subprocess.run(["gcov", "--json-format", "--stdout", gcda], cwd=notes_dir, capture_output=True)
+    for gcda in sorted(glob.glob(os.path.join(notes_dir, "*", "*.gcda"))):
+        p = subprocess.run(["gcov", "--json-format", "--stdout", gcda], cwd=os.path.dirname(gcda),
+                           capture_output=True)
         for chunk in p.stdout.splitlines():
             if not chunk.strip():
                 continue
@@ -70,13 +71,12 @@ def gcov_lines(notes_dir, by_basename):
 
 
 def run_with_coverage(name, source_dir, dissgen, work):
-    """(status, seconds, {path: lines}) of test name run with coverage plugins."""
+    """(kind, seconds, {path: lines}, output) of test name run with coverage plugins."""
     notes = os.path.join(work, name)
     shutil.rmtree(notes, ignore_errors=True)
     os.makedirs(notes)
-    os.chmod(notes, 0o777)   # tshark runs as nobody under root: it writes the .gcda here
     build_dir = os.path.dirname(os.path.dirname(os.path.abspath(dissgen)))
-    env = dict(os.environ, DISSGEN_CXXFLAGS="--coverage -dumpdir %s/" % notes)
+    env = dict(os.environ, DISSGEN_COVERAGE_DIR=notes)
     cmd = run_mutants.TESTS[name](source_dir, build_dir)
     start = time.monotonic()
     p = subprocess.run(cmd, cwd=build_dir, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
@@ -84,7 +84,7 @@ def run_with_coverage(name, source_dir, dissgen, work):
     secs = time.monotonic() - start
     kind, _ = run_mutants.classify(p.returncode, p.stdout)
     by_basename = {os.path.basename(f): f for f in runtime_sources(source_dir)}
-    return kind, secs, gcov_lines(notes, by_basename)
+    return kind, secs, gcov_lines(notes, by_basename), p.stdout
 
 
 def save(source_dir, tests, path):
@@ -108,11 +108,11 @@ def write_map(source_dir, dissgen, names, path):
     os.chmod(work, 0o755)
     try:
         for name in names:
-            kind, secs, lines = run_with_coverage(name, source_dir, dissgen, work)
+            kind, secs, lines, out = run_with_coverage(name, source_dir, dissgen, work)
             print("%-22s %-7s %5.0fs %d runtime files, %d lines" % (
                 name, kind, secs, len(lines), sum(len(v) for v in lines.values())), flush=True)
             if kind in (run_mutants.FAIL, run_mutants.TIMEOUT):
-                raise SystemExit("%s fails unmutated: fix it before mapping" % name)
+                raise SystemExit("%s fails unmutated: fix it before mapping\n%s" % (name, run_mutants.tail(out)))
             tests[name] = {"seconds": round(secs, 1), "lines": lines}
             save(source_dir, tests, path)
     finally:
