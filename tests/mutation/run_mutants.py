@@ -615,7 +615,7 @@ def main(argv=None):
     without_corpus = corpus_missing(mutants + extra, args.source_dir)
     if without_corpus:
         print("no corpus at %s: the mutants' tests %s read it and would skip, deciding nothing; "
-              "put the corpus there (or name the mutants to run with --only)" % (
+              "put the corpus there, or choose (--only) mutants whose tests do not read it" % (
                   corpus_dir(args.source_dir), " ".join(without_corpus)))
         return 1
 
