@@ -51,6 +51,16 @@ std::string share_dir(const std::string& argv0) {
     return (exe.parent_path().parent_path() / "share" / "dissgen").string();
 }
 
+// DIR/<the build folder's name>, which tshark (run as nobody under root) may write its
+// counts into; "" when it cannot be made.
+static std::string coverage_notes_dir(const std::string& folder, const fs::path& build_dir) {
+    fs::path notes = fs::path(folder) / build_dir.filename();
+    std::error_code ec;
+    fs::create_directories(notes, ec);
+    if (ec || chmod(notes.c_str(), 0777) != 0) return "";
+    return notes.string();
+}
+
 std::string find_runtime_dir(const std::string& argv0) {
     if (const char* env = std::getenv("DISSGEN_RUNTIME_DIR"); env && has_runtime(env)) return env;
     fs::path installed = fs::path(share_dir(argv0)) / "runtime";
@@ -81,7 +91,11 @@ std::string build_and_install(const BuildRequest& req, std::string& installed_pa
             return "the plugin runtime in " + req.runtime_dir + " lacks " + extra + ", which these rules use";
     }
 
-    fs::path source = dir / (req.stem + ".cpp");
+    const char* coverage = std::getenv("DISSGEN_COVERAGE_DIR");
+    if (coverage && !*coverage) coverage = nullptr;
+    // Under coverage the notes are named by the source: a plugin stem may be a runtime
+    // file's (handoff.xml makes dissgen_handoff, as dissgen_handoff.cpp).
+    fs::path source = dir / (req.stem + (coverage ? ".generated.cpp" : ".cpp"));
     std::ofstream(source) << req.generated_source;
     fs::path output = dir / (req.stem + ".so");
 
@@ -99,6 +113,14 @@ std::string build_and_install(const BuildRequest& req, std::string& installed_pa
     // Extra flags, e.g. -fsanitize=address,undefined for the sanitizer test runs.
     if (const char* extra = std::getenv("DISSGEN_CXXFLAGS"))
         for (const std::string& w : split_words(extra)) cmd.push_back(w);
+    // gcov coverage for the mutation check's map (tests/mutation/coverage_map.py): each
+    // plugin's notes and counts in a folder of its own, since every plugin has the
+    // runtime's file names and one rule file may make several plugins.
+    if (coverage) {
+        std::string notes = coverage_notes_dir(coverage, dir);
+        if (notes.empty()) return std::string("cannot create a coverage folder in ") + coverage;
+        cmd.insert(cmd.end(), {"--coverage", "-dumpdir", notes + "/"});
+    }
     cmd.push_back(source.string());
     for (const std::string& runtime_source : runtime.sources) cmd.push_back(req.runtime_dir + "/" + runtime_source);
     for (const std::string& extra : req.analysis_sources) cmd.push_back(req.runtime_dir + "/" + extra);

@@ -323,8 +323,8 @@ class TestRequestDefined(TsharkTestCase, unittest.TestCase):
 # --- request{Name} by position (tests/rules/request_by_position.xml, UDP 47505) -------------
 
 BATCH_PORT = 47505
-BATCH_FIELDS = ["frame.number", "batch.answer.word", "batch.answer.text", "batch.expert.no_request_context",
-                "_ws.expert.severity"]
+BATCH_FIELDS = ["frame.number", "batch.answer.word", "batch.answer.text", "batch.answer.asked",
+                "batch.expert.no_request_context", "_ws.expert.severity"]
 
 
 def batches(seed, n):
@@ -368,6 +368,17 @@ def batch_frames(seed=47505, n=40):
     return bs, order, orphans, frames + [batch_frame("response", batch_message("response", b)) for b in orphans]
 
 
+def overlong_frames(bs, first=0x7100):
+    """Batches answered with more answers than their requests asked: each request sends its
+    first operations only, the response answers them all. [(transaction, ops, asked)], frames."""
+    longer = [(first + k, ops, len(ops) // 2) for k, (_, ops) in enumerate(bs) if len(ops) >= 2][:5]
+    frames = []
+    for transaction, ops, asked in longer:
+        frames.append(batch_frame("request", batch_message("request", (transaction, ops[:asked]))))
+        frames.append(batch_frame("response", batch_message("response", (transaction, ops))))
+    return longer, frames
+
+
 class TestRequestByPosition(TsharkTestCase, unittest.TestCase):
     """A field of a repeated node read by position: each answer of a batch is a word or a text
     as the operation at its position in the request says (request{Kind} in the answer's
@@ -378,7 +389,29 @@ class TestRequestByPosition(TsharkTestCase, unittest.TestCase):
     def prepare(cls):
         cls.install(os.path.join("tests", "rules", "request_by_position.xml"), "batch")
         cls.batches, cls.order, cls.orphans, frames = batch_frames()
-        cls.path = cls.env.add_file("batches.pcap", pcapgen.raw_pcap_bytes(frames))
+        cls.overlong, more = overlong_frames(cls.batches)
+        cls.first_overlong = len(frames) + 1
+        cls.path = cls.env.add_file("batches.pcap", pcapgen.raw_pcap_bytes(frames + more))
+
+    def test_positions_the_request_lacks_are_undefined(self):
+        """Answers past the request's operations read request{Kind} of an instance the request
+        did not have: Asked is undefined (left out), not 0, and decodes neither a word nor a text."""
+        with self.checks() as check:
+            check(len(self.overlong) >= 3, "%d responses longer than their requests" % len(self.overlong))
+            for two_pass in (False, True):
+                rows = self.env.field_rows(self.path, BATCH_FIELDS, two_pass)
+                wrong = []
+                for i, (_, ops, asked) in enumerate(self.overlong):
+                    r = rows[self.first_overlong + 2 * i + 1]
+                    want = {"batch.answer.asked": [str(kind) for kind, _, _ in ops[:asked]],
+                            "batch.answer.word": ["0x%04x" % a for kind, _, a in ops[:asked] if kind == 1],
+                            "batch.answer.text": [a.decode() for kind, _, a in ops[:asked] if kind == 2]}
+                    got = {f: r.get(f, []) for f in want}
+                    if got != want:
+                        wrong.append((self.first_overlong + 2 * i + 1, got, want))
+                check(not wrong, "%s: answers past the request's %s operations have no Asked, word or text%s"
+                      % ("-2" if two_pass else "one pass", [a for _, _, a in self.overlong],
+                         "" if not wrong else " (wrong: %s)" % wrong[:2]))
 
     def test_answers_decoded_by_the_operation_at_their_position(self):
         in_flight = max(sum(1 for d, k in self.order[:i] if d == "request") -

@@ -11,11 +11,16 @@ is copied into a temporary folder, configured and built once (dissgen, unit_test
 dissgen_runtime); the checkout itself is never touched.  Then for each mutant: the
 mutated file is written, the build is brought up to date (only what the file feeds),
 and the mutant's tests run in the order given until one fails: the mutant is KILLED.
-When all pass it SURVIVED.  A mutant whose snippet is not found exactly once, or that
+When all pass it SURVIVED.  A test that skipped (exit 77, a "SKIPPED:" line, a skipped
+gtest or unittest) decides nothing: when every test of a mutant skipped it is NOT DECIDED,
+which fails the check like a survivor.  A mutant whose snippet is not found exactly once, or that
 does not build, is INVALID (the code moved on: refresh the mutant).  A kill counts only
 if the killing test passes on the unmutated copy: the first time a test kills a mutant, it
 runs once there (the check stops when it fails).  --work DIR keeps the copy and its build
-for the next run.
+for the next run.  A test's time limit is max(300 s, 3 x its own time on the unmutated
+copy): a test that runs out of the 300 s first is timed there, then run on the mutant again.
+The check refuses to start when a mutant's tests need the corpus (../shared/corpus) and it
+is absent.
 
 --budget SECONDS (CI: the whole check must fit its time limit) starts no mutant once
 that much time has gone; the mutants then run from a place in the list that the source
@@ -28,6 +33,8 @@ Exit status: 0 when every mutant is killed, 1 otherwise, 77 (skip) without tshar
 import argparse
 import fnmatch
 import glob
+import hashlib
+import json
 import os
 import re
 import resource
@@ -41,8 +48,11 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import systematic  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+COVERAGE_MAP = os.path.join(HERE, "coverage.json")   # coverage_map.py writes it
 SKIP_CODE = 77
 TEST_TIMEOUT = 300   # seconds per test run: a mutant that hangs the decoder is killed by it
+TIMEOUT_FACTOR = 3   # ... unless the test's unmutated run took more than a third of it
+BASELINE_TIMEOUT = 3600   # the unmutated run is the yardstick: it gets all the time it needs
 
 
 def integration(script, *extra):
@@ -212,22 +222,57 @@ class Mutant:
         return original.replace(self.find, self.replace)
 
 
+# What one run of a test says about the code it ran.
+PASS, FAIL, SKIP, TIMEOUT = "pass", "fail", "skip", "timeout"
+
+# The marks a skip leaves: our scripts' "SKIPPED:" line, gtest's "[  SKIPPED ]" and
+# unittest's "OK (skipped=N)" / "FAILED (..., skipped=N)".
+SKIP_MARKS = re.compile(r"^SKIPPED:.*$|^\[  SKIPPED \].*$|^(?:OK|FAILED) \(.*skipped=\d+.*\)$", re.M)
+
+
+def classify(returncode, output, timed_out=False):
+    """(kind, reason) of one test run. A failure is a failure whatever else skipped; a
+    pass that skipped anything (exit 77 included: a script that skipped a part it cannot
+    run here, e.g. one needing the corpus) is a SKIP, since the skipped part might have
+    been the one to fail."""
+    if timed_out:
+        return TIMEOUT, "timed out"
+    if returncode not in (0, SKIP_CODE):
+        return FAIL, "exit status %d" % returncode
+    marks = SKIP_MARKS.findall(output or "")
+    if returncode == SKIP_CODE or marks:
+        return SKIP, (marks[0].strip() if marks else "exit status 77")
+    return PASS, ""
+
+
+def time_limit(test, baseline_secs):
+    """Seconds test may take on a mutant: a slow machine makes every test slower, so the
+    limit grows with the test's own unmutated time when that is known."""
+    return max(TEST_TIMEOUT, TIMEOUT_FACTOR * baseline_secs.get(test, 0))
+
+
 def run(cmd, cwd=None, timeout=None, log=None):
-    """(exit status, seconds, output); output to the log file too. A timeout counts as a
-    failure; 77 (a test that skipped a part it cannot run here, e.g. one needing the corpus,
-    after all its other tests passed) as a pass."""
+    """(kind, seconds, output, reason) of one test run (classify); output to the log file too."""
     start = time.monotonic()
     try:
         p = subprocess.run(cmd, cwd=cwd, timeout=timeout, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                            text=True, errors="replace")
-        status, out = (0 if p.returncode == SKIP_CODE else p.returncode), p.stdout
+        kind, reason = classify(p.returncode, p.stdout)
+        out = p.stdout
     except subprocess.TimeoutExpired as e:
-        status, out = -1, (e.stdout or "") if isinstance(e.stdout, str) else ""
+        out = (e.stdout or "") if isinstance(e.stdout, str) else ""
         out += "\n(timed out after %ss)\n" % timeout
+        kind, reason = classify(None, out, timed_out=True)
     if log:
         with open(log, "a", encoding="utf-8") as fh:
             fh.write("$ %s\n%s\n" % (" ".join(cmd), out))
-    return status, time.monotonic() - start, out
+    return kind, time.monotonic() - start, out, reason
+
+
+def run_command(cmd, log=None):
+    """(ok, seconds, output) of a build step: anything but exit 0 is a failure."""
+    kind, secs, out, _ = run(cmd, log=log)
+    return kind == PASS, secs, out
 
 
 def copy_tree(source, dest):
@@ -248,9 +293,8 @@ def copy_tree(source, dest):
 
 
 def build(src, build_dir, jobs, log):
-    status, secs, out = run(["cmake", "--build", build_dir, "-j%d" % jobs, "--target", "dissgen", "unit_tests",
-                             "dissgen_runtime"], log=log)
-    return status == 0, secs, out
+    return run_command(["cmake", "--build", build_dir, "-j%d" % jobs, "--target", "dissgen", "unit_tests",
+                        "dissgen_runtime"], log=log)
 
 
 def commit_number(source_dir):
@@ -268,23 +312,95 @@ def tail(text, lines=15):
 
 
 def run_baseline(t, src, build_dir, jobs, log):
-    """Test t on the unmutated copy (rebuilt first): True when it passes."""
+    """(kind, seconds) of test t on the unmutated copy (rebuilt first)."""
     ok, _, out = build(src, build_dir, jobs, log)
-    status, secs, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log) \
-        if ok else (1, 0, out)
-    print("baseline %-13s %s (%.0fs)" % (t, "pass" if status == 0 else "FAIL", secs), flush=True)
-    if status != 0:
+    kind, secs, out, _ = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=BASELINE_TIMEOUT, log=log) \
+        if ok else (FAIL, 0, out, "")
+    print("baseline %-13s %s (%.0fs)" % (t, kind, secs), flush=True)
+    if kind in (FAIL, TIMEOUT):
         print("the unmutated tree fails '%s': fix that first\n%s" % (t, tail(out)))
-    return status == 0
+    return kind, secs
 
 
-def judge(m, src, build_dir, jobs, log, originals, baselined, no_baseline=False):
-    """Plant mutant m in the copy, rebuild, run its tests; the copy is restored after.
-    Returns (verdict, detail), or None when a test fails on the unmutated copy.
+def decide(tests, on_mutant, on_baseline, baseline_secs):
+    """The verdict of a mutant from its tests' runs: (verdict, detail), or None when a test
+    that matters fails on the unmutated copy.  on_mutant(t, limit) runs t on the mutant,
+    (kind, reason); on_baseline(t) on the unmutated copy, (kind, seconds), and fills
+    baseline_secs (test -> seconds), which time_limit reads.
 
-    A test judges a mutant only if it passes on the unmutated copy: the test that killed
-    a mutant is run there once (the first time it kills one), after the copy is restored.
-    A mutant that passed every test survived whatever those tests do unmutated."""
+    A failure kills only if the test passes unmutated (measured once per test).  A timeout
+    of a test never timed unmutated may be the machine's slowness: the test is timed
+    unmutated and run on the mutant again when its limit grew.  A skip decides nothing."""
+    def measured(t):
+        if t not in baseline_secs:
+            kind, secs = on_baseline(t)
+            if kind in (FAIL, TIMEOUT):
+                return False
+            baseline_secs[t] = secs
+        return True
+
+    passed, skipped = [], []
+    for t in tests:
+        limit = time_limit(t, baseline_secs)
+        kind, reason = on_mutant(t, limit)
+        if kind == TIMEOUT and t not in baseline_secs:
+            if not measured(t):
+                return None
+            if time_limit(t, baseline_secs) > limit:
+                kind, reason = on_mutant(t, time_limit(t, baseline_secs))
+        if kind in (FAIL, TIMEOUT):
+            if not measured(t):
+                return None
+            return "KILLED", "by %s%s" % (t, " (timed out)" if kind == TIMEOUT else "")
+        (skipped if kind == SKIP else passed).append((t, reason))
+    said = "; skipped (decides nothing): " + ", ".join("%s (%s)" % s for s in skipped) if skipped else ""
+    if passed:
+        return "SURVIVED", "passed: " + " ".join(t for t, _ in passed) + said
+    return "NOT DECIDED", "every test skipped" + said[len("; skipped (decides nothing)"):]
+
+
+class Planted:
+    """The copy with mutant m's file written, built on demand: the tests of the mutant and
+    the baseline runs of decide() take turns on the same copy."""
+
+    def __init__(self, m, mutated, src, build_dir, jobs, log, original):
+        self.m, self.mutated, self.original = m, mutated, original
+        self.src, self.build_dir, self.jobs, self.log = src, build_dir, jobs, log
+        self.path = os.path.join(src, m.file)
+        self.current = None
+
+    def _write(self, text):
+        if self.current != text:
+            with open(self.path, "w", encoding="utf-8") as fh:
+                fh.write(text)
+            self.current = text
+
+    def build_mutant(self):
+        """(ok, output) of building the copy with the mutant in."""
+        self._write(self.mutated)
+        ok, _, out = build(self.src, self.build_dir, self.jobs, self.log)
+        return ok, out
+
+    def on_mutant(self, t, limit):
+        if self.current != self.mutated:
+            ok, out = self.build_mutant()
+            if not ok:   # it built before: the same file, the same build
+                return FAIL, "does not rebuild"
+        kind, _, _, reason = run(TESTS[t](self.src, self.build_dir), cwd=self.build_dir, timeout=limit,
+                                 log=self.log)
+        return kind, reason
+
+    def on_baseline(self, t):
+        self.restore()
+        return run_baseline(t, self.src, self.build_dir, self.jobs, self.log)
+
+    def restore(self):
+        self._write(self.original)
+
+
+def judge(m, src, build_dir, jobs, log, originals, baseline_secs, no_baseline=False):
+    """Plant mutant m in the copy, rebuild, run its tests (decide); the copy is restored
+    after.  Returns (verdict, detail), or None when a test fails on the unmutated copy."""
     if getattr(m, "equivalent", None) is not None:
         return "EQUIV", "not run (equivalent.txt): " + m.equivalent
     if m.problem:
@@ -298,28 +414,100 @@ def judge(m, src, build_dir, jobs, log, originals, baselined, no_baseline=False)
         mutated = m.mutate(originals[m.file])
     except ValueError as e:
         return "INVALID", str(e)
-    with open(path, "w", encoding="utf-8") as fh:
-        fh.write(mutated)
-    killer = None
+    planted = Planted(m, mutated, src, build_dir, jobs, log, originals[m.file])
     try:
-        ok, _, out = build(src, build_dir, jobs, log)
+        ok, out = planted.build_mutant()
         if not ok:
             return "INVALID", "does not build: refresh the mutant\n" + tail(out)
-        for t in m.tests:
-            status, _, out = run(TESTS[t](src, build_dir), cwd=build_dir, timeout=TEST_TIMEOUT, log=log)
-            if status != 0:
-                killer = t
-                break
-        if killer is None:
-            return "SURVIVED", "passed: " + " ".join(m.tests)
+        on_baseline = (lambda t: (PASS, 0)) if no_baseline else planted.on_baseline
+        return decide(m.tests, planted.on_mutant, on_baseline, baseline_secs)
     finally:
-        with open(path, "w", encoding="utf-8") as fh:
-            fh.write(originals[m.file])
-    if killer not in baselined and not no_baseline:
-        if not run_baseline(killer, src, build_dir, jobs, log):
-            return None
-        baselined.add(killer)
-    return "KILLED", "by " + killer
+        planted.restore()
+
+
+def unit_suites_reading_corpus(source_dir):
+    """gtest suite names defined in unit test files that read the corpus."""
+    suites = set()
+    for path in glob.glob(os.path.join(source_dir, "tests", "unit", "*.cpp")):
+        text = open(path, encoding="utf-8", errors="replace").read()
+        if "corpus" in text:
+            suites |= set(re.findall(r"^TEST(?:_F|_P)?\((\w+)", text, re.M))
+    return suites
+
+
+def needs_corpus(test, source_dir):
+    """Whether test reads ../shared/corpus: an integration script that names the corpus,
+    or a gtest filter that selects a suite of a unit test file that does."""
+    command = TESTS[test]("SRC", "BUILD")
+    for arg in command:
+        if arg.startswith("SRC/tests/integration/"):
+            path = os.path.join(source_dir, arg[len("SRC/"):])
+            return "corpus" in open(path, encoding="utf-8").read()
+        if arg.startswith("--gtest_filter="):
+            positive = arg[len("--gtest_filter="):].split("-")[0]
+            patterns = [p for p in positive.split(":") if p] or ["*"]
+            return any(fnmatch.fnmatchcase(s + ".x", p) or fnmatch.fnmatchcase(s + "/x.x", p)
+                       for s in unit_suites_reading_corpus(source_dir) for p in patterns)
+    return False
+
+
+def corpus_dir(source_dir):
+    return os.path.normpath(os.path.join(os.path.abspath(source_dir), "..", "shared", "corpus"))
+
+
+def corpus_missing(mutants, source_dir, corpus=None):
+    """The tests of mutants that read the corpus (../shared/corpus) when it is absent (else [])."""
+    if os.path.isdir(corpus or corpus_dir(source_dir)):
+        return []
+    return sorted({t for m in mutants for t in m.tests if needs_corpus(t, source_dir)})
+
+
+def changed_lines(original, mutated):
+    """(first, last) line numbers of original that mutated changes."""
+    p = 0
+    while p < min(len(original), len(mutated)) and original[p] == mutated[p]:
+        p += 1
+    e = 0
+    while e < min(len(original), len(mutated)) - p and original[-1 - e] == mutated[-1 - e]:
+        e += 1
+    first, end = original.count("\n", 0, p) + 1, len(original) - e
+    return first, (original.count("\n", 0, end - 1) + 1 if end > p else first)   # end - 1: the last byte changed
+
+
+def load_coverage(path):
+    """The map coverage_map.py writes (test -> runtime file -> executed lines), or None."""
+    if not os.path.isfile(path):
+        return None
+    with open(path, encoding="utf-8") as fh:
+        return json.load(fh)
+
+
+def tests_running(coverage, file, lines, text):
+    """Names of the tests that the coverage map says execute a line of lines in file
+    (any line of file when its text changed since the map was written: its line numbers
+    may have moved)."""
+    if not coverage or file not in coverage.get("sources", {}):
+        return []
+    moved = coverage["sources"][file] != hashlib.sha256(text.encode("utf-8")).hexdigest()
+    first, last = lines
+    return [t for t, row in coverage.get("tests", {}).items() if t in TESTS and file in row["lines"] and
+            (moved or any(first <= l <= last for l in row["lines"][file]))]
+
+
+def choose_tests(m, coverage, source_dir):
+    """The mutant's own tests and every test the coverage map says executes the mutated
+    lines, cheapest (by the map's seconds) first; tests the map has not timed keep their
+    order, after those."""
+    if getattr(m, "problem", None) or not m.file:
+        return m.tests
+    try:
+        original = open(os.path.join(source_dir, m.file), encoding="utf-8").read()
+        lines = changed_lines(original, m.mutate(original))
+    except (OSError, ValueError):
+        return m.tests   # judge() reports it INVALID
+    chosen = list(dict.fromkeys(m.tests + tests_running(coverage, m.file, lines, original)))
+    timed = coverage.get("tests", {}) if coverage else {}
+    return sorted(chosen, key=lambda t: (timed[t]["seconds"], 0) if t in timed else (float("inf"), chosen.index(t)))
 
 
 def pick_window(spec, count, source_dir):
@@ -350,6 +538,10 @@ def main(argv=None):
                     help="start no mutant after this many seconds (0: run all)")
     ap.add_argument("--without", nargs="*", default=[], metavar="TEST",
                     help="leave these tests out (to measure what the others kill)")
+    ap.add_argument("--coverage", default=COVERAGE_MAP, metavar="FILE",
+                    help="the coverage map that adds the tests executing a mutated line (coverage_map.py)")
+    ap.add_argument("--no-coverage", action="store_true",
+                    help="run only the tests each mutant names (to measure what the map adds)")
     ap.add_argument("--systematic", action="store_true",
                     help="the generated mutants of systematic.py instead of the hand-written ones")
     ap.add_argument("--sample", type=int, default=0, metavar="N", help="a random sample of N of the mutants")
@@ -387,8 +579,9 @@ def main(argv=None):
         generated = systematic.mutants(args.source_dir, include_equivalent=True)
         n = max(1, -(-len(generated) // args.extra_systematic))
         extra = systematic.window(generated, commit_number(args.source_dir) % n, n)[:args.extra_systematic]
+    coverage = None if args.no_coverage else load_coverage(args.coverage)
     for m in mutants + extra:
-        m.tests = [t for t in m.tests if t not in args.without]
+        m.tests = [t for t in choose_tests(m, coverage, args.source_dir) if t not in args.without]
     if args.list:
         for m in mutants + extra:
             print("%-34s %-36s %s" % (m.name, m.path if args.systematic or m in extra else m.file,
@@ -421,6 +614,12 @@ def main(argv=None):
     if shutil.which("tshark") is None:
         print("SKIPPED: tshark is not installed (the mutants' tests need it)")
         return SKIP_CODE
+    without_corpus = corpus_missing(mutants + extra, args.source_dir)
+    if without_corpus:
+        print("no corpus at %s: the mutants' tests %s read it and would skip, deciding nothing; "
+              "put the corpus there, or choose (--only) mutants whose tests do not read it" % (
+                  corpus_dir(args.source_dir), " ".join(without_corpus)))
+        return 1
 
     t0 = time.monotonic()
     work = os.path.abspath(args.work) if args.work else tempfile.mkdtemp(prefix="dissgen-mutation-")
@@ -435,14 +634,15 @@ def main(argv=None):
         shared = os.path.join(os.path.abspath(args.source_dir), "..", "shared")
         if os.path.isdir(shared) and not os.path.lexists(os.path.join(work, "shared")):
             os.symlink(os.path.realpath(shared), os.path.join(work, "shared"))
-        status, secs, out = run(["cmake", "-S", src, "-B", build_dir, "-DCMAKE_BUILD_TYPE=RelWithDebInfo"], log=log)
-        ok, bsecs, bout = build(src, build_dir, args.jobs, log) if status == 0 else (False, 0, out)
+        ok, secs, out = run_command(["cmake", "-S", src, "-B", build_dir, "-DCMAKE_BUILD_TYPE=RelWithDebInfo"],
+                                    log=log)
+        ok, bsecs, bout = build(src, build_dir, args.jobs, log) if ok else (False, 0, out)
         print("build of the copy: %s (%.0fs)" % ("ok" if ok else "FAILED", secs + bsecs), flush=True)
         if not ok:
             print(tail(bout))
             return 1
 
-        baselined = set()
+        baseline_secs = {}
         originals = {}
         extra_start = None
         for i, m in enumerate(mutants + extra):
@@ -457,7 +657,7 @@ def main(argv=None):
                 not_run.append(m)
                 continue
             start = time.monotonic()
-            outcome = judge(m, src, build_dir, args.jobs, log, originals, baselined, args.no_baseline)
+            outcome = judge(m, src, build_dir, args.jobs, log, originals, baseline_secs, args.no_baseline)
             if outcome is None:
                 return 1
             verdict, detail = outcome
@@ -468,15 +668,17 @@ def main(argv=None):
             shutil.rmtree(work, ignore_errors=True)
 
     killed = sum(1 for _, v in results if v == "KILLED")
+    undecided = sum(1 for _, v in results if v == "NOT DECIDED")
     invalid = sum(1 for _, v in results if v == "INVALID")
     equivalent = sum(1 for _, v in results if v == "EQUIV")
     judged = len(results) - equivalent
     total = judged - invalid
     cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
-    print("\nkilled %d of %d mutants (%.1f%%), %d survived; besides, %d invalid (do not build) and %d "
-          "equivalent not run; %.0fs in all, %.0fs of CPU (builds, tests, tshark)" % (
-              killed, total, 100.0 * killed / max(total, 1), sum(1 for _, v in results if v == "SURVIVED"),
-              invalid, equivalent, time.monotonic() - t0, cpu.ru_utime + cpu.ru_stime))
+    survived = sum(1 for _, v in results if v == "SURVIVED")
+    print("\nkilled %d of %d mutants (%.1f%%), %d survived, %d not decided (their tests skipped); besides, "
+          "%d invalid (do not build) and %d equivalent not run; %.0fs in all, %.0fs of CPU (builds, tests, tshark)"
+          % (killed, total, 100.0 * killed / max(total, 1), survived, undecided, invalid, equivalent,
+             time.monotonic() - t0, cpu.ru_utime + cpu.ru_stime))
     for m, v in results:
         if v not in ("KILLED", "EQUIV"):
             print("  %s %s (%s): %s" % (v, m.name, m.file, " ".join(m.why)))
@@ -486,8 +688,8 @@ def main(argv=None):
     # must apply and build.
     # The CI window of systematic mutants (--extra-systematic) reports its survivors without
     # failing the check: most generated sites are not triaged yet (tests/mutation/README.md).
-    bad = [m for m, v in results if m not in extra and
-           (v == "SURVIVED" or (v == "INVALID" and not isinstance(m, systematic.SiteMutant)))]
+    bad = [m for m, v in results if v == "NOT DECIDED" or (m not in extra and
+           (v == "SURVIVED" or (v == "INVALID" and not isinstance(m, systematic.SiteMutant))))]
     if any(v == "SURVIVED" for m, v in results if m in extra):
         print("systematic survivors above: triage them (a test, or a line in equivalent.txt)")
     return 0 if judged and not bad else 1

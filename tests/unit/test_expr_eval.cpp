@@ -203,5 +203,27 @@ TEST(ComputedEval, RealsWhenADecimalTakesPart) {
     EXPECT_DOUBLE_EQ(shown_as_float.v.real, 6.0);
 }
 
+// A request's kept value, read by request{X}: the runtime op the generator emits for a
+// field of the request (DG_OP_REQUEST_FIELD*), over a reader that has it or not.
+dg_expr_value request_operand(guint8 code, guint8 bits, const Slots& request) {
+    const dg_expr_op op{code, bits, 0, 0, 0.0};
+    return dg_expr_eval(&op, 1, read_slot, read_slot, &request, 0);
+}
+
+TEST(ComputedEval, RequestFieldsSignedLikeTheMessagesOwn) {
+    // A 16-bit int of the request holding 0xfffe is -2, as {X} of a field of the message is.
+    dg_expr_value v = request_operand(DG_OP_REQUEST_FIELD_SIGNED, 16, {{0, 0xfffe}});
+    ASSERT_TRUE(v.defined);
+    EXPECT_EQ(v.integer, -2);
+    EXPECT_EQ(request_operand(DG_OP_REQUEST_FIELD_SIGNED, 8, {{0, 0x7f}}).integer, 127);
+    EXPECT_EQ(request_operand(DG_OP_REQUEST_FIELD, 16, {{0, 0xfffe}}).integer, 65534);  // unsigned stays so
+}
+
+TEST(ComputedEval, RequestFieldTheRequestLacksIsUndefinedNotZero) {
+    // The reader has no value (the request's instance lacks the field): undefined, never 0.
+    EXPECT_FALSE(request_operand(DG_OP_REQUEST_FIELD_SIGNED, 16, {}).defined);
+    EXPECT_FALSE(request_operand(DG_OP_REQUEST_FIELD, 16, {}).defined);
+}
+
 }  // namespace
 }  // namespace dissgen::testing

@@ -4,6 +4,8 @@
 // losses and slave states, field names from the runtime's list.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <sstream>
 
 #include "report/charts.h"
@@ -197,6 +199,51 @@ TEST(ReportChart, LongSeriesKeepEveryExtreme) {
     EXPECT_NE(json.find("6000.000]"), std::string::npos) << "the spike's maximum is drawn";
     std::string short_json = series_json({{0.5, 1500}, {1.0, -250}}, 100);
     EXPECT_EQ(short_json, "[[0.500000,[1.500,1.500,1.500]],[1.000000,[-0.250,-0.250,-0.250]]]");
+}
+
+// A curve longer than the report draws (4 000 points) becomes one point per time
+// bucket: [first time of the bucket, [min, mean, max]] of exactly the values in it.
+// Times in quarters over 3 000 s: 12 001 values, buckets 0.75 s wide with no rounding,
+// three values each and the last value (at the end) in the last bucket.
+TEST(ReportChart, DownsampledBucketsHoldTheMinMeanMaxOfTheirValues) {
+    const size_t buckets = 4000;
+    std::vector<TimedValue> series;
+    uint32_t lcg = 12345;
+    for (int i = 0; i <= 12000; ++i) {
+        lcg = lcg * 1103515245u + 12345u;
+        series.push_back({i * 0.25, static_cast<int64_t>(lcg >> 8) % 2000001 - 1000000});
+    }
+    struct Bucket {
+        double t = -1;
+        int64_t lo = 0, hi = 0;
+        double sum = 0;
+        size_t n = 0;
+    };
+    std::vector<Bucket> want(buckets);
+    for (const TimedValue& v : series) {
+        Bucket& b = want[std::min(static_cast<size_t>(v.t / 0.75), buckets - 1)];
+        if (b.n == 0) b.t = v.t, b.lo = b.hi = v.ns;
+        b.lo = std::min(b.lo, v.ns), b.hi = std::max(b.hi, v.ns), b.sum += static_cast<double>(v.ns), ++b.n;
+    }
+    ASSERT_EQ(want.back().n, 4u);
+    std::string json = series_json(series, buckets);
+    const char* at = json.c_str();
+    ASSERT_EQ(*at++, '[');
+    for (size_t i = 0; i < buckets; ++i) {
+        double t, lo, mean, hi;
+        int used = 0;
+        ASSERT_EQ(std::sscanf(at, "[%lf,[%lf,%lf,%lf]]%n", &t, &lo, &mean, &hi, &used), 4) << "point " << i;
+        at += used;
+        ASSERT_EQ(*at, i + 1 < buckets ? ',' : ']') << "point " << i;
+        ++at;
+        const Bucket& b = want[i];
+        EXPECT_DOUBLE_EQ(t, b.t) << "point " << i;
+        EXPECT_NEAR(lo, static_cast<double>(b.lo) / 1000.0, 0.0005) << "point " << i;
+        EXPECT_NEAR(hi, static_cast<double>(b.hi) / 1000.0, 0.0005) << "point " << i;
+        EXPECT_NEAR(mean, b.sum / static_cast<double>(b.n) / 1000.0, 0.0005) << "point " << i;
+        if (::testing::Test::HasFailure()) return;  // one bucket's report is enough
+    }
+    EXPECT_EQ(*at, '\0');
 }
 
 // The histogram's bins are whole nanoseconds, (max - min) / 80 + 1 wide,
