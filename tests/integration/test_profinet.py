@@ -215,6 +215,24 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
                       (number, got, [counter, status, transfer]))
             check(cyclic > 100, "%d cyclic frames" % cyclic)
 
+    def test_trailer_missing_is_reported_where_it_is(self):
+        """A cyclic frame with fewer than 4 bytes after its frame ID (cut short by the
+        capture) gets pnr.expert.bad_length on that frame only, in one pass and with -2;
+        the generated captures have none."""
+        rng = random.Random(3)
+        frames = [pngen.ethernet(*pngen.cyclic_frame(rng), rng) for _ in range(20)]
+        short = 7
+        frames[short - 1] = frames[short - 1][:14 + 2 + 3]
+        cap = self.env.add_file("short.pcap", pngen.pcap(frames))
+        with self.checks() as check:
+            for two_pass in ([], ["-2"]):
+                rows = self.env.tshark(["-r", cap, "-Y", "pnr.expert.bad_length", "-T", "fields",
+                                        "-e", "frame.number"] + two_pass).stdout.split()
+                check(rows == [str(short)], "bad_length %s on frame %d only: %s" % (two_pass, short, rows))
+            clean = self.env.tshark(["-r", self.capture, "-Y", "_ws.expert", "-T", "fields",
+                                     "-e", "frame.number"]).stdout.split()
+            check(clean == [], "no expert info on the generated captures: %s" % clean[:5])
+
     def test_wireshark_fields_without_counterpart_are_listed(self):
         """Every field Wireshark's PROFINET dissectors show on these captures has a
         counterpart or a reason in WITHOUT_COUNTERPART."""
