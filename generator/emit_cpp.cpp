@@ -541,6 +541,7 @@ std::string Emitter::node_row(const Node& n) const {
     if (length_kind == "DG_LEN_COMPUTED") add("length_computed", "");
     unsigned length = n.in_bit_group ? n.group_bytes : static_cast<unsigned>(n.fixed_bits / 8);
     if (length && (n.has_fixed_length() || n.in_bit_group)) add("length", std::to_string(length));
+    if (length_kind == "DG_LEN_REST" && n.rest_keep) add("length", std::to_string(n.rest_keep));
     if (n.shift) add("shift", std::to_string(n.shift));
     if (n.bits) add("bits", std::to_string(n.bits));
     if (n.slot >= 0) add("slot", std::to_string(n.slot));

@@ -106,6 +106,7 @@ struct Node {
     int doc_index = 0;      // 1-based position among all <node> elements
     LengthKind length_kind = LengthKind::Children;
     uint64_t fixed_bits = 0;        // for Bits and Bytes
+    uint32_t rest_keep = 0;         // for Rest: "rest - N" leaves the last N bytes to a trailer
     FieldRef length_ref;            // for Field
     Display display = Display::Origin;
     bool display_given = false;

@@ -278,6 +278,7 @@ private:
     void parse_layout_attributes(std::map<std::string, std::string>& attrs, Node& node);
     void parse_pairing(xmlNode* el, Protocol& proto);
     void parse_length(const std::string& text, int line, Node& node, xmlNode* el);
+    void parse_rest_minus(const std::string& raw, const std::string& tail, int line, Node& node);
     void parse_display(const std::string& text, int line, Node& node);
     void parse_in_list(const std::string& text, int line, Node& node);
     void parse_value(const std::string& text, int line, Node& node);
@@ -742,6 +743,8 @@ void Parser::parse_length(const std::string& raw, int line, Node& node, xmlNode*
         node.length_kind = LengthKind::Children;
     } else if (text == "rest") {
         node.length_kind = LengthKind::Rest;
+    } else if (text.compare(0, 4, "rest") == 0) {
+        parse_rest_minus(raw, text.substr(4), line, node);
     } else if (split_fixed_length(text, false, digits, unit)) {
         digits = significant_digits(digits);
         uint64_t n = digits.size() > 12 ? UINT64_MAX : std::stoull(digits);
@@ -760,6 +763,22 @@ void Parser::parse_length(const std::string& raw, int line, Node& node, xmlNode*
         node.length_kind = LengthKind::Field;
         node.length_ref = make_ref(text, line, "length", true);
     }
+}
+
+// "rest - N": to the end but the last N bytes, which a trailer after the
+// node takes (PROFINET's cycle counter and status bytes end the frame).
+void Parser::parse_rest_minus(const std::string& raw, const std::string& tail, int line, Node& node) {
+    std::string t = trim(tail), digits = t.size() > 1 && t[0] == '-' ? trim(t.substr(1)) : "";
+    bool number = !digits.empty() && digits.size() <= 8 &&
+                  std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); });
+    uint64_t n = number ? std::stoull(digits) : 0;
+    if (!number || n == 0 || n > (1u << 20)) {
+        diags_.error(line, "bad length '" + raw + "': after 'rest' only '- N' may follow, N from 1 to 1048576 "
+                           "(the bytes left to what follows the node)");
+        return;
+    }
+    node.length_kind = LengthKind::Rest;
+    node.rest_keep = static_cast<uint32_t>(n);
 }
 
 void Parser::parse_value(const std::string& text, int line, Node& node) {

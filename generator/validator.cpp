@@ -1053,6 +1053,14 @@ void Validator::check_string_display(Node& n) {
 // Range items become a range_string: at most 32 bits, no two items overlapping.
 void Validator::check_enum_ranges(const Node& n) {
     if (!n.has_enum_ranges()) return;
+    // A computed value is a 64-bit field: Wireshark has no range_string for it
+    // (registered as one, its names were read as a val64_string and crashed).
+    if (n.is_computed()) {
+        diags_.error(n.line, "enum ranges need a field of at most 32 bits; computed value " + quote(n) +
+                                 " is 64 bits: list single values, or give the ranges to a field (an overlay "
+                                 "over the bytes)");
+        return;
+    }
     if (n.bits > 32) {
         diags_.error(n.line, "enum ranges need a field of at most 32 bits; " + quote(n) + " is " +
                                  std::to_string(n.bits) + " bits");
@@ -1228,7 +1236,7 @@ void Validator::check_offsets(Node& n) {
     if (n.repeat || n.count || n.repeat_rest)
         diags_.error(n.line, "node " + quote(n) + " has 'offsets' and 'repeat' or 'count'; the offset table already "
                              "says how many instances there are: use one of them");
-    if (n.length_kind != LengthKind::Rest)
+    if (n.length_kind != LengthKind::Rest || n.rest_keep)
         diags_.error(n.line, "node " + quote(n) + " with 'offsets' needs length=\"rest\": each instance runs to "
                              "where the next offset points, the last one to the end of its container");
     if (const Node* t = n.offsets->target) {

@@ -61,6 +61,22 @@ gint64 stringz_length(const dg_state *st, gint offset, gint end)
     return nul < 0 ? (gint64)(end - offset) + 1 : (gint64)(nul - offset) + 1;
 }
 
+/* `rest - N` (N in n->length, 0 for plain `rest`): the bytes to the end but
+ * the last N, which the trailer after the node takes; FALSE (reported) when
+ * fewer than N are left. */
+static gboolean rest_length(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint end, gint64 *out)
+{
+    gint64 v = (gint64)(end - offset) - (gint64)n->length;
+    if (v < 0) {
+        report(st, tree, &st->p->ei->bad_length, offset, 0,
+               "The length of '%s' is negative (%" G_GINT64_MODIFIER "d): fewer than %u bytes are left after it",
+               n->name, v, n->length);
+        return FALSE;
+    }
+    *out = v;
+    return TRUE;
+}
+
 /* A leaf's length in bytes at offset, or -1 when its length field is
  * missing or negative (reported). */
 gint64 leaf_length(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint end)
@@ -71,7 +87,9 @@ gint64 leaf_length(dg_state *st, const dg_node *n, proto_tree *tree, gint offset
     case DG_LEN_FIELD:
         if (!ref_value(st, &n->length_ref, n, "length", tree, offset, &length)) return -1;
         break;
-    case DG_LEN_REST: length = end - offset; break;
+    case DG_LEN_REST:
+        if (!rest_length(st, n, tree, offset, end, &length)) return -1;
+        break;
     default:
         /* a stringz without a length runs to its NUL, included. */
         length = n->show == DG_SHOW_STRINGZ ? stringz_length(st, offset, end) : 0;
@@ -229,7 +247,7 @@ gboolean container_length(dg_state *st, const dg_node *n, proto_tree *tree, gint
     switch (n->length_kind) {
     case DG_LEN_FIXED: *length = n->length; break;
     case DG_LEN_FIELD: return ref_value(st, &n->length_ref, n, "length", tree, start, length);
-    case DG_LEN_REST: *length = end - start; break;
+    case DG_LEN_REST: return rest_length(st, n, tree, start, end, length);
     default: *length = -1; break;
     }
     return TRUE;

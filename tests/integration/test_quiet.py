@@ -33,6 +33,7 @@ import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pcapgen  # noqa: E402
+import pngen  # noqa: E402
 from tshark_env import TsharkEnv, run_unittests  # noqa: E402
 
 ARGS = None
@@ -382,6 +383,8 @@ CAPTURES = {
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,
+    # No PROFINET sample or corpus capture yet: pngen's frames of every kind.
+    "rules/profinet.xml": lambda: pngen.all_frames(random.Random(7), rounds=4, cyclic=60, alarms=20),
 }
 
 

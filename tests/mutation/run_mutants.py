@@ -87,6 +87,7 @@ TESTS = {
     "everything": integration("test_everything.py"),
     "malformed": integration("test_malformed.py"),
     "enip": integration("test_enip.py"),
+    "profinet": integration("test_profinet.py"),
     "validity": integration("test_validity.py"),
     "validity_unit": unit("Validity.*"),
     "loading": integration("test_plugin_loading.py"),
