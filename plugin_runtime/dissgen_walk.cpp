@@ -66,6 +66,10 @@ gint64 stringz_length(const dg_state *st, gint offset, gint end)
  * fewer than N are left. */
 static gboolean rest_length(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint end, gint64 *out)
 {
+    /* The trailer ends where the frame ends on the wire: in a frame the
+     * capture cut short, the node runs past the captured bytes (reported as
+     * truncated) rather than taking its last captured bytes as the trailer. */
+    if (n->length > 0 && end == st->packet_end) end = (gint)tvb_reported_length(st->tvb);
     gint64 v = (gint64)(end - offset) - (gint64)n->length;
     if (v < 0) {
         report(st, tree, &st->p->ei->bad_length, offset, 0,
@@ -724,7 +728,8 @@ void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
         dissect_leaf(st, n, tree, offset, end);
     else
         dissect_container(st, n, tree, offset, end, in_summary, sink);
-    if (n->extra && n->extra->finding_count) raise_findings(st, n, tree, start, *offset);
+    /* Only a node decoded whole: one that reported a malformed spot has no value to judge. */
+    if (n->extra && n->extra->finding_count && !st->stopped) raise_findings(st, n, tree, start, *offset);
 }
 
 } // namespace dg_rt

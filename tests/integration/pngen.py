@@ -160,8 +160,12 @@ def all_frames(rng, rounds=20, cyclic=200, alarms=60):
     return frames
 
 
-def pcap(frames, base_ts=1704067200):
+def pcap(frames, base_ts=1704067200, captured=None):
+    """A pcap of `frames`; `captured` maps a frame's index to the bytes the capture kept
+    of it (cut by a snapshot length: its length on the wire stays the whole frame's)."""
+    captured = captured or {}
     out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
     for i, f in enumerate(frames):
-        out.append(struct.pack("<IIII", base_ts + i // 1000, (i % 1000) * 1000, len(f), len(f)) + f)
+        kept = f[:captured.get(i, len(f))]
+        out.append(struct.pack("<IIII", base_ts + i // 1000, (i % 1000) * 1000, len(kept), len(f)) + kept)
     return b"".join(out)

@@ -126,6 +126,21 @@ class TestRuleFindings(TsharkTestCase, unittest.TestCase):
             raised = {n: r["_ws.expert.message"] for n, r in rows.items() if r["_ws.expert.message"]}
             self.assertEqual(raised, {}, "no finding on clean replies (%s)" % ("-2" if two_pass else "one pass"))
 
+    def test_node_cut_short_raises_no_finding(self):
+        """A reply cut off before its extended status is malformed: the reply was not
+        decoded whole, so its odd_count finding (whose condition its earlier fields
+        would make hold) is not raised; the whole frames around it still raise theirs."""
+        whole = body(0x21, [5], 0, 0)
+        cut = b"\x02\0\0\0\0\x02\x02\0\0\0\0\x01" + struct.pack("!H", ETHERTYPE) + whole[:-2]
+        path = self.env.add_file("cut.pcap", raw_pcap_bytes([ethernet_frame(whole), cut, ethernet_frame(whole)]))
+        for two_pass in (False, True):
+            rows = self.env.field_rows(path, ["frame.number", "_ws.expert.message"], two_pass)
+            messages = {n: r["_ws.expert.message"] for n, r in rows.items()}
+            self.assertIn("1 values", messages[1])
+            self.assertIn("1 values", messages[3])
+            self.assertTrue(any(m.startswith("Truncated") for m in messages[2]), messages[2])
+            self.assertNotIn("1 values", messages[2], "no finding on the reply cut short")
+
     def test_finding_sits_beside_its_item_on_its_bytes(self):
         n = next(i for i, r in enumerate(self.replies, 1) if any(v > 1000 for v in r[1]))
         out = self.env.tshark(["-r", self.path, "-V", "-Y", "frame.number == %d" % n]).stdout
