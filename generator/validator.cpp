@@ -454,6 +454,9 @@ std::string valid_blocker(const Node& blocker, const Node& t) {
     if (blocker.is_window() || blocker.at) return self + " is placed by address in a window";
     if (blocker.length_kind == LengthKind::Field)
         return self + " takes its length from a field: a message may end it before";
+    if (blocker.length_kind == LengthKind::Rest && blocker.rest_keep)
+        return self + " is 'rest - " + std::to_string(blocker.rest_keep) +
+               "': a message with fewer bytes left does not decode it";
     return self + " is decoded only under a condition ('if', <when>, direction or otherwise)";
 }
 
@@ -469,7 +472,10 @@ const Node* Validator::fixed_offset_blocker(const Node& n, uint64_t& offset) con
     offset_of(proto_.nodes, &n, offset, blocker);
     for (const Node* a = &n; a; a = a->parent) {
         const bool conditional = a->if_field || !a->whens.empty() || a->otherwise || a->direction != Direction::Any;
-        const bool placed = a->is_window() || a->at || (a != &n && a->length_kind == LengthKind::Field);
+        // (a container of `rest - N` is not decoded at all with fewer than N bytes left)
+        const bool cut = a != &n && (a->length_kind == LengthKind::Field ||
+                                     (a->length_kind == LengthKind::Rest && a->rest_keep));
+        const bool placed = a->is_window() || a->at || cut;
         if (!blocker && (conditional || placed)) blocker = a;
     }
     return blocker;
