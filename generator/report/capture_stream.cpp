@@ -2,6 +2,7 @@
 #include "capture_stream.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -192,7 +193,14 @@ std::string read_capture(const CaptureStream& stream, const std::vector<std::str
     std::vector<std::string> argv{stream.tshark, "-n", "-r", capture, "-T", "tabs", "-o", "gui.column.format:" + columns};
     argv.insert(argv.end(), stream.extra_args.begin(), stream.extra_args.end());
     Child child = spawn(argv, stream, merger.out);
-    if (child.pid < 0) return "cannot start " + stream.tshark + ": " + std::strerror(errno);
+    if (child.pid < 0) {
+        const std::string why = std::strerror(errno);
+        if (merger.pid > 0) {  // nobody will read what it joins
+            kill(merger.pid, SIGTERM);
+            waitpid(merger.pid, nullptr, 0);
+        }
+        return "cannot start " + stream.tshark + ": " + why;
+    }
     FILE* in = fdopen(child.out, "r");
     Progress progress("decoding " + joined(captures));
     std::string err;
@@ -224,8 +232,12 @@ std::string read_capture(const CaptureStream& stream, const std::vector<std::str
         waitpid(merger.pid, &merged, 0);
     }
     bool merge_ok = merger.pid <= 0 || (WIFEXITED(merged) && WEXITSTATUS(merged) == 0);
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && merge_ok) return "";
-    if (!merge_ok)
+    const bool tshark_ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    if (tshark_ok && merge_ok) return "";
+    // tshark stopping early (a bad option, a plugin error) kills mergecap with
+    // SIGPIPE on its next write: then tshark's message is the one that matters.
+    const bool merger_cut_off = WIFSIGNALED(merged) && WTERMSIG(merged) == SIGPIPE;
+    if (!merge_ok && (tshark_ok || !merger_cut_off))
         return stream.mergecap + " could not join " + joined(captures) + (merge_err.empty() ? "" : ": " + merge_err);
     return stream.tshark + " failed on " + joined(captures) + (err.empty() ? "" : ": " + err);
 }
