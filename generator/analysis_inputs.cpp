@@ -49,6 +49,14 @@ bool check_input(const AnalysisInput& input, const AnalysisInputSpec& spec, cons
     if (!unit) {
         unit = owner;
         unit_line = input.line;
+        if (const Node* outer = repeated_owner(owner->parent)) {
+            // The view numbers instances within one run of the repeat: a repeat
+            // inside another would give several datagrams the same number.
+            diags.error(input.line, what + "is one value per instance of a repeated node, and " + field + " is in '" +
+                                        owner->name + "', which is itself inside repeated node '" + outer->name +
+                                        "': the instances must be one list per message");
+            return false;
+        }
     } else if (owner != unit) {
         diags.error(input.line, what + "must be in the same repeated node as the inputs before it: " + field +
                                     " is in '" + owner->name + "', the input on line " + std::to_string(unit_line) +
