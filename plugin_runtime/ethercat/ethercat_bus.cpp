@@ -1145,8 +1145,14 @@ guint frame_datagrams(const dg_view *view, guint *header_length, datagram *out, 
         if (x->instance >= max) continue;
         while (cleared <= x->instance) memset(&out[cleared++], 0, sizeof *out);
         place_input(&out[x->instance], x);
-        /* The working counter, last on the wire, makes the datagram whole. */
-        if (x->input == ESC_IN_WKC) n = x->instance + 1;
+        /* The working counter, last on the wire, makes the datagram whole:
+         * its data is the `length` bytes before it. A rule file that puts
+         * the counter elsewhere (the data would start before the datagram's
+         * own command) gives no datagram the analysis could compare. */
+        if (x->input == ESC_IN_WKC) {
+            if (data_offset(&out[x->instance]) <= out[x->instance].offset) return x->instance;
+            n = x->instance + 1;
+        }
     }
     return n;
 }

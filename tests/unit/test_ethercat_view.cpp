@@ -72,6 +72,18 @@ TEST(EthercatView, ADatagramWithoutItsWorkingCounterDoesNotCount) {
     EXPECT_EQ(d[0].wkc, 1);
 }
 
+// A working counter whose `length` bytes before it would start before the
+// datagram's own command (rules that place it elsewhere): the datagrams end
+// before it, so the analysis never reads data outside the datagram.
+TEST(EthercatView, DataBeforeItsDatagramEndsTheDatagrams) {
+    std::vector<dg_view_value> values = two_datagrams();
+    values.back() = value(ESC_IN_WKC, 1, 3, 20, 2);  // 20 - 4 = 16, the second's command
+    dg_view view = {values.data(), (guint)values.size()};
+    datagram d[max_datagrams];
+    guint header_length = 0;
+    EXPECT_EQ(frame_datagrams(&view, &header_length, d, max_datagrams), 1u);
+}
+
 TEST(EthercatView, AtMostMaxDatagramsAndNoneWithoutAView) {
     std::vector<dg_view_value> values = two_datagrams();
     dg_view view = {values.data(), (guint)values.size()};
