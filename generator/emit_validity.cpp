@@ -26,7 +26,7 @@ std::vector<ValueRange> intersect(const std::vector<ValueRange>& a, const std::v
     for (const ValueRange& x : a)
         for (const ValueRange& y : b)
             if (std::max(x.low, y.low) <= std::min(x.high, y.high))
-                out.push_back({std::max(x.low, y.low), std::min(x.high, y.high)});
+                out.push_back({std::max(x.low, y.low), std::min(x.high, y.high), {}});
     return out;
 }
 
@@ -58,7 +58,7 @@ std::string emit_validity(const Protocol& proto) {
                 hooks = hooked ? intersect(hooks, a->hook_list) : a->hook_list;
                 hooked = true;
             }
-        if (hooked && hooks.empty()) hooks.push_back({1, 0});  // no hook value: never tested
+        if (hooked && hooks.empty()) hooks.push_back({1, 0, {}});  // no hook value: never tested
         const size_t hook_first = ranges.size();
         ranges.insert(ranges.end(), hooks.begin(), hooks.end());
         std::ostringstream row;

@@ -18,7 +18,7 @@ std::string add_line(const std::string& kind, const std::vector<std::string>& wo
         out.flags.insert(out.flags.end(), words.begin(), words.end());
     } else if (kind == "analysis") {
         if (words.size() != 2) return "'analysis' takes a name and its dg_analysis symbol";
-        out.analyses.push_back({words[0], words[1], {}, {}});
+        out.analyses.push_back({words[0], words[1], {}, {}, {}});
     } else if (kind == "source" || kind == "header") {
         // Lines after an 'analysis' line list that analysis's files.
         Analysis* owner = out.analyses.empty() ? nullptr : &out.analyses.back();
