@@ -24,8 +24,17 @@ generator_sources=()
 for f in "$src"/generator/*.cpp "$src"/generator/ethercat/*.cpp; do
   [ "$(basename "$f")" = main.cpp ] || generator_sources+=("$f")
 done
+# runtime_list_text.h: the header CMake configures from plugin_runtime/runtime.list
+# (generator/runtime_list_text.h.in), made the same way for this build.
+python3 - "$src/generator/runtime_list_text.h.in" "$src/plugin_runtime/runtime.list" \
+  "$work/runtime_list_text.h" <<'END'
+import sys
+template, listing, out = sys.argv[1:]
+text = open(template, encoding="utf-8").read().replace("@runtime_list_text@", open(listing, encoding="utf-8").read())
+open(out, "w", encoding="utf-8").write(text)
+END
 clang++ -std=c++17 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-  -I"$src/generator" $(pkg-config --cflags libxml-2.0) \
+  -I"$src/generator" -I"$work" $(pkg-config --cflags libxml-2.0) \
   "$here/fuzz_rules.cpp" "${generator_sources[@]}" \
   $(pkg-config --libs libxml-2.0) -o "$work/fuzz_rules"
 
