@@ -332,7 +332,9 @@ class Emitter {
 public:
     Emitter(const Protocol& p, const std::string& source, const EmbeddedTables* extra)
         : p_(p), source_(source), extra_(extra),
-          quiet_(quiet_sizes(p, [this](const Node& n) { return is_pairing_key(n) || n.analysis_input >= 0; })), l_(make_layout(p, quiet_)) {}
+          quiet_(quiet_sizes(p, [this](const Node& n) {
+              return is_pairing_key(n) || n.analysis_input >= 0 || n.cycle_role != 0;
+          })), l_(make_layout(p, quiet_)) {}
     std::string run();
 
 private:
@@ -361,6 +363,7 @@ private:
     std::vector<std::string> summary_rows() const;
     std::string protocol_row() const;
     void request_context();
+    void cycles_tables();
     std::string extra_row(const Node& n) const;
     void condition_and_window_tables();
     void protocol_struct();
@@ -669,6 +672,7 @@ void Emitter::protocol_struct() {
            << " };\n";
         if (!p_.request_fields.empty()) request_context();
     }
+    if (p_.cycles) cycles_tables();
     o_ << "\nstatic dg_protocol " << f << "_protocol =\n    " << protocol_row() << ";\n\n";
     // valid fields: the entries test them first (dg_valid_*)
     const bool valid = has_validity(p_);
@@ -713,8 +717,38 @@ std::string Emitter::protocol_row() const {
     if (!l_.findings.empty()) set.push_back("findings(" + f + "_findings)");
     if (p_.pairing) set.push_back("pairing(&" + f + "_pairing)");
     if (p_.pairing && !p_.request_fields.empty()) set.push_back("request_context(&" + f + "_request_context)");
+    if (p_.cycles) set.push_back("cycles(&" + f + "_cycles)");
     if (extra_ && !extra_->analysis_data.empty()) set.push_back("analysis_data(&" + extra_->analysis_data + ")");
     return named_row("dg_protocol_of(" + c_string(p_.name) + ", " + c_string(p_.abbreviation) + ", " + c_string(f) + ")", set);
+}
+
+// <cycles>: the window, the sequence count's width, whether the sender is
+// part of the signature, and the values each <only>/<never> test holds for
+// (a test without 'in': any value but 0).
+void Emitter::cycles_tables() {
+    const std::string& f = p_.filter;
+    const Cycles& c = *p_.cycles;
+    std::vector<std::string> tests, ranges;
+    auto add_tests = [&](const std::vector<CycleField>& fields, const char* element) {
+        for (const CycleField& t : fields) {
+            const size_t first = ranges.size();
+            if (t.in_list.empty()) ranges.push_back("{ 1, " + hex(UINT64_MAX) + " }");
+            for (const ValueRange& r : t.in_list) ranges.push_back("{ " + hex(r.low) + ", " + hex(r.high) + " }");
+            tests.push_back("/* <" + std::string(element) + ">, line " + std::to_string(t.line) + " */ { " +
+                            std::to_string(first) + ", " + std::to_string(ranges.size() - first) + " }");
+        }
+    };
+    add_tests(c.only, "only");
+    add_tests(c.never, "never");
+    o_ << "\n/* Periodic traffic (<cycles>, line " << c.line
+       << "): each <only>/<never> test's ranges; window, sequence bits, sender in the signature. */\n";
+    if (!tests.empty())
+        o_ << c_array("static const dg_cycle_test " + f + "_cycle_tests", tests)
+           << c_array("static const dg_range " + f + "_cycle_ranges", ranges);
+    o_ << "static const dg_cycles " << f << "_cycles = { " << c.window << ", " << c.sequence_bits << ", "
+       << (c.by_sender ? 1 : 0) << ", " << c.only.size() << ", "
+       << (tests.empty() ? std::string("NULL") : f + "_cycle_tests") << ", "
+       << (tests.empty() ? std::string("NULL") : f + "_cycle_ranges") << " };\n";
 }
 
 // request{...}: the key fields where a response reads them before it is
@@ -872,7 +906,7 @@ bool needs_extra(const Node& n) {
                             n.display == Display::Time)) ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
            n.keeps_values || n.keeps_instances || n.is_computed() || n.has_unit_label() || n.is_overlay() ||
-           !n.findings.empty() || n.analysis_input >= 0;
+           !n.findings.empty() || n.analysis_input >= 0 || n.cycle_role != 0;
 }
 
 void Emitter::extra_table() {
@@ -916,6 +950,7 @@ std::string Emitter::extra_row(const Node& n) const {
     if (slot(n.covers) >= 0) add("covers", std::to_string(slot(n.covers)));
     if (!n.findings.empty()) add("findings", std::to_string(l_.finding_first.at(&n)) + ", " + std::to_string(n.findings.size()));
     if (n.analysis_input >= 0) add("input", std::to_string(n.analysis_input));
+    if (n.cycle_role) add("cycle_role", std::to_string(n.cycle_role) + ", " + std::to_string(n.cycle_test));
     return named_row("dg_node_extra()", set);
 }
 

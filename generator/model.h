@@ -198,6 +198,11 @@ struct Node {
     // input number analysis_input (-1: none), per instance of its repeated node or not
     int analysis_input = -1;
     bool analysis_input_per_instance = false;
+    // derived by the validator: what <cycles> reads from this leaf (0 none,
+    // else a dg_cycle_role: 1 signature, 2 sequence, 3 only, 4 never) and,
+    // for only/never, its test's number
+    int cycle_role = 0;
+    int cycle_test = 0;
 
     bool is_computed() const { return value.has_value(); }
     bool is_container() const { return !children.empty(); }
@@ -264,6 +269,26 @@ struct Pairing {
     std::string analysis;   // "" or the name of a protocol analysis (analyses.h)
 };
 
+// --- periodic traffic (<cycles> in <root>) ---
+// A field <cycles> reads: <signature>, <sequence>, <only> or <never>.
+struct CycleField {
+    FieldRef field;
+    std::vector<ValueRange> in_list;  // <only>/<never>: the values that hold (none given: not 0)
+    int line = 0;
+};
+
+// Messages with the same signature values (and sender) are a stream; a
+// stream whose messages come at a regular period is a cycle.
+struct Cycles {
+    int line = 0;
+    unsigned window = 8;                   // regular periods in a row that make a cycle
+    bool by_sender = false;                // sender="yes": the sender is part of the signature
+    std::vector<CycleField> signature;     // one or more
+    std::optional<CycleField> sequence;    // the sequence count, if any
+    unsigned sequence_bits = 0;            // its width (bits="..."; default: the field's)
+    std::vector<CycleField> only, never;   // conditions
+};
+
 struct Protocol {
     std::string name;
     std::string abbreviation;
@@ -280,6 +305,8 @@ struct Protocol {
     std::vector<std::unique_ptr<Node>> nodes;
     // request/response pairing, when the file declares it
     std::unique_ptr<Pairing> pairing;
+    // periodic traffic, when the file declares it
+    std::unique_ptr<Cycles> cycles;
 
     // --- derived by the validator ---
     int slot_count = 0;

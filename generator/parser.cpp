@@ -56,6 +56,10 @@ const std::vector<std::string> kFindingAttributes = {"name", "severity", "group"
 const std::vector<std::string> kPairingAttributes = {"timeout", "analysis", "order"};
 const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kInputAttributes = {"name", "field"};
+const std::vector<std::string> kCyclesAttributes = {"window", "sender"};
+const std::vector<std::string> kCycleFieldAttributes = {"field"};
+const std::vector<std::string> kSequenceAttributes = {"field", "bits"};
+const std::vector<std::string> kCycleTestAttributes = {"field", "in"};
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
                                                 "origin",  "enum",      "nondisplay",
                                                 // typed values shown as text
@@ -277,6 +281,9 @@ private:
     void parse_finding(xmlNode* el, Node& node);
     void parse_layout_attributes(std::map<std::string, std::string>& attrs, Node& node);
     void parse_pairing(xmlNode* el, Protocol& proto);
+    void parse_cycles(xmlNode* el, Protocol& proto);
+    bool parse_cycle_field(xmlNode* el, const std::vector<std::string>& allowed, CycleField& out,
+                           std::map<std::string, std::string>& attrs);
     void parse_length(const std::string& text, int line, Node& node, xmlNode* el);
     void parse_rest_minus(const std::string& raw, const std::string& tail, int line, Node& node);
     void parse_display(const std::string& text, int line, Node& node);
@@ -414,8 +421,10 @@ std::unique_ptr<Protocol> Parser::parse_root(xmlNode* root) {
             parse_pairing(c, *proto);
         else if (c->type == XML_ELEMENT_NODE && element_name(c) == "heuristic")
             parse_heuristic(c, *proto);
+        else if (c->type == XML_ELEMENT_NODE && element_name(c) == "cycles")
+            parse_cycles(c, *proto);
         else
-            unexpected_child(c, "root", {"node", "hook", "pairing", "heuristic"});
+            unexpected_child(c, "root", {"node", "hook", "pairing", "heuristic", "cycles"});
     }
     if (proto->pdulength) defer(*proto->pdulength, root, proto->line, "pdulength");
     resolve_all();
@@ -538,6 +547,95 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
         defer(pairing.keys[i].field, el->parent, pairing.keys[i].line, "field");
     for (AnalysisInput& input : pairing.inputs)
         defer(input.field, el->parent, input.line, "field");
+}
+
+// Periodic traffic: <cycles window="8" sender="yes"><signature field="XPATH"/>...
+// [<sequence field="XPATH" bits="N"/>] [<only field="XPATH" in="LIST"/>]... [<never .../>]...</cycles>
+void Parser::parse_cycles(xmlNode* el, Protocol& proto) {
+    int line = line_of(el);
+    if (proto.cycles) {
+        diags_.error(line, "only one <cycles> per protocol (the first is on line " + std::to_string(proto.cycles->line) +
+                               "); list every signature field in it");
+        return;
+    }
+    proto.cycles = std::make_unique<Cycles>();
+    Cycles& cycles = *proto.cycles;
+    cycles.line = line;
+    auto attrs = attributes(el, kCyclesAttributes);
+    if (attrs.count("window")) {
+        uint64_t w = 0;
+        if (!parse_number(attrs["window"], w) || w < 1 || w > 64)
+            diags_.error(line, "bad window '" + attrs["window"] +
+                                   "': expected the number of regular periods in a row that make a cycle, 1 to 64 "
+                                   "(1: every stream is a cycle from its second message)");
+        else
+            cycles.window = static_cast<unsigned>(w);
+    }
+    if (attrs.count("sender")) {
+        const std::string v = trim(attrs["sender"]);
+        if (v == "yes" || v == "no")
+            cycles.by_sender = v == "yes";
+        else
+            diags_.error(line, "bad sender '" + attrs["sender"] +
+                                   "': expected yes (the sender's address and port are part of the signature) or no");
+    }
+    for (xmlNode* c = el->children; c; c = c->next) {
+        if (c->type != XML_ELEMENT_NODE) {
+            unexpected_child(c, "cycles", {"signature", "sequence", "only", "never"});
+            continue;
+        }
+        const std::string name = element_name(c);
+        CycleField f;
+        std::map<std::string, std::string> sattrs;
+        if (name == "signature") {
+            if (parse_cycle_field(c, kCycleFieldAttributes, f, sattrs)) cycles.signature.push_back(f);
+        } else if (name == "sequence") {
+            if (cycles.sequence) {
+                diags_.error(line_of(c), "only one <sequence> in <cycles> (the first is on line " +
+                                             std::to_string(cycles.sequence->line) + ")");
+                continue;
+            }
+            if (parse_cycle_field(c, kSequenceAttributes, f, sattrs)) cycles.sequence = f;
+            if (sattrs.count("bits")) {
+                uint64_t b = 0;
+                if (!parse_number(sattrs["bits"], b) || b < 1 || b > 64)
+                    diags_.error(line_of(c), "bad bits '" + sattrs["bits"] +
+                                                 "': expected the sequence count's width, 1 to 64");
+                else
+                    cycles.sequence_bits = static_cast<unsigned>(b);
+            }
+        } else if (name == "only" || name == "never") {
+            if (parse_cycle_field(c, kCycleTestAttributes, f, sattrs))
+                (name == "only" ? cycles.only : cycles.never).push_back(f);
+        } else {
+            unexpected_child(c, "cycles", {"signature", "sequence", "only", "never"});
+        }
+    }
+    if (cycles.signature.empty())
+        diags_.error(line, "<cycles> needs at least one <signature field=\"XPATH\"/>: the fields whose values tell "
+                           "one stream of messages from another");
+    if (cycles.only.size() > 32) diags_.error(cycles.only[32].line, "at most 32 <only> tests in <cycles>");
+    // All fields first, then their references: defer() keeps pointers into the vectors.
+    for (CycleField& f : cycles.signature) defer(f.field, el->parent, f.line, "field");
+    if (cycles.sequence) defer(cycles.sequence->field, el->parent, cycles.sequence->line, "field");
+    for (CycleField& f : cycles.only) defer(f.field, el->parent, f.line, "field");
+    for (CycleField& f : cycles.never) defer(f.field, el->parent, f.line, "field");
+}
+
+// One field of <cycles>: its 'field' XPath and, for <only>/<never>, its 'in' list.
+bool Parser::parse_cycle_field(xmlNode* el, const std::vector<std::string>& allowed, CycleField& out,
+                               std::map<std::string, std::string>& attrs) {
+    out.line = line_of(el);
+    const std::string what = "<" + element_name(el) + ">";
+    attrs = attributes(el, allowed);
+    for (xmlNode* k = el->children; k; k = k->next) unexpected_child(k, element_name(el), {});
+    if (!attrs.count("field") || trim(attrs["field"]).empty()) {
+        diags_.error(out.line, what + " needs a 'field' attribute: an XPath to a numeric field, from <root>");
+        return false;
+    }
+    out.field = make_ref(attrs["field"], out.line, "field", false);
+    if (attrs.count("in") && !parse_value_list(attrs["in"], out.line, "in", out.in_list)) return false;
+    return true;
 }
 
 std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {

@@ -27,6 +27,8 @@ std::vector<NameGroup> make_groups() {
          {DG_PAIRING_FIELDS(DISSGEN_FIELD) DG_PAIRING_EXPERTS(DISSGEN_EXPERT)}},
         {When::RequestContext, "", "values read from the paired request", "request context",
          {DG_REQUEST_CONTEXT_EXPERTS(DISSGEN_EXPERT)}},
+        {When::Cycles, "", "the cycles of <cycles>", "cycles",
+         {DG_CYCLES_FIELDS(DISSGEN_FIELD) DG_CYCLES_EXPERTS(DISSGEN_EXPERT)}},
         {When::Analysis, DG_ANALYSIS_ETHERCAT_ESC, "the " DG_ANALYSIS_ETHERCAT_ESC " analysis",
          DG_ANALYSIS_ETHERCAT_ESC,
          {DG_ESC_FIELDS(DISSGEN_FIELD) DG_BUS_FIELDS(DISSGEN_FIELD) DG_CYCLE_FIELDS(DISSGEN_FIELD) DG_DC_FIELDS(DISSGEN_FIELD) DG_ESC_EXPERTS(DISSGEN_EXPERT)
@@ -50,6 +52,7 @@ bool applies(const NameGroup& g, const Protocol& proto) {
         case When::Reassembly: return reassembles(proto);
         case When::Pairing: return proto.pairing != nullptr;
         case When::RequestContext: return proto.pairing && !proto.request_fields.empty();
+        case When::Cycles: return proto.cycles != nullptr;
         case When::Analysis: return proto.pairing && proto.pairing->analysis == g.analysis;
     }
     return false;

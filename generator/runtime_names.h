@@ -28,7 +28,7 @@ struct RuntimeName {
 
 // The names one part of the runtime registers, and for which protocols.
 struct NameGroup {
-    enum class When { Always, Reassembly, Pairing, RequestContext, Analysis };
+    enum class When { Always, Reassembly, Pairing, RequestContext, Cycles, Analysis };
     When when;
     const char* analysis;  // When::Analysis: the <pairing analysis="..."> it belongs to
     const char* owner;     // in diagnostics: "is reserved for OWNER"
@@ -64,6 +64,7 @@ namespace runtime_field {
 DG_RUNTIME_FIELDS(DISSGEN_NAME_CONSTANT)
 DG_FRAGMENT_FIELDS(DISSGEN_NAME_CONSTANT)
 DG_PAIRING_FIELDS(DISSGEN_NAME_CONSTANT)
+DG_CYCLES_FIELDS(DISSGEN_NAME_CONSTANT)
 DG_ESC_FIELDS(DISSGEN_NAME_CONSTANT)
 DG_BUS_FIELDS(DISSGEN_NAME_CONSTANT)
 DG_CYCLE_FIELDS(DISSGEN_NAME_CONSTANT)
@@ -73,6 +74,7 @@ namespace runtime_expert {
 DG_RUNTIME_EXPERTS(DISSGEN_NAME_CONSTANT)
 DG_PAIRING_EXPERTS(DISSGEN_NAME_CONSTANT)
 DG_REQUEST_CONTEXT_EXPERTS(DISSGEN_NAME_CONSTANT)
+DG_CYCLES_EXPERTS(DISSGEN_NAME_CONSTANT)
 DG_ESC_EXPERTS(DISSGEN_NAME_CONSTANT)
 DG_BUS_EXPERTS(DISSGEN_NAME_CONSTANT)
 }  // namespace runtime_expert

@@ -80,6 +80,9 @@ private:
     const Node* fixed_offset_blocker(const Node& n, uint64_t& offset) const;
     void check_validity();  // valid="LIST" fields and <heuristic>
     void check_pairing();
+    void check_cycles();
+    bool check_cycle_field(const CycleField& f, const char* element, int role, int test,
+                           std::map<const Node*, int>& seen);
     void check_hook_list(const Node& n);
     void check_list_fits(int line, const std::vector<ValueRange>& list, const FieldRef& ref,
                          const char* attribute = "in");
@@ -139,6 +142,7 @@ void Validator::run() {
     check_pdulength();
     check_validity();
     check_pairing();
+    check_cycles();
     check_request_keys();
     runtime_names_ = name_groups_of(proto_);
     assign_filter_names(proto_.nodes, proto_.filter);
@@ -666,6 +670,51 @@ void Validator::check_pairing() {
             diags_.error(key.line, "key field " + quote(*t) + " is already a key (line " + std::to_string(it->second) +
                                        ")");
     }    check_analysis_inputs(proto_, diags_);
+}
+
+// <cycles>: numeric fields, each read for one thing, the sequence count no
+// wider than its field; no analysis that times the protocol's cycles itself.
+void Validator::check_cycles() {
+    if (!proto_.cycles) return;
+    Cycles& c = *proto_.cycles;
+    if (proto_.pairing && proto_.pairing->analysis == DG_ANALYSIS_ETHERCAT_ESC)
+        diags_.error(c.line, "<cycles> cannot be used with <pairing analysis=\"" DG_ANALYSIS_ETHERCAT_ESC
+                             "\">, which finds EtherCAT's cycles itself (" +
+                                 proto_.filter + ".cycle)");
+    std::map<const Node*, int> seen;
+    for (const CycleField& f : c.signature) check_cycle_field(f, "signature", 1, 0, seen);
+    int test = 0;
+    for (const CycleField& f : c.only) check_cycle_field(f, "only", 3, test++, seen);
+    for (const CycleField& f : c.never) check_cycle_field(f, "never", 4, test++, seen);
+    if (!c.sequence || !check_cycle_field(*c.sequence, "sequence", 2, 0, seen)) return;
+    const Node& t = *c.sequence->field.target;  // decoded more than once in a message: the last value counts
+    const unsigned width = t.is_computed() ? 64 : static_cast<unsigned>(t.fixed_bits);
+    if (c.sequence_bits == 0)
+        c.sequence_bits = width;
+    else if (c.sequence_bits > width)
+        diags_.error(c.sequence->line, "bits=\"" + std::to_string(c.sequence_bits) + "\" is wider than sequence field " +
+                                           quote(t) + at_line(t) + " (" + std::to_string(width) + " bits)");
+}
+
+bool Validator::check_cycle_field(const CycleField& f, const char* element, int role, int test,
+                                  std::map<const Node*, int>& seen) {
+    Node* t = f.field.target;
+    if (!t) return false;  // the parser reported the XPath
+    if (!t->is_numeric()) {
+        diags_.error(f.line, std::string(element) + " field " + quote(*t) + at_line(*t) +
+                                 " is not numeric: <cycles> reads leaves of 1-64 bits shown as a number, bool, "
+                                 "enum or nondisplay, or integer computed values");
+        return false;
+    }
+    auto [it, inserted] = seen.emplace(t, f.line);
+    if (!inserted) {
+        diags_.error(f.line, "field " + quote(*t) + " is already read by <cycles> (line " + std::to_string(it->second) +
+                                 "): each field has one part in it");
+        return false;
+    }
+    t->cycle_role = role;
+    t->cycle_test = test;
+    return true;
 }
 
 void Validator::assign_slots() {

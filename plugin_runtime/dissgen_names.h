@@ -83,6 +83,26 @@
     X(no_request_context, "expert.no_request_context", PI_SEQUENCE, PI_NOTE,                                \
       "The request of this response is not in the capture: the values read from it are unknown")
 
+/* --- A protocol with <cycles> (dissgen_cycles.cpp) ------------------------- */
+
+#define DG_CYCLES_FIELDS(X)                                                                                \
+    X(stream_cycle, "cycle", FT_UINT32, BASE_DEC, NULL, "Cycle",                                            \
+      "The cycle this message belongs to: 1, 2, ... in the order the streams became cycles")              \
+    X(stream_period, "cycle.period", FT_RELATIVE_TIME, BASE_NONE, NULL, "Cycle period",                     \
+      "Time since the stream's previous message")                                                         \
+    X(stream_jitter, "cycle.jitter", FT_RELATIVE_TIME, BASE_NONE, NULL, "Cycle jitter",                     \
+      "The period minus the cycle's nominal period (the median of its periods so far)")                    \
+    X(stream_lost, "cycle.lost", FT_UINT32, BASE_DEC, NULL, "Messages lost",                                \
+      "Messages of the stream missing right before this one, by its sequence count")                       \
+    X(stream_duplicate, "cycle.duplicate", FT_FRAMENUM, BASE_NONE, NULL, "Duplicate of",                    \
+      "The stream's previous message, whose sequence count this one repeats")
+
+#define DG_CYCLES_EXPERTS(X)                                                                               \
+    X(stream_lost_expert, "expert.cycle_lost", PI_SEQUENCE, PI_WARN,                                        \
+      "Messages of the stream lost (its sequence count skipped)")                                         \
+    X(stream_duplicate_expert, "expert.cycle_duplicate", PI_SEQUENCE, PI_NOTE,                              \
+      "Message of the stream repeated (its sequence count did not advance)")
+
 /* --- The ethercat-esc analysis: ESC forwarding (ethercat_esc.cpp) ---------- */
 
 #define DG_ANALYSIS_ETHERCAT_ESC "ethercat-esc"

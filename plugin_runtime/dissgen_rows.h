@@ -92,6 +92,7 @@ struct dg_extra_row {
         e.finding_first = first; e.finding_count = count; return *this;
     }
     constexpr dg_extra_row &input(gint8 number) { e.input = number; return *this; }
+    constexpr dg_extra_row &cycle_role(guint8 role, guint8 test) { e.cycle_role = role; e.cycle_test = test; return *this; }
 };
 
 /* UTF-8 strings, times in nanoseconds, no reassembly. */
@@ -154,6 +155,7 @@ struct dg_protocol_row {
     constexpr dg_protocol_row &findings(const dg_finding *v) { p.findings = v; return *this; }
     constexpr dg_protocol_row &top_walk(dg_list_walk fn) { p.top_walk = fn; return *this; }
     constexpr dg_protocol_row &no_padding() { p.no_padding = 1; return *this; }
+    constexpr dg_protocol_row &cycles(const dg_cycles *v) { p.cycles = v; return *this; }
 };
 
 /* Operations of computed values: dg_op(CODE) for operators and index, and

@@ -106,6 +106,10 @@ typedef struct dg_extra {
     /* <pairing><input>: the number of the pairing analysis' input this leaf
      * is (its value goes to the message's dg_view); -1: none */
     gint8 input = -1;
+    /* <cycles>: what the cycle analysis reads from this leaf (dg_cycle_role),
+     * and for DG_CYCLE_ONLY / DG_CYCLE_NEVER its test (dg_cycles.tests); 0: none */
+    guint8 cycle_role = 0;
+    guint8 cycle_test = 0;
 } dg_extra;
 
 /* A <finding>: the expert info `ei` is raised on the node's bytes when the
@@ -251,6 +255,30 @@ typedef struct dg_hook {
  * (dissgen_pairing.cpp). Key fields carry DG_KEY. */
 struct dg_analysis; /* dissgen_pairing.h; each analysis defines its own in its folder */
 
+/* Periodic traffic declared by <cycles> in the rule file (dissgen_cycles.cpp).
+ * A leaf the analysis reads carries its role in dg_extra.cycle_role. */
+enum dg_cycle_role {
+    DG_CYCLE_SIGNATURE = 1, /* part of the stream's signature (every instance, in order) */
+    DG_CYCLE_SEQUENCE = 2,  /* the stream's sequence count */
+    DG_CYCLE_ONLY = 3,      /* the message may be cyclic only when this holds */
+    DG_CYCLE_NEVER = 4      /* the message is never cyclic when this holds (any instance) */
+};
+
+/* <only>/<never>: the leaf's value holds when it lies in one of the ranges
+ * dg_cycles.ranges[range_first .. range_first + range_count). */
+typedef struct dg_cycle_test {
+    guint16 range_first, range_count;
+} dg_cycle_test;
+
+typedef struct dg_cycles {
+    guint8 window;         /* regular periods in a row that make a stream a cycle */
+    guint8 sequence_bits;  /* the sequence count's width; 0: none */
+    guint8 by_sender;      /* the sender's address and port are part of the signature */
+    guint8 only_count;     /* the <only> tests, numbered 0 .. only_count - 1, before the <never> ones */
+    const dg_cycle_test *tests;
+    const dg_range *ranges;
+} dg_cycles;
+
 typedef struct dg_pairing {
     double timeout;          /* seconds a request waits for its response */
     const struct dg_analysis *analysis; /* NULL, or the protocol analysis the rule file names */
@@ -330,6 +358,9 @@ typedef struct dg_protocol {
     /* padding="none": zero bytes a length leaves over are not padding but
      * P.expert.unused, like any others. Generated code gives it only when set. */
     guint8 no_padding = 0;
+    /* <cycles>: periodic streams, NULL when the rule file declares none.
+     * Generated code gives it only for protocols that have one. */
+    const dg_cycles *cycles = nullptr;
 } dg_protocol;
 
 /* The entry points generated code calls. C linkage: plain symbol

@@ -15,6 +15,7 @@
  */
 #pragma once
 
+#include "dissgen_cycles.h"
 #include "dissgen_pairing.h"
 #include "dissgen_runtime.h"
 #include "dissgen_text.h"
@@ -93,6 +94,15 @@ struct dg_state {
     dg_view_value *views;
     guint view_count, view_capacity;
     gboolean wants_view;
+    /* <cycles>, first pass only: what the leaves with a dg_extra.cycle_role
+     * decoded (dg_cycle_input) */
+    gboolean wants_cycles;
+    guint64 *cycle_values;
+    guint16 *cycle_nodes;
+    guint cycle_count, cycle_capacity;
+    guint64 cycle_sequence;
+    gboolean has_cycle_sequence, cycle_never;
+    guint32 cycle_only_held;
     /* request{...}: what the paired request kept, NULL when it is not known */
     mutable const dg_request_values *request;
     mutable gboolean request_missed; /* a value read the request, and it is not known */
@@ -230,6 +240,45 @@ static inline void view_append(dg_state *st, const dg_node *n, guint64 value, gi
     v->instance = st->instance;
 }
 
+/* A leaf the cycle analysis reads (dg_extra.cycle_role), first pass. */
+static inline void cycle_record(dg_state *st, const dg_node *n, guint64 value)
+{
+    const dg_extra *x = n->extra;
+    if (x->cycle_role == DG_CYCLE_SIGNATURE) {
+        if (st->cycle_count == st->cycle_capacity) {
+            st->cycle_capacity = st->cycle_capacity ? 2 * st->cycle_capacity : 8;
+            st->cycle_values = (guint64 *)wmem_realloc(st->pinfo->pool, st->cycle_values,
+                                                       st->cycle_capacity * sizeof(guint64));
+            st->cycle_nodes = (guint16 *)wmem_realloc(st->pinfo->pool, st->cycle_nodes,
+                                                      st->cycle_capacity * sizeof(guint16));
+        }
+        st->cycle_values[st->cycle_count] = value;
+        st->cycle_nodes[st->cycle_count++] = (guint16)(n - st->p->nodes);
+        return;
+    }
+    if (x->cycle_role == DG_CYCLE_SEQUENCE) {
+        st->cycle_sequence = value;
+        st->has_cycle_sequence = TRUE;
+        return;
+    }
+    const dg_cycles *c = st->p->cycles;
+    const dg_cycle_test *t = &c->tests[x->cycle_test];
+    gboolean holds = FALSE;
+    for (guint i = t->range_first; i < (guint)t->range_first + t->range_count && !holds; i++)
+        holds = value >= c->ranges[i].low && value <= c->ranges[i].high;
+    if (!holds) return;
+    if (x->cycle_role == DG_CYCLE_ONLY)
+        st->cycle_only_held |= (guint32)1 << x->cycle_test;
+    else
+        st->cycle_never = TRUE;
+}
+
+/* Whether the cycle analysis reads this leaf, in this pass. */
+static inline __attribute__((always_inline)) gboolean is_cycle_input(const dg_state *st, const dg_node *n)
+{
+    return st->wants_cycles && n->extra && n->extra->cycle_role;
+}
+
 /* Whether the pairing analysis reads this leaf, in this pass. */
 static inline __attribute__((always_inline)) gboolean is_view_input(const dg_state *st, const dg_node *n)
 {
@@ -256,6 +305,7 @@ static inline __attribute__((always_inline)) void store(dg_state *st, const dg_n
     if (st->tap && n->show == DG_SHOW_ENUM) tap_record(st, n, value);
     if (n->flags & DG_KEY) key_append(st, value);
     if (is_view_input(st, n)) view_append(st, n, value, offset, length);
+    if (is_cycle_input(st, n)) cycle_record(st, n, value);
     if (n->slot < 0) return;
     if (n->extra && n->extra->keep_values) table_append(st, n, value);
     if (n->extra && n->extra->keep_instances) table_put(st, n, value);
@@ -271,7 +321,8 @@ static inline __attribute__((always_inline)) void store(dg_state *st, const dg_n
  * stats tree counts it. Otherwise the walk need not read it from the tvb. */
 static inline __attribute__((always_inline)) gboolean value_wanted(const dg_state *st, const dg_node *n)
 {
-    return n->slot >= 0 || (st->tap && n->show == DG_SHOW_ENUM) || (n->flags & DG_KEY) || is_view_input(st, n);
+    return n->slot >= 0 || (st->tap && n->show == DG_SHOW_ENUM) || (n->flags & DG_KEY) || is_view_input(st, n) ||
+           is_cycle_input(st, n);
 }
 
 /* A new instance: the values of the previous one's subtree are gone. */

@@ -678,6 +678,7 @@ void begin_message(dg_state *st, dg_message_buffers *b, const dg_protocol *p, tv
     st->direction = direction_of(pinfo);
     /* The analysis reads its inputs on the first pass only (dissgen_pairing.h). */
     st->wants_view = p->pairing && p->pairing->analysis && !PINFO_FD_VISITED(pinfo);
+    st->wants_cycles = p->cycles && !PINFO_FD_VISITED(pinfo);
     /* Summaries are text for the Info column and for container items; build
      * them only when someone sees them: tshark -T fields and -V have a visible
      * tree and no columns, summary lines have columns and no tree, and a
@@ -762,6 +763,12 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
                                                         st.direction);
         if (st.tap) st.tap->pairing = fp;
         if (p->request_context) request_end(&st, fp, subtree);
+    }
+
+    if (p->cycles) {
+        const dg_cycle_input in = {st.cycle_values, st.cycle_nodes, st.cycle_count, st.cycle_sequence,
+                                   st.has_cycle_sequence, st.cycle_only_held, st.cycle_never};
+        dg_cycles_dissect(p, tvb, pinfo, subtree, st.wants_cycles ? &in : NULL, messages - 1);
     }
 
     if (st.tap) tap_queue_packet(stats_tap, pinfo, st.tap);

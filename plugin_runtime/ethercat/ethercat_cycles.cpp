@@ -36,6 +36,8 @@
  */
 #include "ethercat_cycles.h"
 
+#include "../dissgen_periods.h"
+
 #include <epan/stat_tap_ui.h>
 #include <epan/stats_tree.h>
 #include <epan/tap.h>
@@ -49,6 +51,8 @@ namespace dg_ecat {
 
 namespace {
 
+using namespace dg_periods;
+
 const guint window = 8;
 const guint ring = 16; /* the last frames of a cycle whose return may still come */
 
@@ -57,58 +61,11 @@ struct sig_datagram {
     guint16 adp, ado, length;
 };
 
-/* A growing array of 32-bit values in wmem_file_scope. */
-struct u32_vec {
-    guint32 *v;
-    guint n, cap;
-    void push(guint32 x)
-    {
-        if (n == cap) {
-            cap = cap ? 2 * cap : 16;
-            v = (guint32 *)wmem_realloc(wmem_file_scope(), v, cap * sizeof(guint32));
-        }
-        v[n++] = x;
-    }
-};
-
-/* A binary heap over u32_vec: max-heap when `max`, else min-heap. */
-gboolean before(guint32 a, guint32 b, gboolean max) { return max ? a > b : a < b; }
-
-void heap_push(u32_vec *h, guint32 x, gboolean max)
-{
-    h->push(x);
-    for (guint i = h->n - 1; i > 0;) {
-        guint p = (i - 1) / 2;
-        if (!before(h->v[i], h->v[p], max)) break;
-        guint32 t = h->v[i];
-        h->v[i] = h->v[p];
-        h->v[p] = t;
-        i = p;
-    }
-}
-
-guint32 heap_pop(u32_vec *h, gboolean max)
-{
-    guint32 top = h->v[0];
-    h->v[0] = h->v[--h->n];
-    for (guint i = 0;;) {
-        guint l = 2 * i + 1, r = l + 1, best = i;
-        if (l < h->n && before(h->v[l], h->v[best], max)) best = l;
-        if (r < h->n && before(h->v[r], h->v[best], max)) best = r;
-        if (best == i) break;
-        guint32 t = h->v[i];
-        h->v[i] = h->v[best];
-        h->v[best] = t;
-        i = best;
-    }
-    return top;
-}
-
 struct cycle {
     guint16 number;
     guint count;             /* datagrams of its signature */
     const sig_datagram *sig;
-    u32_vec low, high;       /* its periods: low a max-heap holding the lower half (one more when odd) */
+    running_median periods;  /* its periods */
     guint32 window_periods[window]; /* the qualifying window's: not carried by a marked frame */
     guint frames;            /* marked frames */
     guint32 first_frame;     /* the first marked frame */
@@ -221,8 +178,6 @@ signature *signature_of(cycle_model *m, const datagram *d, guint n)
     return s;
 }
 
-gint64 ns_of(const nstime_t *t) { return (gint64)t->secs * 1000000000 + t->nsecs; }
-
 /* The median of the regular periods in the window, when all of them lie
  * within half of it either way; 0 otherwise. */
 guint64 window_median(const signature *s)
@@ -239,19 +194,6 @@ guint64 window_median(const signature *s)
     if (median == 0 || median > G_MAXUINT32) return 0;
     if (2 * v[0] < median || 2 * v[window - 1] > 3 * median) return 0;
     return median;
-}
-
-void add_period(cycle *c, guint32 p)
-{
-    /* low holds the lower half, its top the (lower) median */
-    if (c->low.n == 0 || p <= c->low.v[0])
-        heap_push(&c->low, p, TRUE);
-    else
-        heap_push(&c->high, p, FALSE);
-    if (c->low.n > c->high.n + 1)
-        heap_push(&c->high, heap_pop(&c->low, TRUE), FALSE);
-    else if (c->high.n > c->low.n)
-        heap_push(&c->low, heap_pop(&c->high, FALSE), TRUE);
 }
 
 cycle *new_cycle(cycle_model *m, signature *s, guint32 frame)
@@ -271,7 +213,7 @@ cycle *new_cycle(cycle_model *m, signature *s, guint32 frame)
     for (guint i = 0; i + 1 < window; i++) {
         guint32 p = (guint32)s->recent[(s->next_slot + i) % window];
         c->window_periods[i] = p;
-        add_period(c, p);
+        c->periods.add(p);
     }
     return c;
 }
@@ -316,17 +258,17 @@ cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_
         s->cyc = new_cycle(m, s, pinfo->num);
     }
     cycle *c = s->cyc;
-    guint32 stored = period < 0 ? 0 : period >= (gint64)G_MAXUINT32 ? G_MAXUINT32 : (guint32)period;
+    guint32 stored = clamp_period(period);
     if (stored == G_MAXUINT32) {
         if (!m->long_periods) m->long_periods = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
         gint64 *exact = wmem_new(wmem_file_scope(), gint64);
         *exact = period;
         wmem_map_insert(m->long_periods, GUINT_TO_POINTER(pinfo->num), exact);
     }
-    add_period(c, stored);
+    c->periods.add(stored);
     mark.cycle = c->number;
     mark.period_ns = stored;
-    mark.nominal_ns = c->low.v[0];
+    mark.nominal_ns = c->periods.median();
     gint64 shown = stored == G_MAXUINT32 ? period : stored; /* what cycles_show() shows */
     double jitter = (double)(shown - (gint64)mark.nominal_ns);
     c->frames++;
@@ -489,30 +431,6 @@ void cycles_show(const cycle_mark *c, tvbuff_t *tvb, packet_info *pinfo, proto_t
 
 namespace {
 
-int compare_u32(const void *a, const void *b)
-{
-    guint32 x = *(const guint32 *)a, y = *(const guint32 *)b;
-    return x < y ? -1 : x > y;
-}
-
-/* Minimum, lower median, nearest-rank 99th percentile and maximum. */
-struct quantiles {
-    guint n;
-    guint32 min, median, p99, max;
-};
-
-quantiles quantiles_of(guint32 *v, guint n)
-{
-    quantiles q = {n, 0, 0, 0, 0};
-    if (!n) return q;
-    qsort(v, n, sizeof *v, compare_u32);
-    q.min = v[0];
-    q.median = v[(n - 1) / 2];
-    q.p99 = v[(99 * (guint64)n + 99) / 100 - 1];
-    q.max = v[n - 1];
-    return q;
-}
-
 /* A cycle's whole-capture figures, from the capture's state. */
 struct figures {
     guint32 nominal;
@@ -524,12 +442,11 @@ struct figures {
 figures figures_of(const cycle *c)
 {
     figures f = {};
-    f.nominal = c->low.n ? c->low.v[0] : 0;
+    f.nominal = c->periods.median();
     /* the marked frames' periods: the cycle's less the window's */
-    guint total = c->low.n + c->high.n;
+    guint total = c->periods.count();
     guint32 *all = g_new(guint32, total + 1);
-    memcpy(all, c->low.v, c->low.n * sizeof(guint32));
-    if (c->high.n) memcpy(all + c->low.n, c->high.v, c->high.n * sizeof(guint32));
+    c->periods.copy_to(all);
     qsort(all, total, sizeof *all, compare_u32);
     guint32 win[window];
     memcpy(win, c->window_periods, sizeof win);
@@ -573,14 +490,6 @@ char *signature_text(const cycle *c)
 
 const char *cycles_filter = "ecatr";
 
-void print_quantiles(const char *what, const quantiles *q)
-{
-    if (!q->n)
-        printf("  %s: none\n", what);
-    else
-        printf("  %s min/median/p99/max (ns): %u %u %u %u\n", what, q->min, q->median, q->p99, q->max);
-}
-
 /* At the end of the capture, from the capture's state (complete by then). */
 void cycles_draw(void *)
 {
@@ -604,21 +513,9 @@ void cycles_draw(void *)
     printf("===================================================================\n");
 }
 
-tap_packet_status cycles_packet(void *, packet_info *, epan_dissect_t *, const void *, tap_flags_t)
-{
-    return TAP_PACKET_DONT_REDRAW;
-}
-
 dg_tap_init_result cycles_cli_init(const char *, void *)
 {
-    /* Listens to the frame tap (every frame) only so that the draw runs at the end. */
-    GString *error = register_tap_listener("frame", &cycles_filter, NULL, TL_REQUIRES_NOTHING, NULL, cycles_packet,
-                                           cycles_draw, NULL);
-    if (error) {
-        fprintf(stderr, "%s,cycles: %s\n", cycles_filter, error->str);
-        g_string_free(error, TRUE);
-    }
-    return dg_tap_init_done(error == NULL);
+    return dg_tap_init_done(listen_to_the_end(&cycles_filter, cycles_draw));
 }
 
 /* The statistics tree (Wireshark's Statistics menu): the same figures, set
@@ -630,12 +527,6 @@ dg_tap_init_result cycles_cli_init(const char *, void *)
 gboolean st_filled;
 
 void st_init(stats_tree *) { st_filled = FALSE; }
-
-void st_set(stats_tree *st, const char *name, int parent, guint64 value)
-{
-    stats_tree_create_node(st, name, parent, STAT_DT_INT, FALSE);
-    set_stat_node(st, name, parent, FALSE, (gint)MIN(value, (guint64)G_MAXINT));
-}
 
 void st_quantiles(stats_tree *st, guint cycle, const char *what, const quantiles *q, int parent)
 {

@@ -123,6 +123,7 @@ TESTS = {
     "transactions": integration("test_transactions.py"),
     "computed": integration("test_computed.py"),
     "rule_findings": integration("test_rule_findings.py"),
+    "rule_cycles": integration("test_rule_cycles.py"),
     "overlays": integration("test_overlays.py"),
     "request_context": integration("test_request_context.py"),
     "request_by_position": integration("test_request_context.py", "TestRequestByPosition"),

@@ -59,6 +59,8 @@ Scaffold scaffold_for(const NameGroup& g) {
         case When::Pairing: return {{"  <pairing>", key, "  </pairing>", id}, {}};
         case When::RequestContext:
             return {{"  <pairing>", key, "  </pairing>", id}, {"  <node name=\"Again\" value=\"request{Id}\"/>"}};
+        case When::Cycles:
+            return {{"  <cycles>", "  <signature field=\"node[@name='Id']\"/>", "  </cycles>", id}, {}};
         case When::Analysis: {
             const AnalysisScaffold inputs = analysis_scaffold(g.analysis);
             Scaffold s{{"  <pairing analysis=\"" + std::string(g.analysis) + "\">", key}, inputs.nodes};

@@ -1,0 +1,459 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* Cycles of any protocol (dissgen_cycles.h; the manual, "Cycles of any
+ * protocol"), decided on the first pass from what came before each message:
+ *
+ *  - A message belongs to a stream when it holds a value of the signature
+ *    fields, every <only> test held and no <never> test did. Its stream is
+ *    the signature's values in decoding order (and, with sender="yes", the
+ *    sender's address and port).
+ *  - With a sequence count `bits` wide, from the stream's second message on,
+ *    the step d = (count - previous count) mod 2^bits says: d = 0, the
+ *    previous message again (a duplicate: P.cycle.duplicate, not timed);
+ *    1 <= d < 2^(bits-1), d - 1 messages lost right before this one
+ *    (P.cycle.lost); a larger d, the count went back (a restart, or a
+ *    message overtaken): nothing lost.
+ *  - A period is the time since the stream's previous message (duplicates
+ *    aside). It is regular when it is above 0 and no message was lost and
+ *    the count did not go back in between.
+ *  - A stream becomes a cycle with its first `window` regular periods in a
+ *    row, all within half of their median either way (that median below
+ *    2^32 ns): the message that completes the window is the cycle's first
+ *    marked one, and every later message of the stream is in the cycle.
+ *  - A marked message shows its period; a regular one joins the cycle's
+ *    periods and has a jitter: the period minus the cycle's nominal period,
+ *    the median (the lower of the two middle values for an even count) of
+ *    its regular periods so far, the window's and this one included.
+ *
+ * Memory: a record per message of a stream that shows something (its
+ * cycle, a loss, a duplicate), in wmem_file_scope; per cycle 8 bytes per
+ * regular period (the running median and the figures of -z P,cycles).
+ */
+#include "dissgen_cycles.h"
+
+#include "dissgen_compat.h"
+#include "dissgen_periods.h"
+
+#include <epan/addr_resolv.h>
+#include <epan/expert.h>
+#include <epan/to_str.h>
+#include <epan/proto_data.h>
+#include <epan/stat_tap_ui.h>
+#include <epan/stats_tree.h>
+#include <epan/tap.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+namespace {
+
+using namespace dg_periods;
+
+/* p_add_proto_data key of a message's mark: this, or-ed with the message's number in its frame. */
+const guint32 mark_key = 0x63790000u;
+const guint most_window = 64; /* the generator accepts window="1" to "64" */
+
+struct cycle;
+
+struct stream {
+    guint32 hash;
+    guint count;
+    guint64 *values;
+    guint16 *nodes;
+    address src;            /* sender="yes": the sender's address and port; AT_NONE otherwise */
+    guint32 port;
+    guint32 last_frame;     /* the stream's latest message that was not a duplicate; 0: none yet */
+    nstime_t last_time;
+    guint64 last_sequence;
+    gboolean has_sequence;
+    guint32 recent[most_window]; /* its last regular periods, a ring */
+    guint regular, next_slot;
+    guint messages, lost, duplicates;
+    cycle *cyc;
+};
+
+struct cycle {
+    guint32 number;
+    const stream *s;
+    running_median periods;  /* the regular periods: the window's and the marked messages' */
+    u32_vec marked;          /* the marked messages' regular periods, for the quantiles */
+    guint frames;            /* marked messages */
+    guint32 first_frame;
+    double jitter_sum, jitter_squares;
+    cycle *next;
+};
+
+/* What one message of a stream shows, on every pass. */
+struct mark {
+    guint32 cycle;          /* 0: not (yet) in a cycle */
+    guint32 lost;           /* messages lost right before it */
+    guint32 duplicate_of;   /* 0: not a duplicate */
+    guint8 timed, jittered; /* period_ns, jitter_ns are set */
+    gint64 period_ns, jitter_ns;
+};
+
+struct capture_state {
+    wmem_map_t *streams;    /* stream -> itself */
+    cycle *first, *last;
+    guint32 cycles;
+    guint32 last_frame;     /* the last frame the first pass brought here */
+};
+
+const dg_protocol *protocol;
+capture_state *capture;
+
+int hf_stream_cycle = -1, hf_stream_period = -1, hf_stream_jitter = -1, hf_stream_lost = -1,
+    hf_stream_duplicate = -1;
+expert_field ei_stream_lost_expert = EI_INIT, ei_stream_duplicate_expert = EI_INIT;
+
+void capture_init(void) { capture = NULL; }
+void capture_cleanup(void) { capture = NULL; /* its memory goes with wmem_file_scope */ }
+
+capture_state *current_capture(void)
+{
+    if (!capture) {
+        capture = wmem_new0(wmem_file_scope(), capture_state);
+        capture->streams = wmem_map_new(wmem_file_scope(), [](gconstpointer p) { return ((const stream *)p)->hash; },
+                                        [](gconstpointer a, gconstpointer b) -> gboolean {
+                                            const stream *x = (const stream *)a, *y = (const stream *)b;
+                                            return x->hash == y->hash && x->count == y->count && x->port == y->port &&
+                                                   addresses_equal(&x->src, &y->src) &&
+                                                   !memcmp(x->values, y->values, x->count * sizeof(guint64)) &&
+                                                   !memcmp(x->nodes, y->nodes, x->count * sizeof(guint16));
+                                        });
+    }
+    return capture;
+}
+
+guint32 fnv(guint32 h, const void *data, gsize n)
+{
+    const guint8 *b = (const guint8 *)data;
+    for (gsize i = 0; i < n; i++) h = (h ^ b[i]) * 16777619u;
+    return h;
+}
+
+stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info *pinfo)
+{
+    stream probe; /* what the map's hash and equality read, no more */
+    probe.count = in->count;
+    probe.values = (guint64 *)in->values;
+    probe.nodes = (guint16 *)in->nodes;
+    clear_address(&probe.src);
+    probe.port = 0;
+    if (protocol->cycles->by_sender) {
+        probe.src = pinfo->src; /* shallow: copied below if the stream is new */
+        probe.port = pinfo->srcport;
+    }
+    guint32 h = fnv(2166136261u, probe.values, in->count * sizeof(guint64));
+    h = fnv(h, probe.nodes, in->count * sizeof(guint16));
+    h = fnv(h, &probe.port, sizeof probe.port);
+    h = add_address_to_hash(h, &probe.src);
+    probe.hash = h;
+    stream *s = (stream *)wmem_map_lookup(c->streams, &probe);
+    if (s) return s;
+    s = wmem_new0(wmem_file_scope(), stream);
+    s->hash = h;
+    s->count = in->count;
+    s->values = (guint64 *)wmem_memdup(wmem_file_scope(), in->values, in->count * sizeof(guint64));
+    s->nodes = (guint16 *)wmem_memdup(wmem_file_scope(), in->nodes, in->count * sizeof(guint16));
+    copy_address_wmem(wmem_file_scope(), &s->src, &probe.src);
+    s->port = probe.port;
+    wmem_map_insert(c->streams, s, s);
+    return s;
+}
+
+/* The median of the window's regular periods when all of them lie within
+ * half of it either way; 0 otherwise. */
+guint32 window_median(const stream *s, guint window)
+{
+    guint32 v[most_window];
+    memcpy(v, s->recent, window * sizeof(guint32));
+    qsort(v, window, sizeof *v, compare_u32);
+    guint32 median = v[(window - 1) / 2];
+    if (median == 0 || median == G_MAXUINT32) return 0;
+    if (2 * (guint64)v[0] < median || 2 * (guint64)v[window - 1] > 3 * (guint64)median) return 0;
+    return median;
+}
+
+cycle *new_cycle(capture_state *c, stream *s, guint window, guint32 frame)
+{
+    cycle *cy = wmem_new0(wmem_file_scope(), cycle);
+    cy->number = ++c->cycles;
+    cy->s = s;
+    cy->first_frame = frame;
+    if (c->last)
+        c->last->next = cy;
+    else
+        c->first = cy;
+    c->last = cy;
+    /* the window's periods, oldest first; the last is the marking message's own */
+    for (guint i = 0; i + 1 < window; i++) cy->periods.add(s->recent[(s->next_slot + i) % window]);
+    return cy;
+}
+
+/* The sequence count's step since the stream's previous message: FALSE when
+ * it is a duplicate; else *lost messages lost (G_MAXUINT32: the count went back). */
+gboolean sequence_step(stream *s, const dg_cycle_input *in, guint bits, guint32 *lost)
+{
+    *lost = 0;
+    if (!bits || !in->has_sequence) return TRUE;
+    const guint64 mask = bits >= 64 ? G_MAXUINT64 : ((guint64)1 << bits) - 1;
+    const guint64 count = in->sequence & mask;
+    if (s->has_sequence) {
+        guint64 step = (count - s->last_sequence) & mask;
+        if (step == 0) return FALSE;
+        *lost = step <= mask >> 1 ? (guint32)MIN(step - 1, (guint64)G_MAXUINT32 - 1) : G_MAXUINT32;
+    }
+    s->last_sequence = count;
+    s->has_sequence = TRUE;
+    return TRUE;
+}
+
+/* First pass: times the message in its stream; what it shows, or NULL. */
+mark *time_message(capture_state *c, const dg_cycle_input *in, const packet_info *pinfo)
+{
+    c->last_frame = pinfo->num;
+    const dg_cycles *cy = protocol->cycles;
+    const guint32 all_only = cy->only_count >= 32 ? G_MAXUINT32 : ((guint32)1 << cy->only_count) - 1;
+    if (!in->count || in->never || (in->only_held & all_only) != all_only) return NULL;
+    stream *s = stream_of(c, in, pinfo);
+    s->messages++;
+    mark m = {};
+    guint32 lost;
+    if (!sequence_step(s, in, cy->sequence_bits, &lost)) {
+        s->duplicates++;
+        m.duplicate_of = s->last_frame;
+        m.cycle = s->cyc ? s->cyc->number : 0;
+        return (mark *)wmem_memdup(wmem_file_scope(), &m, sizeof m);
+    }
+    const gboolean went_back = lost == G_MAXUINT32;
+    if (!went_back) {
+        m.lost = lost;
+        s->lost += lost;
+    }
+    const gboolean first = s->last_frame == 0;
+    const gint64 period = first ? 0 : ns_of(&pinfo->abs_ts) - ns_of(&s->last_time);
+    s->last_frame = pinfo->num;
+    s->last_time = pinfo->abs_ts;
+    const gboolean regular = !first && period > 0 && lost == 0;
+    if (!first && !s->cyc) {
+        if (!regular) {
+            s->regular = 0;
+        } else {
+            s->recent[s->next_slot] = clamp_period(period);
+            s->next_slot = (s->next_slot + 1) % cy->window;
+            if (s->regular < cy->window) s->regular++;
+            if (s->regular == cy->window && window_median(s, cy->window))
+                s->cyc = new_cycle(c, s, cy->window, pinfo->num);
+        }
+    }
+    cycle *cyc = s->cyc;
+    if (cyc) {
+        m.cycle = cyc->number;
+        m.timed = TRUE;
+        m.period_ns = period;
+        cyc->frames++;
+        if (regular) {
+            cyc->periods.add(clamp_period(period));
+            cyc->marked.push(clamp_period(period));
+            m.jittered = TRUE;
+            m.jitter_ns = period - (gint64)cyc->periods.median();
+            cyc->jitter_sum += (double)m.jitter_ns;
+            cyc->jitter_squares += (double)m.jitter_ns * (double)m.jitter_ns;
+        }
+    }
+    if (!m.cycle && !m.lost) return NULL;
+    return (mark *)wmem_memdup(wmem_file_scope(), &m, sizeof m);
+}
+
+nstime_t nstime_of(gint64 ns)
+{
+    nstime_t t;
+    t.secs = (time_t)(ns / 1000000000);
+    t.nsecs = (int)(ns % 1000000000);
+    return t;
+}
+
+void add_generated_time(proto_tree *tree, int hf, tvbuff_t *tvb, gint64 ns)
+{
+    nstime_t t = nstime_of(ns);
+    proto_item_set_generated(proto_tree_add_time(tree, hf, tvb, 0, 0, &t));
+}
+
+void show(const mark *m, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    if (m->cycle) proto_item_set_generated(proto_tree_add_uint(tree, hf_stream_cycle, tvb, 0, 0, m->cycle));
+    if (m->timed) add_generated_time(tree, hf_stream_period, tvb, m->period_ns);
+    if (m->jittered) add_generated_time(tree, hf_stream_jitter, tvb, m->jitter_ns);
+    if (m->lost) {
+        proto_item *it = proto_tree_add_uint(tree, hf_stream_lost, tvb, 0, 0, m->lost);
+        proto_item_set_generated(it);
+        expert_add_info_format(pinfo, it, &ei_stream_lost_expert, "%u message%s of this stream lost right before this one",
+                               m->lost, m->lost == 1 ? "" : "s");
+    }
+    if (m->duplicate_of) {
+        proto_item *it = proto_tree_add_uint(tree, hf_stream_duplicate, tvb, 0, 0, m->duplicate_of);
+        proto_item_set_generated(it);
+        expert_add_info_format(pinfo, it, &ei_stream_duplicate_expert,
+                               "Repeats frame %u: the same sequence count", m->duplicate_of);
+    }
+}
+
+/* --- -z P,cycles and the statistics tree --------------------------------- */
+
+/* A cycle's whole-capture figures, from the capture's state. */
+struct figures {
+    guint32 nominal;
+    quantiles period;
+    double jitter_sd;
+};
+
+figures figures_of(const cycle *c)
+{
+    figures f = {};
+    f.nominal = c->periods.median();
+    guint32 *v = g_new(guint32, c->marked.n + 1);
+    if (c->marked.n) memcpy(v, c->marked.v, c->marked.n * sizeof(guint32));
+    f.period = quantiles_of(v, c->marked.n);
+    g_free(v);
+    guint n = c->marked.n;
+    double mean = n ? c->jitter_sum / n : 0;
+    double var = n ? c->jitter_squares / n - mean * mean : 0;
+    f.jitter_sd = var > 0 ? sqrt(var) : 0.0;
+    return f;
+}
+
+/* "Connection ID 0x00ff0001, sender 192.168.1.10:2222": each signature field
+ * by its node's name and value as the stream first had them. */
+char *stream_text(const stream *s)
+{
+    GString *t = g_string_new("");
+    for (guint i = 0; i < s->count; i++) {
+        const dg_node *n = &protocol->nodes[s->nodes[i]];
+        if (i) g_string_append(t, ", ");
+        if (n->show == DG_SHOW_DEC || n->show == DG_SHOW_INT)
+            g_string_append_printf(t, "%s %" G_GUINT64_FORMAT, n->name, s->values[i]);
+        else
+            g_string_append_printf(t, "%s 0x%" G_GINT64_MODIFIER "x", n->name, s->values[i]);
+    }
+    if (s->src.type != AT_NONE) {
+        char *addr = address_to_str(NULL, &s->src);
+        g_string_append_printf(t, s->port ? ", sender %s:%u" : ", sender %s", addr, s->port);
+        wmem_free(NULL, addr);
+    }
+    return g_string_free(t, FALSE);
+}
+
+/* At the end of the capture, from the capture's state (complete by then). */
+void cycles_draw(void *)
+{
+    printf("===================================================================\n");
+    printf("%s cycles (%s)\n", protocol->name, protocol->filter);
+    if (!capture || !capture->first) printf("No cycles\n");
+    for (const cycle *c = capture ? capture->first : NULL; c; c = c->next) {
+        figures f = figures_of(c);
+        char *name = stream_text(c->s);
+        printf("Cycle %u: %s\n", c->number, name);
+        g_free(name);
+        printf("  first frame: %u\n", c->first_frame);
+        printf("  messages: %u\n", c->frames);
+        printf("  nominal period (ns): %u\n", f.nominal);
+        print_quantiles("period", &f.period);
+        printf("  jitter std dev (ns): %.1f\n", f.jitter_sd);
+        if (protocol->cycles->sequence_bits) {
+            printf("  messages lost: %u\n", c->s->lost);
+            printf("  duplicates: %u\n", c->s->duplicates);
+        }
+    }
+    printf("===================================================================\n");
+}
+
+const char *cli_filter;
+
+dg_tap_init_result cycles_cli_init(const char *, void *)
+{
+    return dg_tap_init_done(listen_to_the_end(&cli_filter, cycles_draw));
+}
+
+/* The statistics tree (Wireshark's Statistics menu): the same figures, set
+ * once the capture's state is complete, which it is when a frame is tapped
+ * that the first pass has gone beyond (the GUI taps a capture once it is
+ * read, tshark -2 in its second pass). In one pass the tree stays empty;
+ * -z P,cycles is the way there. */
+gboolean st_filled;
+
+void st_init(stats_tree *) { st_filled = FALSE; }
+
+tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *, const void *, tap_flags_t)
+{
+    if (st_filled || !capture || pinfo->num >= capture->last_frame) return TAP_PACKET_DONT_REDRAW;
+    st_filled = TRUE;
+    for (const cycle *c = capture->first; c; c = c->next) {
+        figures f = figures_of(c);
+        char *text = stream_text(c->s);
+        char *name = g_strdup_printf("Cycle %u: %s", c->number, text);
+        int id = stats_tree_create_node(st, name, 0, STAT_DT_INT, TRUE);
+        set_stat_node(st, name, 0, FALSE, (gint)c->frames);
+        g_free(name);
+        g_free(text);
+        struct {
+            const char *what;
+            guint64 value;
+            gboolean shown;
+        } rows[] = {{"messages", c->frames, TRUE},
+                    {"nominal period (ns)", f.nominal, TRUE},
+                    {"period min (ns)", f.period.min, f.period.n > 0},
+                    {"period median (ns)", f.period.median, f.period.n > 0},
+                    {"period p99 (ns)", f.period.p99, f.period.n > 0},
+                    {"period max (ns)", f.period.max, f.period.n > 0},
+                    {"jitter std dev (ns)", (guint64)(f.jitter_sd + 0.5), TRUE},
+                    {"messages lost", c->s->lost, protocol->cycles->sequence_bits > 0},
+                    {"duplicates", c->s->duplicates, protocol->cycles->sequence_bits > 0}};
+        for (const auto &row : rows) {
+            if (!row.shown) continue;
+            char *label = g_strdup_printf("Cycle %u %s", c->number, row.what);
+            st_set(st, label, id, row.value);
+            g_free(label);
+        }
+    }
+    return TAP_PACKET_REDRAW;
+}
+
+} /* namespace */
+
+void dg_cycles_register(const dg_protocol *p)
+{
+    protocol = p;
+    cli_filter = p->filter;
+    /* Wireshark keeps pointers to these: static arrays, names that live until exit. */
+    static hf_register_info hf[] = {DG_CYCLES_FIELDS(DG_HF_ROW)};
+    static const char *const names[] = {DG_CYCLES_FIELDS(DG_FIELD_NAME)};
+    dg_name_fields(hf, names, G_N_ELEMENTS(hf), p->filter);
+    proto_register_field_array(*p->proto, hf, (int)G_N_ELEMENTS(hf));
+    static ei_register_info ei[] = {DG_CYCLES_EXPERTS(DG_EI_ROW)};
+    static const char *const ei_names[] = {DG_CYCLES_EXPERTS(DG_EXPERT_NAME)};
+    dg_name_experts(ei, ei_names, G_N_ELEMENTS(ei), p->filter);
+    expert_register_field_array(expert_register_protocol(*p->proto), ei, (int)G_N_ELEMENTS(ei));
+    register_init_routine(capture_init);
+    register_cleanup_routine(capture_cleanup);
+
+    static stat_tap_ui ui = {REGISTER_STAT_GROUP_GENERIC, NULL, NULL, cycles_cli_init, 0, NULL};
+    ui.cli_string = g_strdup_printf("%s,cycles", p->filter);
+    register_stat_tap_ui(&ui, NULL);
+    /* Statistics > "P cycles" in Wireshark (tshark -2 -z P.cycles,tree) */
+    stats_tree_register_plugin("frame", g_strdup_printf("%s.cycles", p->filter),
+                               g_strdup_printf("%s cycles", p->short_name), 0, st_packet, st_init, NULL);
+}
+
+void dg_cycles_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
+                       const dg_cycle_input *in, guint message)
+{
+    const mark *m;
+    if (!PINFO_FD_VISITED(pinfo)) {
+        m = in ? time_message(current_capture(), in, pinfo) : NULL;
+        if (m) p_add_proto_data(wmem_file_scope(), pinfo, *p->proto, mark_key | message, (void *)m);
+    } else {
+        m = (const mark *)p_get_proto_data(wmem_file_scope(), pinfo, *p->proto, mark_key | message);
+    }
+    if (m) show(m, tvb, pinfo, tree);
+}

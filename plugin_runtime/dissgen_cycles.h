@@ -1,0 +1,38 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* Periodic traffic declared by <cycles> in the rule file, for any protocol
+ * (docs/manual.md, "Cycles of any protocol"): the messages of one stream
+ * (the same values of the signature fields, and sender) are timed, and
+ * those that come at a regular period are a cycle, with its period and
+ * jitter; a sequence count adds the messages lost and repeated.
+ *
+ * Worked out once, on the first pass, from what the walk decoded (the
+ * leaves whose dg_extra.cycle_role is set), and kept per message in
+ * Wireshark's per-capture memory, so that later passes (tshark -2, the GUI
+ * in any order) show the same items. */
+#pragma once
+
+#include "dissgen_runtime.h"
+
+/* What the walk decoded of one message for <cycles> (first pass). */
+typedef struct dg_cycle_input {
+    const guint64 *values;     /* the signature fields' values, in decoding order */
+    const guint16 *nodes;      /* the node of each (dg_protocol.nodes), for the stream's name */
+    guint count;
+    guint64 sequence;
+    gboolean has_sequence;
+    guint32 only_held;         /* bit i: <only> test i held */
+    gboolean never;            /* a <never> test held */
+} dg_cycle_input;
+
+extern "C" {
+
+/* At registration: the fields, expert infos, -z P,cycles and the
+ * statistics tree, and the per-capture init/cleanup routines. */
+void dg_cycles_register(const dg_protocol *p);
+
+/* After a message was decoded: on the first pass (`in` given) times it in
+ * its stream; on every pass shows what was found in `tree` (the expert infos
+ * also without a tree). `message`: its number within the frame (0 first). */
+void dg_cycles_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
+                       const dg_cycle_input *in, guint message);
+}

@@ -1,0 +1,170 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* The arithmetic of periods that every cycle analysis shares: the rule
+ * files' cycles (dissgen_cycles.cpp) and EtherCAT's (ethercat_cycles.cpp).
+ * Periods are nanoseconds in 32 bits (up to 4.29 s: a longer one is no
+ * cycle's), kept in wmem_file_scope:
+ *
+ *   u32_vec          a growing array
+ *   running_median   the lower median of every period added so far, in
+ *                    O(log n) per period (two heaps)
+ *   quantiles_of()   minimum, median, 99th percentile and maximum
+ *   and what their reports share: -z P,cycles drawn at the end of the
+ *   capture (listen_to_the_end), its quantile lines, statistics tree rows
+ *
+ * C++ only, inside the runtime. */
+#pragma once
+
+#include <epan/stats_tree.h>
+#include <epan/tap.h>
+#include <epan/wmem_scopes.h>
+#include <glib.h>
+#include <wsutil/nstime.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+namespace dg_periods __attribute__((visibility("hidden"))) {
+
+/* A growing array of 32-bit values in wmem_file_scope. */
+struct u32_vec {
+    guint32 *v;
+    guint n, cap;
+    void push(guint32 x)
+    {
+        if (n == cap) {
+            cap = cap ? 2 * cap : 16;
+            v = (guint32 *)wmem_realloc(wmem_file_scope(), v, cap * sizeof(guint32));
+        }
+        v[n++] = x;
+    }
+};
+
+/* A binary heap over u32_vec: max-heap when `max`, else min-heap. */
+inline gboolean heap_before(guint32 a, guint32 b, gboolean max) { return max ? a > b : a < b; }
+
+inline void heap_push(u32_vec *h, guint32 x, gboolean max)
+{
+    h->push(x);
+    for (guint i = h->n - 1; i > 0;) {
+        guint p = (i - 1) / 2;
+        if (!heap_before(h->v[i], h->v[p], max)) break;
+        guint32 t = h->v[i];
+        h->v[i] = h->v[p];
+        h->v[p] = t;
+        i = p;
+    }
+}
+
+inline guint32 heap_pop(u32_vec *h, gboolean max)
+{
+    guint32 top = h->v[0];
+    h->v[0] = h->v[--h->n];
+    for (guint i = 0;;) {
+        guint l = 2 * i + 1, r = l + 1, best = i;
+        if (l < h->n && heap_before(h->v[l], h->v[best], max)) best = l;
+        if (r < h->n && heap_before(h->v[r], h->v[best], max)) best = r;
+        if (best == i) break;
+        guint32 t = h->v[i];
+        h->v[i] = h->v[best];
+        h->v[best] = t;
+        i = best;
+    }
+    return top;
+}
+
+/* Every period added, in two heaps: `low` (a max-heap) the lower half, one
+ * more when the count is odd, so that its top is the lower median. */
+struct running_median {
+    u32_vec low, high;
+    void add(guint32 p)
+    {
+        if (low.n == 0 || p <= low.v[0])
+            heap_push(&low, p, TRUE);
+        else
+            heap_push(&high, p, FALSE);
+        if (low.n > high.n + 1)
+            heap_push(&high, heap_pop(&low, TRUE), FALSE);
+        else if (high.n > low.n)
+            heap_push(&low, heap_pop(&high, FALSE), TRUE);
+    }
+    guint32 median() const { return low.n ? low.v[0] : 0; }
+    guint count() const { return low.n + high.n; }
+    /* Every period added, in no order, into `out` (count() of them). */
+    void copy_to(guint32 *out) const
+    {
+        if (low.n) memcpy(out, low.v, low.n * sizeof(guint32));
+        if (high.n) memcpy(out + low.n, high.v, high.n * sizeof(guint32));
+    }
+};
+
+inline int compare_u32(const void *a, const void *b)
+{
+    guint32 x = *(const guint32 *)a, y = *(const guint32 *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Minimum, lower median, nearest-rank 99th percentile and maximum. */
+struct quantiles {
+    guint n;
+    guint32 min, median, p99, max;
+};
+
+/* Sorts v (n values) and takes its quantiles. */
+inline quantiles quantiles_of(guint32 *v, guint n)
+{
+    quantiles q = {n, 0, 0, 0, 0};
+    if (!n) return q;
+    qsort(v, n, sizeof *v, compare_u32);
+    q.min = v[0];
+    q.median = v[(n - 1) / 2];
+    q.p99 = v[(99 * (guint64)n + 99) / 100 - 1];
+    q.max = v[n - 1];
+    return q;
+}
+
+/* A period in ns as the 32 bits kept: 0 when time went backwards,
+ * G_MAXUINT32 from 4.29 s up. */
+inline guint32 clamp_period(gint64 ns)
+{
+    return ns < 0 ? 0 : ns >= (gint64)G_MAXUINT32 ? G_MAXUINT32 : (guint32)ns;
+}
+
+inline gint64 ns_of(const nstime_t *t) { return (gint64)t->secs * 1000000000 + t->nsecs; }
+
+/* --- reports ------------------------------------------------------------ */
+
+inline void print_quantiles(const char *what, const quantiles *q)
+{
+    if (!q->n)
+        printf("  %s: none\n", what);
+    else
+        printf("  %s min/median/p99/max (ns): %u %u %u %u\n", what, q->min, q->median, q->p99, q->max);
+}
+
+/* A statistics tree row `name` under `parent` set to `value`. */
+inline void st_set(stats_tree *st, const char *name, int parent, guint64 value)
+{
+    stats_tree_create_node(st, name, parent, STAT_DT_INT, FALSE);
+    set_stat_node(st, name, parent, FALSE, (gint)MIN(value, (guint64)G_MAXINT));
+}
+
+inline tap_packet_status no_packet(void *, packet_info *, epan_dissect_t *, const void *, tap_flags_t)
+{
+    return TAP_PACKET_DONT_REDRAW;
+}
+
+/* -z FILTER,cycles: draw() runs once the capture is read, when the capture's
+ * state is complete. It listens to the frame tap (every frame) only for that;
+ * `filter` must outlive the listener. FALSE (and a message) when it cannot. */
+inline gboolean listen_to_the_end(const char *const *filter, tap_draw_cb draw)
+{
+    GString *error = register_tap_listener("frame", (void *)filter, NULL, TL_REQUIRES_NOTHING, NULL, no_packet,
+                                           draw, NULL);
+    if (!error) return TRUE;
+    fprintf(stderr, "%s,cycles: %s\n", *filter, error->str);
+    g_string_free(error, TRUE);
+    return FALSE;
+}
+
+} /* namespace dg_periods */
