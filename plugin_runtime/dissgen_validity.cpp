@@ -2,6 +2,9 @@
 /* valid="LIST" fields and <heuristic> registration: see dissgen_validity.h. */
 #include "dissgen_validity.h"
 
+#include <epan/conversation.h>
+#include <epan/dissectors/packet-tcp.h>
+
 #include <string.h>
 
 namespace {
@@ -44,6 +47,31 @@ int dissect_valid_message(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, v
     return call_data_dissector(tvb, pinfo, tree);
 }
 
+/* Per capture: a conversation (its conversation_t) -> the port its opener
+ * sent its first message to, for conversations a heuristic found messages in. */
+wmem_map_t *opened_to;
+
+/* The port of the service a heuristic found this message's conversation
+ * talking to, so that its messages get a direction as through a port hook (to
+ * that port a request, from it a response): over TCP the port the SYN went
+ * to; otherwise the port this protocol's first message of the conversation
+ * went to (its sender opened the conversation). 0 when it cannot tell. */
+guint32 service_port(packet_info *pinfo)
+{
+    if (pinfo->ptype != PT_TCP && pinfo->ptype != PT_UDP) return 0;
+    conversation_t *conv = find_or_create_conversation(pinfo);
+    if (pinfo->ptype == PT_TCP) {
+        struct tcp_analysis *tcpd = get_tcp_conversation_data(conv, pinfo);
+        if (tcpd && tcpd->server_port) return tcpd->server_port;
+    }
+    if (!opened_to) opened_to = wmem_map_new_autoreset(wmem_epan_scope(), wmem_file_scope(), g_direct_hash, g_direct_equal);
+    gpointer port = wmem_map_lookup(opened_to, conv);
+    if (port) return GPOINTER_TO_UINT(port);
+    if (PINFO_FD_VISITED(pinfo) || !pinfo->destport) return 0; /* the first pass saw no message of ours here */
+    wmem_map_insert(opened_to, conv, GUINT_TO_POINTER(pinfo->destport));
+    return pinfo->destport;
+}
+
 } /* namespace */
 
 extern "C" {
@@ -77,10 +105,14 @@ int dg_valid_dissect_stream(const dg_validity *v, tvbuff_t *tvb, packet_info *pi
 gboolean dg_valid_heuristic(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     if (!dg_valid_at(v, tvb, pinfo, 0, (gint)tvb_captured_length(tvb))) return FALSE;
+    /* As a port hook would: the message's direction comes from the service's port. */
+    const guint32 hooked = pinfo->match_uint, port = service_port(pinfo);
+    if (port) pinfo->match_uint = port;
     if (v->p->pdu_node >= 0 && pinfo->ptype == PT_TCP)
         dg_valid_dissect_stream(v, tvb, pinfo, tree);
     else
         dg_dissect(v->p, tvb, pinfo, tree);
+    pinfo->match_uint = hooked;
     return TRUE;
 }
 

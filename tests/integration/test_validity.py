@@ -16,7 +16,11 @@ pdulength on a tcp.port hook; <heuristic table="udp"/> and a disabled one on tcp
   heuristic-decodes` lists the protocol enabled on udp and disabled on tcp;
 - TCP on a port nobody registered: nothing until `--enable-heuristic mbl_tcp`, then
   every message;
-- a heuristic list this Wireshark does not have: a warning, and tshark goes on.
+- a heuristic list this Wireshark does not have: a warning, and tshark goes on;
+- a message a heuristic found has its conversation's direction: over TCP the SYN says
+  which port is the server's, otherwise the first message's receiver is; its request and
+  response layouts decode as through a port hook, in one pass and with -2 (on ports where
+  the lower one is the client's, so that no guess by port numbers could pass).
 
     test_validity.py --dissgen build/bin/dissgen --source-dir .
 """
@@ -98,6 +102,110 @@ def bad_header_connection(dport):
     send((message(12, 16, b"\x00\x01\x00\x01\x02\x00\x0a"), 12))
     send((message(13, 3, b"\x00\x01\x00\x02"), 13))
     return flow.frames, tids
+
+
+DIRECTED = """<root name="Directed" abbreviation="DIRH" filter="dirh"
+      pdulength="node[@name='Length']" pdulengthadd="6">
+  <heuristic table="udp"/>
+  <heuristic table="tcp"/>
+  <node name="Transaction" length="2byte" displaytype="numberdec"/>
+  <node name="Protocol" length="2byte" displaytype="numberdec" valid="0"/>
+  <node name="Length" length="2byte" displaytype="numberdec" valid="2-254"/>
+  <node name="Unit" length="1byte" displaytype="numberdec"/>
+  <node name="Function" length="1byte" displaytype="numberhex"/>
+  <node name="Read request" filter="request" direction="request">
+    <node name="Start" length="2byte" displaytype="numberdec"/>
+    <node name="Quantity" length="2byte" displaytype="numberdec"/>
+  </node>
+  <node name="Read response" filter="response" direction="response">
+    <node name="Byte count" filter="byte_count" length="1byte" displaytype="numberdec"/>
+    <node name="Values" length="rest" displaytype="origin"/>
+  </node>
+</root>
+"""
+SERVER_PORT, CLIENT_PORT = 41999, 1500   # the client's port is the lower one
+
+
+def tcp_segment(payload, sport, dport, seq, ack, flags, src, dst):
+    """One TCP segment (flags: 0x02 SYN, 0x12 SYN+ACK, 0x10 ACK, 0x18 PSH+ACK) in IPv4 in Ethernet."""
+    t = struct.pack("!HHIIBBHHH", sport, dport, seq, ack, 5 << 4, flags, 65535, 0, 0) + payload
+    ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(t), 0, 0x4000, 64, 6, 0, bytes(src), bytes(dst))
+    ip = ip[:10] + struct.pack("!H", pcapgen.ip_checksum(ip)) + ip[12:]
+    return b"\x02\0\0\0\0\x02\x02\0\0\0\0\x01\x08\x00" + ip + t
+
+
+def read_request(tid, start, quantity):
+    return message(tid, 3, struct.pack("!HH", start, quantity))
+
+
+def read_response(tid, values):
+    return message(tid, 3, bytes([2 * len(values)]) + b"".join(struct.pack("!H", v) for v in values))
+
+
+def directed_tcp(handshake):
+    """A client asking a server on SERVER_PORT three times, with or without the handshake:
+    the frames and, per frame with a message, 'request' or 'response'."""
+    client, server = (10, 0, 0, 1), (10, 0, 0, 2)
+    cseq, sseq, frames, kinds = 100, 700, [], []
+    if handshake:
+        frames += [tcp_segment(b"", CLIENT_PORT, SERVER_PORT, cseq, 0, 0x02, client, server),
+                   tcp_segment(b"", SERVER_PORT, CLIENT_PORT, sseq, cseq + 1, 0x12, server, client),
+                   tcp_segment(b"", CLIENT_PORT, SERVER_PORT, cseq + 1, sseq + 1, 0x10, client, server)]
+        kinds += [None, None, None]
+    cseq, sseq = cseq + 1, sseq + 1
+    for tid in range(1, 4):
+        q, r = read_request(tid, 100 * tid, tid), read_response(tid, list(range(tid)))
+        frames.append(tcp_segment(q, CLIENT_PORT, SERVER_PORT, cseq, sseq, 0x18, client, server))
+        cseq += len(q)
+        frames.append(tcp_segment(r, SERVER_PORT, CLIENT_PORT, sseq, cseq, 0x18, server, client))
+        sseq += len(r)
+        kinds += ["request", "response"]
+    return frames, kinds
+
+
+class HeuristicDirection(TsharkTestCase, unittest.TestCase):
+    """Messages found by a heuristic decode their request and response layouts."""
+
+    @classmethod
+    def prepare(cls):
+        cls.env.install_plugin(ARGS.dissgen, cls.env.add_file("dirh.xml", DIRECTED.encode()))
+        cls.env.assert_plugin_loaded("dirh")
+
+    def kinds(self, frames, name):
+        path = self.env.add_file(name, pcapgen.raw_pcap_bytes(frames))
+        fields = ["frame.number", "dirh.transaction", "dirh.request.start", "dirh.response.byte_count"]
+        out = []
+        for two_pass in (False, True):
+            rows = self.env.field_rows(path, fields, two_pass=two_pass)
+            out.append([None if not rows.get(n, {}).get("dirh.transaction") else
+                        "request" if rows[n]["dirh.request.start"] and not rows[n]["dirh.response.byte_count"] else
+                        "response" if rows[n]["dirh.response.byte_count"] and not rows[n]["dirh.request.start"] else
+                        "both or neither" for n in range(1, len(frames) + 1)])
+        return out
+
+    def test_tcp_the_syn_names_the_server(self):
+        frames, kinds = directed_tcp(handshake=True)
+        self.assertEqual(self.kinds(frames, "dirh_syn.pcap"), [kinds, kinds])
+
+    def test_tcp_without_handshake_the_first_receiver_is_the_server(self):
+        frames, kinds = directed_tcp(handshake=False)
+        self.assertEqual(self.kinds(frames, "dirh_nosyn.pcap"), [kinds, kinds])
+
+    def test_udp_the_first_receiver_is_the_server(self):
+        client, server = b"\x0a\0\0\x01", b"\x0a\0\0\x02"
+        frames, kinds = [], []
+        for tid in range(1, 4):
+            frames.append(udp_frame(read_request(tid, 7, 2), CLIENT_PORT, SERVER_PORT, client, server))
+            frames.append(udp_frame(read_response(tid, [5, 6]), SERVER_PORT, CLIENT_PORT, server, client))
+            kinds += ["request", "response"]
+        self.assertEqual(self.kinds(frames, "dirh_udp.pcap"), [kinds, kinds])
+
+
+def udp_frame(payload, sport, dport, src, dst):
+    u = struct.pack("!HHHH", sport, dport, 8 + len(payload), 0) + payload
+    ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src, dst)
+    ip = ip[:10] + struct.pack("!H", pcapgen.ip_checksum(ip)) + ip[12:]
+    return b"\x02\0\0\0\0\x02\x02\0\0\0\0\x01\x08\x00" + ip + u
 
 
 class Validity(TsharkTestCase, unittest.TestCase):
