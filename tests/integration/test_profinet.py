@@ -23,8 +23,9 @@ import sys
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cyclemodel  # noqa: E402
 import pngen  # noqa: E402
-from tshark_env import TsharkEnv, TsharkTestCase, run_unittests  # noqa: E402
+from tshark_env import TsharkEnv, TsharkTestCase, relative_time_ns, run_unittests  # noqa: E402
 
 # Wireshark's fields -> ours (each side a list: their values are pooled per frame).
 COUNTERPARTS = [
@@ -262,6 +263,64 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
         print("\nWireshark fields without a counterpart: " + ", ".join(sorted(shown - mapped)))
         self.assertEqual(unexplained, [])
 
+
+
+class CyclesOfCyclicData(TsharkTestCase, unittest.TestCase):
+    """<cycles> in rules/profinet.xml: each device's cyclic frame ID is a cycle once 8
+    regular periods came in a row, timed to the ns as the manual says (test_rule_cycles'
+    model); a DCP Hello sent just as regularly, and alarms, are no cycle."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install("rules/profinet.xml", "pnr")
+        rng = random.Random(8892)
+        packets = []
+        devices = [(0xC001, 1_000_000, 60), (0x8002, 2_000_000, 40), (0x0103, 4_000_000, 25)]
+        for n, (frame_id, period, count) in enumerate(devices):
+            mac = bytes([0x00, 0x0E, 0xCF, 0, 0, n + 1])
+            for i in range(count):
+                t = 10**9 + n * 137_000 + i * period + rng.randint(-period // 20, period // 20)
+                body = bytes(40) + struct.pack(">HBB", (i * 32) & 0xFFFF, 0x35, 0)
+                packets.append((t, bytes([0x01, 0x0E, 0xCF, 0, 0, 0]) + mac + struct.pack(">HH", 0x8892, frame_id) + body))
+        hello_mac = bytes([0x00, 0x0E, 0xCF, 0, 0, 9])
+        for i in range(30):  # a DCP Hello every 3 ms exactly
+            body = pngen.dcp(pngen.HELLO, pngen.REQUEST, [], 0x1000 + i)
+            packets.append((10**9 + i * 3_000_000, bytes([0x01, 0x0E, 0xCF, 0, 0, 1]) + hello_mac +
+                            struct.pack(">HH", 0x8892, 0xFEFC) + body))
+        packets.sort(key=lambda p: p[0])
+        cls.packets = [(t, f + bytes(max(0, 60 - len(f)))) for t, f in packets]
+        cls.capture = cls.env.add_file("cycles.pcap", cyclemodel.pcap_ns(cls.packets))
+
+    def test_each_devices_cyclic_frame_is_a_cycle(self):
+        messages = [(n, t, (struct.unpack(">H", f[14:16])[0], f[6:12]), None)
+                    for n, (t, f) in enumerate(self.packets, 1)
+                    if 0x0100 <= struct.unpack(">H", f[14:16])[0] <= 0x0FFF or
+                    0x8000 <= struct.unpack(">H", f[14:16])[0] <= 0xFBFF]
+        marks, cycles = cyclemodel.model(messages, window=8, bits=0)
+        with self.checks() as check:
+            check(len(cycles) == 3, "%d cycles, expected one per device (the Hello is none)" % len(cycles))
+            for two_pass in (False, True):
+                out = self.env.tshark(["-r", self.capture, "-q", "-z", "pnr,cycles"] + (["-2"] if two_pass else []))
+                got = cyclemodel.parse_report(out.stdout)
+                check(len(got) == len(cycles), "-z pnr,cycles lists %d cycles" % len(got))
+                for c, g in zip(cycles, got):
+                    frame_id, mac = c["stream"]["key"]
+                    name = "FrameID 0x%x, sender %s" % (frame_id, ":".join("%02x" % b for b in mac))
+                    check(g["name"] == name, "cycle %d is %r, expected %r" % (c["number"], g["name"], name))
+                    want = cyclemodel.figures(c)
+                    del want["lost"], want["duplicates"]  # no sequence count: not printed
+                    check(g["figures"] == want, "cycle %d: %s, expected %s" % (c["number"], g["figures"], want))
+                rows = self.env.field_rows(self.capture, ["frame.number", "pnr.cycle", "pnr.cycle.period",
+                                                          "pnr.cycle.jitter"], two_pass=two_pass)
+                for frame, row in sorted(rows.items()):
+                    got = {}
+                    if row["pnr.cycle"]:
+                        got = {"cycle": int(row["pnr.cycle"][0]),
+                               "period": relative_time_ns(row["pnr.cycle.period"][0])}
+                        if row["pnr.cycle.jitter"]:
+                            got["jitter"] = relative_time_ns(row["pnr.cycle.jitter"][0])
+                    check(got == marks.get(frame, {}), "frame %d %s: %s, expected %s"
+                          % (frame, "-2" if two_pass else "one pass", got, marks.get(frame, {})))
 
 if __name__ == "__main__":
     ARGS, status = run_unittests()

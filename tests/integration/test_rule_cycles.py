@@ -21,104 +21,19 @@ from the bytes and timestamps of the capture, to the nanosecond, in one pass and
 
 import os
 import random
-import re
 import struct
 import sys
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pcapgen import ip_checksum  # noqa: E402
+from cyclemodel import figures, model, parse_report, pcap_ns, read_pcap  # noqa: E402
 from tshark_env import TsharkTestCase, relative_time_ns, run_unittests  # noqa: E402
 
 ARGS = None
 IO_PORT = 2222
 FIELDS = ["frame.number", "enipr.cycle", "enipr.cycle.period", "enipr.cycle.jitter", "enipr.cycle.lost",
           "enipr.cycle.duplicate", "enipr.expert.cycle_lost", "enipr.expert.cycle_duplicate"]
-
-
-# --- the manual's rules, computed independently --------------------------------------
-
-def window_median(periods):
-    v = sorted(periods)
-    median = v[(len(v) - 1) // 2]
-    if median == 0 or median >= 0xFFFFFFFF or 2 * v[0] < median or 2 * v[-1] > 3 * median:
-        return 0
-    return median
-
-
-def clamp(ns):
-    return 0 if ns < 0 else min(ns, 0xFFFFFFFF)
-
-
-def model(messages, window, bits):
-    """messages: (frame, time ns, stream key, sequence count) in capture order.
-    Returns ({frame: mark}, [cycle]) as the manual describes them."""
-    mask = (1 << bits) - 1
-    streams, cycles, marks = {}, [], {}
-    for frame, ts, key, seq in messages:
-        s = streams.setdefault(key, {"key": key, "last_frame": 0, "last_ts": 0, "last_seq": None, "recent": [],
-                                     "cycle": None, "lost": 0, "duplicates": 0})
-        lost, back = 0, False
-        if seq is not None:
-            seq &= mask
-            if s["last_seq"] is not None:
-                step = (seq - s["last_seq"]) & mask
-                if step == 0:
-                    s["duplicates"] += 1
-                    marks[frame] = {"cycle": s["cycle"]["number"] if s["cycle"] else 0,
-                                    "duplicate": s["last_frame"]}
-                    continue
-                if step <= mask >> 1:
-                    lost = step - 1
-                else:
-                    back = True
-            s["last_seq"] = seq
-        s["lost"] += lost
-        first = s["last_frame"] == 0
-        period = 0 if first else ts - s["last_ts"]
-        s["last_frame"], s["last_ts"] = frame, ts
-        regular = not first and period > 0 and lost == 0 and not back
-        if not first and s["cycle"] is None:
-            if not regular:
-                s["recent"] = []
-            else:
-                s["recent"] = (s["recent"] + [clamp(period)])[-window:]
-                if len(s["recent"]) == window and window_median(s["recent"]):
-                    c = {"number": len(cycles) + 1, "stream": s, "first": frame, "frames": 0,
-                         "periods": s["recent"][:-1], "marked": [], "jitters": []}
-                    cycles.append(c)
-                    s["cycle"] = c
-        mark = {"lost": lost} if lost else {}
-        c = s["cycle"]
-        if c:
-            c["frames"] += 1
-            mark.update(cycle=c["number"], period=period)
-            if regular:
-                c["periods"].append(clamp(period))
-                c["marked"].append(clamp(period))
-                nominal = sorted(c["periods"])[(len(c["periods"]) - 1) // 2]
-                mark["jitter"] = period - nominal
-                c["jitters"].append(period - nominal)
-        if mark:
-            marks[frame] = mark
-    return marks, cycles
-
-
-def figures(c):
-    """What -z enipr,cycles prints for cycle c."""
-    v = sorted(c["marked"])
-    n = len(v)
-    quant = (v[0], v[(n - 1) // 2], v[(99 * n + 99) // 100 - 1], v[-1]) if n else None
-    total = squares = 0.0
-    for j in c["jitters"]:
-        total += float(j)
-        squares += float(j) * float(j)
-    mean = total / n if n else 0.0
-    var = squares / n - mean * mean if n else 0.0
-    return {"first frame": c["first"], "messages": c["frames"],
-            "nominal": sorted(c["periods"])[(len(c["periods"]) - 1) // 2],
-            "period": quant, "jitter sd": "%.1f" % (var ** 0.5 if var > 0 else 0.0),
-            "lost": c["stream"]["lost"], "duplicates": c["stream"]["duplicates"]}
 
 
 # --- captures: writing and reading ----------------------------------------------------
@@ -133,30 +48,6 @@ def udp_frame(payload, src_ip, dst_ip=(10, 0, 0, 100), sport=IO_PORT, dport=IO_P
     ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, bytes(src_ip), bytes(dst_ip))
     ip = ip[:10] + struct.pack("!H", ip_checksum(ip)) + ip[12:]
     return b"\x02\0\0\0\0\x64\x02\0\0\0\0" + bytes([src_ip[3]]) + b"\x08\x00" + ip + u
-
-
-def pcap_ns(packets):
-    """A nanosecond pcap of (time ns, Ethernet frame)."""
-    out = [struct.pack("<IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 1)]
-    for ts, data in packets:
-        out.append(struct.pack("<IIII", ts // 10**9, ts % 10**9, len(data), len(data)) + data)
-    return b"".join(out)
-
-
-def read_pcap(path):
-    """[(time ns, Ethernet frame)] of a classic pcap (microsecond or nanosecond)."""
-    with open(path, "rb") as fh:
-        blob = fh.read()
-    magic = struct.unpack("<I", blob[:4])[0]
-    order = "<" if magic in (0xA1B2C3D4, 0xA1B23C4D) else ">"
-    magic = struct.unpack(order + "I", blob[:4])[0]
-    scale = 1 if magic == 0xA1B23C4D else 1000
-    out, pos = [], 24
-    while pos + 16 <= len(blob):
-        sec, frac, caplen, _orig = struct.unpack(order + "IIII", blob[pos:pos + 16])
-        out.append((sec * 10**9 + frac * scale, blob[pos + 16:pos + 16 + caplen]))
-        pos += 16 + caplen
-    return out
 
 
 def io_messages(packets):
@@ -300,36 +191,6 @@ class TestRuleCycles(TsharkTestCase, unittest.TestCase):
             _marks, cycles = self.assert_marks(staged, messages, check)
             check(len(cycles) == 24, "%d cycles, expected one per connection (24)" % len(cycles))
             self.assert_report(staged, cycles, check)
-
-
-def parse_report(text):
-    """The cycles of -z enipr,cycles: [{"name", "figures"}]."""
-    cycles = []
-    for line in text.splitlines():
-        m = re.match(r"Cycle (\d+): (.*)$", line)
-        if m:
-            cycles.append({"name": m.group(2), "figures": {}})
-            continue
-        m = re.match(r"  ([a-z0-9 /()]+?): (.*)$", line)
-        if not m or not cycles:
-            continue
-        what, value = m.groups()
-        f = cycles[-1]["figures"]
-        if what == "first frame":
-            f["first frame"] = int(value)
-        elif what == "messages":
-            f["messages"] = int(value)
-        elif what == "nominal period (ns)":
-            f["nominal"] = int(value)
-        elif what.startswith("period"):
-            f["period"] = None if value == "none" else tuple(int(x) for x in value.split())
-        elif what == "jitter std dev (ns)":
-            f["jitter sd"] = value
-        elif what == "messages lost":
-            f["lost"] = int(value)
-        elif what == "duplicates":
-            f["duplicates"] = int(value)
-    return cycles
 
 
 if __name__ == "__main__":
