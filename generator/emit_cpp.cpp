@@ -732,7 +732,7 @@ void Emitter::cycles_tables() {
     auto add_tests = [&](const std::vector<CycleField>& fields, const char* element) {
         for (const CycleField& t : fields) {
             const size_t first = ranges.size();
-            if (t.in_list.empty()) ranges.push_back("{ 1, " + hex(UINT64_MAX) + " }");
+            if (t.in_list.empty()) ranges.push_back("{ " + hex(1) + ", " + hex(UINT64_MAX) + " }");
             for (const ValueRange& r : t.in_list) ranges.push_back("{ " + hex(r.low) + ", " + hex(r.high) + " }");
             tests.push_back("/* <" + std::string(element) + ">, line " + std::to_string(t.line) + " */ { " +
                             std::to_string(first) + ", " + std::to_string(ranges.size() - first) + " }");

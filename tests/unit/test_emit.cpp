@@ -33,6 +33,37 @@ TEST(Emit, NoPaddingOnlyWhenTheRootSaysSo) {
     EXPECT_FALSE(contains(emit_cpp(*zeros.proto, "rules.xml"), "no_padding"));  // the default emits nothing new
 }
 
+// <cycles>: each field's role (and its test) on the field, the tests' ranges
+// (no 'in': any value but 0), the window, the sequence count's width (the
+// field's when not given) and the sender; nothing of it without <cycles>.
+TEST(Emit, CyclesGiveEachFieldItsRoleAndTheTestsTheirRanges) {
+    const std::string nodes =
+        "  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+        "  <node name=\"Flags\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+        "  <node name=\"Stream\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+        "  <node name=\"Count\" length=\"2byte\" displaytype=\"numberdec\"/>\n</root>\n";
+    Front with = front_end(
+        "<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n"
+        "  <cycles window=\"5\" sender=\"yes\">\n"
+        "    <signature field=\"node[@name='Stream']\"/>\n"
+        "    <sequence field=\"node[@name='Count']\"/>\n"
+        "    <only field=\"node[@name='Kind']\" in=\"1,3-4\"/>\n"
+        "    <never field=\"node[@name='Flags']\"/>\n"
+        "  </cycles>\n" + nodes);
+    Front without = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n" + nodes);
+    ASSERT_TRUE(with.ok() && without.ok()) << with.messages() << without.messages();
+    const std::string code = emit_cpp(*with.proto, "rules.xml");
+    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 5, 16, 1, 1, t_cycle_tests, t_cycle_ranges };"))
+        << code;
+    EXPECT_TRUE(contains(code, "{ 0x1, 0x1 }") && contains(code, "{ 0x3, 0x4 }") &&
+                contains(code, "{ 0x1, 0xffffffffffffffff }"));
+    EXPECT_TRUE(contains(code, "/* <only>, line 5 */ { 0, 2 }") && contains(code, "/* <never>, line 6 */ { 2, 1 }"));
+    EXPECT_TRUE(contains(code, ".cycle_role(1, 0)") && contains(code, ".cycle_role(2, 0)") &&
+                contains(code, ".cycle_role(3, 0)") && contains(code, ".cycle_role(4, 1)"));
+    EXPECT_TRUE(contains(code, ".cycles(&t_cycles)"));
+    EXPECT_FALSE(contains(emit_cpp(*without.proto, "rules.xml"), "cycle"));  // costs nothing where absent
+}
+
 TEST(FieldType, EveryDisplayTypeOnWholeBytes) {
     Front f = front_end(rules("  <node name=\"mac\" length=\"6byte\" displaytype=\"address\"/>\n"
                               "  <node name=\"ip\" length=\"4byte\" displaytype=\"address\"/>\n"
