@@ -374,7 +374,9 @@ private:
     void range_strings(const Node& n);
     std::string rvals(const Node& n) const { return l_.ident.at(&n) + "_rvals"; }
     std::map<const Node*, int> extra_index_;
-    std::string hf(const Node& n) const { return "hf_" + l_.ident.at(&n); }
+    // alternatives sharing a filter name share the first one's field
+    std::string hf(const Node& n) const { return "hf_" + l_.ident.at(n.shares_field ? n.shares_field : &n); }
+    bool registers_hf(const Node& n) const { return has_hf(n) && !n.shares_field; }
     std::string ett(const Node& n) const { return "ett_" + l_.ident.at(&n); }
     std::string vals(const Node& n) const { return l_.ident.at(&n) + "_vals"; }
     bool has_hf(const Node& n) const { return !n.filter_name.empty(); }
@@ -427,7 +429,7 @@ void Emitter::header() {
 void Emitter::declarations() {
     o_ << "static int proto_" << p_.filter << " = -1;\n\n";
     for (const Node* n : l_.nodes)
-        if (has_hf(*n)) o_ << "static int " << hf(*n) << " = -1;\n";
+        if (registers_hf(*n)) o_ << "static int " << hf(*n) << " = -1;\n";
     o_ << "\nstatic gint ett_" << p_.filter << " = -1;\n";
     for (const Node* n : l_.nodes)
         if (n->is_container()) o_ << "static gint " << ett(*n) << " = -1;\n";
@@ -764,7 +766,7 @@ void Emitter::register_functions() {
     o_ << "void proto_register_" << f << "(void)\n{\n    static hf_register_info hf[] = {\n";
     bool first = true;
     for (const Node* n : l_.nodes) {
-        if (!has_hf(*n)) continue;
+        if (!registers_hf(*n)) continue;
         FieldType t = field_type(*n);
         std::string strings = "NULL";
         if (n->is_leaf() && n->display == Display::Enum)
@@ -985,7 +987,7 @@ std::string list_fields(const Protocol& proto) {
     std::ostringstream out;
     out << proto.filter << "\tFT_PROTOCOL\t" << proto.name << "\t" << kRulesSource << "\n";
     for_each_node(proto.nodes, [&](const Node& n) {
-        if (n.filter_name.empty()) return;
+        if (n.filter_name.empty() || n.shares_field) return;  // a shared field is listed once
         out << n.filter_name << "\t" << field_type(n).type << "\t" << n.name << "\t" << kRulesSource << "\n";
     });
     for_each_node(proto.nodes, [&](const Node& n) {  // <finding>s: expert infos, named by their text

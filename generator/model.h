@@ -132,6 +132,9 @@ struct Node {
     ByteOrder byteorder = ByteOrder::Big;  // effective
     std::string segment;                   // this node's filter-name segment
     std::string filter_name;               // full display-filter name ("" if none)
+    // an alternative of an earlier node with the same filter name and field
+    // type: registered once, as that node's field (nullptr: its own field)
+    const Node* shares_field = nullptr;
     // bit group membership: a group is a run of sibling leaves read as one
     // integer of group_bytes bytes; shift/bits place this leaf inside it.
     bool in_bit_group = false;

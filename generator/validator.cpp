@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "validator.h"
 
+#include "alternatives.h"
 #include "analysis_inputs.h"
 #include "expression.h"
 #include "findings.h"
@@ -87,6 +88,7 @@ private:
                    const Node*& blocker) const;
     void parse_summary(Node& n);
     void assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, const std::string& prefix);
+    void share_filter_name(Node& n, const Node& owner);
     void mark_slot(Node* n) { if (n) needs_slot_[n] = true; }
     void assign_slots();
     void check_table_sizes();
@@ -110,6 +112,7 @@ private:
     Diagnostics& diags_;
     std::map<const Node*, bool> needs_slot_;
     std::map<std::string, const Node*> filter_owner_;
+    std::map<std::string, std::vector<const Node*>> filter_sharers_;  // every node of a shared filter name
     std::vector<const NameGroup*> runtime_names_;  // the names the runtime registers for this protocol
 };
 
@@ -640,12 +643,37 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
         if (!own.empty()) {
             check_runtime_name(n);
             auto [it, inserted] = filter_owner_.emplace(own, &n);
-            if (!inserted)
-                diags_.error(n.line, "duplicate filter name '" + own + "' (also used by " + quote(*it->second) +
-                                         at_line(*it->second) + "); give one of them a 'filter' attribute");
+            if (!inserted) share_filter_name(n, *it->second);
         }
         assign_filter_names(n.children, own.empty() ? prefix : own);
     }
+}
+
+// A filter name already taken by `owner`: one field for both when they are
+// alternatives (at most one is decoded) of the same Wireshark type, as
+// Wireshark's pn_dcp.option is filled by every option's layout; otherwise an error.
+void Validator::share_filter_name(Node& n, const Node& owner) {
+    const std::string& name = n.filter_name;
+    std::vector<const Node*>& holders = filter_sharers_[name];
+    if (holders.empty()) holders.push_back(&owner);
+    for (const Node* other : holders)
+        if (!are_alternatives(proto_, *other, n)) {
+            diags_.error(n.line, "duplicate filter name '" + name + "' (also used by " + quote(*other) +
+                                     at_line(*other) + "); give one of them a 'filter' attribute");
+            return;
+        }
+    std::string mismatch = shared_field_mismatch(owner, n);
+    if (!mismatch.empty()) {
+        diags_.error(n.line, "alternatives " + quote(owner) + at_line(owner) + " and " + quote(n) + at_line(n) +
+                                 " share the filter name '" + name + "' but not its field type (" + mismatch +
+                                 "); give one of them a 'filter' attribute");
+        return;
+    }
+    n.shares_field = &owner;
+    holders.push_back(&n);
+    if (n.name != owner.name)
+        diags_.warning(n.line, quote(n) + " shares the filter name '" + name + "' with " + quote(owner) +
+                                   at_line(owner) + " and is shown with its name " + quote(owner));
 }
 
 // <pairing> key fields are numeric leaves, each named once.

@@ -81,6 +81,7 @@ TESTS_BY_FILE = {
     "plugin_runtime/ethercat/ethercat_cycles.cpp": ["cycles", "report"],
     "plugin_runtime/ethercat/": ["bus_pdo", "bus_tables", "bus_wkc"],
     "generator/validator.cpp": ["rules_err", "unit", "widths", "everything"],
+    "generator/alternatives.cpp": ["rules_err", "unit"],
     "generator/quiet.cpp": ["unit", "quiet"],
     "generator/expression.cpp": ["unit", "rules_err", "computed"],
     "generator/emit_cpp.cpp": ["field_types", "widths", "everything", "typed_values", "computed", "layout"],
