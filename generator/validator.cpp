@@ -25,7 +25,8 @@ std::string at_line(const Node& n) { return " (line " + std::to_string(n.line) +
 // Displays that show whole bytes and never join a bit group.
 bool is_byte_display(Display d) {
     return d == Display::Origin || d == Display::Address || d == Display::String || d == Display::StringZ ||
-           d == Display::IPv4 || d == Display::Float || d == Display::Time;
+           d == Display::IPv4 || d == Display::Float || d == Display::Time || d == Display::DateTime ||
+           d == Display::Guid;
 }
 
 bool is_ancestor_or_self(const Node* ancestor, const Node* n) {
@@ -96,6 +97,7 @@ private:
     void check_display_direction_handoff(Node& n);
     void check_unit(const Node& n);
     void check_string_display(Node& n);
+    void check_datetime_length(const Node& n);
     void check_enum_ranges(const Node& n);
     void check_handoff(const Node& n);
     void check_reassembly(Node& n);
@@ -1011,16 +1013,23 @@ void Validator::check_request_keys() {
 
 // --- display types, range enums, repeat="rest", direction, hand-off, reassembly ---
 
-// unit="...": a time's unit (ns, us, ms, s), or the label a number is shown
-// with ("°C", "rpm"): numbers in decimal (numberdec, int) or float.
+// unit="...": a time's unit (ns, us, ms, s), a datetime's encoding (s+ns or a
+// count of ns, us, ms or s since 1970), or the label a number is shown with
+// ("°C", "rpm"): numbers in decimal (numberdec, int) or float.
 void Validator::check_unit(const Node& n) {
     if (n.display == Display::Time) {
         if (n.unit != "ns" && n.unit != "us" && n.unit != "ms" && n.unit != "s")
             diags_.error(n.line, "bad unit '" + n.unit + "': expected 'ns', 'us', 'ms' or 's'");
         return;
     }
+    if (n.display == Display::DateTime) {
+        if (n.unit != "s+ns" && n.unit != "ns" && n.unit != "us" && n.unit != "ms" && n.unit != "s")
+            diags_.error(n.line, "bad unit '" + n.unit + "' for a datetime: expected 's+ns' (seconds and nanoseconds, "
+                                 "the default), or a count since 1970 of 'ns', 'us', 'ms' or 's'");
+        return;
+    }
     if (n.is_container() || (n.display != Display::NumberDec && n.display != Display::Int && n.display != Display::Float)) {
-        diags_.error(n.line, "'unit' applies to time leaves and to numbers shown as numberdec, int or float; " +
+        diags_.error(n.line, "'unit' applies to time and datetime leaves and to numbers shown as numberdec, int or float; " +
                                  quote(n) + " is shown as " + display_name(n.display));
         return;
     }
@@ -1080,8 +1089,24 @@ void Validator::check_string_display(Node& n) {
                 diags_.error(n.line, "time display needs 1 to 8 whole bytes; " + quote(n) + " is " +
                                          std::to_string(n.fixed_bits) + " bits");
             break;
+        case Display::DateTime: check_datetime_length(n); break;
+        case Display::Guid:
+            if (!n.has_fixed_length() || n.fixed_bits != 128)
+                diags_.error(n.line, "guid display needs a length of 16byte; " + quote(n) + " has another length");
+            break;
         default: break;
     }
+}
+
+// The lengths Wireshark reads an absolute time of each encoding from: 8
+// bytes, or 4 for seconds (a 32-bit count, as time_t was).
+void Validator::check_datetime_length(const Node& n) {
+    const std::string unit = n.datetime_unit();
+    const bool seconds = unit == "s";
+    if (unit != "s+ns" && unit != "ns" && unit != "us" && unit != "ms" && !seconds) return;  // check_unit
+    if (n.has_fixed_length() && (n.fixed_bits == 64 || (seconds && n.fixed_bits == 32))) return;
+    diags_.error(n.line, "datetime display with unit '" + unit + "' needs a length of " +
+                             (seconds ? "4byte or 8byte" : "8byte") + "; " + quote(n) + " has another length");
 }
 
 // Range items become a range_string: at most 32 bits, no two items overlapping.

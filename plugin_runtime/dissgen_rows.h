@@ -92,6 +92,7 @@ struct dg_extra_row {
         e.finding_first = first; e.finding_count = count; return *this;
     }
     constexpr dg_extra_row &input(gint8 number) { e.input = number; return *this; }
+    constexpr dg_extra_row &time_encoding(guint32 v) { e.time_encoding = v; return *this; }
 };
 
 /* UTF-8 strings, times in nanoseconds, no reassembly. */
