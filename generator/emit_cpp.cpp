@@ -276,6 +276,8 @@ const char* show_of(const Node& n) {
         case Display::Int: return "DG_SHOW_INT";
         case Display::Float: return "DG_SHOW_FLOAT";
         case Display::Time: return "DG_SHOW_TIME";
+        case Display::DateTime: return "DG_SHOW_DATETIME";
+        case Display::Guid: return "DG_SHOW_GUID";
     }
     return "DG_SHOW_HIDDEN";
 }
@@ -377,7 +379,9 @@ private:
     void range_strings(const Node& n);
     std::string rvals(const Node& n) const { return l_.ident.at(&n) + "_rvals"; }
     std::map<const Node*, int> extra_index_;
-    std::string hf(const Node& n) const { return "hf_" + l_.ident.at(&n); }
+    // alternatives sharing a filter name share the first one's field
+    std::string hf(const Node& n) const { return "hf_" + l_.ident.at(n.shares_field ? n.shares_field : &n); }
+    bool registers_hf(const Node& n) const { return has_hf(n) && !n.shares_field; }
     std::string ett(const Node& n) const { return "ett_" + l_.ident.at(&n); }
     std::string vals(const Node& n) const { return l_.ident.at(&n) + "_vals"; }
     bool has_hf(const Node& n) const { return !n.filter_name.empty(); }
@@ -430,7 +434,7 @@ void Emitter::header() {
 void Emitter::declarations() {
     o_ << "static int proto_" << p_.filter << " = -1;\n\n";
     for (const Node* n : l_.nodes)
-        if (has_hf(*n)) o_ << "static int " << hf(*n) << " = -1;\n";
+        if (registers_hf(*n)) o_ << "static int " << hf(*n) << " = -1;\n";
     o_ << "\nstatic gint ett_" << p_.filter << " = -1;\n";
     for (const Node* n : l_.nodes)
         if (n->is_container()) o_ << "static gint " << ett(*n) << " = -1;\n";
@@ -798,7 +802,7 @@ void Emitter::register_functions() {
     o_ << "void proto_register_" << f << "(void)\n{\n    static hf_register_info hf[] = {\n";
     bool first = true;
     for (const Node* n : l_.nodes) {
-        if (!has_hf(*n)) continue;
+        if (!registers_hf(*n)) continue;
         FieldType t = field_type(*n);
         std::string strings = "NULL";
         if (n->is_leaf() && n->display == Display::Enum)
@@ -901,9 +905,20 @@ void Emitter::range_strings(const Node& n) {
     o_ << "    { 0, 0, NULL }\n};\n\n";
 }
 
+// A datetime's ENC_TIME_* encoding (s+ns, ENC_TIME_SECS_NSECS, is the runtime's default).
+std::string datetime_encoding(const Node& n) {
+    const std::string unit = n.datetime_unit();
+    if (unit == "ns") return "ENC_TIME_NSECS";
+    if (unit == "us") return "ENC_TIME_USECS";
+    if (unit == "ms") return "ENC_TIME_MSECS";
+    if (unit == "s") return "ENC_TIME_SECS";
+    return "ENC_TIME_SECS_NSECS";
+}
+
 bool needs_extra(const Node& n) {
     return (n.is_leaf() && (n.display == Display::String || n.display == Display::StringZ ||
                             n.display == Display::Time)) ||
+           (n.is_leaf() && n.display == Display::DateTime && n.datetime_unit() != "s+ns") ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
            n.keeps_values || n.keeps_instances || n.is_computed() || n.has_unit_label() || n.is_overlay() ||
            !n.findings.empty() || n.analysis_input >= 0 || n.cycle_role != 0;
@@ -928,6 +943,7 @@ std::string Emitter::extra_row(const Node& n) const {
     if (n.encoding == "ascii") add("encoding", "ENC_ASCII");
     if (n.display == Display::Time && (n.unit == "s" || n.unit == "ms" || n.unit == "us"))
         add("units_per_second", n.unit == "s" ? "1" : n.unit == "ms" ? "1000" : "1000000");
+    if (n.display == Display::DateTime && n.datetime_unit() != "s+ns") add("time_encoding", datetime_encoding(n));
     if (n.repeat_rest) add("repeat_rest", "");
     if (n.direction != Direction::Any)
         add("direction", n.direction == Direction::Request ? "DG_DIR_REQUEST" : "DG_DIR_RESPONSE");
@@ -963,7 +979,7 @@ std::vector<FragmentField> fragment_fields(const Protocol& proto) {
     return out;
 }
 
-// The Wireshark type of string, stringz, ipv4, int, float and time leaves.
+// The Wireshark type of string, stringz, ipv4, int, float, time, datetime and guid leaves.
 std::optional<FieldType> typed_field_type(const Node& n) {
     unsigned bytes = value_bytes(n);
     switch (n.display) {
@@ -972,6 +988,8 @@ std::optional<FieldType> typed_field_type(const Node& n) {
         case Display::IPv4: return FieldType{"FT_IPv4", "BASE_NONE", 0};
         case Display::Float: return FieldType{n.fixed_bits == 64 ? "FT_DOUBLE" : "FT_FLOAT", "BASE_NONE", 0};
         case Display::Time: return FieldType{"FT_RELATIVE_TIME", "BASE_NONE", 0};
+        case Display::DateTime: return FieldType{"FT_ABSOLUTE_TIME", "ABSOLUTE_TIME_UTC", 0};
+        case Display::Guid: return FieldType{"FT_GUID", "BASE_NONE", 0};
         case Display::Int: {
             return FieldType{"FT_INT" + std::to_string(bytes * 8), "BASE_DEC", group_mask(n)};
         }
@@ -1020,7 +1038,7 @@ std::string list_fields(const Protocol& proto) {
     std::ostringstream out;
     out << proto.filter << "\tFT_PROTOCOL\t" << proto.name << "\t" << kRulesSource << "\n";
     for_each_node(proto.nodes, [&](const Node& n) {
-        if (n.filter_name.empty()) return;
+        if (n.filter_name.empty() || n.shares_field) return;  // a shared field is listed once
         out << n.filter_name << "\t" << field_type(n).type << "\t" << n.name << "\t" << kRulesSource << "\n";
     });
     for_each_node(proto.nodes, [&](const Node& n) {  // <finding>s: expert infos, named by their text

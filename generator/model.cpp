@@ -18,6 +18,8 @@ const char* display_name(Display d) {
         case Display::Int: return "int";
         case Display::Float: return "float";
         case Display::Time: return "time";
+        case Display::DateTime: return "datetime";
+        case Display::Guid: return "guid";
     }
     return "?";
 }

@@ -19,7 +19,9 @@ enum class ByteOrder { Big, Little };
 enum class Display {
     Address, NumberHex, NumberDec, Bool, Origin, Enum, NonDisplay,
     // values shown as text, addresses, signed and floating-point numbers, times
-    String, StringZ, IPv4, Int, Float, Time
+    String, StringZ, IPv4, Int, Float, Time,
+    // absolute dates and times (Wireshark's FT_ABSOLUTE_TIME), GUIDs (FT_GUID)
+    DateTime, Guid
 };
 
 // direction="request|response" (Any: no such attribute)
@@ -132,6 +134,9 @@ struct Node {
     ByteOrder byteorder = ByteOrder::Big;  // effective
     std::string segment;                   // this node's filter-name segment
     std::string filter_name;               // full display-filter name ("" if none)
+    // an alternative of an earlier node with the same filter name and field
+    // type: registered once, as that node's field (nullptr: its own field)
+    const Node* shares_field = nullptr;
     // bit group membership: a group is a run of sibling leaves read as one
     // integer of group_bytes bytes; shift/bits place this leaf inside it.
     bool in_bit_group = false;
@@ -146,10 +151,12 @@ struct Node {
     // --- display attributes, repeat="rest", direction, hand-off, reassembly ---
     std::string encoding = "utf-8";        // string, stringz: "ascii" or "utf-8"
     bool encoding_given = false;
-    std::string unit = "ns";               // time: "ns", "us", "ms" or "s"
+    std::string unit = "ns";               // time: "ns", "us", "ms" or "s"; datetime: also "s+ns"
     bool unit_given = false;
-    // unit="°C" on a number: the label its item is shown with (not a time's unit)
-    bool has_unit_label() const { return unit_given && display != Display::Time; }
+    // unit="°C" on a number: the label its item is shown with (not a time's or datetime's unit)
+    bool has_unit_label() const { return unit_given && display != Display::Time && display != Display::DateTime; }
+    // a datetime's encoding: its unit, or seconds and nanoseconds as two 32-bit values by default
+    std::string datetime_unit() const { return unit_given ? unit : "s+ns"; }
     bool repeat_rest = false;              // repeat="rest": until the enclosing container ends
     Direction direction = Direction::Any;  // direction="request|response"
     std::optional<std::string> dissector;  // dissector="NAME": hand the bytes to that dissector

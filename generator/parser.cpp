@@ -64,7 +64,9 @@ const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberd
                                                 "origin",  "enum",      "nondisplay",
                                                 // typed values shown as text
                                                 "string",  "stringz",   "ipv4",      "int",
-                                                "float",   "time"};
+                                                "float",   "time",
+                                                // absolute dates and times, GUIDs
+                                                "datetime", "guid"};
 
 int line_of(const xmlNode* el) {
     if (el->type == XML_ELEMENT_NODE && el->line == 65535 && el->psvi)  // set by use_start_lines
@@ -820,7 +822,8 @@ void Parser::parse_display(const std::string& text, int line, Node& node) {
                                       Display::Bool,    Display::Origin,    Display::Enum,
                                       Display::NonDisplay,
                                       Display::String,  Display::StringZ,   Display::IPv4,
-                                      Display::Int,     Display::Float,     Display::Time};
+                                      Display::Int,     Display::Float,     Display::Time,
+                                      Display::DateTime, Display::Guid};
     for (size_t i = 0; i < kDisplayNames.size(); ++i) {
         if (text == kDisplayNames[i]) {
             node.display = kValues[i];

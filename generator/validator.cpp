@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "validator.h"
 
+#include "alternatives.h"
 #include "analysis_inputs.h"
 #include "expression.h"
 #include "findings.h"
@@ -24,7 +25,8 @@ std::string at_line(const Node& n) { return " (line " + std::to_string(n.line) +
 // Displays that show whole bytes and never join a bit group.
 bool is_byte_display(Display d) {
     return d == Display::Origin || d == Display::Address || d == Display::String || d == Display::StringZ ||
-           d == Display::IPv4 || d == Display::Float || d == Display::Time;
+           d == Display::IPv4 || d == Display::Float || d == Display::Time || d == Display::DateTime ||
+           d == Display::Guid;
 }
 
 bool is_ancestor_or_self(const Node* ancestor, const Node* n) {
@@ -90,6 +92,7 @@ private:
                    const Node*& blocker) const;
     void parse_summary(Node& n);
     void assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, const std::string& prefix);
+    void share_filter_name(Node& n, const Node& owner);
     void mark_slot(Node* n) { if (n) needs_slot_[n] = true; }
     void assign_slots();
     void check_table_sizes();
@@ -97,6 +100,7 @@ private:
     void check_display_direction_handoff(Node& n);
     void check_unit(const Node& n);
     void check_string_display(Node& n);
+    void check_datetime_length(const Node& n);
     void check_enum_ranges(const Node& n);
     void check_handoff(const Node& n);
     void check_reassembly(Node& n);
@@ -113,6 +117,7 @@ private:
     Diagnostics& diags_;
     std::map<const Node*, bool> needs_slot_;
     std::map<std::string, const Node*> filter_owner_;
+    std::map<std::string, std::vector<const Node*>> filter_sharers_;  // every node of a shared filter name
     std::vector<const NameGroup*> runtime_names_;  // the names the runtime registers for this protocol
 };
 
@@ -644,12 +649,37 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
         if (!own.empty()) {
             check_runtime_name(n);
             auto [it, inserted] = filter_owner_.emplace(own, &n);
-            if (!inserted)
-                diags_.error(n.line, "duplicate filter name '" + own + "' (also used by " + quote(*it->second) +
-                                         at_line(*it->second) + "); give one of them a 'filter' attribute");
+            if (!inserted) share_filter_name(n, *it->second);
         }
         assign_filter_names(n.children, own.empty() ? prefix : own);
     }
+}
+
+// A filter name already taken by `owner`: one field for both when they are
+// alternatives (at most one is decoded) of the same Wireshark type, as
+// Wireshark's pn_dcp.option is filled by every option's layout; otherwise an error.
+void Validator::share_filter_name(Node& n, const Node& owner) {
+    const std::string& name = n.filter_name;
+    std::vector<const Node*>& holders = filter_sharers_[name];
+    if (holders.empty()) holders.push_back(&owner);
+    for (const Node* other : holders)
+        if (!are_alternatives(proto_, *other, n)) {
+            diags_.error(n.line, "duplicate filter name '" + name + "' (also used by " + quote(*other) +
+                                     at_line(*other) + "); give one of them a 'filter' attribute");
+            return;
+        }
+    std::string mismatch = shared_field_mismatch(owner, n);
+    if (!mismatch.empty()) {
+        diags_.error(n.line, "alternatives " + quote(owner) + at_line(owner) + " and " + quote(n) + at_line(n) +
+                                 " share the filter name '" + name + "' but not its field type (" + mismatch +
+                                 "); give one of them a 'filter' attribute");
+        return;
+    }
+    n.shares_field = &owner;
+    holders.push_back(&n);
+    if (n.name != owner.name)
+        diags_.warning(n.line, quote(n) + " shares the filter name '" + name + "' with " + quote(owner) +
+                                   at_line(owner) + " and is shown with its name " + quote(owner));
 }
 
 // <pairing> key fields are numeric leaves, each named once.
@@ -1032,16 +1062,23 @@ void Validator::check_request_keys() {
 
 // --- display types, range enums, repeat="rest", direction, hand-off, reassembly ---
 
-// unit="...": a time's unit (ns, us, ms, s), or the label a number is shown
-// with ("°C", "rpm"): numbers in decimal (numberdec, int) or float.
+// unit="...": a time's unit (ns, us, ms, s), a datetime's encoding (s+ns or a
+// count of ns, us, ms or s since 1970), or the label a number is shown with
+// ("°C", "rpm"): numbers in decimal (numberdec, int) or float.
 void Validator::check_unit(const Node& n) {
     if (n.display == Display::Time) {
         if (n.unit != "ns" && n.unit != "us" && n.unit != "ms" && n.unit != "s")
             diags_.error(n.line, "bad unit '" + n.unit + "': expected 'ns', 'us', 'ms' or 's'");
         return;
     }
+    if (n.display == Display::DateTime) {
+        if (n.unit != "s+ns" && n.unit != "ns" && n.unit != "us" && n.unit != "ms" && n.unit != "s")
+            diags_.error(n.line, "bad unit '" + n.unit + "' for a datetime: expected 's+ns' (seconds and nanoseconds, "
+                                 "the default), or a count since 1970 of 'ns', 'us', 'ms' or 's'");
+        return;
+    }
     if (n.is_container() || (n.display != Display::NumberDec && n.display != Display::Int && n.display != Display::Float)) {
-        diags_.error(n.line, "'unit' applies to time leaves and to numbers shown as numberdec, int or float; " +
+        diags_.error(n.line, "'unit' applies to time and datetime leaves and to numbers shown as numberdec, int or float; " +
                                  quote(n) + " is shown as " + display_name(n.display));
         return;
     }
@@ -1101,8 +1138,24 @@ void Validator::check_string_display(Node& n) {
                 diags_.error(n.line, "time display needs 1 to 8 whole bytes; " + quote(n) + " is " +
                                          std::to_string(n.fixed_bits) + " bits");
             break;
+        case Display::DateTime: check_datetime_length(n); break;
+        case Display::Guid:
+            if (!n.has_fixed_length() || n.fixed_bits != 128)
+                diags_.error(n.line, "guid display needs a length of 16byte; " + quote(n) + " has another length");
+            break;
         default: break;
     }
+}
+
+// The lengths Wireshark reads an absolute time of each encoding from: 8
+// bytes, or 4 for seconds (a 32-bit count, as time_t was).
+void Validator::check_datetime_length(const Node& n) {
+    const std::string unit = n.datetime_unit();
+    const bool seconds = unit == "s";
+    if (unit != "s+ns" && unit != "ns" && unit != "us" && unit != "ms" && !seconds) return;  // check_unit
+    if (n.has_fixed_length() && (n.fixed_bits == 64 || (seconds && n.fixed_bits == 32))) return;
+    diags_.error(n.line, "datetime display with unit '" + unit + "' needs a length of " +
+                             (seconds ? "4byte or 8byte" : "8byte") + "; " + quote(n) + " has another length");
 }
 
 // Range items become a range_string: at most 32 bits, no two items overlapping.

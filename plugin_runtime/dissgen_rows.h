@@ -93,6 +93,7 @@ struct dg_extra_row {
     }
     constexpr dg_extra_row &input(gint8 number) { e.input = number; return *this; }
     constexpr dg_extra_row &cycle_role(guint8 role, guint8 test) { e.cycle_role = role; e.cycle_test = test; return *this; }
+    constexpr dg_extra_row &time_encoding(guint32 v) { e.time_encoding = v; return *this; }
 };
 
 /* UTF-8 strings, times in nanoseconds, no reassembly. */

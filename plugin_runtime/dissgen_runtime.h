@@ -26,7 +26,8 @@ enum dg_length_kind {
 enum dg_show {
     DG_SHOW_HEX = 0, DG_SHOW_DEC, DG_SHOW_BOOL, DG_SHOW_ENUM, DG_SHOW_ADDRESS, DG_SHOW_BYTES, DG_SHOW_HIDDEN,
     /* values shown as text, addresses, signed and floating-point numbers, times */
-    DG_SHOW_STRING, DG_SHOW_STRINGZ, DG_SHOW_IPV4, DG_SHOW_INT, DG_SHOW_FLOAT, DG_SHOW_TIME
+    DG_SHOW_STRING, DG_SHOW_STRINGZ, DG_SHOW_IPV4, DG_SHOW_INT, DG_SHOW_FLOAT, DG_SHOW_TIME,
+    DG_SHOW_DATETIME, DG_SHOW_GUID
 };
 enum dg_flags {
     DG_LITTLE = 1 << 0,      /* little-endian value */
@@ -110,6 +111,8 @@ typedef struct dg_extra {
      * and for DG_CYCLE_ONLY / DG_CYCLE_NEVER its test (dg_cycles.tests); 0: none */
     guint8 cycle_role = 0;
     guint8 cycle_test = 0;
+    /* datetime: its ENC_TIME_* encoding (ENC_TIME_SECS_NSECS, 0, when the node has no dg_extra) */
+    guint32 time_encoding = ENC_TIME_SECS_NSECS;
 } dg_extra;
 
 /* A <finding>: the expert info `ei` is raised on the node's bytes when the

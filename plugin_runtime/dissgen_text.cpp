@@ -10,6 +10,8 @@
  */
 #include "dissgen_state.h"
 
+#include <epan/to_str.h>
+
 #include <float.h>
 #include <string.h>
 
@@ -39,8 +41,29 @@ namespace {
 
 /* --- shown values -------------------------------------------------------- */
 
-/* The values of string, stringz, ipv4, int, float and time leaves,
- * for summaries and the Info column (as the tree item shows them). */
+/* A datetime's bytes as Wireshark reads them for its item (the ENC_TIME_*
+ * encodings the generator gives: seconds and nanoseconds, or a count of
+ * ns, us, ms or s since 1970). */
+nstime_t datetime_at(const dg_state *st, const dg_node *n, gint offset, gint length)
+{
+    guint encoding = encoding_of(n);
+    guint64 count = read_uint(st->tvb, offset, (guint)length, encoding);
+    nstime_t t;
+    switch (n->extra ? n->extra->time_encoding : ENC_TIME_SECS_NSECS) {
+    case ENC_TIME_NSECS: t.secs = (time_t)(count / 1000000000); t.nsecs = (int)(count % 1000000000); break;
+    case ENC_TIME_USECS: t.secs = (time_t)(count / 1000000); t.nsecs = (int)(count % 1000000) * 1000; break;
+    case ENC_TIME_MSECS: t.secs = (time_t)(count / 1000); t.nsecs = (int)(count % 1000) * 1000000; break;
+    case ENC_TIME_SECS: t.secs = (time_t)count; t.nsecs = 0; break;
+    default: /* two 32-bit values */
+        t.secs = (time_t)read_uint(st->tvb, offset, 4, encoding);
+        t.nsecs = (int)read_uint(st->tvb, offset + 4, 4, encoding);
+        break;
+    }
+    return t;
+}
+
+/* The values of string, stringz, ipv4, int, float, time, datetime and guid
+ * leaves, for summaries and the Info column (as the tree item shows them). */
 void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
 {
     const dg_node *n = s->node;
@@ -73,6 +96,17 @@ void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
         nstime_t t = time_of(n, s->value);
         g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "d.%09d seconds", (gint64)t.secs, t.nsecs);
         break;
+    }
+    case DG_SHOW_DATETIME: {
+        nstime_t t = datetime_at(st, n, s->offset, s->length);
+        append_str(out, abs_time_to_str(st->pinfo->pool, &t, ABSOLUTE_TIME_UTC, TRUE));
+        return;
+    }
+    case DG_SHOW_GUID: {
+        e_guid_t guid;
+        tvb_get_guid(st->tvb, s->offset, &guid, encoding_of(n));
+        append_str(out, guid_to_str(st->pinfo->pool, &guid));
+        return;
     }
     default: return;
     }
@@ -132,7 +166,7 @@ void append_bare_value(const dg_state *st, dg_text *out, const dg_slot *s)
         if (s->length > 0) append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' '));
         return;
     case DG_SHOW_STRING: case DG_SHOW_STRINGZ: case DG_SHOW_IPV4: case DG_SHOW_INT: case DG_SHOW_FLOAT:
-    case DG_SHOW_TIME:
+    case DG_SHOW_TIME: case DG_SHOW_DATETIME: case DG_SHOW_GUID:
         append_typed_value(st, out, s);
         return;
     default:

@@ -106,8 +106,9 @@ gint64 leaf_length(dg_state *st, const dg_node *n, proto_tree *tree, gint offset
  * there, then say what is missing. */
 void report_short_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint64 length, gint left)
 {
-    /* An IPv4 address or a float has one size only: Wireshark throws on fewer bytes. */
-    gboolean fixed_size = n->show == DG_SHOW_IPV4 || n->show == DG_SHOW_FLOAT;
+    /* An IPv4 address, a float, a datetime or a GUID has one size only: Wireshark throws on fewer bytes. */
+    gboolean fixed_size = n->show == DG_SHOW_IPV4 || n->show == DG_SHOW_FLOAT || n->show == DG_SHOW_DATETIME ||
+                          n->show == DG_SHOW_GUID;
     if (!(n->flags & DG_NUMERIC) && !fixed_size && left > 0 && tree) {
         proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, left, item_encoding(n));
         if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);

@@ -93,6 +93,7 @@ TESTS = {
     "loading": integration("test_plugin_loading.py"),
     "esi": unit("Esi*:Files/EsiErr.*:Design.*:Eni.*:Files/NetworkErr.*:BusTables.*:ManualBus.*:-*Golden*"),
     "typed_values": integration("test_typed_values.py"),
+    "dates_guids_shared_names": integration("test_dates_guids_shared_names.py"),
     "info_column": integration("test_info_column.py"),
     "layout": integration("test_layout.py"),
     "bus_tables": integration("test_bus_tables.py"),

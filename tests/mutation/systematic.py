@@ -56,7 +56,7 @@ SMALL = 64   # integer literals up to this value are constants that get +1 and -
 TESTS_BY_FILE = {
     "plugin_runtime/dissgen_values.h": ["unit", "widths", "everything"],
     "plugin_runtime/dissgen_text.h": ["unit", "typed_values", "widths"],
-    "plugin_runtime/dissgen_text.cpp": ["typed_values", "widths", "everything", "computed"],
+    "plugin_runtime/dissgen_text.cpp": ["typed_values", "widths", "everything", "computed", "dates_guids_shared_names"],
     "plugin_runtime/dissgen_label.h": ["typed_values", "widths", "everything"],
     "plugin_runtime/dissgen_walk.cpp": ["widths", "everything", "malformed", "layout", "typed_values"],
     "plugin_runtime/dissgen_conditions.cpp": ["unit", "layout", "widths", "everything", "edges_peek"],
@@ -81,6 +81,7 @@ TESTS_BY_FILE = {
     "plugin_runtime/ethercat/ethercat_cycles.cpp": ["cycles", "report"],
     "plugin_runtime/ethercat/": ["bus_pdo", "bus_tables", "bus_wkc"],
     "generator/validator.cpp": ["rules_err", "unit", "widths", "everything"],
+    "generator/alternatives.cpp": ["rules_err", "unit", "dates_guids_shared_names"],
     "generator/quiet.cpp": ["unit", "quiet"],
     "generator/expression.cpp": ["unit", "rules_err", "computed"],
     "generator/emit_cpp.cpp": ["field_types", "widths", "everything", "typed_values", "computed", "layout"],

@@ -59,6 +59,13 @@ inline bool contains(const std::string& haystack, const std::string& needle) {
     return haystack.find(needle) != std::string::npos;
 }
 
+// How many times `needle` occurs in `haystack`.
+inline size_t count_of(const std::string& haystack, const std::string& needle) {
+    size_t n = 0;
+    for (size_t at = haystack.find(needle); at != std::string::npos; at = haystack.find(needle, at + 1)) ++n;
+    return n;
+}
+
 // What <pairing analysis="NAME"> needs in a small test file: the <input>
 // lines inside <pairing>, and the nodes they name (from <root>): a leaf per
 // input of the message, and, in a repeated node, one per input of each

@@ -1,0 +1,70 @@
+// Absolute dates and times (datetime) and GUIDs (guid): from the parsed
+// model to the registered field types and the emitted tables.
+#include <gtest/gtest.h>
+
+#include "emit_cpp.h"
+#include "test_support.h"
+
+namespace dissgen::testing {
+namespace {
+
+TEST(DatesAndGuids, FieldTypesAndEncodings) {
+    Front f = front_end(rules("  <node name=\"net\" length=\"8byte\" displaytype=\"datetime\"/>\n"
+                              "  <node name=\"ns\" length=\"8byte\" displaytype=\"datetime\" unit=\"ns\"/>\n"
+                              "  <node name=\"us\" length=\"64bit\" displaytype=\"datetime\" unit=\"us\"/>\n"
+                              "  <node name=\"ms\" length=\"8byte\" displaytype=\"datetime\" unit=\"ms\"/>\n"
+                              "  <node name=\"s\" length=\"4byte\" displaytype=\"datetime\" unit=\"s\"/>\n"
+                              "  <node name=\"id\" length=\"16byte\" displaytype=\"guid\"/>\n",
+                              "ethertype=\"0x88b5\" byteorder=\"little\""));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Protocol& p = *f.proto;
+    for (const char* name : {"net", "ns", "us", "ms", "s"}) {
+        EXPECT_EQ(field_type(*find(p, name)).type, "FT_ABSOLUTE_TIME") << name;
+        EXPECT_EQ(field_type(*find(p, name)).display, "ABSOLUTE_TIME_UTC") << name;
+        // not numbers: no length, count or condition may read them
+        EXPECT_FALSE(find(p, name)->is_numeric()) << name;
+    }
+    EXPECT_EQ(field_type(*find(p, "id")).type, "FT_GUID");
+    EXPECT_FALSE(find(p, "id")->is_numeric());
+
+    std::string code = emit_cpp(p, "t.xml");
+    EXPECT_EQ(count_of(code, "DG_SHOW_DATETIME"), 5u) << code;
+    EXPECT_EQ(count_of(code, "DG_SHOW_GUID"), 1u) << code;
+    // s+ns is the runtime's default (no dg_extra row); the other units say their encoding.
+    EXPECT_EQ(count_of(code, "time_encoding("), 4u) << code;
+    for (const char* enc : {"ENC_TIME_NSECS", "ENC_TIME_USECS", "ENC_TIME_MSECS", "ENC_TIME_SECS)"})
+        EXPECT_TRUE(contains(code, std::string("dg_node_extra().time_encoding(") + enc)) << enc << "\n" << code;
+    EXPECT_FALSE(contains(code, "ENC_TIME_SECS_NSECS")) << code;
+    EXPECT_FALSE(contains(code, "BASE_UNIT_STRING")) << "a datetime's unit is no label";
+}
+
+TEST(DatesAndGuids, WrongLengthsAreErrorsOnTheirLine) {
+    struct Case {
+        const char* node;
+        const char* message;
+    };
+    const Case cases[] = {
+        {"length=\"4byte\" displaytype=\"datetime\"", "datetime display with unit 's+ns' needs a length of 8byte"},
+        {"length=\"4byte\" displaytype=\"datetime\" unit=\"ns\"", "datetime display with unit 'ns' needs a length of 8byte"},
+        {"length=\"2byte\" displaytype=\"datetime\" unit=\"s\"", "datetime display with unit 's' needs a length of 4byte or 8byte"},
+        {"length=\"rest\" displaytype=\"datetime\"", "datetime display with unit 's+ns' needs a length of 8byte"},
+        {"length=\"15byte\" displaytype=\"guid\"", "guid display needs a length of 16byte"},
+        {"length=\"rest\" displaytype=\"guid\"", "guid display needs a length of 16byte"},
+    };
+    for (const Case& c : cases) {
+        Front f = front_end(rules("  <node name=\"k\" length=\"1byte\"/>\n  <node name=\"v\" " + std::string(c.node) + "/>\n"));
+        EXPECT_FALSE(f.ok()) << c.node;
+        EXPECT_TRUE(contains(f.messages(), "rules.xml:3: error: " + std::string(c.message))) << f.messages();
+    }
+}
+
+TEST(DatesAndGuids, EightByteSecondsAndUnitsOfTimeStayAsTheyWere) {
+    Front f = front_end(rules("  <node name=\"s64\" length=\"8byte\" displaytype=\"datetime\" unit=\"s\"/>\n"
+                              "  <node name=\"t\" length=\"4byte\" displaytype=\"time\" unit=\"us\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    Front bad = front_end(rules("  <node name=\"t\" length=\"4byte\" displaytype=\"time\" unit=\"s+ns\"/>\n"));
+    EXPECT_TRUE(contains(bad.messages(), "bad unit 's+ns': expected 'ns', 'us', 'ms' or 's'")) << bad.messages();
+}
+
+}  // namespace
+}  // namespace dissgen::testing
