@@ -23,6 +23,8 @@ machine, so differences of a few percent show.
                request's start gives (request{Start} + index)
     finding    base + two <finding>s: one checked on every register (value 0xffff: seldom
                raised), one on the status word (a note in a quarter of the packets)
+    cycles     base + <cycles>: a stream per function and sender, the transaction as its
+               sequence count (every packet is in a cycle, timed, none lost)
 
 Each row gives the instructions per packet that tshark spends in
 epan_dissect_run_with_taps (the dissection of a packet, from the frame through Ethernet,
@@ -51,11 +53,15 @@ HEAD = ('<root name="Construct bench" abbreviation="CONB" filter="conb" byteorde
 PAIRING = ('  <pairing>\n'
            '    <key field="node[@name=\'Transaction\']"/>\n'
            '  </pairing>\n')
+CYCLES = ('  <cycles sender="yes">\n'
+          '    <signature field="node[@name=\'Function\']"/>\n'
+          '    <sequence field="node[@name=\'Transaction\']"/>\n'
+          '  </cycles>\n')
 
 
 def rules(kind):
     valid = ' valid="1-16"' if kind == "validity" else ""
-    out = [HEAD, PAIRING if kind in ("pairing", "request") else "",
+    out = [HEAD, PAIRING if kind in ("pairing", "request") else "", CYCLES if kind == "cycles" else "",
            '  <node name="Transaction" length="2byte" displaytype="numberhex"/>\n'
            '  <node name="Function" length="1byte" displaytype="numberdec"%s/>\n'
            '  <node name="Status" length="2byte" displaytype="numberhex"/>\n'
@@ -101,7 +107,7 @@ def rules(kind):
     return "".join(out)
 
 
-KINDS = ["base", "branch", "unused", "validity", "computed", "overlay", "pairing", "request", "finding"]
+KINDS = ["base", "branch", "unused", "validity", "computed", "overlay", "pairing", "request", "finding", "cycles"]
 REFERENCE = {"request": "pairing", "unused": "branch"}
 
 
