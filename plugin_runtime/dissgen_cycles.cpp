@@ -25,8 +25,9 @@
  *    its regular periods so far, the window's and this one included.
  *
  * Memory: a record per message of a stream that shows something (its
- * cycle, a loss, a duplicate), in wmem_file_scope; per cycle 8 bytes per
- * regular period (the running median and the figures of -z P,cycles).
+ * cycle, a loss, a duplicate), in wmem_file_scope, and a pointer per frame
+ * (the table of first messages' records); per cycle 8 bytes per regular
+ * period (the running median and the figures of -z P,cycles).
  */
 #include "dissgen_cycles.h"
 
@@ -94,6 +95,10 @@ struct mark {
 
 struct capture_state {
     wmem_map_t *streams;    /* stream -> itself */
+    /* per frame number, its first message's mark (NULL: none): a table is
+     * cheaper than p_add_proto_data, which the later messages of a frame use */
+    const mark **by_frame;
+    guint32 by_frame_size;
     cycle *first, *last;
     guint32 cycles;
     guint32 last_frame;     /* the last frame the first pass brought here */
@@ -125,11 +130,13 @@ capture_state *current_capture(void)
     return capture;
 }
 
-guint32 fnv(guint32 h, const void *data, gsize n)
+/* A hash of 64-bit words (each value, node and port of the signature). */
+guint32 mix(guint32 h, guint64 v)
 {
-    const guint8 *b = (const guint8 *)data;
-    for (gsize i = 0; i < n; i++) h = (h ^ b[i]) * 16777619u;
-    return h;
+    v ^= v >> 33;
+    v *= G_GUINT64_CONSTANT(0xff51afd7ed558ccd);
+    v ^= v >> 33;
+    return (h ^ (guint32)v) * 16777619u;
 }
 
 stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info *pinfo)
@@ -144,10 +151,10 @@ stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info 
         probe.src = pinfo->src; /* shallow: copied below if the stream is new */
         probe.port = pinfo->srcport;
     }
-    guint32 h = fnv(2166136261u, probe.values, in->count * sizeof(guint64));
-    h = fnv(h, probe.nodes, in->count * sizeof(guint16));
-    h = fnv(h, &probe.port, sizeof probe.port);
-    h = add_address_to_hash(h, &probe.src);
+    guint32 h = 2166136261u;
+    for (guint i = 0; i < in->count; i++) h = mix(h, in->values[i] ^ ((guint64)in->nodes[i] << 48));
+    h = mix(h, probe.port);
+    if (probe.src.type != AT_NONE) h = add_address_to_hash(h, &probe.src);
     probe.hash = h;
     stream *s = (stream *)wmem_map_lookup(c->streams, &probe);
     if (s) return s;
@@ -266,6 +273,17 @@ mark *time_message(capture_state *c, const dg_cycle_input *in, const packet_info
     return (mark *)wmem_memdup(wmem_file_scope(), &m, sizeof m);
 }
 
+void keep_first_mark(capture_state *c, guint32 frame, const mark *m)
+{
+    if (frame >= c->by_frame_size) {
+        guint32 size = MAX(frame + 1, 2 * c->by_frame_size);
+        c->by_frame = (const mark **)wmem_realloc(wmem_file_scope(), c->by_frame, size * sizeof *c->by_frame);
+        memset(c->by_frame + c->by_frame_size, 0, (size - c->by_frame_size) * sizeof *c->by_frame);
+        c->by_frame_size = size;
+    }
+    c->by_frame[frame] = m;
+}
+
 nstime_t nstime_of(gint64 ns)
 {
     nstime_t t;
@@ -282,6 +300,7 @@ void add_generated_time(proto_tree *tree, int hf, tvbuff_t *tvb, gint64 ns)
 
 void show(const mark *m, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
+    if (!tree && !m->lost && !m->duplicate_of) return; /* nothing to add, no expert to raise */
     if (m->cycle) proto_item_set_generated(proto_tree_add_uint(tree, hf_stream_cycle, tvb, 0, 0, m->cycle));
     if (m->timed) add_generated_time(tree, hf_stream_period, tvb, m->period_ns);
     if (m->jittered) add_generated_time(tree, hf_stream_jitter, tvb, m->jitter_ns);
@@ -448,10 +467,16 @@ void dg_cycles_register(const dg_protocol *p)
 void dg_cycles_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
                        const dg_cycle_input *in, guint message)
 {
-    const mark *m;
+    const mark *m = NULL;
     if (!PINFO_FD_VISITED(pinfo)) {
-        m = in ? time_message(current_capture(), in, pinfo) : NULL;
-        if (m) p_add_proto_data(wmem_file_scope(), pinfo, *p->proto, mark_key | message, (void *)m);
+        capture_state *c = current_capture();
+        m = in ? time_message(c, in, pinfo) : NULL;
+        if (m && message == 0)
+            keep_first_mark(c, pinfo->num, m);
+        else if (m)
+            p_add_proto_data(wmem_file_scope(), pinfo, *p->proto, mark_key | message, (void *)m);
+    } else if (message == 0) {
+        m = capture && pinfo->num < capture->by_frame_size ? capture->by_frame[pinfo->num] : NULL;
     } else {
         m = (const mark *)p_get_proto_data(wmem_file_scope(), pinfo, *p->proto, mark_key | message);
     }
