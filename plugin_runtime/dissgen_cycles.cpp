@@ -102,6 +102,7 @@ struct capture_state {
     cycle *first, *last;
     guint32 cycles;
     guint32 last_frame;     /* the last frame the first pass brought here */
+    guint messages_timed;   /* and how many of its messages were timed */
 };
 
 const dg_protocol *protocol;
@@ -219,7 +220,6 @@ gboolean sequence_step(stream *s, const dg_cycle_input *in, guint bits, guint32 
 /* First pass: times the message in its stream; what it shows, or NULL. */
 mark *time_message(capture_state *c, const dg_cycle_input *in, const packet_info *pinfo)
 {
-    c->last_frame = pinfo->num;
     const dg_cycles *cy = protocol->cycles;
     const guint32 all_only = cy->only_count >= 32 ? G_MAXUINT32 : ((guint32)1 << cy->only_count) - 1;
     if (!in->count || in->never || (in->only_held & all_only) != all_only) return NULL;
@@ -468,15 +468,23 @@ void dg_cycles_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, 
                        const dg_cycle_input *in, guint message)
 {
     const mark *m = NULL;
-    if (!PINFO_FD_VISITED(pinfo)) {
-        capture_state *c = current_capture();
+    capture_state *c = current_capture();
+    /* The first pass may bring a message back (a frame dissected again, as
+     * TCP reassembly can): it is timed once, then shown as it was. */
+    const gboolean timed = PINFO_FD_VISITED(pinfo) || (pinfo->num == c->last_frame && message < c->messages_timed);
+    if (!timed) {
+        if (pinfo->num != c->last_frame) {
+            c->last_frame = pinfo->num;
+            c->messages_timed = 0;
+        }
+        c->messages_timed = MAX(c->messages_timed, message + 1);
         m = in ? time_message(c, in, pinfo) : NULL;
         if (m && message == 0)
             keep_first_mark(c, pinfo->num, m);
         else if (m)
             p_add_proto_data(wmem_file_scope(), pinfo, *p->proto, mark_key | message, (void *)m);
     } else if (message == 0) {
-        m = capture && pinfo->num < capture->by_frame_size ? capture->by_frame[pinfo->num] : NULL;
+        m = pinfo->num < c->by_frame_size ? c->by_frame[pinfo->num] : NULL;
     } else {
         m = (const mark *)p_get_proto_data(wmem_file_scope(), pinfo, *p->proto, mark_key | message);
     }
