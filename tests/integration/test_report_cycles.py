@@ -19,7 +19,8 @@ cycles report, and:
 - Debian's chromium, headless, draws a canvas in every chart; the screenshot (written to
   --screenshots, default the system's temporary folder) is not blank;
 - with a second plugin with <pairing> installed, the report asks for --protocol, and
-  --protocol picks either one; an unknown one is one clear message.
+  --protocol picks either one (the pairing-only one: its round trips and unanswered
+  requests as the fields show them, no cycle section); an unknown one is one clear message.
 """
 
 import os
@@ -35,6 +36,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from tshark_env import NOBODY, TsharkTestCase, run_unittests  # noqa: E402
 from test_report import TableReader, browser_checks, screenshot_path  # noqa: E402
 from test_rule_cycles import generated_capture, parse_report, pcap_ns  # noqa: E402
+from test_request_context import frame, payload, schedule, transactions  # noqa: E402
+import pcapgen  # noqa: E402
 
 ARGS = None
 CORPUS_CAPTURE = os.path.join("..", "shared", "corpus", "enip", "enip_cip_example.pcap")
@@ -47,6 +50,13 @@ def expected_row(number, cycle):
     counted = "lost" in f
     return ([str(number), cycle["name"], str(f["first frame"]), str(f["messages"]), str(f["nominal"])] + period +
             [f["jitter sd"], str(f["lost"]) if counted else "", str(f["duplicates"]) if counted else ""])
+
+
+def request_context_frames():
+    """Modbus-style requests and responses of tests/rules/request_context.xml (pairing, no
+    cycles), every 17th transaction's response left out."""
+    txns = transactions(47502, 120)
+    return [frame(d, payload(d, txns[k], None)) for d, k in schedule(txns, 1) if not (d == "response" and k % 17 == 3)]
 
 
 def table(page, table_id):
@@ -164,7 +174,12 @@ class TestReportCycles(TsharkTestCase, unittest.TestCase):
                                                               "request_context.xml"), "--dir", plugins],
                        check=True, capture_output=True)
         subprocess.run(["chmod", "-R", "a+rX", home], check=True)
+        pairs = self.env.add_file("pairs.pcap", pcapgen.raw_pcap_bytes(request_context_frames()))
         try:
+            rqc, pairing_page, _took = self.report(pairs, "pairing", extra=["--protocol", "rqc"], home=home)
+            rqc_fields = subprocess.run(self.env.command(["-r", pairs, "-T", "fields", "-e", "rqc.time", "-e",
+                                                          "rqc.no_response_to"]),
+                                        env=dict(self.env.env(), HOME=home), capture_output=True, text=True).stdout
             both, _page, _took = self.report(self.generated, "both", home=home)
             chosen, page, _took = self.report(self.generated, "chosen", extra=["--protocol", "enipr"], home=home)
             unknown, _page, _took = self.report(self.generated, "unknown", extra=["--protocol", "nosuch"], home=home)
@@ -175,6 +190,17 @@ class TestReportCycles(TsharkTestCase, unittest.TestCase):
                   "two candidates: exit 1, names them and --protocol (%d: %s)" % (both.returncode, both.stderr.strip()))
             check(chosen.returncode == 0 and len(table(page, "cycles")) == 4,
                   "--protocol enipr: its report, 4 cycles (%d: %s)" % (chosen.returncode, chosen.stderr.strip()))
+            trips = sum(1 for line in rqc_fields.splitlines() if line.split("\t")[0])
+            unanswered = sum(len(line.split("\t")[1].split(",")) for line in rqc_fields.splitlines()
+                             if line.split("\t")[1:] and line.split("\t")[1])
+            headline = re.search(r'id="headline">\d+ frames, [0-9.]+ s; (\d+) round trips?, (\d+) requests? without',
+                                 pairing_page)
+            check(rqc.returncode == 0 and headline is not None and
+                  (int(headline.group(1)), int(headline.group(2))) == (trips, unanswered) and unanswered > 0,
+                  "--protocol rqc (pairing, no cycles): headline %s, the fields %d round trips, %d unanswered"
+                  % (headline and headline.groups(), trips, unanswered))
+            check('id="round-trip"' in pairing_page and 'id="cycles"' not in pairing_page and
+                  'id="loss-events"' not in pairing_page, "pairing only: a round-trip chart, no cycles, no losses")
             check(unknown.returncode == 1 and "nosuch" in unknown.stderr,
                   "an unknown --protocol: exit 1, named (%d: %s)" % (unknown.returncode, unknown.stderr.strip()))
 

@@ -23,10 +23,11 @@ std::string events_json(const std::vector<StreamEvent>& events) {
 }
 
 void headline(const CyclesModel& m, const std::string& tool_version, std::ostream& out) {
-    out << "<h1>" << escape_html(m.protocol) << " cycles: " << escape_html(capture_name(m.captures))
-        << "</h1>\n<p class=\"note\" id=\"headline\">" << m.frames << " frames, " << num(m.duration, 3) << " s; "
-        << plural(m.cycles.size(), "cycle") << ", " << plural(m.messages_lost(), "message") << " lost, "
-        << plural(m.duplicates.size(), "duplicate");
+    out << "<h1>" << escape_html(m.protocol) << " timing: " << escape_html(capture_name(m.captures))
+        << "</h1>\n<p class=\"note\" id=\"headline\">" << m.frames << " frames, " << num(m.duration, 3) << " s";
+    if (m.has_cycles)
+        out << "; " << plural(m.cycles.size(), "cycle") << ", " << plural(m.messages_lost(), "message") << " lost, "
+            << plural(m.duplicates.size(), "duplicate");
     if (m.has_pairing)
         out << "; " << plural(m.round_trip.size(), "round trip") << ", " << plural(m.no_response.size(), "request")
             << " without response";
@@ -135,7 +136,7 @@ const char kScript[] = R"JS(
   const losses = data.lost.map(e => [e[0], e[1], null]).concat(data.duplicates.map(e => [e[0], null, e[1]]));
   losses.sort((a, b) => a[0] - b[0]);
   chart('loss-events', losses, Object.assign({labels: ['t', 'Messages lost', 'Duplicate'], ylabel: 'Messages',
-      title: 'Losses and repeats over time', includeZero: true,
+      title: 'Losses and repeats over time', includeZero: true, xRangePad: 10,
       series: {'Messages lost': Object.assign({color: '#d62728'}, marks),
                'Duplicate': Object.assign({color: '#ff7f0e'}, marks)}}, common));
   // Round trips with the requests left unanswered as marks on top.
@@ -143,7 +144,8 @@ const char kScript[] = R"JS(
   const rows = bars(data.round_trip).map(p => [p[0], p[1], null]);
   data.no_response.forEach(e => rows.push([e[0], null, [top, top, top]]));
   rows.sort((a, b) => a[0] - b[0]);
-  chart('round-trip', rows, Object.assign({customBars: true, labels: ['t', 'Round trip (µs)', 'No response'],
+  chart('round-trip', rows, Object.assign({customBars: true, connectSeparatedPoints: true,
+      labels: ['t', 'Round trip (µs)', 'No response'],
       ylabel: 'Round trip (µs)', title: 'Round trip over time',
       series: {'No response': Object.assign({color: '#d62728'}, marks)}}, common));
 })();
@@ -154,7 +156,7 @@ const char kScript[] = R"JS(
 std::string write_cycles_report_html(const CyclesModel& m, const std::string& tool_version, std::ostream& out) {
     std::string js, css, error = read_dygraphs(js, css);
     if (!error.empty()) return error;
-    write_page_head(m.protocol + " cycles: " + capture_name(m.captures), js, css, out);
+    write_page_head(m.protocol + " timing: " + capture_name(m.captures), js, css, out);
     headline(m, tool_version, out);
     cycles_section(m, out);
     losses_section(m, out);
