@@ -7,7 +7,8 @@
 //   dissgen install FILE.xml [--dir DIR | --system]
 //                                          generate, build and install the plugin
 //   dissgen esi PATH...                    list the device catalogue of ESI files
-//   dissgen report CAPTURE... -o FILE.html timing report of an EtherCAT capture
+//   dissgen report CAPTURE... -o FILE.html timing report of an EtherCAT capture, or of
+//                                          any protocol whose rules declare cycles or pairing
 //   dissgen sources [FILE.xml]             the runtime files and compile options of a plugin
 // check, generate, fields and install take --esi PATH (repeatable),
 // --network FILE and --compact: the catalogue and the designed network are
@@ -28,6 +29,8 @@
 #include "ethercat/esi_reader.h"
 #include "ethercat/network_reader.h"
 #include "parser.h"
+#include "report/any/cycles_model.h"
+#include "report/any/cycles_page.h"
 #include "report/capture_stream.h"
 #include "report/ethercat/report_page.h"
 #include "report/ethercat/timing_model.h"
@@ -50,7 +53,7 @@ const char kUsage[] =
     "       dissgen fields FILE.xml\n"
     "       dissgen install FILE.xml [--dir DIR | --system]\n"
     "       dissgen esi PATH...\n"
-    "       dissgen report CAPTURE... -o FILE.html [--rules FILE.xml]\n"
+    "       dissgen report CAPTURE... -o FILE.html [--rules FILE.xml] [--protocol FILTER]\n"
     "       dissgen sources [FILE.xml]\n"
     "       dissgen --help | --version\n"
     "  check, generate, fields, install and report also take [--esi PATH]... [--network FILE] [--compact]\n"
@@ -68,7 +71,9 @@ const char kUsage[] =
     "            with a plugin built from the rules and those for this run) and write one\n"
     "            self-contained HTML page: cycles, periods, jitter, round trips, lost frames,\n"
     "            working-counter errors, the slaves' AL states, the network check; several\n"
-    "            captures (a ring-buffer file set of dumpcap, in order) report as one\n"
+    "            captures (a ring-buffer file set of dumpcap, in order) report as one;\n"
+    "            without an EtherCAT plugin, of the protocol whose rules declare <cycles> or\n"
+    "            <pairing>: its cycles' periods and jitter, losses, round trips\n"
     "  sources   what a plugin of the rule file (without one: of any rule file) is built\n"
     "            from: a line 'flags OPTION...', then 'source PATH' and 'header PATH' lines,\n"
     "            paths relative to the runtime folder (share/dissgen/runtime)\n"
@@ -84,6 +89,8 @@ const char kUsage[] =
     "  --compact       embed only the device models the network uses\n"
     "  --rules FILE    report: the rules of the plugin built for --esi/--network\n"
     "                  (default: the shipped ethercat.xml)\n"
+    "  --protocol FILTER  report: the protocol to report on, by filter name, when\n"
+    "                  several installed plugins have cycles or pairing\n"
     "  -h, --help      print this help and exit\n"
     "  --version       print dissgen's version and exit\n";
 
@@ -339,6 +346,12 @@ std::string build_report_plugin(const std::string& rules, BusInput& bus, const s
     return root;
 }
 
+// "" when `path` is open for writing, else a message for the user.
+std::string open_report(const std::string& path, std::ofstream& out) {
+    out.open(path, std::ios::binary);
+    return out ? "" : "cannot write " + path;
+}
+
 // The runtime files and compile options of a plugin of `path` ("" for every
 // analysis): plugin_runtime/runtime.list, as dissgen compiles it.
 int cmd_sources(const std::string& path) {
@@ -356,8 +369,60 @@ int cmd_sources(const std::string& path) {
     return 0;
 }
 
-int cmd_report(const std::vector<std::string>& captures, const std::string& out_path, std::string rules, BusInput& bus,
-               const std::string& argv0) {
+// Reads the capture into a Model with its Builder (the EtherCAT one, or any
+// protocol's with <cycles>/<pairing>) and writes its page with `write`.
+template <class Model, class Builder>
+int write_report(CaptureStream& stream, const std::vector<std::string>& known, const std::string& protocol,
+                 const std::vector<std::string>& captures, const std::string& out_path,
+                 std::string (*write)(const Model&, const std::string&, std::ostream&)) {
+    stream.fields = Builder::fields(protocol, known);
+    stream.extra_args = Builder::statistics_args(protocol, known);
+    Model model;
+    model.captures = captures;
+    Builder builder(protocol, stream.fields, model);
+    stream.on_other_line = [&](std::string_view line) { builder.add_statistics_line(line); };
+    std::string error = read_capture(stream, captures, [&](const FieldRow& row) { builder.add(row); });
+    std::ofstream out;
+    if (error.empty()) error = open_report(out_path, out);
+    if (error.empty()) error = write(model, DISSGEN_VERSION, out);
+    if (!error.empty()) {
+        std::cerr << "dissgen: report: " << error << "\n";
+        return 1;
+    }
+    std::cout << "wrote " << out_path << ": " << model.frames << " frames, " << model.cycles.size() << " cycles\n";
+    return 0;
+}
+
+// Which protocol to report on: `wanted` (--protocol), else the EtherCAT one,
+// else the only one with cycles or pairing. "" after a message when none or
+// several fit; `ethercat` says which report it gets.
+std::string choose_protocol(const std::vector<std::string>& known, const std::string& wanted,
+                            const std::string& tshark, bool& ethercat) {
+    const std::string ecat = ethercat_protocol(known);
+    const std::vector<std::string> others = cycles_protocols(known, ecat);
+    ethercat = !ecat.empty() && (wanted.empty() || wanted == ecat);
+    if (ethercat) return ecat;
+    if (!wanted.empty()) {
+        if (std::find(others.begin(), others.end(), wanted) != others.end()) return wanted;
+        std::cerr << "dissgen: report: " << tshark << " has no protocol '" << wanted
+                  << "' of dissgen with cycles or pairing\n";
+        return "";
+    }
+    if (others.size() == 1) return others[0];
+    if (others.empty()) {
+        std::cerr << "dissgen: report: " << tshark << " has no EtherCAT plugin of dissgen (no protocol with "
+                     "the " DG_ANALYSIS_ETHERCAT_ESC " analysis's fields) and no plugin whose rules declare "
+                     "<cycles> or <pairing>: install one first, e.g. dissgen install rules/ethercat.xml\n";
+        return "";
+    }
+    std::cerr << "dissgen: report: several protocols have cycles or pairing (";
+    for (size_t i = 0; i < others.size(); ++i) std::cerr << (i ? ", " : "") << others[i];
+    std::cerr << "): choose one with --protocol\n";
+    return "";
+}
+
+int cmd_report(const std::vector<std::string>& captures, const std::string& out_path, std::string rules,
+               const std::string& wanted, BusInput& bus, const std::string& argv0) {
     CaptureStream stream;
     if (const char* t = std::getenv("DISSGEN_TSHARK"); t && *t) stream.tshark = t;
     std::string plugin_root;
@@ -383,36 +448,14 @@ int cmd_report(const std::vector<std::string>& captures, const std::string& out_
     } cleanup{plugin_root};
 
     std::vector<std::string> known = known_fields(stream);
-    std::string protocol = ethercat_protocol(known);
-    if (protocol.empty()) {
-        std::cerr << "dissgen: report: " << stream.tshark << " has no EtherCAT plugin of dissgen (no protocol with "
-                     "the " DG_ANALYSIS_ETHERCAT_ESC " analysis's fields): install it first, e.g. dissgen install "
-                     "rules/ethercat.xml\n";
-        return 1;
-    }
-    stream.fields = TimingModelBuilder::fields(protocol, known);
-    stream.extra_args = TimingModelBuilder::statistics_args(protocol, known);
-    TimingModel model;
-    model.captures = captures;
-    TimingModelBuilder builder(protocol, stream.fields, model);
-    stream.on_other_line = [&](std::string_view line) { builder.add_statistics_line(line); };
-    std::string error = read_capture(stream, captures, [&](const FieldRow& row) { builder.add(row); });
-    if (!error.empty()) {
-        std::cerr << "dissgen: report: " << error << "\n";
-        return 1;
-    }
-    std::ofstream out(out_path, std::ios::binary);
-    if (!out) {
-        std::cerr << "dissgen: report: cannot write " << out_path << "\n";
-        return 1;
-    }
-    error = write_report_html(model, DISSGEN_VERSION, out);
-    if (!error.empty()) {
-        std::cerr << "dissgen: report: " << error << "\n";
-        return 1;
-    }
-    std::cout << "wrote " << out_path << ": " << model.frames << " frames, " << model.cycles.size() << " cycles\n";
-    return 0;
+    bool ethercat = false;
+    std::string protocol = choose_protocol(known, wanted, stream.tshark, ethercat);
+    if (protocol.empty()) return 1;
+    if (ethercat)
+        return write_report<TimingModel, TimingModelBuilder>(stream, known, protocol, captures, out_path,
+                                                             write_report_html);
+    return write_report<CyclesModel, CyclesModelBuilder>(stream, known, protocol, captures, out_path,
+                                                         write_cycles_report_html);
 }
 
 }  // namespace
@@ -428,16 +471,19 @@ int main(int argc, char** argv) {
         return 0;
     }
     const std::string command = args[0];
-    std::string out_dir, dir, rules;
+    std::string out_dir, dir, rules, protocol;
     std::vector<std::string> files;
     bool system = false;
     BusInput bus;
     for (size_t i = 1; i < args.size(); ++i) {
         const std::string& a = args[i];
-        if ((a == "-o" || a == "--dir" || a == "--esi" || a == "--network" || a == "--rules") && i + 1 < args.size()) {
+        if ((a == "-o" || a == "--dir" || a == "--esi" || a == "--network" || a == "--rules" ||
+             a == "--protocol") &&
+            i + 1 < args.size()) {
             const std::string& v = args[++i];
             if (a == "-o") out_dir = v;
             else if (a == "--rules") rules = v;
+            else if (a == "--protocol") protocol = v;
             else if (a == "--dir") dir = v;
             else if (a == "--esi") bus.esi.push_back(v);
             else if (!bus.network_file.empty()) {
@@ -468,18 +514,18 @@ int main(int argc, char** argv) {
                       << kUsage;
             return 2;
         }
-        return cmd_report(files, out_dir, rules, bus, argv[0]);
+        return cmd_report(files, out_dir, rules, protocol, bus, argv[0]);
     }
     if (command == "sources") {
         if (files.size() > 1 || bus.given() || bus.compact || !out_dir.empty() || !dir.empty() || system ||
-            !rules.empty()) {
+            !rules.empty() || !protocol.empty()) {
             std::cerr << "dissgen: sources takes at most one rule file\n" << kUsage;
             return 2;
         }
         return cmd_sources(files.empty() ? "" : files[0]);
     }
-    if (!rules.empty()) {
-        std::cerr << "dissgen: --rules is an option of report\n";
+    if (!rules.empty() || !protocol.empty()) {
+        std::cerr << "dissgen: " << (rules.empty() ? "--protocol" : "--rules") << " is an option of report\n";
         return 2;
     }
     if (files.size() > 1) {

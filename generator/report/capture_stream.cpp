@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -121,6 +122,19 @@ std::vector<std::string_view> split_values(std::string_view joined) {
         start = sep + 1;
     }
     return values;
+}
+
+bool has_field(const std::vector<std::string>& known, const std::string& name) {
+    return std::find(known.begin(), known.end(), name) != known.end();
+}
+
+FieldColumns::FieldColumns(const std::vector<std::string>& fields) {
+    for (size_t i = 0; i < fields.size(); ++i) columns_[fields[i]] = i;
+}
+
+std::string_view FieldColumns::get(const FieldRow& row, const std::string& field) const {
+    auto it = columns_.find(field);
+    return it == columns_.end() || it->second >= row.size() ? std::string_view() : row[it->second];
 }
 
 std::vector<std::string> known_fields(const CaptureStream& stream) {

@@ -10,6 +10,7 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 namespace dissgen {
@@ -44,5 +45,19 @@ std::vector<std::string> known_fields(const CaptureStream& stream);
 
 // The values of one field of a row, split at kValueSeparator.
 std::vector<std::string_view> split_values(std::string_view joined);
+
+// Whether `name` is among `known` (known_fields()).
+bool has_field(const std::vector<std::string>& known, const std::string& name);
+
+// A row's values by field name, for rows read with `fields`: "" for a field
+// not asked for (the installed plugin lacks it) as for one the frame lacks.
+class FieldColumns {
+public:
+    explicit FieldColumns(const std::vector<std::string>& fields);
+    std::string_view get(const FieldRow& row, const std::string& field) const;
+
+private:
+    std::unordered_map<std::string, size_t> columns_;
+};
 
 }  // namespace dissgen

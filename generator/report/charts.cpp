@@ -14,7 +14,48 @@ namespace {
 
 constexpr size_t kHistogramBins = 80;
 
+const char kStyle[] = R"CSS(
+body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; }
+h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 1.6em; }
+table { border-collapse: collapse; font-size: 0.85em; }
+th, td { border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: right; }
+td:nth-child(2), th:nth-child(2) { text-align: left; }
+.pair { display: flex; gap: 1em; flex-wrap: wrap; }
+.chart { width: 640px; height: 280px; }
+.chart.wide { width: 1300px; }
+.empty { height: auto; color: #777; }
+.note { color: #555; }
+)CSS";
+
+
+std::string file_name(const std::string& path) {
+    size_t slash = path.find_last_of('/');
+    return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
 }  // namespace
+
+// The functions both reports' scripts draw with (before their own script).
+const char kChartScript[] = R"JS(
+function bars(series) { return series.map(p => [p[0], p[1]]); }
+function chart(id, rows, options) {
+  const el = document.getElementById(id);
+  if (!el) return;
+  if (!rows.length) { el.textContent = 'No values.'; el.className += ' empty'; return; }
+  new Dygraph(el, rows, options);
+}
+// Per cycle, its period over time and its jitter histogram, counting `what`.
+function cycleCharts(cycles, common, what) {
+  cycles.forEach(c => {
+    chart('period-' + c.number, bars(c.period),
+          Object.assign({customBars: true, labels: ['t', 'Period (µs)'], ylabel: 'Period (µs)',
+                         title: 'Cycle ' + c.number + ': period over time'}, common));
+    chart('jitter-' + c.number, c.histogram,
+          {labels: ['Jitter (µs)', what], stepPlot: true, fillGraph: true, xRangePad: 12, xlabel: 'Jitter (µs)',
+           ylabel: what, title: 'Cycle ' + c.number + ': jitter histogram', axes: {y: {axisLabelWidth: 64}}});
+  });
+}
+)JS";
 
 std::string escape_html(const std::string& text) {
     std::string out;
@@ -116,6 +157,18 @@ std::string read_dygraphs(std::string& js, std::string& css) {
         return "cannot read dygraphs from " + dir + " (" + why +
                "; install Debian's libjs-dygraphs, or set DISSGEN_DYGRAPHS_DIR)";
     return "";
+}
+
+std::string capture_name(const std::vector<std::string>& paths) {
+    std::string name;
+    for (const std::string& p : paths) name += (name.empty() ? "" : " + ") + file_name(p);
+    return name;
+}
+
+void write_page_head(const std::string& title, const std::string& js, const std::string& css, std::ostream& out) {
+    out << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << escape_html(title)
+        << "</title>\n<style>" << css << "</style>\n<style>" << kStyle << "</style>\n<script>" << js
+        << "</script>\n</head><body>\n";
 }
 
 }  // namespace dissgen

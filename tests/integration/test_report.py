@@ -268,6 +268,37 @@ def png_pixels(path):
     return width, height, colours
 
 
+def screenshot_path(folder, name):
+    """name in folder (--screenshots), default the system's temporary folder."""
+    folder = folder or tempfile.gettempdir()
+    os.makedirs(folder, exist_ok=True)
+    return os.path.join(folder, name)
+
+
+def browser_checks(check, chromium, html_path, page, shot, least_charts):
+    """Debian's chromium, headless, draws a canvas in every chart of the page at html_path
+    (whose text is `page`), and its screenshot, written to shot, is not blank."""
+    charts = re.findall(r'<div class="chart[^"]*" id="([^"]+)"', page)
+    profile = tempfile.mkdtemp(prefix="dissgen-chromium-")
+    base = [chromium, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+            "--user-data-dir=" + profile, "--window-size=1400,2400", "--virtual-time-budget=5000"]
+    url = "file://" + html_path
+    try:
+        dom = subprocess.run(base + ["--dump-dom", url], capture_output=True, text=True, timeout=180).stdout
+        subprocess.run(base + ["--screenshot=" + shot, url], capture_output=True, timeout=180)
+    finally:
+        shutil.rmtree(profile, ignore_errors=True)
+    check(len(charts) >= least_charts, "the page has charts (%d)" % len(charts))
+    for chart in charts:
+        m = re.search(r'id="%s"(.*?)(?=<div class="chart|<h2|<table|</body)' % re.escape(chart), dom, re.S)
+        check(m is not None and "<canvas" in m.group(1), "chromium drew chart %s" % chart)
+    check(os.path.exists(shot), "screenshot written: %s" % shot)
+    if os.path.exists(shot):
+        width, height, colours = png_pixels(shot)
+        check(width == 1400 and len(colours) > 20,
+              "the screenshot (%dx%d) shows a drawing (%d colours)" % (width, height, len(colours)))
+
+
 # ----------------------------------------------------------------------------- the tests
 
 class TestReport(TsharkTestCase, unittest.TestCase):
@@ -401,29 +432,9 @@ class TestReport(TsharkTestCase, unittest.TestCase):
         if not chromium:
             self.skipTest("chromium is not installed (Debian package chromium)")
         _p, page, _took = self.report(self.capture, "browser")
-        charts = re.findall(r'<div class="chart[^"]*" id="([^"]+)"', page)
-        profile = tempfile.mkdtemp(prefix="dissgen-chromium-")
-        shots = ARGS.screenshots or tempfile.gettempdir()
-        os.makedirs(shots, exist_ok=True)
-        shot = os.path.join(shots, "dissgen-report.png")
-        base = [chromium, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
-                "--user-data-dir=" + profile, "--window-size=1400,2400", "--virtual-time-budget=5000"]
-        url = "file://" + os.path.join(self.out, "browser.html")
-        try:
-            dom = subprocess.run(base + ["--dump-dom", url], capture_output=True, text=True, timeout=180).stdout
-            subprocess.run(base + ["--screenshot=" + shot, url], capture_output=True, timeout=180)
-        finally:
-            shutil.rmtree(profile, ignore_errors=True)
         with self.checks() as check:
-            check(len(charts) >= 4, "the page has charts (%d)" % len(charts))
-            for chart in charts:
-                m = re.search(r'id="%s"(.*?)(?=<div class="chart|<h2|</body)' % re.escape(chart), dom, re.S)
-                check(m is not None and "<canvas" in m.group(1), "chromium drew chart %s" % chart)
-            check(os.path.exists(shot), "screenshot written: %s" % shot)
-            if os.path.exists(shot):
-                width, height, colours = png_pixels(shot)
-                check(width == 1400 and len(colours) > 20,
-                      "the screenshot (%dx%d) shows a drawing (%d colours)" % (width, height, len(colours)))
+            browser_checks(check, chromium, os.path.join(self.out, "browser.html"), page,
+                           screenshot_path(ARGS.screenshots, "dissgen-report.png"), 4)
 
     def test_bad_input_is_one_clear_message(self):
         p, _page, _took = self.report(self.env.path("absent.pcap"), "absent", check=False)

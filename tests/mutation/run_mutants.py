@@ -110,6 +110,7 @@ TESTS = {
     "esc_commands": integration("test_esc_commands.py"),
     "ecat_figures": integration("test_ecat_figures.py"),
     "report": integration("test_report.py"),
+    "report_cycles": integration("test_report_cycles.py"),
     "edges_handoff": integration("test_edges.py", "TestEdges.test_handoff_gives_the_other_dissector_the_leaf_only"),
     "edges_peek": integration("test_edges.py", "TestEdges.test_peek_at_shifted_bit_group_members"),
     "edges_offsets": integration("test_edges.py", "TestEdges.test_offsets_from_enclosing_containers"),

@@ -18,11 +18,7 @@ constexpr size_t kPlotBuckets = 4000;     // points per curve, at most
 constexpr size_t kMarkerLimit = 4000;     // lost / working-counter markers drawn, at most
 
 std::string events_json(const std::vector<Event>& events) {
-    std::string out = "[";
-    size_t step = events.size() > kMarkerLimit ? (events.size() + kMarkerLimit - 1) / kMarkerLimit : 1;
-    for (size_t i = 0; i < events.size(); i += step)
-        out += (i ? "," : "") + std::string("[") + num(events[i].t, 6) + "," + std::to_string(events[i].frame) + "]";
-    return out + "]";
+    return markers_json(events, [](const Event& e) { return e.frame; }, kMarkerLimit);
 }
 
 // The Slaves section's rows: by position, then by station address those
@@ -116,18 +112,6 @@ void cycle_table(const TimingModel& m, std::ostream& out) {
     out << "</tbody></table>\n";
 }
 
-std::string file_name(const std::string& path) {
-    size_t slash = path.find_last_of('/');
-    return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
-// "bus.pcapng", or "ring_00001.pcap + ring_00002.pcap" for a file set.
-std::string capture_name(const std::vector<std::string>& paths) {
-    std::string name;
-    for (const std::string& p : paths) name += (name.empty() ? "" : " + ") + file_name(p);
-    return name;
-}
-
 // The page's script: draws the charts from the embedded data.
 const char kScript[] = R"JS(
 (function () {
@@ -136,21 +120,7 @@ const char kScript[] = R"JS(
   const stateLevel = {1: 1, 2: 2, 3: 2.5, 4: 3, 8: 4};
   const common = {customBars: true, legend: 'follow', labelsSeparateLines: true,
                   xlabel: 'Capture time (s)', animatedZooms: false, axes: {y: {axisLabelWidth: 64}}};
-  function bars(series) { return series.map(p => [p[0], p[1]]); }
-  function chart(id, rows, options) {
-    const el = document.getElementById(id);
-    if (!el) return;
-    if (!rows.length) { el.textContent = 'No values.'; el.className += ' empty'; return; }
-    new Dygraph(el, rows, options);
-  }
-  data.cycles.forEach(c => {
-    chart('period-' + c.number, bars(c.period),
-          Object.assign({labels: ['t', 'Period (µs)'], ylabel: 'Period (µs)',
-                         title: 'Cycle ' + c.number + ': period over time'}, common));
-    chart('jitter-' + c.number, c.histogram,
-          {labels: ['Jitter (µs)', 'Frames'], stepPlot: true, fillGraph: true, xRangePad: 12, xlabel: 'Jitter (µs)',
-           ylabel: 'Frames', title: 'Cycle ' + c.number + ': jitter histogram', axes: {y: {axisLabelWidth: 64}}});
-  });
+  cycleCharts(data.cycles, common, 'Frames');
   // Round trips with the lost frames and working-counter errors as marks on top.
   const top = data.round_trip.reduce((m, p) => Math.max(m, p[1][2]), 0) * 1.05 || 1;
   const rows = bars(data.round_trip).map(p => [p[0], p[1], null, null]);
@@ -178,28 +148,13 @@ const char kScript[] = R"JS(
 })();
 )JS";
 
-const char kStyle[] = R"CSS(
-body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; }
-h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 1.6em; }
-table { border-collapse: collapse; font-size: 0.85em; }
-th, td { border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: right; }
-td:nth-child(2), th:nth-child(2) { text-align: left; }
-.pair { display: flex; gap: 1em; flex-wrap: wrap; }
-.chart { width: 640px; height: 280px; }
-.chart.wide { width: 1300px; }
-.empty { height: auto; color: #777; }
-.note { color: #555; }
-)CSS";
-
 }  // namespace
 
 std::string write_report_html(const TimingModel& m, const std::string& tool_version, std::ostream& out) {
     std::string js, css, error = read_dygraphs(js, css);
     if (!error.empty()) return error;
 
-    out << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>EtherCAT timing: "
-        << escape_html(capture_name(m.captures)) << "</title>\n<style>" << css << "</style>\n<style>" << kStyle
-        << "</style>\n<script>" << js << "</script>\n</head><body>\n";
+    write_page_head("EtherCAT timing: " + capture_name(m.captures), js, css, out);
     // The headline's working-counter count is the expert info's kind (differs
     // from the expected), not the cycle table's: it says so in the expert's words.
     out << "<h1>EtherCAT timing: " << escape_html(capture_name(m.captures)) << "</h1>\n<p class=\"note\">"
@@ -240,17 +195,9 @@ std::string write_report_html(const TimingModel& m, const std::string& tool_vers
 
     // The data the charts draw.
     out << "<script type=\"application/json\" id=\"report-data\">{\"duration\":" << num(m.duration, 6)
-        << ",\"cycles\":[";
-    bool first = true;
-    for (const auto& [number, c] : m.cycles) {
-        out << (first ? "" : ",") << "{\"number\":" << number << ",\"signature\":" << json_string(c.signature)
-            << ",\"period\":" << series_json(c.period, kPlotBuckets) << ",\"histogram\":" << histogram_json(c.jitter)
-            << "}";
-        first = false;
-    }
-    out << "],\"round_trip\":" << series_json(m.round_trip, kPlotBuckets) << ",\"lost\":" << events_json(m.lost)
+        << ",\"cycles\":" << cycles_json(m.cycles, kPlotBuckets) << ",\"round_trip\":" << series_json(m.round_trip, kPlotBuckets) << ",\"lost\":" << events_json(m.lost)
         << ",\"wkc_errors\":" << events_json(m.wkc_differs) << ",\"slaves\":" << slaves_json(slaves) << "}</script>\n";
-    out << "<script>" << kScript << "</script>\n</body></html>\n";
+    out << "<script>" << kChartScript << kScript << "</script>\n</body></html>\n";
     return out ? "" : "cannot write the report";
 }
 

@@ -37,46 +37,7 @@ const char* const kRuntimeExperts[] = {
 // The network check's expert infos.
 const char* const kNetworkExperts[] = {runtime_expert::ok, runtime_expert::count, runtime_expert::model};
 
-bool known_field(const std::vector<std::string>& known, const std::string& name) {
-    return std::find(known.begin(), known.end(), name) != known.end();
-}
-
-// base 0: "0x0130" as tshark prints hexadecimal fields, "12" as decimal ones.
-bool parse_uint(std::string_view text, uint64_t& value, int base = 0) {
-    if (text.empty() || text[0] == '-') return false;
-    std::string s(text);
-    char* end = nullptr;
-    value = std::strtoull(s.c_str(), &end, base);
-    return end && *end == '\0';
-}
-
-// frame.time_epoch "1700000000.123456789" -> whole seconds and ns.
-bool parse_epoch(std::string_view text, int64_t& s, int64_t& ns) {
-    size_t dot = text.find('.');
-    uint64_t whole = 0, frac = 0;
-    if (!parse_uint(text.substr(0, dot), whole, 10)) return false;
-    ns = 0;
-    if (dot != std::string_view::npos) {
-        std::string_view digits = text.substr(dot + 1, 9);
-        if (!digits.empty() && !parse_uint(digits, frac, 10)) return false;
-        ns = static_cast<int64_t>(frac);
-        for (size_t i = digits.size(); i < 9; ++i) ns *= 10;
-    }
-    s = static_cast<int64_t>(whole);
-    return true;
-}
-
 }  // namespace
-
-bool parse_seconds_ns(std::string_view text, int64_t& ns) {
-    bool negative = !text.empty() && text[0] == '-';
-    if (negative) text.remove_prefix(1);
-    int64_t s = 0, frac = 0;
-    if (!parse_epoch(text, s, frac)) return false;
-    ns = s * 1000000000 + frac;
-    if (negative) ns = -ns;
-    return true;
-}
 
 std::string al_state_name(unsigned status) {
     switch (status & 0x0f) {
@@ -98,7 +59,7 @@ std::string ethercat_protocol(const std::vector<std::string>& known) {
     for (const std::string& f : known)
         if (f.size() > tail.size() && f.compare(f.size() - tail.size(), tail.size(), tail) == 0) {
             std::string filter = f.substr(0, f.size() - tail.size());
-            if (known_field(known, runtime_filter_name(filter, runtime_field::time))) return filter;
+            if (has_field(known, runtime_filter_name(filter, runtime_field::time))) return filter;
         }
     return "";
 }
@@ -110,16 +71,16 @@ std::vector<std::string> TimingModelBuilder::fields(const std::string& filter, c
     for (const char* e : kRuntimeExperts) names.push_back(runtime_filter_name(filter, e));
     std::vector<std::string> asked;
     for (const std::string& n : names)
-        if (known_field(known, n)) asked.push_back(n);
+        if (has_field(known, n)) asked.push_back(n);
     return asked;
 }
 
 std::vector<std::string> TimingModelBuilder::statistics_args(const std::string& filter,
                                                              const std::vector<std::string>& known) {
     std::vector<std::string> args;
-    if (known_field(known, runtime_filter_name(filter, runtime_field::cycle)))
+    if (has_field(known, runtime_filter_name(filter, runtime_field::cycle)))
         args.insert(args.end(), {"-z", filter + ",cycles"});
-    if (known_field(known, runtime_filter_name(filter, runtime_expert::ok))) {
+    if (has_field(known, runtime_filter_name(filter, runtime_expert::ok))) {
         std::string experts;
         for (const char* e : kNetworkExperts) experts += (experts.empty() ? "" : " || ") + runtime_filter_name(filter, e);
         args.insert(args.end(), {"-z", "expert,chat," + experts});
@@ -167,16 +128,6 @@ void TimingModelBuilder::add_network_line(std::string_view line) {
 
 namespace {
 
-// "  period min/median/p99/max (ns): 1 2 3 4", or "  period: none".
-bool parse_quantiles(std::string_view rest, Quantiles& q) {
-    if (rest == "none") return true;
-    std::string text(rest);
-    long long v[4];
-    if (std::sscanf(text.c_str(), "%lld %lld %lld %lld", &v[0], &v[1], &v[2], &v[3]) != 4) return false;
-    q = {v[0], v[1], v[2], v[3]};
-    return true;
-}
-
 bool parse_count(std::string_view rest, uint64_t& count) { return parse_uint(rest, count, 10); }
 
 // One "  label: value" line of a cycle's block into its figure.
@@ -215,15 +166,9 @@ bool TimingModelBuilder::add_cycle_statistics_line(std::string_view line) {
 
 void TimingModelBuilder::add(const FieldRow& row) {
     uint64_t frame = 0;
-    int64_t s = 0, ns = 0;
-    if (!parse_uint(value(row, column("frame.number")), frame) ||
-        !parse_epoch(value(row, column("frame.time_epoch")), s, ns))
+    double t = 0;
+    if (!parse_uint(value(row, column("frame.number")), frame) || !clock_.at(value(row, column("frame.time_epoch")), t))
         return;
-    if (first_s_ < 0) {
-        first_s_ = s;
-        first_ns_ = ns;
-    }
-    double t = static_cast<double>(s - first_s_) + static_cast<double>(ns - first_ns_) * 1e-9;
     model_.frames++;
     model_.duration = t;
 

@@ -15,13 +15,9 @@
 
 #include "../capture_stream.h"
 #include "../charts.h"
+#include "../tshark_values.h"
 
 namespace dissgen {
-
-// min/median/p99/max in ns, as -z P,cycles prints them; zero for "none".
-struct Quantiles {
-    int64_t min = 0, median = 0, p99 = 0, max = 0;
-};
 
 // One cycle's figures, the lines of its -z P,cycles block (docs/manual.md, "Cycles").
 struct CycleFigures {
@@ -107,11 +103,8 @@ private:
     TimingModel& model_;
     std::unordered_map<std::string, int> columns_;
     Cycle* statistics_cycle_ = nullptr;  // the -z P,cycles block being read
-    int64_t first_s_ = -1, first_ns_ = 0;
+    CaptureClock clock_;
 };
-
-// "0.001000250" or "-0.000000125" (seconds, as tshark prints relative times) -> ns.
-bool parse_seconds_ns(std::string_view text, int64_t& ns);
 
 // "INIT", "PREOP", "BOOT", "SAFEOP", "OP" (the state bits only, not the error bit).
 std::string al_state_name(unsigned status);
