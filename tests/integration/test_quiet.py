@@ -303,6 +303,15 @@ def rule_findings_frames():
     return [m.ethernet_frame(m.body(*r)) for r in m.replies(41, 40)]
 
 
+def dates_guids_frames():
+    """tests/rules/dates_guids_shared.xml: test_dates_guids_shared_names.py's messages of
+    every kind (dates and GUIDs, each alternative sharing a filter name)."""
+    import test_dates_guids_shared_names as m
+    payloads = [m.times_message(), m.short_message(5, 1704067200, 500), m.long_message(7, 10**18 + 3),
+                m.other_message(4, 9), m.other_message(9, 1)]
+    return [m.frame(p) for p in payloads * 4]
+
+
 def overlays_frames():
     """tests/rules/overlays.xml: test_overlays.py's messages, well-formed and malformed."""
     import test_overlays as m
@@ -380,6 +389,7 @@ CAPTURES = {
     "tests/rules/request_defined.xml": request_defined_frames,
     "tests/rules/no_padding.xml": no_padding_frames,
     "tests/rules/findings.xml": rule_findings_frames,
+    "tests/rules/dates_guids_shared.xml": dates_guids_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,
