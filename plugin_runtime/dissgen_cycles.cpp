@@ -52,7 +52,6 @@ using namespace dg_periods;
 
 /* p_add_proto_data key of a message's mark: this, or-ed with the message's number in its frame. */
 const guint32 mark_key = 0x63790000u;
-const guint most_window = 64; /* the generator accepts window="1" to "64" */
 
 struct cycle;
 
@@ -170,19 +169,6 @@ stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info 
     return s;
 }
 
-/* The median of the window's regular periods when all of them lie within
- * half of it either way; 0 otherwise. */
-guint32 window_median(const stream *s, guint window)
-{
-    guint32 v[most_window];
-    memcpy(v, s->recent, window * sizeof(guint32));
-    qsort(v, window, sizeof *v, compare_u32);
-    guint32 median = v[(window - 1) / 2];
-    if (median == 0 || median == G_MAXUINT32) return 0;
-    if (2 * (guint64)v[0] < median || 2 * (guint64)v[window - 1] > 3 * (guint64)median) return 0;
-    return median;
-}
-
 cycle *new_cycle(capture_state *c, stream *s, guint window, guint32 frame)
 {
     cycle *cy = wmem_new0(wmem_file_scope(), cycle);
@@ -250,7 +236,7 @@ mark *time_message(capture_state *c, const dg_cycle_input *in, const packet_info
             s->recent[s->next_slot] = clamp_period(period);
             s->next_slot = (s->next_slot + 1) % cy->window;
             if (s->regular < cy->window) s->regular++;
-            if (s->regular == cy->window && window_median(s, cy->window))
+            if (s->regular == cy->window && steady_median(s->recent, cy->window))
                 s->cyc = new_cycle(c, s, cy->window, pinfo->num);
         }
     }
@@ -282,14 +268,6 @@ void keep_first_mark(capture_state *c, guint32 frame, const mark *m)
         c->by_frame_size = size;
     }
     c->by_frame[frame] = m;
-}
-
-nstime_t nstime_of(gint64 ns)
-{
-    nstime_t t;
-    t.secs = (time_t)(ns / 1000000000);
-    t.nsecs = (int)(ns % 1000000000);
-    return t;
 }
 
 void add_generated_time(proto_tree *tree, int hf, tvbuff_t *tvb, gint64 ns)

@@ -8,6 +8,7 @@
  *   running_median   the lower median of every period added so far, in
  *                    O(log n) per period (two heaps)
  *   quantiles_of()   minimum, median, 99th percentile and maximum
+ *   steady_median()  whether a detection window's periods make a cycle
  *   and what their reports share: -z P,cycles drawn at the end of the
  *   capture (listen_to_the_end), its quantile lines, statistics tree rows
  *
@@ -131,6 +132,33 @@ inline guint32 clamp_period(gint64 ns)
 }
 
 inline gint64 ns_of(const nstime_t *t) { return (gint64)t->secs * 1000000000 + t->nsecs; }
+
+inline nstime_t nstime_of(gint64 ns)
+{
+    nstime_t t;
+    t.secs = (time_t)(ns / 1000000000);
+    t.nsecs = (int)(ns % 1000000000);
+    return t;
+}
+
+/* the longest detection window of a cycle analysis: the generator accepts
+ * window="1" to "64" */
+const guint most_window = 64;
+
+/* The median of a detection window's periods (n of them, at most
+ * most_window, in any order) when all of them lie within half of it either
+ * way: a steady stream, a cycle. 0 when they do not, or when the median is
+ * no period (0, or clamped at 4.29 s). */
+inline guint32 steady_median(const guint32 *periods, guint n)
+{
+    guint32 v[most_window];
+    memcpy(v, periods, n * sizeof(guint32));
+    qsort(v, n, sizeof *v, compare_u32);
+    guint32 median = v[(n - 1) / 2];
+    if (median == 0 || median == G_MAXUINT32) return 0;
+    if (2 * (guint64)v[0] < median || 2 * (guint64)v[n - 1] > 3 * (guint64)median) return 0;
+    return median;
+}
 
 /* --- reports ------------------------------------------------------------ */
 

@@ -90,7 +90,7 @@ struct signature {
     guint32 last_answered_frame; /* the last of its frames answered, and when */
     nstime_t last_return;
     nstime_t last_rtt;
-    guint64 recent[window];      /* its last regular periods, a ring */
+    guint32 recent[window];      /* its last regular periods, a ring */
     guint regular;               /* how many in a row (up to window) */
     guint next_slot;
     cycle *cyc;
@@ -178,24 +178,6 @@ signature *signature_of(cycle_model *m, const datagram *d, guint n)
     return s;
 }
 
-/* The median of the regular periods in the window, when all of them lie
- * within half of it either way; 0 otherwise. */
-guint64 window_median(const signature *s)
-{
-    guint64 v[window];
-    memcpy(v, s->recent, sizeof v);
-    for (guint i = 1; i < window; i++)
-        for (guint j = i; j > 0 && v[j - 1] > v[j]; j--) {
-            guint64 t = v[j];
-            v[j] = v[j - 1];
-            v[j - 1] = t;
-        }
-    guint64 median = v[(window - 1) / 2];
-    if (median == 0 || median > G_MAXUINT32) return 0;
-    if (2 * v[0] < median || 2 * v[window - 1] > 3 * median) return 0;
-    return median;
-}
-
 cycle *new_cycle(cycle_model *m, signature *s, guint32 frame)
 {
     cycle *c = wmem_new0(wmem_file_scope(), cycle);
@@ -211,7 +193,7 @@ cycle *new_cycle(cycle_model *m, signature *s, guint32 frame)
     m->last = c;
     /* the window's periods, oldest first; the last is the marking frame's own */
     for (guint i = 0; i + 1 < window; i++) {
-        guint32 p = (guint32)s->recent[(s->next_slot + i) % window];
+        guint32 p = s->recent[(s->next_slot + i) % window];
         c->window_periods[i] = p;
         c->periods.add(p);
     }
@@ -251,10 +233,10 @@ cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_
             s->regular = 0;
             return mark;
         }
-        s->recent[s->next_slot] = (guint64)period;
+        s->recent[s->next_slot] = clamp_period(period);
         s->next_slot = (s->next_slot + 1) % window;
         if (s->regular < window) s->regular++;
-        if (s->regular < window || !window_median(s)) return mark;
+        if (s->regular < window || !steady_median(s->recent, window)) return mark;
         s->cyc = new_cycle(m, s, pinfo->num);
     }
     cycle *c = s->cyc;
@@ -370,14 +352,6 @@ double dc_returned(cycle_model *m, const datagram *s, const datagram *b, guint n
 namespace {
 
 int hf_cycle = -1, hf_period = -1, hf_jitter = -1, hf_systime = -1, hf_drift = -1;
-
-nstime_t nstime_of(gint64 ns)
-{
-    nstime_t t;
-    t.secs = (time_t)(ns / 1000000000);
-    t.nsecs = (int)(ns % 1000000000);
-    return t;
-}
 
 gint64 period_of(const cycle_mark *c, guint32 frame)
 {
