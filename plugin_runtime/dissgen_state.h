@@ -263,10 +263,7 @@ static inline void cycle_record(dg_state *st, const dg_node *n, guint64 value)
     }
     const dg_cycles *c = st->p->cycles;
     const dg_cycle_test *t = &c->tests[x->cycle_test];
-    gboolean holds = FALSE;
-    for (guint i = t->range_first; i < (guint)t->range_first + t->range_count && !holds; i++)
-        holds = value >= c->ranges[i].low && value <= c->ranges[i].high;
-    if (!holds) return;
+    if (!in_ranges(c->ranges, t->range_first, t->range_count, value)) return;
     if (x->cycle_role == DG_CYCLE_ONLY)
         st->cycle_only_held |= (guint32)1 << x->cycle_test;
     else

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 /* valid="LIST" fields and <heuristic> registration: see dissgen_validity.h. */
 #include "dissgen_validity.h"
+#include "dissgen_values.h"
 
 #include <epan/conversation.h>
 #include <epan/dissectors/packet-tcp.h>
@@ -8,13 +9,6 @@
 #include <string.h>
 
 namespace {
-
-gboolean listed(const dg_range *ranges, guint16 first, guint16 count, guint64 value)
-{
-    for (guint16 i = first; i < first + count; i++)
-        if (value >= ranges[i].low && value <= ranges[i].high) return TRUE;
-    return FALSE;
-}
 
 /* The field's value; its bytes are known to be there. */
 guint64 field_value(const dg_valid_field *f, tvbuff_t *tvb, gint at)
@@ -80,9 +74,9 @@ gboolean dg_valid_at(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, gi
 {
     for (guint16 i = 0; i < v->field_count; i++) {
         const dg_valid_field *f = &v->fields[i];
-        if (f->hook_count && !listed(v->ranges, f->hook_first, f->hook_count, pinfo->match_uint)) continue;
+        if (f->hook_count && !dg_rt::in_ranges(v->ranges, f->hook_first, f->hook_count, pinfo->match_uint)) continue;
         if ((gint64)f->offset + f->length > (gint64)available) return FALSE;
-        if (!listed(v->ranges, f->in_first, f->in_count, field_value(f, tvb, offset + (gint)f->offset))) return FALSE;
+        if (!dg_rt::in_ranges(v->ranges, f->in_first, f->in_count, field_value(f, tvb, offset + (gint)f->offset))) return FALSE;
     }
     return TRUE;
 }
