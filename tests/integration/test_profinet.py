@@ -230,9 +230,46 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
                 rows = self.env.tshark(["-r", cap, "-Y", "pnr.expert.bad_length", "-T", "fields",
                                         "-e", "frame.number"] + two_pass).stdout.split()
                 check(rows == [str(short)], "bad_length %s on frame %d only: %s" % (two_pass, short, rows))
-            clean = self.env.tshark(["-r", self.capture, "-Y", "_ws.expert", "-T", "fields",
+            clean = self.env.tshark(["-r", self.capture, "-Y", "_ws.expert && !(pnr.finding.provider_stopped || pnr.finding.station_problem || pnr.finding.data_invalid)", "-T", "fields",
                                      "-e", "frame.number"]).stdout.split()
-            check(clean == [], "no expert info on the generated captures: %s" % clean[:5])
+            check(clean == [], "no expert info but the status findings on the generated captures: %s" % clean[:5])
+
+    def test_data_status_findings_where_the_bits_say(self):
+        """provider_stopped, station_problem and data_invalid fire on exactly the cyclic frames
+        whose DataStatus byte says so (Ignore clear), each once, in one pass and with -2."""
+        want = {}
+        for number, frame in enumerate(self.frames, 1):
+            frame_id = struct.unpack(">H", frame[14:16])[0]
+            if not any(low <= frame_id <= high for low, high in pngen.CLASS_RANGES):
+                continue
+            status = frame[-2]
+            names = set()
+            if not status & 0x80:
+                if not status & 0x10:
+                    names.add("provider_stopped")
+                if not status & 0x20:
+                    names.add("station_problem")
+                if status & 0x10 and not status & 0x04:
+                    names.add("data_invalid")
+            if names:
+                want[number] = sorted(names)
+        with self.checks() as check:
+            check(all(any(n in v for v in want.values()) for n in ("provider_stopped", "station_problem",
+                                                                    "data_invalid")),
+                  "the capture holds every status finding")
+            for two_pass in ([], ["-2"]):
+                got = {}
+                for name in ("provider_stopped", "station_problem", "data_invalid"):
+                    out = self.env.tshark(["-r", self.capture, "-Y", "pnr.finding." + name, "-T", "fields",
+                                           "-e", "frame.number", "-e", "pnr.finding." + name,
+                                           "-E", "occurrence=a"] + two_pass).stdout.splitlines()
+                    for line in out:
+                        got.setdefault(int(line.split("\t")[0]), []).append(name)
+                got = {k: sorted(v) for k, v in got.items()}
+                differ = [(k, got.get(k), want.get(k)) for k in sorted(set(got) | set(want))
+                          if got.get(k) != want.get(k)]
+                check(got == want, "%s: findings on %d frames, the bytes say %d; first differences %s"
+                      % (two_pass or "one pass", len(got), len(want), differ[:4]))
 
     def test_trailer_of_a_frame_cut_by_the_capture_is_not_taken_from_its_data(self):
         """A cyclic frame the capture cut short (its wire length kept) has its trailer past
