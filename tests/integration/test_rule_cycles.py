@@ -7,7 +7,8 @@ sequence number of the Sequenced Address item).
 Every message's enipr.cycle, .period, .jitter, .lost and .duplicate, the expert infos
 (exactly on the frames with a gap or a repeat, nowhere else) and `-z enipr,cycles` are
 checked against a model of the manual's rules ("Cycles of any protocol") computed here
-from the bytes and timestamps of the capture, to the nanosecond, in one pass and with -2:
+from the bytes and timestamps of the capture, to the nanosecond, in one pass and with -2,
+and so is the statistics tree of the Statistics menu (`-2 -z enipr.cycles,tree`):
 
 - a generated capture (nanosecond timestamps): several connections at different RPIs with
   known injected jitter, drops of one and of three packets, a packet sent twice, a
@@ -20,6 +21,7 @@ from the bytes and timestamps of the capture, to the nanosecond, in one pass and
 """
 
 import os
+import re
 import random
 import struct
 import sys
@@ -153,6 +155,31 @@ class TestRuleCycles(TsharkTestCase, unittest.TestCase):
                 check(g["name"] == name, "cycle %d is %r, expected %r" % (c["number"], g["name"], name))
                 want = figures(c)
                 check(g["figures"] == want, "cycle %d figures %s, expected %s" % (c["number"], g["figures"], want))
+        self.assert_statistics_tree(path, cycles, check)
+
+    def assert_statistics_tree(self, path, cycles, check):
+        """The statistics tree (Statistics menu; tshark -2 -z enipr.cycles,tree) holds the model's
+        figures, row by row (the jitter's standard deviation rounded to the ns)."""
+        out = self.env.tshark(["-2", "-r", path, "-q", "-z", "enipr.cycles,tree"]).stdout
+        have = {}
+        for line in out.splitlines():
+            m = re.match(r"^\s*Cycle (\d+) (\S.*?)\s{2,}(\d+)\s", line)
+            if m:
+                have[(int(m.group(1)), m.group(2))] = int(m.group(3))
+        want = {}
+        for c in cycles:
+            f, n = figures(c), c["number"]
+            want[(n, "messages")] = f["messages"]
+            want[(n, "nominal period (ns)")] = f["nominal"]
+            for name, value in zip(("min", "median", "p99", "max"), f["period"] or ()):
+                want[(n, "period %s (ns)" % name)] = min(value, 2**31 - 1)
+            want[(n, "jitter std dev (ns)")] = int(float(f["jitter sd"]) + 0.5)
+            want[(n, "messages lost")] = f["lost"]
+            want[(n, "duplicates")] = f["duplicates"]
+        differ = sorted(k for k in set(have) | set(want) if k not in have or k not in want or
+                        abs(have[k] - want[k]) > (1 if k[1].startswith("jitter") else 0))  # sd: rounding
+        check(not differ, "-2 -z enipr.cycles,tree: %d rows as the model computes%s" % (
+            len(want), "" if not differ else " (differ: %s)" % [(k, have.get(k), want.get(k)) for k in differ[:5]]))
 
     def test_generated_capture_to_the_nanosecond(self):
         messages = io_messages(read_pcap(self.generated))
