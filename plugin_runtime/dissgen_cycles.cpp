@@ -372,45 +372,29 @@ dg_tap_init_result cycles_cli_init(const char *, void *)
     return dg_tap_init_done(listen_to_the_end(&cli_filter, cycles_draw));
 }
 
-/* The statistics tree (Wireshark's Statistics menu): the same figures, set
- * once the capture's state is complete, which it is when a frame is tapped
- * that the first pass has gone beyond (the GUI taps a capture once it is
- * read, tshark -2 in its second pass). In one pass the tree stays empty;
- * -z P,cycles is the way there. */
+/* The statistics tree (Wireshark's Statistics menu): the same figures,
+ * filled once the capture's state is complete (st_fill_now). */
 gboolean st_filled;
 
 void st_init(stats_tree *) { st_filled = FALSE; }
 
 tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *, const void *, tap_flags_t)
 {
-    if (st_filled || !capture || pinfo->num >= capture->last_frame) return TAP_PACKET_DONT_REDRAW;
-    st_filled = TRUE;
+    if (!st_fill_now(&st_filled, capture != NULL, pinfo->num, capture ? capture->last_frame : 0))
+        return TAP_PACKET_DONT_REDRAW;
+    const gboolean counted = protocol->cycles->sequence_bits > 0;
     for (const cycle *c = capture->first; c; c = c->next) {
         figures f = figures_of(c);
         char *text = stream_text(c->s);
-        char *name = g_strdup_printf("Cycle %u: %s", c->number, text);
-        int id = stats_tree_create_node(st, name, 0, STAT_DT_INT, TRUE);
-        set_stat_node(st, name, 0, FALSE, (gint)c->frames);
-        g_free(name);
+        int id = st_cycle_node(st, c->number, text, c->frames);
         g_free(text);
-        struct {
-            const char *what;
-            guint64 value;
-            gboolean shown;
-        } rows[] = {{"messages", c->frames, TRUE},
-                    {"nominal period (ns)", f.nominal, TRUE},
-                    {"period min (ns)", f.period.min, f.period.n > 0},
-                    {"period median (ns)", f.period.median, f.period.n > 0},
-                    {"period p99 (ns)", f.period.p99, f.period.n > 0},
-                    {"period max (ns)", f.period.max, f.period.n > 0},
-                    {"jitter std dev (ns)", (guint64)(f.jitter_sd + 0.5), TRUE},
-                    {"messages lost", c->s->lost, protocol->cycles->sequence_bits > 0},
-                    {"duplicates", c->s->duplicates, protocol->cycles->sequence_bits > 0}};
-        for (const auto &row : rows) {
-            if (!row.shown) continue;
-            char *label = g_strdup_printf("Cycle %u %s", c->number, row.what);
-            st_set(st, label, id, row.value);
-            g_free(label);
+        st_cycle_row(st, c->number, "messages", id, c->frames);
+        st_cycle_row(st, c->number, "nominal period (ns)", id, f.nominal);
+        st_quantile_rows(st, c->number, "period", &f.period, id);
+        st_cycle_row(st, c->number, "jitter std dev (ns)", id, (guint64)(f.jitter_sd + 0.5));
+        if (counted) {
+            st_cycle_row(st, c->number, "messages lost", id, c->s->lost);
+            st_cycle_row(st, c->number, "duplicates", id, c->s->duplicates);
         }
     }
     return TAP_PACKET_REDRAW;

@@ -177,6 +177,49 @@ inline void st_set(stats_tree *st, const char *name, int parent, guint64 value)
     set_stat_node(st, name, parent, FALSE, (gint)MIN(value, (guint64)G_MAXINT));
 }
 
+/* The statistics tree's node of cycle `number` ("Cycle N: TEXT", counting
+ * its frames) under the root; its id, the parent of the cycle's rows. */
+inline int st_cycle_node(stats_tree *st, guint number, const char *text, guint frames)
+{
+    char *name = g_strdup_printf("Cycle %u: %s", number, text);
+    int id = stats_tree_create_node(st, name, 0, STAT_DT_INT, TRUE);
+    set_stat_node(st, name, 0, FALSE, (gint)frames);
+    g_free(name);
+    return id;
+}
+
+/* A row "Cycle N WHAT" of cycle `number` under its node `parent`. */
+inline void st_cycle_row(stats_tree *st, guint number, const char *what, int parent, guint64 value)
+{
+    char *label = g_strdup_printf("Cycle %u %s", number, what);
+    st_set(st, label, parent, value);
+    g_free(label);
+}
+
+/* The rows "Cycle N WHAT min/median/p99/max (ns)", when there are values. */
+inline void st_quantile_rows(stats_tree *st, guint number, const char *what, const quantiles *q, int parent)
+{
+    const char *const names[] = {"min", "median", "p99", "max"};
+    const guint32 values[] = {q->min, q->median, q->p99, q->max};
+    for (guint i = 0; q->n && i < 4; i++) {
+        char *row = g_strdup_printf("%s %s (ns)", what, names[i]);
+        st_cycle_row(st, number, row, parent, values[i]);
+        g_free(row);
+    }
+}
+
+/* Whether to fill a statistics tree now: once per tap run, and only once the
+ * capture's state is complete, which it is when a frame is tapped that the
+ * first pass has gone beyond (the GUI taps a capture once it is read, tshark
+ * -2 in its second pass). In one pass tshark taps each frame as the first
+ * pass reaches it: the tree stays empty; -z P,cycles is the way there. */
+inline gboolean st_fill_now(gboolean *filled, gboolean have_state, guint32 frame, guint32 last_frame)
+{
+    if (*filled || !have_state || frame >= last_frame) return FALSE;
+    *filled = TRUE;
+    return TRUE;
+}
+
 inline tap_packet_status no_packet(void *, packet_info *, epan_dissect_t *, const void *, tap_flags_t)
 {
     return TAP_PACKET_DONT_REDRAW;

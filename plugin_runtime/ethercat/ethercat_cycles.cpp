@@ -492,54 +492,29 @@ dg_tap_init_result cycles_cli_init(const char *, void *)
     return dg_tap_init_done(listen_to_the_end(&cycles_filter, cycles_draw));
 }
 
-/* The statistics tree (Wireshark's Statistics menu): the same figures, set
- * once the capture's state is complete, which it is when a frame is tapped
- * that the first pass has gone beyond (the GUI taps a capture once it is
- * read, tshark -2 in its second pass). In one pass tshark taps each frame as
- * the first pass reaches it: the tree stays empty; -z ecatr,cycles is the
- * way there. */
+/* The statistics tree (Wireshark's Statistics menu): the same figures,
+ * filled once the capture's state is complete (st_fill_now). */
 gboolean st_filled;
 
 void st_init(stats_tree *) { st_filled = FALSE; }
 
-void st_quantiles(stats_tree *st, guint cycle, const char *what, const quantiles *q, int parent)
-{
-    const char *const names[] = {"min", "median", "p99", "max"};
-    const guint32 values[] = {q->min, q->median, q->p99, q->max};
-    for (guint i = 0; q->n && i < 4; i++) {
-        char *name = g_strdup_printf("Cycle %u %s %s (ns)", cycle, what, names[i]);
-        st_set(st, name, parent, values[i]);
-        g_free(name);
-    }
-}
-
 tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *, const void *, tap_flags_t)
 {
-    if (st_filled || !current || pinfo->num >= current->last_frame) return TAP_PACKET_DONT_REDRAW;
-    st_filled = TRUE;
+    if (!st_fill_now(&st_filled, current != NULL, pinfo->num, current ? current->last_frame : 0))
+        return TAP_PACKET_DONT_REDRAW;
     for (const cycle *c = current->first; c; c = c->next) {
         figures f = figures_of(c);
         char *sig = signature_text(c);
-        char *name = g_strdup_printf("Cycle %u: %s", c->number, sig);
-        int id = stats_tree_create_node(st, name, 0, STAT_DT_INT, TRUE);
-        set_stat_node(st, name, 0, FALSE, (gint)c->frames);
-        g_free(name);
+        int id = st_cycle_node(st, c->number, sig, c->frames);
         g_free(sig);
-        char label[96];
-#define ST_ROW(text, value)                                                  \
-    do {                                                                     \
-        g_snprintf(label, sizeof label, "Cycle %u " text, c->number);        \
-        st_set(st, label, id, value);                                        \
-    } while (0)
-        ST_ROW("frames", c->frames);
-        ST_ROW("nominal period (ns)", f.nominal);
-        st_quantiles(st, c->number, "period", &f.period, id);
-        ST_ROW("jitter std dev (ns)", (guint64)(f.jitter_sd + 0.5));
-        st_quantiles(st, c->number, "round trip", &f.rtt, id);
-        ST_ROW("frames returned", c->answered);
-        ST_ROW("frames lost", f.lost);
-        ST_ROW("working counter errors", c->wkc_errors);
-#undef ST_ROW
+        st_cycle_row(st, c->number, "frames", id, c->frames);
+        st_cycle_row(st, c->number, "nominal period (ns)", id, f.nominal);
+        st_quantile_rows(st, c->number, "period", &f.period, id);
+        st_cycle_row(st, c->number, "jitter std dev (ns)", id, (guint64)(f.jitter_sd + 0.5));
+        st_quantile_rows(st, c->number, "round trip", &f.rtt, id);
+        st_cycle_row(st, c->number, "frames returned", id, c->answered);
+        st_cycle_row(st, c->number, "frames lost", id, f.lost);
+        st_cycle_row(st, c->number, "working counter errors", id, c->wkc_errors);
     }
     return TAP_PACKET_REDRAW;
 }
