@@ -15,8 +15,8 @@
 
 /* What the walk decoded of one message for <cycles> (first pass). */
 typedef struct dg_cycle_input {
-    const guint64 *values;     /* the signature fields' values, in decoding order */
-    const guint16 *nodes;      /* the node of each (dg_protocol.nodes), for the stream's name */
+    guint64 *values;           /* the signature fields' values, in decoding order */
+    guint16 *nodes;            /* the node of each (dg_protocol.nodes), for the stream's name */
     guint count;
     guint64 sequence;
     gboolean has_sequence;

@@ -97,12 +97,8 @@ struct dg_state {
     /* <cycles>, first pass only: what the leaves with a dg_extra.cycle_role
      * decoded (dg_cycle_input) */
     gboolean wants_cycles;
-    guint64 *cycle_values;
-    guint16 *cycle_nodes;
-    guint cycle_count, cycle_capacity;
-    guint64 cycle_sequence;
-    gboolean has_cycle_sequence, cycle_never;
-    guint32 cycle_only_held;
+    dg_cycle_input cycle;
+    guint cycle_capacity;
     /* request{...}: what the paired request kept, NULL when it is not known */
     mutable const dg_request_values *request;
     mutable gboolean request_missed; /* a value read the request, and it is not known */
@@ -244,30 +240,29 @@ static inline void view_append(dg_state *st, const dg_node *n, guint64 value, gi
 static inline void cycle_record(dg_state *st, const dg_node *n, guint64 value)
 {
     const dg_extra *x = n->extra;
+    dg_cycle_input *in = &st->cycle;
     if (x->cycle_role == DG_CYCLE_SIGNATURE) {
-        if (st->cycle_count == st->cycle_capacity) {
+        if (in->count == st->cycle_capacity) {
             st->cycle_capacity = st->cycle_capacity ? 2 * st->cycle_capacity : 8;
-            st->cycle_values = (guint64 *)wmem_realloc(st->pinfo->pool, st->cycle_values,
-                                                       st->cycle_capacity * sizeof(guint64));
-            st->cycle_nodes = (guint16 *)wmem_realloc(st->pinfo->pool, st->cycle_nodes,
-                                                      st->cycle_capacity * sizeof(guint16));
+            in->values = (guint64 *)wmem_realloc(st->pinfo->pool, in->values, st->cycle_capacity * sizeof(guint64));
+            in->nodes = (guint16 *)wmem_realloc(st->pinfo->pool, in->nodes, st->cycle_capacity * sizeof(guint16));
         }
-        st->cycle_values[st->cycle_count] = value;
-        st->cycle_nodes[st->cycle_count++] = (guint16)(n - st->p->nodes);
+        in->values[in->count] = value;
+        in->nodes[in->count++] = (guint16)(n - st->p->nodes);
         return;
     }
     if (x->cycle_role == DG_CYCLE_SEQUENCE) {
-        st->cycle_sequence = value;
-        st->has_cycle_sequence = TRUE;
+        in->sequence = value;
+        in->has_sequence = TRUE;
         return;
     }
     const dg_cycles *c = st->p->cycles;
     const dg_cycle_test *t = &c->tests[x->cycle_test];
     if (!in_ranges(c->ranges, t->range_first, t->range_count, value)) return;
     if (x->cycle_role == DG_CYCLE_ONLY)
-        st->cycle_only_held |= (guint32)1 << x->cycle_test;
+        in->only_held |= (guint32)1 << x->cycle_test;
     else
-        st->cycle_never = TRUE;
+        in->never = TRUE;
 }
 
 /* Whether the cycle analysis reads this leaf, in this pass. */

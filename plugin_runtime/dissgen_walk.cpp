@@ -767,9 +767,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     }
 
     if (p->cycles) {
-        const dg_cycle_input in = {st.cycle_values, st.cycle_nodes, st.cycle_count, st.cycle_sequence,
-                                   st.has_cycle_sequence, st.cycle_only_held, st.cycle_never};
-        dg_cycles_dissect(p, tvb, pinfo, subtree, st.wants_cycles ? &in : NULL, messages - 1);
+        dg_cycles_dissect(p, tvb, pinfo, subtree, st.wants_cycles ? &st.cycle : NULL, messages - 1);
     }
 
     if (st.tap) tap_queue_packet(stats_tap, pinfo, st.tap);
