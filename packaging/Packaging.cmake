@@ -201,4 +201,25 @@ set_tests_properties(version_mismatch PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 300
 add_test(NAME gui_screenshot
          COMMAND bash ${CMAKE_SOURCE_DIR}/tests/gui/screenshot.sh --ctest --dissgen $<TARGET_FILE:dissgen>
                  --out ${CMAKE_BINARY_DIR}/gui/wireshark-ethercat.png)
-set_tests_properties(gui_screenshot PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 600)
+set_tests_properties(gui_screenshot PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 600 RESOURCE_LOCK gui)
+
+# The statistics tree of each shipped protocol's cycles, opened from the real
+# Wireshark's Statistics menu on a generated capture: its window shows the rows
+# tshark -2 -z P.cycles,tree gives (read back through its Save as...); the
+# screenshots are kept as gui/statistics-STEM.png (~30 s each).
+add_test(NAME gui_cycle_captures
+         COMMAND python3 ${CMAKE_SOURCE_DIR}/tests/gui/cycle_captures.py ${CMAKE_BINARY_DIR}/gui/captures)
+set_tests_properties(gui_cycle_captures PROPERTIES FIXTURES_SETUP gui_captures)
+foreach(entry "ethercat|ECATR|ethercat-two-tasks" "enip|ENIPR|enip-io" "profinet|PNR|profinet-cyclic")
+  string(REPLACE "|" ";" parts "${entry}")
+  list(GET parts 0 stem)
+  list(GET parts 1 abbreviation)
+  list(GET parts 2 capture)
+  add_test(NAME gui_statistics_${stem}
+           COMMAND bash ${CMAKE_SOURCE_DIR}/tests/gui/screenshot.sh --ctest --dissgen $<TARGET_FILE:dissgen>
+                   --rules ${CMAKE_SOURCE_DIR}/rules/${stem}.xml
+                   --capture ${CMAKE_BINARY_DIR}/gui/captures/${capture}.pcap
+                   --statistics "${abbreviation} cycles" --out ${CMAKE_BINARY_DIR}/gui/statistics-${stem}.png)
+  set_tests_properties(gui_statistics_${stem} PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 600
+                       FIXTURES_REQUIRED gui_captures RESOURCE_LOCK gui)
+endforeach()

@@ -5,9 +5,13 @@
 # under Xvfb on samples/ethercat-demo.pcap, go to a frame, expand the rules'
 # tree, save a screenshot, and check that Wireshark started, loaded the plugin
 # with no error dialog and no loader message, and exits 0 when asked to quit.
+# With --statistics ENTRY (and --rules, --capture), open that entry of the
+# Statistics menu instead (e.g. "ENIPR cycles", the statistics tree of a rule
+# file's <cycles>), check its window shows rows and save a screenshot of it.
 #
 #   tests/gui/screenshot.sh [--dissgen PATH] [--out FILE.png] [--frame N] [--keep]
 #                           [--also-install RULES.xml] [--ctest]
+#                           [--rules RULES.xml] [--capture FILE] [--statistics ENTRY]
 #
 # Default --dissgen: build/bin/dissgen, else dissgen on PATH. Default --out: a
 # file in the temporary folder (docs/images/wireshark-ethercat.png is made with
@@ -22,7 +26,9 @@ set -u
 
 here=$(cd "$(dirname "$0")" && pwd)
 source_dir=$(cd "$here/../.." && pwd)
-dissgen="" out="" frame=8 keep=0 also="" from_ctest=0
+dissgen="" out="" frame=8 keep=0 also="" from_ctest=0 statistics=""
+capture="$source_dir/samples/ethercat-demo.pcap"
+rules="$source_dir/rules/ethercat.xml"
 while [ $# -gt 0 ]; do
   case "$1" in
     --dissgen) dissgen="$2"; shift 2 ;;
@@ -31,7 +37,11 @@ while [ $# -gt 0 ]; do
     --keep) keep=1; shift ;;
     --ctest) from_ctest=1; shift ;;
     --also-install) also=$(readlink -f "$2"); shift 2 ;;
-    *) echo "usage: $0 [--dissgen PATH] [--out FILE.png] [--frame N] [--keep] [--also-install RULES]" >&2
+    --rules) rules=$(readlink -f "$2"); shift 2 ;;
+    --capture) capture=$(readlink -f "$2"); shift 2 ;;
+    --statistics) statistics="$2"; shift 2 ;;
+    *) echo "usage: $0 [--dissgen PATH] [--out FILE.png] [--frame N] [--keep] [--also-install RULES]" \
+            "[--rules RULES.xml] [--capture FILE] [--statistics ENTRY]" >&2
        exit 2 ;;
   esac
 done
@@ -41,8 +51,9 @@ if [ -z "$dissgen" ]; then
 fi
 [ -n "$dissgen" ] && [ -x "$dissgen" ] || { echo "SKIPPED: no dissgen (build it, or pass --dissgen)"; exit 77; }
 dissgen=$(readlink -f "$dissgen")
-capture="$source_dir/samples/ethercat-demo.pcap"
-rules="$source_dir/rules/ethercat.xml"
+[ -r "$capture" ] || { echo "SKIPPED: no capture $capture"; exit 77; }
+capture_name=$(basename "$capture")
+plugin="dissgen_$(basename "$rules" .xml).so"
 t0=$(date +%s)
 
 # --- tools -------------------------------------------------------------------
@@ -80,7 +91,7 @@ chmod 755 "$work"
 home="$work/home"
 mkdir -p "$home/run" "$work/fb"
 chmod 700 "$home/run"
-cp "$capture" "$home/ethercat-demo.pcap"
+cp "$capture" "$home/$capture_name"
 xvfb_pid="" ws_pid=""
 cleanup() {
   [ -n "$ws_pid" ] && kill "$ws_pid" 2>/dev/null
@@ -123,7 +134,7 @@ else
   echo "$passed passed, $failed failed"; exit 1
 fi
 as_user "${user_env[@]}" tshark -G plugins >"$work/plugins" 2>&1
-grep -q "dissgen_ethercat.so" "$work/plugins" && ok "tshark (same user and HOME) lists dissgen_ethercat.so" ||
+grep -q "$plugin" "$work/plugins" && ok "tshark (same user and HOME) lists $plugin" ||
   not_ok "tshark does not list the plugin: $(cat "$work/plugins")"
 
 # --- X server --------------------------------------------------------------------
@@ -155,7 +166,7 @@ printf 'gui.geometry_main_upper_pane: %d\ngui.geometry_main_lower_pane: %d\n' "$
   >"$home/.config/wireshark/recent"
 [ "$(id -u)" -eq 0 ] && chown -R 65534:65534 "$home/.config"
 start_wireshark() {
-  as_user "${user_env[@]}" wireshark -r "$home/ethercat-demo.pcap" -g "$frame" -o gui.layout_type:1 \
+  as_user "${user_env[@]}" wireshark -r "$home/$capture_name" -g "$frame" -o gui.layout_type:1 \
     >"$work/wireshark.out" 2>"$work/wireshark.err" &
   ws_pid=$!
 }
@@ -173,12 +184,12 @@ windows() {
 }
 # Any window but the main one (titled "The Wireshark Network Analyzer" until the
 # file is read, then after the file) is a dialog: an error, a warning.
-dialogs() { windows | grep -v " \"ethercat-demo\.pcap" | grep -v " \"The Wireshark Network Analyzer\"" ; }
+dialogs() { windows | grep -vF " \"$capture_name" | grep -v " \"The Wireshark Network Analyzer\"" ; }
 save_screen() { python3 "$here/xwd2png.py" "$work/fb/Xvfb_screen0" "$1" && echo "    (screen saved as $1)"; }
 
 main="" found=""
 for _ in $(seq 120); do
-  main=$(windows | awk '/ "ethercat-demo\.pcap/ {print $1; exit}')
+  main=$(windows | awk -v t=" \"$capture_name" 'index($0, t) {print $1; exit}')
   found=$(dialogs)
   [ -n "$main" ] || [ -n "$found" ] && break
   if ! kill -0 "$ws_pid" 2>/dev/null; then
@@ -202,35 +213,111 @@ if [ -n "$found" ]; then
 fi
 ok "no dialog window"
 if [ -n "$main" ]; then
-  ok "Wireshark's main window shows ethercat-demo.pcap ($(( $(date +%s) - t0 ))s)"
+  ok "Wireshark's main window shows $capture_name ($(( $(date +%s) - t0 ))s)"
 else
   not_ok "no Wireshark main window with the capture; windows: $(windows | tr '\n' ' ') stderr: $(cat "$work/wireshark.err")"
   echo "$passed passed, $failed failed"; exit 1
 fi
 
-# A click in the packet details pane gives it the keyboard; select its third
-# top-level item (Frame, Ethernet II, EtherCAT) and expand it with all its
-# subtrees (Shift+Right, View > Expand Subtrees).
-xdotool windowfocus --sync "$main" 2>/dev/null || xdotool windowfocus "$main"
-sleep 0.5
-xdotool mousemove --window "$main" $((width / 2)) $((90 + list_height + details_height / 2)) click 1
-sleep 0.5
-xdotool key --delay 300 Home Down Down shift+Right
-xdotool mousemove $((width + 100)) $((height + 20))   # the pointer off the window
-sleep 1.5
+# Wireshark's Statistics menu has no search: the entry is found by opening the
+# menu (Alt+S), going down k items and taking it, k first where Debian's
+# Wireshark 4.0 puts a stats tree plugin, then around it; a wrong item's
+# dialog is closed again. Prints the entry's window id.
+open_statistics_entry() {
+  local k w d
+  for k in 26 27 25 28 24 29 23 30 31 32 33 34 35 36 37 38 39 40 22 21 20; do
+    xdotool windowfocus --sync "$main" 2>/dev/null || xdotool windowfocus "$main"
+    xdotool key Escape Escape
+    sleep 0.3
+    xdotool key alt+s
+    sleep 0.7
+    xdotool key --repeat "$k" --delay 20 Down
+    xdotool key Return
+    for _ in $(seq 12); do   # a window comes, or (a submenu, a separator) none
+      sleep 0.5
+      w=$(xdotool search --onlyvisible --name " $statistics " 2>/dev/null | head -1)
+      [ -n "$w" ] || [ -n "$(dialogs)" ] && break
+    done
+    if [ -n "$w" ]; then echo "$w"; return 0; fi
+    for d in $(dialogs | cut -d' ' -f1); do   # another item's dialog
+      xdotool windowfocus "$d" 2>/dev/null; xdotool key Escape; sleep 0.5
+    done
+  done
+  return 1
+}
 
-# --- screenshot --------------------------------------------------------------------
-eval "$(xdotool getwindowgeometry --shell "$main")"   # X Y WIDTH HEIGHT
-png="${out:-$work/wireshark-ethercat.png}"
-mkdir -p "$(dirname "$png")"
-if python3 "$here/xwd2png.py" "$work/fb/Xvfb_screen0" "$png" --crop "$X,$Y,$WIDTH,$HEIGHT"; then
-  ok "screenshot $png ($(stat -c %s "$png") bytes, ${WIDTH}x${HEIGHT})"
+# The rows "Cycle N WHAT  VALUE" of a statistics tree's text (tshark -z ...,tree,
+# or the dialog's Save as... in plain text), sorted.
+tree_rows() { sed -n 's/^ *\(Cycle [0-9][0-9]* [^ ].*[^ ]\)  *\([0-9][0-9]*\) .*$/\1 = \2/p' "$1" | sort; }
+
+if [ -n "$statistics" ]; then
+  # --- the Statistics menu entry -------------------------------------------------------
+  if dialog=$(open_statistics_entry); then
+    ok "Statistics > $statistics opens its window ($(xdotool getwindowname "$dialog"))"
+  else
+    not_ok "no entry '$statistics' in the Statistics menu; windows: $(windows | tr '\n' ' ')"
+    save_screen "${out:-$work/screen.png}"
+    echo "$passed passed, $failed failed"; exit 1
+  fi
+  xdotool mousemove $((width + 100)) $((height + 20))
+  sleep 2   # the tree is filled once the capture is tapped again
+  eval "$(xdotool getwindowgeometry --shell "$dialog")"   # X Y WIDTH HEIGHT
+  png="${out:-$work/statistics.png}"
+  mkdir -p "$(dirname "$png")"
+  python3 "$here/xwd2png.py" "$work/fb/Xvfb_screen0" "$png" --crop "$X,$Y,$WIDTH,$HEIGHT" &&
+    ok "screenshot $png ($(stat -c %s "$png") bytes, ${WIDTH}x${HEIGHT})" || not_ok "screenshot failed"
+  size=$(stat -c %s "$png" 2>/dev/null || echo 0)
+  [ "$size" -gt 10000 ] && [ "$size" -lt 300000 ] && ok "screenshot size $size bytes (10 KB .. 300 KB)" ||
+    not_ok "screenshot size $size bytes"
+  # What the window shows, through its Save as... button (bottom right, left of
+  # Close) as plain text, against tshark -2 -z TREE,tree of the same capture.
+  tree=$(echo "$statistics" | awk '{print tolower($1) "." $2}')
+  as_user "${user_env[@]}" tshark -2 -r "$home/$capture_name" -q -z "$tree,tree" >"$work/tshark-tree.txt" 2>&1
+  xdotool mousemove $((X + WIDTH - 144)) $((Y + HEIGHT - 24)) click 1
+  for _ in $(seq 20); do   # the file dialog
+    sleep 0.5
+    dialogs | grep -qv "^$dialog " && break
+  done
+  sleep 0.5
+  xdotool type --delay 20 "$home/shown.txt"
+  xdotool key Return
+  for _ in $(seq 20); do [ -s "$home/shown.txt" ] && break; sleep 0.5; done
+  tree_rows "$home/shown.txt" >"$work/shown.rows"
+  tree_rows "$work/tshark-tree.txt" >"$work/tshark.rows"
+  rows=$(wc -l <"$work/shown.rows")
+  if [ "$rows" -gt 0 ] && cmp -s "$work/shown.rows" "$work/tshark.rows"; then
+    ok "the window shows $rows rows, each as tshark -2 -z $tree,tree gives it"
+  else
+    not_ok "the window's rows ($rows) differ from tshark -2 -z $tree,tree: $(diff "$work/shown.rows" \
+      "$work/tshark.rows" | head -5 | tr '\n' ' ')"
+  fi
+  xdotool windowfocus "$dialog" 2>/dev/null; xdotool key Escape
+  sleep 1
 else
-  not_ok "screenshot failed"
+  # A click in the packet details pane gives it the keyboard; select its third
+  # top-level item (Frame, Ethernet II, EtherCAT) and expand it with all its
+  # subtrees (Shift+Right, View > Expand Subtrees).
+  xdotool windowfocus --sync "$main" 2>/dev/null || xdotool windowfocus "$main"
+  sleep 0.5
+  xdotool mousemove --window "$main" $((width / 2)) $((90 + list_height + details_height / 2)) click 1
+  sleep 0.5
+  xdotool key --delay 300 Home Down Down shift+Right
+  xdotool mousemove $((width + 100)) $((height + 20))   # the pointer off the window
+  sleep 1.5
+
+  # --- screenshot --------------------------------------------------------------------
+  eval "$(xdotool getwindowgeometry --shell "$main")"   # X Y WIDTH HEIGHT
+  png="${out:-$work/wireshark-ethercat.png}"
+  mkdir -p "$(dirname "$png")"
+  if python3 "$here/xwd2png.py" "$work/fb/Xvfb_screen0" "$png" --crop "$X,$Y,$WIDTH,$HEIGHT"; then
+    ok "screenshot $png ($(stat -c %s "$png") bytes, ${WIDTH}x${HEIGHT})"
+  else
+    not_ok "screenshot failed"
+  fi
+  size=$(stat -c %s "$png" 2>/dev/null || echo 0)
+  [ "$size" -gt 10000 ] && [ "$size" -lt 300000 ] && ok "screenshot size $size bytes (10 KB .. 300 KB)" ||
+    not_ok "screenshot size $size bytes"
 fi
-size=$(stat -c %s "$png" 2>/dev/null || echo 0)
-[ "$size" -gt 10000 ] && [ "$size" -lt 300000 ] && ok "screenshot size $size bytes (10 KB .. 300 KB)" ||
-  not_ok "screenshot size $size bytes"
 
 found=$(dialogs)
 [ -z "$found" ] && ok "still no dialog window" || not_ok "dialog windows: $found"

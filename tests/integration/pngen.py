@@ -7,6 +7,7 @@ of the three RT classes with random trailers, and alarms (high/low, every RTA PD
     frames = pngen.all_frames(random.Random(1), cyclic=200)   # [bytes]
     pngen.pcap(frames)                                          # a pcap file's bytes
 """
+import random
 import struct
 
 ETHERTYPE = 0x8892
@@ -169,3 +170,25 @@ def pcap(frames, base_ts=1704067200, captured=None):
         kept = f[:captured.get(i, len(f))]
         out.append(struct.pack("<IIII", base_ts + i // 1000, (i % 1000) * 1000, len(kept), len(f)) + kept)
     return b"".join(out)
+
+
+def cyclic_devices(seed=8892):
+    """(time ns, frame) of three devices sending cyclic data at 1, 2 and 4 ms (each frame
+    ID of another RT class, jitter up to 5 % of the period, the cycle counter advancing
+    by 32), and a DCP Hello every 3 ms exactly (regular, but no cyclic data)."""
+    rng = random.Random(seed)
+    packets = []
+    devices = [(0xC001, 1_000_000, 60), (0x8002, 2_000_000, 40), (0x0103, 4_000_000, 25)]
+    for n, (frame_id, period, count) in enumerate(devices):
+        mac = bytes([0x00, 0x0E, 0xCF, 0, 0, n + 1])
+        for i in range(count):
+            t = 10**9 + n * 137_000 + i * period + rng.randint(-period // 20, period // 20)
+            body = bytes(40) + struct.pack(">HBB", (i * 32) & 0xFFFF, 0x35, 0)
+            packets.append((t, bytes([0x01, 0x0E, 0xCF, 0, 0, 0]) + mac + struct.pack(">HH", 0x8892, frame_id) + body))
+    hello_mac = bytes([0x00, 0x0E, 0xCF, 0, 0, 9])
+    for i in range(30):
+        body = dcp(HELLO, REQUEST, [], 0x1000 + i)
+        packets.append((10**9 + i * 3_000_000, bytes([0x01, 0x0E, 0xCF, 0, 0, 1]) + hello_mac +
+                        struct.pack(">HH", 0x8892, 0xFEFC) + body))
+    packets.sort(key=lambda p: p[0])
+    return [(t, f + bytes(max(0, 60 - len(f)))) for t, f in packets]

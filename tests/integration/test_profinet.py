@@ -310,22 +310,7 @@ class CyclesOfCyclicData(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
         cls.install("rules/profinet.xml", "pnr")
-        rng = random.Random(8892)
-        packets = []
-        devices = [(0xC001, 1_000_000, 60), (0x8002, 2_000_000, 40), (0x0103, 4_000_000, 25)]
-        for n, (frame_id, period, count) in enumerate(devices):
-            mac = bytes([0x00, 0x0E, 0xCF, 0, 0, n + 1])
-            for i in range(count):
-                t = 10**9 + n * 137_000 + i * period + rng.randint(-period // 20, period // 20)
-                body = bytes(40) + struct.pack(">HBB", (i * 32) & 0xFFFF, 0x35, 0)
-                packets.append((t, bytes([0x01, 0x0E, 0xCF, 0, 0, 0]) + mac + struct.pack(">HH", 0x8892, frame_id) + body))
-        hello_mac = bytes([0x00, 0x0E, 0xCF, 0, 0, 9])
-        for i in range(30):  # a DCP Hello every 3 ms exactly
-            body = pngen.dcp(pngen.HELLO, pngen.REQUEST, [], 0x1000 + i)
-            packets.append((10**9 + i * 3_000_000, bytes([0x01, 0x0E, 0xCF, 0, 0, 1]) + hello_mac +
-                            struct.pack(">HH", 0x8892, 0xFEFC) + body))
-        packets.sort(key=lambda p: p[0])
-        cls.packets = [(t, f + bytes(max(0, 60 - len(f)))) for t, f in packets]
+        cls.packets = pngen.cyclic_devices()
         cls.capture = cls.env.add_file("cycles.pcap", cyclemodel.pcap_ns(cls.packets))
 
     def test_each_devices_cyclic_frame_is_a_cycle(self):
