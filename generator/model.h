@@ -293,6 +293,7 @@ struct Cycles {
     std::vector<CycleField> signature;     // one or more
     std::optional<CycleField> sequence;    // the sequence count, if any
     unsigned sequence_bits = 0;            // its width (bits="..."; default: the field's)
+    uint64_t sequence_step = 1;            // how much it advances per message (step="..."); 0: learned
     std::vector<CycleField> only, never;   // conditions
 };
 

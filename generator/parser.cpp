@@ -58,7 +58,7 @@ const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kInputAttributes = {"name", "field"};
 const std::vector<std::string> kCyclesAttributes = {"window", "sender"};
 const std::vector<std::string> kCycleFieldAttributes = {"field"};
-const std::vector<std::string> kSequenceAttributes = {"field", "bits"};
+const std::vector<std::string> kSequenceAttributes = {"field", "bits", "step"};
 const std::vector<std::string> kCycleTestAttributes = {"field", "in"};
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
                                                 "origin",  "enum",      "nondisplay",
@@ -605,6 +605,17 @@ void Parser::parse_cycles(xmlNode* el, Protocol& proto) {
                                                  "': expected the sequence count's width, 1 to 64");
                 else
                     cycles.sequence_bits = static_cast<unsigned>(b);
+            }
+            if (sattrs.count("step")) {
+                uint64_t n = 0;
+                if (sattrs["step"] == "learned")
+                    cycles.sequence_step = 0;
+                else if (!parse_number(sattrs["step"], n) || n < 1)
+                    diags_.error(line_of(c), "bad step '" + sattrs["step"] +
+                                                 "': expected how much the count advances per message (a number "
+                                                 "from 1) or 'learned'");
+                else
+                    cycles.sequence_step = n;
             }
         } else if (name == "only" || name == "never") {
             if (parse_cycle_field(c, kCycleTestAttributes, f, sattrs))

@@ -724,6 +724,11 @@ void Validator::check_cycles() {
     else if (c.sequence_bits > width)
         diags_.error(c.sequence->line, "bits=\"" + std::to_string(c.sequence_bits) + "\" is wider than sequence field " +
                                            quote(t) + at_line(t) + " (" + std::to_string(width) + " bits)");
+    // a step of half the count's range or more would make every advance look like a count going back
+    if (c.sequence_step > 1 && c.sequence_bits < 64 && c.sequence_step > ((uint64_t{1} << c.sequence_bits) - 1) >> 1)
+        diags_.error(c.sequence->line, "step=\"" + std::to_string(c.sequence_step) +
+                                           "\" is not below half the range of a " +
+                                           std::to_string(c.sequence_bits) + "-bit sequence count");
 }
 
 bool Validator::check_cycle_field(const CycleField& f, const char* element, int role, int test,

@@ -65,6 +65,7 @@ struct stream {
     guint32 last_frame;     /* the stream's latest message that was not a duplicate; 0: none yet */
     nstime_t last_time;
     guint64 last_sequence;
+    guint64 learned_step; /* step="learned": the count's advance per message, 0 until known */
     gboolean has_sequence;
     guint32 recent[most_window]; /* its last regular periods, a ring */
     guint regular, next_slot;
@@ -185,18 +186,33 @@ cycle *new_cycle(capture_state *c, stream *s, guint window, guint32 frame)
     return cy;
 }
 
-/* The sequence count's step since the stream's previous message: FALSE when
- * it is a duplicate; else *lost messages lost (G_MAXUINT32: the count went back). */
-gboolean sequence_step(stream *s, const dg_cycle_input *in, guint bits, guint32 *lost)
+/* Messages lost before an advance of the count by `advance` (not 0) in a
+ * stream whose count advances by `step` per message: G_MAXUINT32 when the
+ * count went back (half the range or more: a restart, a message overtaken) or
+ * jumped by no whole number of steps. */
+guint32 lost_before(guint64 advance, guint64 step, guint64 mask)
+{
+    if (advance > mask >> 1 || advance % step) return G_MAXUINT32;
+    return (guint32)MIN(advance / step - 1, (guint64)G_MAXUINT32 - 1);
+}
+
+/* The sequence count's advance since the stream's previous message: FALSE
+ * when it is a duplicate; else *lost messages lost (G_MAXUINT32: the count
+ * went back). A learned step (`step` 0) is the stream's first advance, or a
+ * smaller one that divides it (the first held a loss). */
+gboolean sequence_step(stream *s, const dg_cycle_input *in, guint bits, guint64 step, guint32 *lost)
 {
     *lost = 0;
     if (!bits || !in->has_sequence) return TRUE;
     const guint64 mask = bits >= 64 ? G_MAXUINT64 : ((guint64)1 << bits) - 1;
     const guint64 count = in->sequence & mask;
     if (s->has_sequence) {
-        guint64 step = (count - s->last_sequence) & mask;
-        if (step == 0) return FALSE;
-        *lost = step <= mask >> 1 ? (guint32)MIN(step - 1, (guint64)G_MAXUINT32 - 1) : G_MAXUINT32;
+        const guint64 advance = (count - s->last_sequence) & mask;
+        if (advance == 0) return FALSE;
+        if (!step && advance <= mask >> 1 && (!s->learned_step || s->learned_step % advance == 0))
+            s->learned_step = advance;
+        const guint64 by = step ? step : s->learned_step;
+        *lost = by ? lost_before(advance, by, mask) : G_MAXUINT32;
     }
     s->last_sequence = count;
     s->has_sequence = TRUE;
@@ -213,7 +229,7 @@ mark *time_message(capture_state *c, const dg_cycle_input *in, const packet_info
     s->messages++;
     mark m = {};
     guint32 lost;
-    if (!sequence_step(s, in, cy->sequence_bits, &lost)) {
+    if (!sequence_step(s, in, cy->sequence_bits, cy->sequence_step, &lost)) {
         s->duplicates++;
         m.duplicate_of = s->last_frame;
         m.cycle = s->cyc ? s->cyc->number : 0;

@@ -280,6 +280,7 @@ typedef struct dg_cycles {
     guint8 only_count;     /* the <only> tests, numbered 0 .. only_count - 1, before the <never> ones */
     const dg_cycle_test *tests;
     const dg_range *ranges;
+    guint64 sequence_step; /* how much the count advances per message; 0: learned from the stream */
 } dg_cycles;
 
 typedef struct dg_pairing {

@@ -20,26 +20,29 @@ def clamp(ns):
     return 0 if ns < 0 else min(ns, 0xFFFFFFFF)
 
 
-def model(messages, window, bits):
-    """messages: (frame, time ns, stream key, sequence count) in capture order.
+def model(messages, window, bits, step=1):
+    """messages: (frame, time ns, stream key, sequence count) in capture order; step: how
+    much the count advances per message, 0 when learned from the stream (step="learned").
     Returns ({frame: mark}, [cycle]) as the manual describes them."""
     mask = (1 << bits) - 1
     streams, cycles, marks = {}, [], {}
     for frame, ts, key, seq in messages:
         s = streams.setdefault(key, {"key": key, "last_frame": 0, "last_ts": 0, "last_seq": None, "recent": [],
-                                     "cycle": None, "lost": 0, "duplicates": 0})
+                                     "cycle": None, "lost": 0, "duplicates": 0, "step": step})
         lost, back = 0, False
         if seq is not None:
             seq &= mask
             if s["last_seq"] is not None:
-                step = (seq - s["last_seq"]) & mask
-                if step == 0:
+                advance = (seq - s["last_seq"]) & mask
+                if advance == 0:
                     s["duplicates"] += 1
                     marks[frame] = {"cycle": s["cycle"]["number"] if s["cycle"] else 0,
                                     "duplicate": s["last_frame"]}
                     continue
-                if step <= mask >> 1:
-                    lost = step - 1
+                if not step and advance <= mask >> 1 and (not s["step"] or s["step"] % advance == 0):
+                    s["step"] = advance  # learned: the first advance, or a smaller one dividing it
+                if s["step"] and advance <= mask >> 1 and advance % s["step"] == 0:
+                    lost = min(advance // s["step"] - 1, 2**32 - 2)
                 else:
                     back = True
             s["last_seq"] = seq

@@ -175,16 +175,26 @@ def pcap(frames, base_ts=1704067200, captured=None):
 def cyclic_devices(seed=8892):
     """(time ns, frame) of three devices sending cyclic data at 1, 2 and 4 ms (each frame
     ID of another RT class, jitter up to 5 % of the period, the cycle counter advancing
-    by 32), and a DCP Hello every 3 ms exactly (regular, but no cyclic data)."""
+    by 32, 64 and 128 and wrapping past 0xFFFF), and a DCP Hello every 3 ms exactly
+    (regular, but no cyclic data). Faults: the first device's frames 30 and 31 are lost
+    and its frame 45 is sent twice; the second's frame 1 is lost (its first advance is
+    two steps) and so are 20 to 22."""
     rng = random.Random(seed)
     packets = []
-    devices = [(0xC001, 1_000_000, 60), (0x8002, 2_000_000, 40), (0x0103, 4_000_000, 25)]
-    for n, (frame_id, period, count) in enumerate(devices):
+    devices = [(0xC001, 1_000_000, 60, 32, 0xF000, {30, 31}, {45}),
+               (0x8002, 2_000_000, 40, 64, 100, {1, 20, 21, 22}, set()),
+               (0x0103, 4_000_000, 25, 128, 0xFE00, set(), set())]
+    for n, (frame_id, period, count, step, first, lost, repeated) in enumerate(devices):
         mac = bytes([0x00, 0x0E, 0xCF, 0, 0, n + 1])
         for i in range(count):
             t = 10**9 + n * 137_000 + i * period + rng.randint(-period // 20, period // 20)
-            body = bytes(40) + struct.pack(">HBB", (i * 32) & 0xFFFF, 0x35, 0)
-            packets.append((t, bytes([0x01, 0x0E, 0xCF, 0, 0, 0]) + mac + struct.pack(">HH", 0x8892, frame_id) + body))
+            if i in lost:
+                continue
+            body = bytes(40) + struct.pack(">HBB", (first + i * step) & 0xFFFF, 0x35, 0)
+            frame = bytes([0x01, 0x0E, 0xCF, 0, 0, 0]) + mac + struct.pack(">HH", 0x8892, frame_id) + body
+            packets.append((t, frame))
+            if i in repeated:
+                packets.append((t + 30_000, frame))
     hello_mac = bytes([0x00, 0x0E, 0xCF, 0, 0, 9])
     for i in range(30):
         body = dcp(HELLO, REQUEST, [], 0x1000 + i)

@@ -53,7 +53,7 @@ TEST(Emit, CyclesGiveEachFieldItsRoleAndTheTestsTheirRanges) {
     Front without = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n" + nodes);
     ASSERT_TRUE(with.ok() && without.ok()) << with.messages() << without.messages();
     const std::string code = emit_cpp(*with.proto, "rules.xml");
-    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 5, 16, 1, 1, t_cycle_tests, t_cycle_ranges };"))
+    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 5, 16, 1, 1, t_cycle_tests, t_cycle_ranges, 1u };"))
         << code;
     EXPECT_TRUE(contains(code, "{ 0x1, 0x1 }") && contains(code, "{ 0x3, 0x4 }") &&
                 contains(code, "{ 0x1, 0xffffffffffffffff }"));
