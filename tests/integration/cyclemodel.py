@@ -146,3 +146,23 @@ def parse_report(text):
         elif what == "duplicates":
             f["duplicates"] = int(value)
     return cycles
+
+
+def mark_fields(protocol):
+    """The fields of a message's cycle mark, then its two cycle expert infos."""
+    return ["%s.cycle" % protocol, "%s.cycle.period" % protocol, "%s.cycle.jitter" % protocol,
+            "%s.cycle.lost" % protocol, "%s.cycle.duplicate" % protocol,
+            "%s.expert.cycle_lost" % protocol, "%s.expert.cycle_duplicate" % protocol]
+
+
+def mark_of(row, protocol):
+    """A message's mark as model() gives it, from its row of mark_fields (field_rows)."""
+    from tshark_env import relative_time_ns
+    got = {}
+    for key, field, value in (("cycle", "cycle", int), ("period", "cycle.period", relative_time_ns),
+                              ("jitter", "cycle.jitter", relative_time_ns), ("lost", "cycle.lost", int),
+                              ("duplicate", "cycle.duplicate", int)):
+        shown = row["%s.%s" % (protocol, field)]
+        if shown:
+            got[key] = value(shown[0])
+    return got

@@ -25,7 +25,7 @@ import unittest
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import cyclemodel  # noqa: E402
 import pngen  # noqa: E402
-from tshark_env import TsharkEnv, TsharkTestCase, relative_time_ns, run_unittests  # noqa: E402
+from tshark_env import TsharkEnv, TsharkTestCase, run_unittests  # noqa: E402
 
 # Wireshark's fields -> ours (each side a list: their values are pooled per frame).
 COUNTERPARTS = [
@@ -321,8 +321,7 @@ class CyclesOfCyclicData(TsharkTestCase, unittest.TestCase):
                     if 0x0100 <= struct.unpack(">H", f[14:16])[0] <= 0x0FFF or
                     0x8000 <= struct.unpack(">H", f[14:16])[0] <= 0xFBFF]
         marks, cycles = cyclemodel.model(messages, window=8, bits=16, step=0)
-        fields = ["pnr.cycle", "pnr.cycle.period", "pnr.cycle.jitter", "pnr.cycle.lost", "pnr.cycle.duplicate",
-                  "pnr.expert.cycle_lost", "pnr.expert.cycle_duplicate"]
+        fields = cyclemodel.mark_fields("pnr")
         with self.checks() as check:
             check(len(cycles) == 3, "%d cycles, expected one per device (the Hello is none)" % len(cycles))
             # the loss in the second device's first advance is where its step is learned: not told
@@ -341,17 +340,7 @@ class CyclesOfCyclicData(TsharkTestCase, unittest.TestCase):
                     check(g["figures"] == want, "cycle %d: %s, expected %s" % (c["number"], g["figures"], want))
                 rows = self.env.field_rows(self.capture, ["frame.number"] + fields, two_pass=two_pass)
                 for frame, row in sorted(rows.items()):
-                    got = {}
-                    if row["pnr.cycle"]:
-                        got["cycle"] = int(row["pnr.cycle"][0])
-                    if row["pnr.cycle.period"]:
-                        got["period"] = relative_time_ns(row["pnr.cycle.period"][0])
-                    if row["pnr.cycle.jitter"]:
-                        got["jitter"] = relative_time_ns(row["pnr.cycle.jitter"][0])
-                    if row["pnr.cycle.lost"]:
-                        got["lost"] = int(row["pnr.cycle.lost"][0])
-                    if row["pnr.cycle.duplicate"]:
-                        got["duplicate"] = int(row["pnr.cycle.duplicate"][0])
+                    got = cyclemodel.mark_of(row, "pnr")
                     want = marks.get(frame, {})
                     how = "-2" if two_pass else "one pass"
                     check(got == want, "frame %d %s: %s, expected %s" % (frame, how, got, want))

@@ -29,13 +29,12 @@ import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from pcapgen import ip_checksum  # noqa: E402
-from cyclemodel import figures, model, parse_report, pcap_ns, read_pcap  # noqa: E402
-from tshark_env import TsharkTestCase, relative_time_ns, run_unittests  # noqa: E402
+from cyclemodel import figures, mark_fields, mark_of, model, parse_report, pcap_ns, read_pcap  # noqa: E402
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 
 ARGS = None
 IO_PORT = 2222
-FIELDS = ["frame.number", "enipr.cycle", "enipr.cycle.period", "enipr.cycle.jitter", "enipr.cycle.lost",
-          "enipr.cycle.duplicate", "enipr.expert.cycle_lost", "enipr.expert.cycle_duplicate"]
+FIELDS = ["frame.number"] + mark_fields("enipr")
 
 
 # --- captures: writing and reading ----------------------------------------------------
@@ -124,17 +123,7 @@ class TestRuleCycles(TsharkTestCase, unittest.TestCase):
             how = "-2" if two_pass else "one pass"
             for frame, row in sorted(rows.items()):
                 want = marks.get(frame, {})
-                got = {}
-                if row["enipr.cycle"]:
-                    got["cycle"] = int(row["enipr.cycle"][0])
-                if row["enipr.cycle.period"]:
-                    got["period"] = relative_time_ns(row["enipr.cycle.period"][0])
-                if row["enipr.cycle.jitter"]:
-                    got["jitter"] = relative_time_ns(row["enipr.cycle.jitter"][0])
-                if row["enipr.cycle.lost"]:
-                    got["lost"] = int(row["enipr.cycle.lost"][0])
-                if row["enipr.cycle.duplicate"]:
-                    got["duplicate"] = int(row["enipr.cycle.duplicate"][0])
+                got = mark_of(row, "enipr")
                 if not check(got == want, "%s frame %d: %s, expected %s" % (how, frame, got, want)):
                     continue
                 # the expert infos sit exactly where the marks say
