@@ -17,6 +17,7 @@ flag at random, AInv and AMNI, ASnd's IdentResponse, StatusResponse, NMTRequest,
 """
 import os
 import random
+import struct
 import sys
 import unittest
 
@@ -248,6 +249,22 @@ class PowerlinkAgainstWireshark(TsharkTestCase, unittest.TestCase):
                 clean = self.env.tshark(["-r", self.capture, "-Y", "_ws.expert", "-T", "fields",
                                          "-e", "frame.number"] + two_pass).stdout.split()
                 check(clean == [], "no expert info %s: %s" % (two_pass, clean[:5]))
+
+    def test_size_past_the_frame_is_reported_where_it_is(self):
+        """A PRes whose Size points past the frame gets eplr.expert.past_end on that frame
+        only, in one pass and with -2 (the generated captures have none: above)."""
+        rng = random.Random(3)
+        frames = [eplgen.ethernet(eplgen.PRES, 5, eplgen.pres(rng, 5)) for _ in range(10)]
+        lying = 7
+        frame = bytearray(frames[lying - 1])
+        frame[14 + 8:14 + 10] = struct.pack("<H", 2000)
+        frames[lying - 1] = bytes(frame)
+        cap = self.env.add_file("past_end.pcap", eplgen.pcap(frames))
+        with self.checks() as check:
+            for two_pass in ([], ["-2"]):
+                rows = self.env.tshark(["-r", cap, "-Y", "eplr.expert.past_end", "-T", "fields",
+                                        "-e", "frame.number"] + two_pass).stdout.split()
+                check(rows == [str(lying)], "past_end %s on frame %d only: %s" % (two_pass, lying, rows))
 
     def test_wireshark_fields_without_counterpart_are_listed(self):
         """Every field epl shows on these captures has a counterpart or a reason in
