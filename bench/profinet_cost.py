@@ -26,11 +26,6 @@ sys.path.insert(0, os.path.join(HERE, "..", "tests", "integration"))
 import pngen  # noqa: E402
 from tshark_env import TsharkEnv  # noqa: E402
 
-CONFIGS = {
-    "ours": [],
-    "wireshark": ["--disable-protocol", "pnr"],
-    "floor": ["--disable-protocol", "pnr", "--disable-protocol", "pn_rt"],
-}
 MODES = {"summary": [], "-V": ["-V"]}
 
 
@@ -51,27 +46,41 @@ def instructions(env, args):
     return int(found.group(1))
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--dissgen", default=os.path.join(HERE, "..", "build", "bin", "dissgen"))
-    ap.add_argument("--frames", type=int, default=2000)
-    a = ap.parse_args()
+def compare(dissgen, rules, ours, theirs, capture, frames):
+    """Print, per mode, the instructions per frame of protocol `ours` (the plugin of
+    `rules`) and of Wireshark's `theirs` on `capture` (a pcap's bytes of `frames` frames),
+    each above the floor (both disabled: the frames left undissected), and their ratio."""
+    configs = {
+        "ours": [],
+        "wireshark": ["--disable-protocol", ours],
+        "floor": ["--disable-protocol", ours, "--disable-protocol", theirs],
+    }
     with TsharkEnv() as env:
-        env.install_plugin(a.dissgen, os.path.join(HERE, "..", "rules", "profinet.xml"))
-        env.assert_plugin_loaded("pnr")
-        rng = random.Random(5)
-        frames = []
-        while len(frames) < a.frames:
-            frames += pngen.all_frames(rng)
-        cap = env.add_file("bench.pcap", pngen.pcap(frames[:a.frames]))
+        env.install_plugin(dissgen, rules)
+        env.assert_plugin_loaded(ours)
+        cap = env.add_file("bench.pcap", capture)
         for mode, extra in MODES.items():
-            counts = {name: instructions(env, ["-r", cap] + extra + flags) for name, flags in CONFIGS.items()}
-            per = {name: (counts[name] - counts["floor"]) / a.frames for name in ("ours", "wireshark")}
+            counts = {name: instructions(env, ["-r", cap] + extra + flags) for name, flags in configs.items()}
+            per = {name: (counts[name] - counts["floor"]) / frames for name in ("ours", "wireshark")}
             print("%-8s ours %8.0f  wireshark %8.0f  instructions/frame above the floor  (ratio %.2f; "
                   "totals: %s)" % (mode, per["ours"], per["wireshark"], per["ours"] / per["wireshark"],
                                    ", ".join("%s %d" % kv for kv in counts.items())), flush=True)
+
+
+def main_for(doc, rules, ours, theirs, all_frames, pcap):
+    """A cost script's command line: --frames frames of all_frames(rng) (a generator's
+    frames of every kind), the plugin of rules/<rules> compared with Wireshark's theirs."""
+    ap = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--dissgen", default=os.path.join(HERE, "..", "build", "bin", "dissgen"))
+    ap.add_argument("--frames", type=int, default=2000)
+    a = ap.parse_args()
+    rng = random.Random(5)
+    frames = []
+    while len(frames) < a.frames:
+        frames += all_frames(rng)
+    compare(a.dissgen, os.path.join(HERE, "..", "rules", rules), ours, theirs, pcap(frames[:a.frames]), a.frames)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main_for(__doc__, "profinet.xml", "pnr", "pn_rt", pngen.all_frames, pngen.pcap))

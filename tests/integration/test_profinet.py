@@ -24,6 +24,7 @@ import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import cyclemodel  # noqa: E402
+import differential  # noqa: E402
 import pngen  # noqa: E402
 from tshark_env import TsharkEnv, TsharkTestCase, run_unittests  # noqa: E402
 
@@ -139,15 +140,6 @@ WITHOUT_COUNTERPART = {
 }
 
 
-def number_or_text(value):
-    if value in ("True", "False"):
-        return int(value == "True")
-    try:
-        return int(value, 0)
-    except ValueError:
-        return value
-
-
 class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
@@ -156,14 +148,7 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
         cls.capture = cls.env.add_file("profinet.pcap", pngen.pcap(cls.frames))
 
     def rows(self, fields, extra=()):
-        args = ["-r", self.capture, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=|"] + list(extra)
-        for f in ["frame.number"] + fields:
-            args += ["-e", f]
-        out = {}
-        for line in self.env.tshark(args).stdout.splitlines():
-            cols = line.split("\t")
-            out[int(cols[0])] = [c.split("|") if c else [] for c in cols[1:]]
-        return out
+        return differential.field_table(self.env, self.capture, fields, extra)
 
     def test_ours_decodes_wireshark_stays_selectable(self):
         with self.checks() as check:
@@ -176,23 +161,11 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
                   "Decode As pn_rt gives every frame to pn_rt")
 
     def test_values_agree_with_wireshark(self):
-        theirs_fields = [f for ws, _ in COUNTERPARTS for f in ws]
-        ours_fields = [f for _, o in COUNTERPARTS for f in o]
-        theirs = self.rows(theirs_fields, ["--disable-protocol", "pnr"])
-        ours = self.rows(ours_fields)
-        total = matched = 0
+        total, matched, value_misses = differential.agreement(self.env, self.capture, COUNTERPARTS, "pnr",
+                                                              lambda _field, value: differential.number_or_text(value))
         misses = collections.Counter()
-        for number, row in theirs.items():
-            values = dict(zip(theirs_fields, row))
-            mine = dict(zip(ours_fields, ours[number]))
-            for ws, o in COUNTERPARTS:
-                want = collections.Counter(number_or_text(v) for f in ws for v in values[f])
-                have = collections.Counter(number_or_text(v) for f in o for v in mine[f])
-                common = sum((want & have).values())
-                total += sum(want.values())
-                matched += common
-                if common < sum(want.values()):
-                    misses[ws[0]] += sum(want.values()) - common
+        for (field, _frame, _value), n in value_misses.items():
+            misses[field] += n
         share = 100.0 * matched / max(total, 1)
         print("\nagreement: %d of %d Wireshark values (%.2f %%)" % (matched, total, share))
         for field, n in misses.most_common():
@@ -293,9 +266,7 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
         """Every field Wireshark's PROFINET dissectors show on these captures has a
         counterpart or a reason in WITHOUT_COUNTERPART."""
         mapped = {f for ws, _ in COUNTERPARTS for f in ws}
-        pdml = self.env.tshark(["-r", self.capture, "-T", "pdml", "--disable-protocol", "pnr"]).stdout
-        import re
-        shown = set(re.findall(r'<field name="((?:pn_rt|pn_dcp|pn_io)\.[^"]+)"', pdml))
+        shown = differential.fields_shown(self.env, self.capture, ["pn_rt.", "pn_dcp.", "pn_io."], "pnr")
         unexplained = sorted(shown - mapped - set(WITHOUT_COUNTERPART))
         print("\nWireshark fields without a counterpart: " + ", ".join(sorted(shown - mapped)))
         self.assertEqual(unexplained, [])

@@ -32,6 +32,7 @@ import sys
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import eplgen  # noqa: E402
 import pcapgen  # noqa: E402
 import pngen  # noqa: E402
 from tshark_env import TsharkEnv, run_unittests  # noqa: E402
@@ -395,6 +396,8 @@ CAPTURES = {
     "rules/enip.xml": None,
     # No PROFINET sample or corpus capture yet: pngen's frames of every kind.
     "rules/profinet.xml": lambda: pngen.all_frames(random.Random(7), rounds=4, cyclic=60, alarms=20),
+    # Nor of POWERLINK: eplgen's frames of every message type and ASnd service.
+    "rules/powerlink.xml": lambda: eplgen.all_frames(random.Random(7), rounds=6),
 }
 
 

@@ -88,6 +88,7 @@ TESTS = {
     "malformed": integration("test_malformed.py"),
     "enip": integration("test_enip.py"),
     "profinet": integration("test_profinet.py"),
+    "powerlink": integration("test_powerlink.py"),
     "validity": integration("test_validity.py"),
     "validity_unit": unit("Validity.*"),
     "loading": integration("test_plugin_loading.py"),
