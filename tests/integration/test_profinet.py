@@ -3,14 +3,16 @@
 """PROFINET from rules alone: rules/profinet.xml (pnr) against Wireshark's pn_rt, pn_dcp and
 pn_io, value by value, on generated captures (pngen.py): every DCP service with every
 option/suboption block, cyclic frames of RT classes 1-3 with random cycle counters and
-status bits, alarms of every RTA PDU type.
+status bits, alarms of every RTA PDU type, PTCP frames of every kind with every TLV block
+(against pn_ptcp).
 
 - the plugin loads beside Wireshark's PROFINET dissectors and takes ethertype 0x8892;
   with pnr disabled, pn_rt decodes the frames again;
 - for each Wireshark field of COUNTERPARTS, per frame, its values are matched with our
   counterpart fields' values (as multisets: pn_dcp spreads one concept over several fields,
   e.g. a suboption per option); the agreement is the share of Wireshark's values matched,
-  printed with what did not match; goal: 99.5 %;
+  printed with what did not match, and PTCP's own share; goal: 99.5 %; ours are the same
+  in one pass and with -2;
 - the trailer: our cycle counter, data status and transfer status equal the bytes the
   generator wrote at the end of each cyclic frame;
 - fields of Wireshark's without a counterpart are listed (WITHOUT_COUNTERPART says why).
@@ -116,6 +118,37 @@ COUNTERPARTS = [
     (["pn_io.alarm_specifier.manufacturer"], ["pnr.alarm.notification.specifier.manufacturer"]),
     (["pn_io.alarm_specifier.submodule"], ["pnr.alarm.notification.specifier.submodule"]),
     (["pn_io.alarm_specifier.ardiagnosis"], ["pnr.alarm.notification.specifier.ar_diagnosis"]),
+    (["pn_ptcp.res1"], ["pnr.ptcp.reserved_1"]),
+    (["pn_ptcp.res2"], ["pnr.ptcp.reserved_2"]),
+    (["pn_ptcp.delay10ns"], ["pnr.ptcp.delay10ns"]),
+    (["pn_ptcp.sequence_id"], ["pnr.ptcp.sequence_id"]),
+    (["pn_ptcp.delay1ns_byte"], ["pnr.ptcp.delay1ns_byte"]),
+    (["pn_ptcp.delay1ns"], ["pnr.ptcp.delay1ns"]),
+    (["pn_ptcp.delay1ns_fup"], ["pnr.ptcp.delay1ns_fup"]),
+    (["pn_ptcp.tl_type"], ["pnr.ptcp.block.type"]),
+    (["pn_ptcp.tl_length"], ["pnr.ptcp.block.length"]),
+    (["pn_ptcp.master_source_address"], ["pnr.ptcp.block.master_source_address"]),
+    (["pn_ptcp.subdomain_uuid"], ["pnr.ptcp.block.subdomain_uuid"]),
+    (["pn_ptcp.epoch_number"], ["pnr.ptcp.block.epoch_number"]),
+    (["pn_ptcp.seconds"], ["pnr.ptcp.block.seconds"]),
+    (["pn_ptcp.nanoseconds"], ["pnr.ptcp.block.nanoseconds"]),
+    (["pn_ptcp.flags"], ["pnr.ptcp.block.flags"]),
+    (["pn_ptcp.currentutcoffset"], ["pnr.ptcp.block.current_utc_offset"]),
+    (["pn_ptcp.master_priority1_prio"], ["pnr.ptcp.block.master_priority1.priority"]),
+    (["pn_ptcp.master_priority1_level"], ["pnr.ptcp.block.master_priority1.level"]),
+    (["pn_ptcp.master_priority1_res"], ["pnr.ptcp.block.master_priority1.reserved"]),
+    (["pn_ptcp.master_priority1_act"], ["pnr.ptcp.block.master_priority1.active"]),
+    (["pn_ptcp.master_priority2"], ["pnr.ptcp.block.master_priority2"]),
+    (["pn_ptcp.clock_class"], ["pnr.ptcp.block.clock_class"]),
+    (["pn_ptcp.clock_accuracy"], ["pnr.ptcp.block.clock_accuracy"]),
+    (["pn_ptcp.clockvariance"], ["pnr.ptcp.block.clock_variance"]),
+    (["pn_ptcp.t2portrxdelay"], ["pnr.ptcp.block.t2_port_rx_delay"]),
+    (["pn_ptcp.t3porttxdelay"], ["pnr.ptcp.block.t3_port_tx_delay"]),
+    (["pn_ptcp.port_mac_address"], ["pnr.ptcp.block.port_mac_address"]),
+    (["pn_ptcp.t2timestamp"], ["pnr.ptcp.block.t2_timestamp"]),
+    (["pn_ptcp.oui"], ["pnr.ptcp.block.oui"]),
+    (["pn_ptcp.subtype"], ["pnr.ptcp.block.subtype"]),
+    (["pn_ptcp.irdata_uuid"], ["pnr.ptcp.block.ir_data_uuid"]),
 ]
 
 # Wireshark's fields (of those its dissectors show on these captures) that have no
@@ -136,6 +169,9 @@ WITHOUT_COUNTERPART = {
     "pn_io.error_code2.expert": "an expert info with pn_io's meaning of ErrorCode2 (a table pnr does not hold)",
     "pn_dcp.block_error.unknown": "an expert info on a BlockError other than Ok: pnr names the error "
                                   "(pnr.dcp.block.response.block_error) without an expert info",
+    "pn_ptcp.header": "a container (pnr.ptcp's RTSync, Announce, FollowUp and Delay headers)",
+    "pn_ptcp.block": "a container (pnr.ptcp.block)",
+    "pn_ptcp.tlvheader": "a container: its Type and Length are pnr.ptcp.block.type and .length",
 }
 
 
@@ -152,7 +188,7 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
         cls.install("rules/profinet.xml", "pnr")
-        cls.frames = pngen.all_frames(random.Random(41), rounds=40, cyclic=400, alarms=120)
+        cls.frames = pngen.all_frames(random.Random(41), rounds=40, cyclic=400, alarms=120, ptcp=400)
         cls.capture = cls.env.add_file("profinet.pcap", pngen.pcap(cls.frames))
 
     def rows(self, fields, extra=()):
@@ -180,7 +216,9 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
         ours_fields = [f for _, o in COUNTERPARTS for f in o]
         theirs = self.rows(theirs_fields, ["--disable-protocol", "pnr"])
         ours = self.rows(ours_fields)
+        self.assertEqual(self.rows(ours_fields, ["-2"]), ours, "our values are the same with -2")
         total = matched = 0
+        ptcp_total = ptcp_matched = 0
         misses = collections.Counter()
         for number, row in theirs.items():
             values = dict(zip(theirs_fields, row))
@@ -191,14 +229,48 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
                 common = sum((want & have).values())
                 total += sum(want.values())
                 matched += common
+                if ws[0].startswith("pn_ptcp."):
+                    ptcp_total += sum(want.values())
+                    ptcp_matched += common
                 if common < sum(want.values()):
                     misses[ws[0]] += sum(want.values()) - common
         share = 100.0 * matched / max(total, 1)
         print("\nagreement: %d of %d Wireshark values (%.2f %%)" % (matched, total, share))
+        ptcp_share = 100.0 * ptcp_matched / max(ptcp_total, 1)
+        print("PTCP: %d of %d pn_ptcp values (%.2f %%)" % (ptcp_matched, ptcp_total, ptcp_share))
         for field, n in misses.most_common():
             print("  not matched: %s x%d" % (field, n))
         self.assertGreater(total, 10000, "the captures give Wireshark's dissectors many values")
+        self.assertGreater(ptcp_total, 5000, "the PTCP frames give pn_ptcp many values")
         self.assertGreaterEqual(share, 99.5)
+        self.assertGreaterEqual(ptcp_share, 99.5)
+
+    def test_ptcp_blocks_end_at_end(self):
+        """Each PTCP frame has exactly the TLV blocks its bytes hold up to and with End, of
+        the types written there, in one pass and with -2: the frame's padding after End is
+        no block, and no block is lost."""
+        want = {}
+        for number, frame in enumerate(self.frames, 1):
+            if struct.unpack(">H", frame[14:16])[0] not in pngen.PTCP_IDS:
+                continue
+            types, at = [], 14 + 2 + 20
+            while True:
+                word = struct.unpack(">H", frame[at:at + 2])[0]
+                types.append(word >> 9)
+                if word >> 9 == 0:
+                    break
+                at += 2 + (word & 0x1FF)
+            want[number] = types
+        with self.checks() as check:
+            check(len(want) > 300, "%d PTCP frames" % len(want))
+            check({t for v in want.values() for t in v} == {0, 1, 2, 3, 4, 5, 6, 7, 0x7F},
+                  "the PTCP frames hold every block type")
+            for two_pass in ([], ["-2"]):
+                rows = self.rows(["pnr.ptcp.block.type"], two_pass)
+                got = {n: [int(v, 0) for v in rows[n][0]] for n in want}
+                differ = [(n, got[n], want[n]) for n in want if got[n] != want[n]]
+                check(not differ, "%s: blocks differ from the bytes on %d frames, first %s"
+                      % (two_pass or "one pass", len(differ), differ[:3]))
 
     def test_trailer_is_the_last_four_bytes(self):
         fields = ["pnr.frame_id", "pnr.cyclic.cycle_counter", "pnr.cyclic.data_status", "pnr.cyclic.transfer_status"]
@@ -295,7 +367,7 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
         mapped = {f for ws, _ in COUNTERPARTS for f in ws}
         pdml = self.env.tshark(["-r", self.capture, "-T", "pdml", "--disable-protocol", "pnr"]).stdout
         import re
-        shown = set(re.findall(r'<field name="((?:pn_rt|pn_dcp|pn_io)\.[^"]+)"', pdml))
+        shown = set(re.findall(r'<field name="((?:pn_rt|pn_dcp|pn_io|pn_ptcp)\.[^"]+)"', pdml))
         unexplained = sorted(shown - mapped - set(WITHOUT_COUNTERPART))
         print("\nWireshark fields without a counterpart: " + ", ".join(sorted(shown - mapped)))
         self.assertEqual(unexplained, [])
