@@ -361,6 +361,21 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
                 check(str(cut) not in counters and len(counters) == 19,
                       "a cycle counter on every frame but the cut one %s: %s" % (two_pass, counters))
 
+    def test_ptcp_delay_is_the_sum_of_its_parts(self):
+        """pnr.ptcp.delay, which pn_ptcp shows only as text, is Delay10ns x 10 + Delay1ns_Byte
+        + Delay1ns as the generator wrote them, on every RTSync frame and no other."""
+        want = {}
+        for number, frame in enumerate(self.frames, 1):
+            if struct.unpack(">H", frame[14:16])[0] in pngen.PTCP_RTSYNC:
+                delay10ns, _, one_byte, _, delay1ns = struct.unpack(">IHBBI", frame[16 + 8:16 + 20])
+                want[number] = [delay10ns * 10 + one_byte + delay1ns]
+        rows = self.rows(["pnr.ptcp.delay"])
+        got = {n: [int(v) for v in row[0]] for n, row in rows.items() if row[0]}
+        with self.checks() as check:
+            check(len(want) > 50, "%d RTSync frames" % len(want))
+            differ = [(n, got.get(n), want.get(n)) for n in sorted(set(got) | set(want)) if got.get(n) != want.get(n)]
+            check(not differ, "delay differs on %d frames, first %s" % (len(differ), differ[:3]))
+
     def test_wireshark_fields_without_counterpart_are_listed(self):
         """Every field Wireshark's PROFINET dissectors show on these captures has a
         counterpart or a reason in WITHOUT_COUNTERPART."""
