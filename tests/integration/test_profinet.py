@@ -361,6 +361,24 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
                 check(str(cut) not in counters and len(counters) == 19,
                       "a cycle counter on every frame but the cut one %s: %s" % (two_pass, counters))
 
+    def test_ptcp_block_past_its_frame_is_reported_where_it_is(self):
+        """A PTCP block whose Length runs past the frame gets pnr.expert.past_end on that
+        frame only, in one pass and with -2 (the generated captures have none: see
+        test_trailer_missing_is_reported_where_it_is)."""
+        rng = random.Random(6)
+        frames = [pngen.ethernet(*pngen.ptcp_frame(rng), rng) for _ in range(20)]
+        bad = 5
+        first = bytearray(frames[bad - 1])
+        word = struct.unpack(">H", first[36:38])[0]
+        first[36:38] = struct.pack(">H", word & 0xFE00 | 0x1FF)
+        frames[bad - 1] = bytes(first)
+        cap = self.env.add_file("ptcp_past_end.pcap", pngen.pcap(frames))
+        with self.checks() as check:
+            for two_pass in ([], ["-2"]):
+                rows = self.env.tshark(["-r", cap, "-Y", "_ws.expert", "-T", "fields", "-e", "frame.number",
+                                        "-e", "pnr.expert.past_end"] + two_pass).stdout.splitlines()
+                check(rows == ["%d\t1" % bad], "past_end %s on frame %d only: %s" % (two_pass, bad, rows))
+
     def test_ptcp_delay_is_the_sum_of_its_parts(self):
         """pnr.ptcp.delay, which pn_ptcp shows only as text, is Delay10ns x 10 + Delay1ns_Byte
         + Delay1ns as the generator wrote them, on every RTSync frame and no other."""
