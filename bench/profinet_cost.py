@@ -6,10 +6,10 @@ instructions counted by valgrind (callgrind): immune to the other load of a shar
     python3 bench/profinet_cost.py [--dissgen build/bin/dissgen] [--frames 2000]
 
 Generates --frames PROFINET frames (tests/integration/pngen.py: DCP of every service,
-cyclic RT frames, alarms), installs the plugin into a temporary HOME and counts one tshark
+cyclic RT frames, alarms, PTCP), installs the plugin into a temporary HOME and counts one tshark
 run per cell: summary lines (`-r`) and packet details (`-V`), each with
     ours       pnr (the default for ethertype 0x8892 once installed)
-    wireshark  --disable-protocol pnr: pn_rt and its sub-dissectors
+    wireshark  --disable-protocol pnr: pn_rt and its sub-dissectors (pn_dcp, pn_io, pn_ptcp)
     floor      --disable-protocol pnr --disable-protocol pn_rt: 0x8892 left undissected
 and prints (total - floor) / frames for ours and Wireshark's, and their ratio.
 """

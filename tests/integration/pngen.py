@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Random PROFINET frames on ethertype 0x8892 (Python 3 stdlib only), for the tests of
 rules/profinet.xml: every DCP service with every option/suboption block, cyclic RT frames
-of the three RT classes with random trailers, and alarms (high/low, every RTA PDU type).
+of the three RT classes with random trailers, alarms (high/low, every RTA PDU type) and
+PTCP time synchronisation (every PDU kind with every TLV block).
 
     frames = pngen.all_frames(random.Random(1), cyclic=200)   # [bytes]
     pngen.pcap(frames)                                          # a pcap file's bytes
@@ -151,12 +152,74 @@ def alarm_frame(rng):
     return rng.choice([0xFC01, 0xFE01]), header + var
 
 
-def all_frames(rng, rounds=20, cyclic=200, alarms=60):
+# --- PTCP (IEC 61158-6-10 time synchronisation) ----------------------------
+
+PTCP_RTSYNC = (0x0020, 0x0021, 0x0080, 0x0081)  # with follow-up, then without (Clock, Time)
+PTCP_ANNOUNCE = (0xFF00, 0xFF01)
+PTCP_FOLLOW_UP = (0xFF20, 0xFF21)
+PTCP_DELAY = (0xFF40, 0xFF41, 0xFF42, 0xFF43)  # DelayReq, DelayRes, DelayFuRes, DelayRes
+PTCP_IDS = PTCP_RTSYNC + PTCP_ANNOUNCE + PTCP_FOLLOW_UP + PTCP_DELAY
+PROFINET_OUIS = (0x000ECF, 0x010ECF)
+
+
+def tlv(block_type, body):
+    """A TLV block: 7 bits of type, 9 bits of length, the body."""
+    return struct.pack(">H", block_type << 9 | len(body)) + body
+
+
+def ptcp_blocks(rng):
+    """Every TLV block but End, with random values; each a multiple of 4 bytes long, as the
+    specification lays them out (so the paddings inside sit where it puts them). No block of
+    a reserved type (0x08-0x7E): pn_ptcp skips its length twice and decodes what follows
+    from the wrong place, so there would be nothing right to compare with."""
+    u32 = lambda: rng.randrange(1 << 32)  # noqa: E731
+    organization = rng.choice(PROFINET_OUIS)
+    return [
+        tlv(1, rand_bytes(rng, 6) + rand_bytes(rng, 16)),                                  # Subdomain
+        tlv(2, struct.pack(">HII", rng.randrange(1 << 16), u32(), rng.randrange(10**9))),  # Time
+        tlv(3, struct.pack(">HHH", rng.randrange(1 << 16), rng.randrange(1 << 16), 0)),     # TimeExtension
+        tlv(4, struct.pack(">BBBBh", rng.randrange(256), rng.choice([0xFF, rng.randrange(256)]),
+                           rng.choice([0xFF, rng.randrange(256)]),
+                           rng.choice([0x20, 0x21, 0x22, 0x25, 0x29, 0xFE, rng.randrange(256)]),
+                           rng.randrange(-32768, 32768))),                                 # Master
+        tlv(5, struct.pack(">HII", 0, u32(), u32())),                                      # PortParameter
+        tlv(6, rand_bytes(rng, 6)),                                                        # DelayParameter
+        tlv(7, struct.pack(">HI", 0, u32())),                                              # PortTime
+        tlv(0x7F, struct.pack(">I", organization)[1:] + b"\x01\x00\x00" + rand_bytes(rng, 16)),  # PROFINET RTData
+        tlv(0x7F, struct.pack(">I", rng.randrange(1 << 24))[1:] + rand_bytes(rng, 3)),     # other organization
+    ]
+
+
+def ptcp_frame(rng):
+    """(frame ID, PTCP PDU): a header of the frame ID's kind, TLV blocks, End."""
+    frame_id = rng.choice(PTCP_IDS)
+    sequence = rng.randrange(1 << 16)
+    if frame_id in PTCP_RTSYNC:
+        header = struct.pack(">IIIHBBI", rng.randrange(1 << 32), rng.randrange(1 << 32), rng.randrange(1 << 32),
+                             sequence, rng.randrange(256), 0, rng.randrange(1 << 32))
+    elif frame_id in PTCP_ANNOUNCE:
+        header = bytes(12) + struct.pack(">H", sequence) + bytes(6)
+    elif frame_id in PTCP_FOLLOW_UP:
+        header = bytes(12) + struct.pack(">HHi", sequence, 0, rng.randrange(-(1 << 31), 1 << 31))
+    else:
+        header = bytes(12) + struct.pack(">HHI", sequence, 0, rng.randrange(1 << 32))
+    blocks = ptcp_blocks(rng)
+    rng.shuffle(blocks)
+    return frame_id, header + b"".join(blocks[:rng.randrange(1, len(blocks) + 1)]) + tlv(0, b"")
+
+
+def all_frames(rng, rounds=20, cyclic=200, alarms=60, ptcp=60):
+    """DCP, cyclic and alarm frames, then `ptcp` PTCP frames from a generator of their own
+    (seeded from `rng`'s draws after the others), all shuffled: the frames before PTCP
+    are the same with and without it."""
     frames = []
     for _ in range(rounds):
         frames += [ethernet(fid, body, rng) for fid, body in dcp_frames(rng)]
     frames += [ethernet(*cyclic_frame(rng), rng) for _ in range(cyclic)]
     frames += [ethernet(*alarm_frame(rng), rng) for _ in range(alarms)]
+    if ptcp:
+        own = random.Random(rng.randrange(1 << 32))
+        frames += [ethernet(*ptcp_frame(own), own) for _ in range(ptcp)]
     rng.shuffle(frames)
     return frames
 

@@ -3,14 +3,16 @@
 """PROFINET from rules alone: rules/profinet.xml (pnr) against Wireshark's pn_rt, pn_dcp and
 pn_io, value by value, on generated captures (pngen.py): every DCP service with every
 option/suboption block, cyclic frames of RT classes 1-3 with random cycle counters and
-status bits, alarms of every RTA PDU type.
+status bits, alarms of every RTA PDU type, PTCP frames of every kind with every TLV block
+(against pn_ptcp).
 
 - the plugin loads beside Wireshark's PROFINET dissectors and takes ethertype 0x8892;
   with pnr disabled, pn_rt decodes the frames again;
 - for each Wireshark field of COUNTERPARTS, per frame, its values are matched with our
   counterpart fields' values (as multisets: pn_dcp spreads one concept over several fields,
   e.g. a suboption per option); the agreement is the share of Wireshark's values matched,
-  printed with what did not match; goal: 99.5 %;
+  printed with what did not match, and PTCP's own share; goal: 99.5 %; ours are the same
+  in one pass and with -2;
 - the trailer: our cycle counter, data status and transfer status equal the bytes the
   generator wrote at the end of each cyclic frame;
 - fields of Wireshark's without a counterpart are listed (WITHOUT_COUNTERPART says why).
@@ -117,6 +119,37 @@ COUNTERPARTS = [
     (["pn_io.alarm_specifier.manufacturer"], ["pnr.alarm.notification.specifier.manufacturer"]),
     (["pn_io.alarm_specifier.submodule"], ["pnr.alarm.notification.specifier.submodule"]),
     (["pn_io.alarm_specifier.ardiagnosis"], ["pnr.alarm.notification.specifier.ar_diagnosis"]),
+    (["pn_ptcp.res1"], ["pnr.ptcp.reserved_1"]),
+    (["pn_ptcp.res2"], ["pnr.ptcp.reserved_2"]),
+    (["pn_ptcp.delay10ns"], ["pnr.ptcp.delay10ns"]),
+    (["pn_ptcp.sequence_id"], ["pnr.ptcp.sequence_id"]),
+    (["pn_ptcp.delay1ns_byte"], ["pnr.ptcp.delay1ns_byte"]),
+    (["pn_ptcp.delay1ns"], ["pnr.ptcp.delay1ns"]),
+    (["pn_ptcp.delay1ns_fup"], ["pnr.ptcp.delay1ns_fup"]),
+    (["pn_ptcp.tl_type"], ["pnr.ptcp.block.type"]),
+    (["pn_ptcp.tl_length"], ["pnr.ptcp.block.length"]),
+    (["pn_ptcp.master_source_address"], ["pnr.ptcp.block.master_source_address"]),
+    (["pn_ptcp.subdomain_uuid"], ["pnr.ptcp.block.subdomain_uuid"]),
+    (["pn_ptcp.epoch_number"], ["pnr.ptcp.block.epoch_number"]),
+    (["pn_ptcp.seconds"], ["pnr.ptcp.block.seconds"]),
+    (["pn_ptcp.nanoseconds"], ["pnr.ptcp.block.nanoseconds"]),
+    (["pn_ptcp.flags"], ["pnr.ptcp.block.flags"]),
+    (["pn_ptcp.currentutcoffset"], ["pnr.ptcp.block.current_utc_offset"]),
+    (["pn_ptcp.master_priority1_prio"], ["pnr.ptcp.block.master_priority1.priority"]),
+    (["pn_ptcp.master_priority1_level"], ["pnr.ptcp.block.master_priority1.level"]),
+    (["pn_ptcp.master_priority1_res"], ["pnr.ptcp.block.master_priority1.reserved"]),
+    (["pn_ptcp.master_priority1_act"], ["pnr.ptcp.block.master_priority1.active"]),
+    (["pn_ptcp.master_priority2"], ["pnr.ptcp.block.master_priority2"]),
+    (["pn_ptcp.clock_class"], ["pnr.ptcp.block.clock_class"]),
+    (["pn_ptcp.clock_accuracy"], ["pnr.ptcp.block.clock_accuracy"]),
+    (["pn_ptcp.clockvariance"], ["pnr.ptcp.block.clock_variance"]),
+    (["pn_ptcp.t2portrxdelay"], ["pnr.ptcp.block.t2_port_rx_delay"]),
+    (["pn_ptcp.t3porttxdelay"], ["pnr.ptcp.block.t3_port_tx_delay"]),
+    (["pn_ptcp.port_mac_address"], ["pnr.ptcp.block.port_mac_address"]),
+    (["pn_ptcp.t2timestamp"], ["pnr.ptcp.block.t2_timestamp"]),
+    (["pn_ptcp.oui"], ["pnr.ptcp.block.oui"]),
+    (["pn_ptcp.subtype"], ["pnr.ptcp.block.subtype"]),
+    (["pn_ptcp.irdata_uuid"], ["pnr.ptcp.block.ir_data_uuid"]),
 ]
 
 # Wireshark's fields (of those its dissectors show on these captures) that have no
@@ -137,6 +170,9 @@ WITHOUT_COUNTERPART = {
     "pn_io.error_code2.expert": "an expert info with pn_io's meaning of ErrorCode2 (a table pnr does not hold)",
     "pn_dcp.block_error.unknown": "an expert info on a BlockError other than Ok: pnr names the error "
                                   "(pnr.dcp.block.response.block_error) without an expert info",
+    "pn_ptcp.header": "a container (pnr.ptcp's RTSync, Announce, FollowUp and Delay headers)",
+    "pn_ptcp.block": "a container (pnr.ptcp.block)",
+    "pn_ptcp.tlvheader": "a container: its Type and Length are pnr.ptcp.block.type and .length",
 }
 
 
@@ -144,7 +180,7 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
         cls.install("rules/profinet.xml", "pnr")
-        cls.frames = pngen.all_frames(random.Random(41), rounds=40, cyclic=400, alarms=120)
+        cls.frames = pngen.all_frames(random.Random(41), rounds=40, cyclic=400, alarms=120, ptcp=400)
         cls.capture = cls.env.add_file("profinet.pcap", pngen.pcap(cls.frames))
 
     def rows(self, fields, extra=()):
@@ -161,17 +197,52 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
                   "Decode As pn_rt gives every frame to pn_rt")
 
     def test_values_agree_with_wireshark(self):
-        total, matched, value_misses = differential.agreement(self.env, self.capture, COUNTERPARTS, "pnr",
-                                                              lambda _field, value: differential.number_or_text(value))
+        ours_fields = [f for _, o in COUNTERPARTS for f in o]
+        self.assertEqual(self.rows(ours_fields, ["-2"]), self.rows(ours_fields), "our values are the same with -2")
+        normalize = lambda _field, value: differential.number_or_text(value)  # noqa: E731
+        total, matched, value_misses = differential.agreement(self.env, self.capture, COUNTERPARTS, "pnr", normalize)
+        ptcp = [(ws, o) for ws, o in COUNTERPARTS if ws[0].startswith("pn_ptcp.")]
+        ptcp_total, ptcp_matched, _ = differential.agreement(self.env, self.capture, ptcp, "pnr", normalize)
         misses = collections.Counter()
         for (field, _frame, _value), n in value_misses.items():
             misses[field] += n
         share = 100.0 * matched / max(total, 1)
         print("\nagreement: %d of %d Wireshark values (%.2f %%)" % (matched, total, share))
+        ptcp_share = 100.0 * ptcp_matched / max(ptcp_total, 1)
+        print("PTCP: %d of %d pn_ptcp values (%.2f %%)" % (ptcp_matched, ptcp_total, ptcp_share))
         for field, n in misses.most_common():
             print("  not matched: %s x%d" % (field, n))
         self.assertGreater(total, 10000, "the captures give Wireshark's dissectors many values")
+        self.assertGreater(ptcp_total, 5000, "the PTCP frames give pn_ptcp many values")
         self.assertGreaterEqual(share, 99.5)
+        self.assertGreaterEqual(ptcp_share, 99.5)
+
+    def test_ptcp_blocks_end_at_end(self):
+        """Each PTCP frame has exactly the TLV blocks its bytes hold up to and with End, of
+        the types written there, in one pass and with -2: the frame's padding after End is
+        no block, and no block is lost."""
+        want = {}
+        for number, frame in enumerate(self.frames, 1):
+            if struct.unpack(">H", frame[14:16])[0] not in pngen.PTCP_IDS:
+                continue
+            types, at = [], 14 + 2 + 20
+            while True:
+                word = struct.unpack(">H", frame[at:at + 2])[0]
+                types.append(word >> 9)
+                if word >> 9 == 0:
+                    break
+                at += 2 + (word & 0x1FF)
+            want[number] = types
+        with self.checks() as check:
+            check(len(want) > 300, "%d PTCP frames" % len(want))
+            check({t for v in want.values() for t in v} == {0, 1, 2, 3, 4, 5, 6, 7, 0x7F},
+                  "the PTCP frames hold every block type")
+            for two_pass in ([], ["-2"]):
+                rows = self.rows(["pnr.ptcp.block.type"], two_pass)
+                got = {n: [int(v, 0) for v in rows[n][0]] for n in want}
+                differ = [(n, got[n], want[n]) for n in want if got[n] != want[n]]
+                check(not differ, "%s: blocks differ from the bytes on %d frames, first %s"
+                      % (two_pass or "one pass", len(differ), differ[:3]))
 
     def test_trailer_is_the_last_four_bytes(self):
         fields = ["pnr.frame_id", "pnr.cyclic.cycle_counter", "pnr.cyclic.data_status", "pnr.cyclic.transfer_status"]
@@ -262,11 +333,44 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
                 check(str(cut) not in counters and len(counters) == 19,
                       "a cycle counter on every frame but the cut one %s: %s" % (two_pass, counters))
 
+    def test_ptcp_block_past_its_frame_is_reported_where_it_is(self):
+        """A PTCP block whose Length runs past the frame gets pnr.expert.past_end on that
+        frame only, in one pass and with -2 (the generated captures have none: see
+        test_trailer_missing_is_reported_where_it_is)."""
+        rng = random.Random(6)
+        frames = [pngen.ethernet(*pngen.ptcp_frame(rng), rng) for _ in range(20)]
+        bad = 5
+        first = bytearray(frames[bad - 1])
+        word = struct.unpack(">H", first[36:38])[0]
+        first[36:38] = struct.pack(">H", word & 0xFE00 | 0x1FF)
+        frames[bad - 1] = bytes(first)
+        cap = self.env.add_file("ptcp_past_end.pcap", pngen.pcap(frames))
+        with self.checks() as check:
+            for two_pass in ([], ["-2"]):
+                rows = self.env.tshark(["-r", cap, "-Y", "_ws.expert", "-T", "fields", "-e", "frame.number",
+                                        "-e", "pnr.expert.past_end"] + two_pass).stdout.splitlines()
+                check(rows == ["%d\t1" % bad], "past_end %s on frame %d only: %s" % (two_pass, bad, rows))
+
+    def test_ptcp_delay_is_the_sum_of_its_parts(self):
+        """pnr.ptcp.delay, which pn_ptcp shows only as text, is Delay10ns x 10 + Delay1ns_Byte
+        + Delay1ns as the generator wrote them, on every RTSync frame and no other."""
+        want = {}
+        for number, frame in enumerate(self.frames, 1):
+            if struct.unpack(">H", frame[14:16])[0] in pngen.PTCP_RTSYNC:
+                delay10ns, _, one_byte, _, delay1ns = struct.unpack(">IHBBI", frame[16 + 8:16 + 20])
+                want[number] = [delay10ns * 10 + one_byte + delay1ns]
+        rows = self.rows(["pnr.ptcp.delay"])
+        got = {n: [int(v) for v in row[0]] for n, row in rows.items() if row[0]}
+        with self.checks() as check:
+            check(len(want) > 50, "%d RTSync frames" % len(want))
+            differ = [(n, got.get(n), want.get(n)) for n in sorted(set(got) | set(want)) if got.get(n) != want.get(n)]
+            check(not differ, "delay differs on %d frames, first %s" % (len(differ), differ[:3]))
+
     def test_wireshark_fields_without_counterpart_are_listed(self):
         """Every field Wireshark's PROFINET dissectors show on these captures has a
         counterpart or a reason in WITHOUT_COUNTERPART."""
         mapped = {f for ws, _ in COUNTERPARTS for f in ws}
-        shown = differential.fields_shown(self.env, self.capture, ["pn_rt.", "pn_dcp.", "pn_io."], "pnr")
+        shown = differential.fields_shown(self.env, self.capture, ["pn_rt.", "pn_dcp.", "pn_io.", "pn_ptcp."], "pnr")
         unexplained = sorted(shown - mapped - set(WITHOUT_COUNTERPART))
         print("\nWireshark fields without a counterpart: " + ", ".join(sorted(shown - mapped)))
         self.assertEqual(unexplained, [])
