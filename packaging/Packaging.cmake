@@ -210,7 +210,8 @@ set_tests_properties(gui_screenshot PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 600 R
 add_test(NAME gui_cycle_captures
          COMMAND python3 ${CMAKE_SOURCE_DIR}/tests/gui/cycle_captures.py ${CMAKE_BINARY_DIR}/gui/captures)
 set_tests_properties(gui_cycle_captures PROPERTIES FIXTURES_SETUP gui_captures)
-foreach(entry "ethercat|ECATR|ethercat-two-tasks" "enip|ENIPR|enip-io" "profinet|PNR|profinet-cyclic")
+foreach(entry "ethercat|ECATR|ethercat-two-tasks" "enip|ENIPR|enip-io" "profinet|PNR|profinet-cyclic"
+      "powerlink|EPLR|powerlink-cycle")
   string(REPLACE "|" ";" parts "${entry}")
   list(GET parts 0 stem)
   list(GET parts 1 abbreviation)

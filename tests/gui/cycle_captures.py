@@ -9,14 +9,18 @@ time to the nanosecond.
                                OUTDIR/profinet-cyclic.pcap (three devices' cyclic
                                data, pngen.cyclic_devices) and
                                OUTDIR/ethercat-two-tasks.pcap (two EtherCAT tasks at
-                               1 and 10 ms, test_cycles.two_tasks)
+                               1 and 10 ms, test_cycles.two_tasks) and
+                               OUTDIR/powerlink-cycle.pcap (a POWERLINK cycle of
+                               three nodes, eplgen.cycle)
 """
 import os
+import random
 import sys
 
 here = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(here, "..", "integration"))
 import cyclemodel  # noqa: E402
+import eplgen  # noqa: E402
 import pngen  # noqa: E402
 import test_cycles  # noqa: E402
 import test_losses  # noqa: E402
@@ -26,7 +30,8 @@ import test_rule_cycles  # noqa: E402
 def main(out):
     os.makedirs(out, exist_ok=True)
     captures = {"enip-io.pcap": test_rule_cycles.generated_capture(),
-                "profinet-cyclic.pcap": pngen.cyclic_devices()}
+                "profinet-cyclic.pcap": pngen.cyclic_devices(),
+                "powerlink-cycle.pcap": eplgen.cycle(random.Random(88))[0]}
     for name, packets in captures.items():
         with open(os.path.join(out, name), "wb") as f:
             f.write(cyclemodel.pcap_ns(packets))
