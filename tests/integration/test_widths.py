@@ -306,7 +306,7 @@ class Widths(TsharkTestCase, unittest.TestCase):
         cls.env.install_plugin(ARGS.dissgen, rules)
         g = Gen(ARGS.seed)
         cls.cases = cases(g, ARGS.messages)
-        cap = cls.env.add_file("widths.pcap", pcap([(frame(c.data), len(frame(c.data))) for c in cls.cases]))
+        cls.capture = cap = cls.env.add_file("widths.pcap", pcap([(frame(c.data), len(frame(c.data))) for c in cls.cases]))
         listing = subprocess_lines([ARGS.dissgen, "fields", rules])
         # the rule file's fields (the fourth column says "rules"), not the runtime's expert infos,
         # and the field the runtime registers for every protocol
@@ -350,6 +350,17 @@ class Widths(TsharkTestCase, unittest.TestCase):
             want, got = ", ".join(c.info), self.rows[i]["_ws.col.Info"]
             if want != got:
                 bad.append("%s:\n  expected %r\n  got      %r" % (self.where(i), want, got))
+        self.assertEqual(bad[:10], [], "%d packets differ" % len(bad))
+
+    def test_info_column_by_the_table_walk(self):
+        """The runtime's own summary builder (DISSGEN_TABLE_WALK=1: no compiled summaries)
+        gives the same Info column: hex digits for a field of any bit width."""
+        p = self.env.tshark(["-r", self.capture, "-T", "fields", "-e", "_ws.col.Info"],
+                            extra_env={"DISSGEN_TABLE_WALK": "1"})
+        got = p.stdout.splitlines()
+        self.assertEqual(len(got), len(self.cases))
+        bad = ["%s:\n  expected %r\n  got      %r" % (self.where(i), ", ".join(c.info), got[i])
+               for i, c in enumerate(self.cases) if ", ".join(c.info) != got[i]]
         self.assertEqual(bad[:10], [], "%d packets differ" % len(bad))
 
     def test_expert_infos_by_message_and_filter_name(self):

@@ -229,10 +229,11 @@ class TsharkEnv:
             rows[int(cols[0])] = {f: (v.split(aggregator) if v else []) for f, v in zip(fields[1:], cols[1:])}
         return (rows, p.stderr) if with_stderr else rows
 
-    def tshark(self, args, check=True, stdout=None, timeout=1800):
-        """Run tshark; return CompletedProcess (text stdout/stderr unless stdout is a file)."""
+    def tshark(self, args, check=True, stdout=None, timeout=1800, extra_env=None):
+        """Run tshark; return CompletedProcess (text stdout/stderr unless stdout is a file).
+        extra_env: variables set for this run only (DISSGEN_TABLE_WALK, ...)."""
         cmd = self.command(args)
-        p = subprocess.run(cmd, env=self.env(), cwd=self.home, timeout=timeout, text=True,
+        p = subprocess.run(cmd, env=dict(self.env(), **(extra_env or {})), cwd=self.home, timeout=timeout, text=True,
                            stdout=stdout if stdout is not None else subprocess.PIPE,
                            stderr=subprocess.PIPE)
         if check and p.returncode != 0:
