@@ -4,11 +4,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "object_cache.h"
 #include "runtime_list.h"
 #include "wireshark_env.h"
 
@@ -33,6 +35,21 @@ bool has_runtime(const fs::path& dir) {
     for (const std::string& source : runtime_list().sources)
         if (!fs::exists(dir / source, ec)) return false;
     return fs::exists(dir / "dissgen_runtime.h", ec);
+}
+
+// Every header of the runtime and its analyses: what a cached object may have included.
+std::vector<std::string> runtime_headers(const std::string& runtime_dir) {
+    std::vector<std::string> headers;
+    std::error_code ec;
+    for (fs::recursive_directory_iterator it(runtime_dir, ec), end; !ec && it != end; it.increment(ec))
+        if (it->path().extension() == ".h") headers.push_back(it->path().string());
+    std::sort(headers.begin(), headers.end());
+    return headers;
+}
+
+std::string trimmed(const std::string& s) {
+    size_t end = s.find_last_not_of(" \t\r\n");
+    return end == std::string::npos ? "" : s.substr(0, end + 1);
 }
 
 }  // namespace
@@ -121,9 +138,20 @@ std::string build_and_install(const BuildRequest& req, std::string& installed_pa
         if (notes.empty()) return std::string("cannot create a coverage folder in ") + coverage;
         cmd.insert(cmd.end(), {"--coverage", "-dumpdir", notes + "/"});
     }
-    cmd.push_back(source.string());
-    for (const std::string& runtime_source : runtime.sources) cmd.push_back(req.runtime_dir + "/" + runtime_source);
-    for (const std::string& extra : req.analysis_sources) cmd.push_back(req.runtime_dir + "/" + extra);
+    std::vector<std::string> sources = {source.string()};
+    for (const std::string& runtime_source : runtime.sources) sources.push_back(req.runtime_dir + "/" + runtime_source);
+    for (const std::string& extra : req.analysis_sources) sources.push_back(req.runtime_dir + "/" + extra);
+    std::vector<std::string> link_inputs = sources;
+    // The coverage notes name each plugin's folder: compiled in one go, nothing cached.
+    if (!coverage) {
+        // The Wireshark headers the objects are compiled against, by version.
+        std::string version;
+        run_command({"pkg-config", "--modversion", "wireshark"}, &version);
+        CompileJob job{cmd, sources, runtime_headers(req.runtime_dir), default_cache_dir(), dir.string(),
+                       "Wireshark " + trimmed(version)};
+        if (std::string error = compile_objects(job, link_inputs); !error.empty()) return error;
+    }
+    cmd.insert(cmd.end(), link_inputs.begin(), link_inputs.end());
     cmd.push_back("-o");
     cmd.push_back(output.string());
     cmd.push_back("-Wl,--no-undefined");

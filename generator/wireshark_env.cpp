@@ -14,8 +14,13 @@
 namespace dissgen {
 
 int run_command(const std::vector<std::string>& argv, std::string* output, bool merge_stderr) {
+    // The argument vector is built before fork(): the child of a threaded dissgen
+    // (object_cache.cpp compiles in parallel) must not allocate before exec.
+    std::vector<char*> args;
+    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
     int pipefd[2];
-    if (pipe(pipefd) != 0) return -1;
+    if (pipe2(pipefd, O_CLOEXEC) != 0) return -1;
     pid_t pid = fork();
     if (pid < 0) return -1;
     if (pid == 0) {
@@ -28,9 +33,6 @@ int run_command(const std::vector<std::string>& argv, std::string* output, bool 
         }
         close(pipefd[0]);
         close(pipefd[1]);
-        std::vector<char*> args;
-        for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-        args.push_back(nullptr);
         execvp(args[0], args.data());
         _exit(127);
     }

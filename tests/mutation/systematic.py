@@ -95,6 +95,7 @@ TESTS_BY_FILE = {
     "generator/analyses.cpp": ["unit", "plugin_contents", "pairing"],
     "generator/build_plugin.cpp": ["loading", "plugin_contents", "everything"],
     "generator/wireshark_env.cpp": ["loading", "everything"],
+    "generator/object_cache.cpp": ["unit", "loading", "everything"],
     "generator/main.cpp": ["unit", "loading", "everything", "plugin_contents"],
     "generator/ethercat/": ["esi", "bus_tables", "bus_pdo", "bus_coe"],
     "generator/report/": ["unit", "report"],
