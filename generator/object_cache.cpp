@@ -57,8 +57,8 @@ bool read_file(const std::string& path, std::string& out) {
 
 // What every object of this job depends on besides its own source: the compiler (by what
 // it says it is), its options, and the headers. Paths inside the build's temporary folder
-// are named relative to it (the folder is new each time; -fmacro-prefix-map keeps it out
-// of __FILE__).
+// are named relative to it (the folder is new each time; -ffile-prefix-map keeps it out
+// of __FILE__ and debug information).
 std::string job_key(const CompileJob& job, std::string& error) {
     Key key;
     key.add(kCacheFormat);
@@ -112,7 +112,7 @@ std::string compile_objects(const CompileJob& job, std::vector<std::string>& obj
     const bool cached = usable_dir(job.cache_dir);
     const std::string store = cached ? job.cache_dir : job.work_dir;
     std::vector<std::string> compiler = job.compiler;
-    compiler.push_back("-fmacro-prefix-map=" + job.work_dir + "/=");
+    compiler.push_back("-ffile-prefix-map=" + job.work_dir + "/=");
     std::string error;
     std::string common = job_key(CompileJob{compiler, {}, job.headers, "", job.work_dir, job.salt}, error);
     if (!error.empty()) return error;
