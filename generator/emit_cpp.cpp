@@ -70,7 +70,8 @@ std::string named_row(const std::string& start, const std::vector<std::string>& 
 
 namespace {
 
-unsigned value_bytes(const Node& n) { return n.in_bit_group ? n.group_bytes : n.bits / 8; }
+// The bytes a numeric leaf's item is read from: its bit group's, a packed bit field's one byte.
+unsigned value_bytes(const Node& n) { return n.in_bit_group ? n.group_bytes : n.packed_bits ? 1 : n.bits / 8; }
 
 // A bit field's mask inside its group (0 for a whole-byte field).
 uint64_t group_mask(const Node& n) {
@@ -300,6 +301,7 @@ std::string flags_of(const Node& n, bool pairing_key) {
 
 const char* length_kind_of(const Node& n) {
     if (n.in_bit_group) return "DG_LEN_FIXED";
+    if (n.packed_bits) return "DG_LEN_PACKED";
     if (n.is_computed()) return "DG_LEN_COMPUTED";
     switch (n.length_kind) {
         case LengthKind::Bits:
@@ -546,6 +548,7 @@ std::string Emitter::node_row(const Node& n) const {
     if (length_kind == "DG_LEN_REST") add("length_rest", "");
     if (length_kind == "DG_LEN_CHILDREN") add("length_children", "");
     if (length_kind == "DG_LEN_COMPUTED") add("length_computed", "");
+    if (length_kind == "DG_LEN_PACKED") add("length_packed", "");
     unsigned length = n.in_bit_group ? n.group_bytes : static_cast<unsigned>(n.fixed_bits / 8);
     if (length && (n.has_fixed_length() || n.in_bit_group)) add("length", std::to_string(length));
     if (length_kind == "DG_LEN_REST" && n.rest_keep) add("length", std::to_string(n.rest_keep));

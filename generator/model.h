@@ -140,6 +140,9 @@ struct Node {
     // bit group membership: a group is a run of sibling leaves read as one
     // integer of group_bytes bytes; shift/bits place this leaf inside it.
     bool in_bit_group = false;
+    // a packed list of bit fields: a leaf of 1, 2 or 4 bits with `count`, its
+    // values filling whole bytes of their own (no bit group)
+    bool packed_bits = false;
     bool group_first = false;
     bool group_last = false;
     unsigned group_bytes = 0;

@@ -55,6 +55,7 @@ private:
     void check_leaf_display(Node& n);
     void layout_children(std::vector<std::unique_ptr<Node>>& children);
     void close_group(std::vector<Node*>& group, unsigned bits);
+    void layout_packed_bits(Node& n);
     std::optional<uint64_t> fixed_bytes(const Node& n) const;
     std::optional<uint64_t> children_fixed_bytes(const Node& n) const;
     void check_fixed_container(const Node& n);
@@ -275,6 +276,20 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
             if (n.is_container()) layout_children(n.children);
             continue;
         }
+        if (bit_leaf && !whole_bytes && n.count && !n.repeat && !n.repeat_rest && !n.offsets) {
+            // count="..." on a bit field: a packed list, which starts and ends on a byte
+            // boundary of its own.
+            if (!group.empty()) {
+                diags_.error(group.front()->line, "bit group starting at " + quote(*group.front()) + " ends after " +
+                                                      std::to_string(group_bits) +
+                                                      " bits, not on a byte boundary (next is " + quote(n) + at_line(n) +
+                                                      ", a packed list of bit fields, which starts a byte)");
+                group.clear();
+                group_bits = 0;
+            }
+            layout_packed_bits(n);
+            continue;
+        }
         if (!bit_leaf) {
             diags_.error(group.front()->line, "bit group starting at " + quote(*group.front()) + " ends after " +
                                                   std::to_string(group_bits) +
@@ -285,8 +300,8 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
             continue;
         }
         if (n.is_repeated() || n.if_field)
-            diags_.error(n.line, "bit field " + quote(n) + " cannot have 'repeat', 'count' or 'if': it shares bytes "
-                                 "with its neighbours in a bit group");
+            diags_.error(n.line, "bit field " + quote(n) + " cannot have 'repeat' or 'if': it shares bytes with its "
+                                 "neighbours in a bit group (with 'count' alone, a packed list)");
         else if (n.has_hook)
             diags_.error(n.line, "bit field " + quote(n) + " cannot have 'ifhook': it shares bytes with its "
                                  "neighbours in a bit group");
@@ -313,6 +328,20 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
     if (!group.empty())
         diags_.error(group.front()->line, "bit group starting at " + quote(*group.front()) + " ends after " +
                                               std::to_string(group_bits) + " bits, not on a byte boundary");
+}
+
+// A bit field with count="...": its values are packed into whole bytes, N per byte
+// (docs/manual.md, "Bit fields"); one straddling two bytes would need a bit order
+// across bytes that no protocol we know uses.
+void Validator::layout_packed_bits(Node& n) {
+    if (n.fixed_bits != 1 && n.fixed_bits != 2 && n.fixed_bits != 4)
+        diags_.error(n.line, "bit field " + quote(n) + " with 'count' is " + std::to_string(n.fixed_bits) +
+                                 " bits; a packed list of bit fields takes 1, 2 or 4 bits a value");
+    if (n.display == Display::Origin && !n.display_given) n.display = Display::NumberHex;
+    if (is_byte_display(n.display) || n.display == Display::Float)
+        diags_.error(n.line, std::string(display_name(n.display)) + " display needs whole bytes; bit field " +
+                                 quote(n) + " is a packed list (use numberhex, numberdec, bool, enum or int)");
+    n.packed_bits = true;
 }
 
 void Validator::close_group(std::vector<Node*>& group, unsigned bits) {
@@ -1125,7 +1154,7 @@ void Validator::check_string_display(Node& n) {
                                          " has none (use stringz for text that ends with a NUL)");
             [[fallthrough]];
         case Display::StringZ:
-            if (n.length_kind == LengthKind::Bits && n.fixed_bits % 8 != 0 && !n.in_bit_group)
+            if (n.length_kind == LengthKind::Bits && n.fixed_bits % 8 != 0 && !n.in_bit_group && !n.packed_bits)
                 diags_.error(n.line, shown + " display needs whole bytes; " + quote(n) + " is " +
                                          std::to_string(n.fixed_bits) + " bits");
             break;
@@ -1139,7 +1168,7 @@ void Validator::check_string_display(Node& n) {
                                          quote(n) + " has another length");
             break;
         case Display::Time:
-            if (n.has_fixed_length() && n.fixed_bits <= 64 && n.fixed_bits % 8 != 0 && !n.in_bit_group)
+            if (n.has_fixed_length() && n.fixed_bits <= 64 && n.fixed_bits % 8 != 0 && !n.in_bit_group && !n.packed_bits)
                 diags_.error(n.line, "time display needs 1 to 8 whole bytes; " + quote(n) + " is " +
                                          std::to_string(n.fixed_bits) + " bits");
             break;
@@ -1270,7 +1299,8 @@ void Validator::check_layout(Node& n) {
         else
             check_reference(n, w.ref, "when");
     }
-    bool bit_field = n.is_leaf() && (n.in_bit_group || (n.length_kind == LengthKind::Bits && n.fixed_bits % 8 != 0));
+    bool bit_field = n.is_leaf() && (n.in_bit_group || (n.length_kind == LengthKind::Bits && n.fixed_bits % 8 != 0 &&
+                                                         !n.packed_bits));
     if (bit_field && (!n.whens.empty() || n.otherwise))
         diags_.error(n.line, "bit field " + quote(n) + " cannot have <when> or 'otherwise': it shares bytes with its "
                              "neighbours in a bit group");

@@ -25,6 +25,7 @@ struct dg_node_row {
     constexpr dg_node_row &length_field(dg_ref ref) { n.length_kind = DG_LEN_FIELD; n.length_ref = ref; return *this; }
     constexpr dg_node_row &length_rest() { n.length_kind = DG_LEN_REST; return *this; }
     constexpr dg_node_row &length_children() { n.length_kind = DG_LEN_CHILDREN; return *this; }
+    constexpr dg_node_row &length_packed() { n.length_kind = DG_LEN_PACKED; return *this; }
     constexpr dg_node_row &length_computed() { n.length_kind = DG_LEN_COMPUTED; return *this; }
     constexpr dg_node_row &shift(guint8 v) { n.shift = v; return *this; }
     constexpr dg_node_row &bits(guint8 v) { n.bits = v; return *this; }

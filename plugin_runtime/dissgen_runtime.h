@@ -20,7 +20,8 @@ enum dg_length_kind {
     DG_LEN_FIELD = 1,    /* value of an earlier field, dg_node.length_ref */
     DG_LEN_REST = 2,     /* to the end of the enclosing known-length container */
     DG_LEN_CHILDREN = 3, /* sum of the children */
-    DG_LEN_COMPUTED = 4  /* none: a computed value (dg_extra.expr_first/count) */
+    DG_LEN_COMPUTED = 4, /* none: a computed value (dg_extra.expr_first/count) */
+    DG_LEN_PACKED = 5    /* a list of bit fields: dg_node.count values of dg_node.bits bits, packed into bytes */
 };
 /* How a leaf's value is shown; used for summaries and the Info column. */
 enum dg_show {

@@ -425,6 +425,45 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     if (collect) summaries_end(st, n, &summaries);
 }
 
+/* A packed list of bit fields (length="Nbit" with count, N dividing 8): `count`
+ * values of N bits, filling each byte from its least significant bits in a
+ * little-endian node, from its most significant otherwise; the list takes the
+ * whole bytes they need, bits after the last value included. Each value is an
+ * item on its byte showing its bits; the slot keeps the last. */
+void dissect_packed_bits(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end)
+{
+    gint64 wanted = 0;
+    if (!ref_value(st, &n->count, n, "count", tree, *offset, &wanted)) return;
+    const guint per_byte = 8u / n->bits;
+    const gint64 bytes = (wanted + per_byte - 1) / per_byte;
+    const gint64 have = MIN(bytes, (gint64)(end - *offset));
+    const gint64 instances = MIN(wanted, have * per_byte);
+    const guint mask = (1u << n->bits) - 1;
+    const guint32 outer_instance = st->instance;
+    for (gint64 i = 0; i < instances; i++) {
+        const gint at = *offset + (gint)(i / per_byte);
+        const guint pos = (guint)(i % per_byte) * n->bits;            /* bits before it in its byte */
+        const guint from_msb = (n->flags & DG_LITTLE) ? 8 - pos - n->bits : pos;
+        st->instance = (guint32)i;
+        if (tree) {
+            proto_item *item = proto_tree_add_bits_item(tree, *n->hf, st->tvb, at * 8 + (gint)from_msb, n->bits,
+                                                        ENC_BIG_ENDIAN);
+            if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+        }
+        if (value_wanted(st, n))
+            store(st, n, (tvb_get_guint8(st->tvb, at) >> (8 - from_msb - n->bits)) & mask, at, 1);
+    }
+    st->instance = outer_instance;
+    *offset += (gint)have;
+    if (st->tap) tap_record(st, n, (guint64)instances);
+    if (instances < wanted) {
+        report(st, tree, &st->p->ei->count_short, *offset, 0,
+               "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after %" G_GINT64_MODIFIER "d",
+               n->name, wanted, instances);
+        st->stopped = FALSE; /* the data simply ended, as for any repetition */
+    }
+}
+
 /* Whether entry k of offset table t, placed at base, lies in
  * [low, end]; otherwise reports it (bad_offset), which ends the node. */
 gboolean entry_ok(dg_state *st, const dg_node *n, proto_tree *tree, const dg_table *t, guint k, gint64 base,
@@ -716,7 +755,9 @@ void dissect_node(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
             dissect_overlay(st, n, tree, in_summary); /* the bytes of an earlier node */
         else
             dissect_located(st, n, tree, offset, end, in_summary); /* offset table */
-    } else if (is_repeated(n))
+    } else if (n->length_kind == DG_LEN_PACKED)
+        dissect_packed_bits(st, n, tree, offset, end);
+    else if (is_repeated(n))
         dissect_repeated(st, n, tree, offset, end, in_summary);
     else
         dissect_instance(st, n, tree, offset, end, in_summary, NULL);
