@@ -143,6 +143,9 @@ struct Node {
     // a packed list of bit fields: a leaf of 1, 2 or 4 bits with `count`, its
     // values filling whole bytes of their own (no bit group)
     bool packed_bits = false;
+    // a conditional member of a bit group that means the previous member's bits
+    // otherwise (same width, conditions that never hold together): takes no bits of its own
+    bool bit_alternative = false;
     bool group_first = false;
     bool group_last = false;
     unsigned group_bytes = 0;

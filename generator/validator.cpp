@@ -56,6 +56,7 @@ private:
     void layout_children(std::vector<std::unique_ptr<Node>>& children);
     void close_group(std::vector<Node*>& group, unsigned bits);
     void layout_packed_bits(Node& n);
+    void mean_same_bits(Node& n, std::vector<const Node*>& alternatives);
     std::optional<uint64_t> fixed_bytes(const Node& n) const;
     std::optional<uint64_t> children_fixed_bytes(const Node& n) const;
     void check_fixed_container(const Node& n);
@@ -260,17 +261,51 @@ void Validator::check_leaf_display(Node& n) {
     }
 }
 
+namespace {
+
+// "Nbyte" counts as 8N bits: a whole-byte leaf inside a group joins it, unless it
+// shows bytes (origin, address), which a group cannot hold.
+bool is_bit_leaf(const Node& n) {
+    return n.is_leaf() && (n.length_kind == LengthKind::Bits ||
+                           (n.length_kind == LengthKind::Bytes && !is_byte_display(n.display)));
+}
+
+bool lists_meet(const std::vector<ValueRange>& a, const std::vector<ValueRange>& b) {
+    for (const ValueRange& x : a)
+        for (const ValueRange& y : b)
+            if (x.low <= y.high && y.low <= x.high) return true;
+    return false;
+}
+
+// Whether n, right after the members that mean the latest bits of a bit group,
+// is one more meaning of them: it is never decoded with any of them. That is so
+// when n is an `otherwise` in the chain of alternatives of each (docs/manual.md,
+// "Alternatives with a default"), or when n and each have an `if` on the same
+// field with lists that share no value.
+bool means_same_bits(const Node& n, const std::vector<const Node*>& alternatives) {
+    if (!n.if_field && !n.otherwise) return false;
+    for (size_t i = 0; i < alternatives.size(); ++i) {
+        const Node& a = *alternatives[i];
+        bool in_chain = n.otherwise && (a.if_field || a.otherwise);
+        for (size_t j = i + 1; in_chain && j < alternatives.size(); ++j) in_chain = alternatives[j]->otherwise;
+        bool disjoint = a.if_field && n.if_field && a.if_field->target && a.if_field->target == n.if_field->target &&
+                        !lists_meet(a.in_list, n.in_list);
+        if (!in_chain && !disjoint) return false;
+    }
+    return !alternatives.empty();
+}
+
+}  // namespace
+
 // Groups consecutive bit fields into whole-byte integers (docs/manual.md,
 // "Lengths, bit fields, repetition, conditions"); recurses into containers.
 void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
     std::vector<Node*> group;
+    std::vector<const Node*> alternatives;  // the members that mean the latest bits, in order
     unsigned group_bits = 0;
     for (auto& child : children) {
         Node& n = *child;
-        // "Nbyte" counts as 8N bits: a whole-byte leaf inside a group joins it,
-        // unless it shows bytes (origin, address), which a group cannot hold.
-        bool bit_leaf = n.is_leaf() && (n.length_kind == LengthKind::Bits ||
-                                         (n.length_kind == LengthKind::Bytes && !is_byte_display(n.display)));
+        bool bit_leaf = is_bit_leaf(n);
         bool whole_bytes = bit_leaf && n.fixed_bits % 8 == 0;
         if (group.empty() && (!bit_leaf || whole_bytes)) {
             if (n.is_container()) layout_children(n.children);
@@ -299,8 +334,8 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
             if (n.is_container()) layout_children(n.children);
             continue;
         }
-        if (n.is_repeated() || n.if_field)
-            diags_.error(n.line, "bit field " + quote(n) + " cannot have 'repeat' or 'if': it shares bytes with its "
+        if (n.is_repeated())
+            diags_.error(n.line, "bit field " + quote(n) + " cannot have 'repeat': it shares bytes with its "
                                  "neighbours in a bit group (with 'count' alone, a packed list)");
         else if (n.has_hook)
             diags_.error(n.line, "bit field " + quote(n) + " cannot have 'ifhook': it shares bytes with its "
@@ -317,9 +352,16 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
         if (!group.empty() && n.byteorder != group.front()->byteorder)
             diags_.error(n.line, "bit field " + quote(n) + " has another byte order than its bit group starting at " +
                                      quote(*group.front()));
+        if (!group.empty() && means_same_bits(n, alternatives)) {
+            mean_same_bits(n, alternatives);  // the same bits again, with another meaning
+        } else {
+            alternatives.assign(1, &n);
+            group_bits += static_cast<unsigned>(std::min<uint64_t>(n.fixed_bits, 1u << 20));
+        }
         group.push_back(&n);
-        group_bits += static_cast<unsigned>(std::min<uint64_t>(n.fixed_bits, 1u << 20));
-        if (group_bits % 8 == 0) {
+        // The group ends on a byte boundary, unless the next sibling means these bits too.
+        const Node* next = &child != &children.back() ? (&child + 1)->get() : nullptr;
+        if (group_bits % 8 == 0 && !(next && is_bit_leaf(*next) && means_same_bits(*next, alternatives))) {
             close_group(group, group_bits);
             group.clear();
             group_bits = 0;
@@ -344,6 +386,19 @@ void Validator::layout_packed_bits(Node& n) {
     n.packed_bits = true;
 }
 
+
+// n means the bits of the members in `alternatives` (means_same_bits): it takes
+// none of its own, and must have their width.
+void Validator::mean_same_bits(Node& n, std::vector<const Node*>& alternatives) {
+    const Node& first = *alternatives.front();
+    if (n.fixed_bits != first.fixed_bits)
+        diags_.error(n.line, "bit field " + quote(n) + " is another meaning of the bits of " + quote(first) +
+                                 at_line(first) + ", which has " + std::to_string(first.fixed_bits) + " bits, not " +
+                                 std::to_string(n.fixed_bits) + "; alternatives of the same bits have the same width");
+    n.bit_alternative = true;
+    alternatives.push_back(&n);
+}
+
 void Validator::close_group(std::vector<Node*>& group, unsigned bits) {
     if (bits > 64) {
         diags_.error(group.front()->line, "bit group starting at " + quote(*group.front()) + " is " +
@@ -351,11 +406,17 @@ void Validator::close_group(std::vector<Node*>& group, unsigned bits) {
         return;
     }
     unsigned used = 0;
+    const Node* meant = nullptr;  // the member whose bits an alternative means
     for (Node* n : group) {
         n->in_bit_group = true;
         n->group_bytes = bits / 8;
+        if (n->bit_alternative && meant) {
+            n->shift = meant->shift;
+            continue;
+        }
         n->shift = n->byteorder == ByteOrder::Little ? used : bits - used - n->bits;
         used += n->bits;
+        meant = n;
     }
     group.front()->group_first = true;
     group.back()->group_last = true;
@@ -373,17 +434,17 @@ std::optional<uint64_t> Validator::fixed_bytes(const Node& n) const {
 // The bytes n's children take when all of them have a fixed size (bit groups
 // count by their whole bytes); nullopt when one of them is variable.
 std::optional<uint64_t> Validator::children_fixed_bytes(const Node& n) const {
-    uint64_t sum = 0, group_bits = 0;
+    uint64_t sum = 0;
     for (const auto& c : n.children) {
         if (c->in_bit_group) {
-            group_bits += c->bits;
+            if (c->group_first) sum += c->group_bytes;
             continue;
         }
         auto b = fixed_bytes(*c);
         if (!b) return std::nullopt;
         sum += *b;
     }
-    return sum + group_bits / 8;
+    return sum;
 }
 
 void Validator::check_fixed_container(const Node& n) {
@@ -1301,9 +1362,12 @@ void Validator::check_layout(Node& n) {
     }
     bool bit_field = n.is_leaf() && (n.in_bit_group || (n.length_kind == LengthKind::Bits && n.fixed_bits % 8 != 0 &&
                                                          !n.packed_bits));
-    if (bit_field && (!n.whens.empty() || n.otherwise))
-        diags_.error(n.line, "bit field " + quote(n) + " cannot have <when> or 'otherwise': it shares bytes with its "
-                             "neighbours in a bit group");
+    if (bit_field && !n.whens.empty())
+        diags_.error(n.line, "bit field " + quote(n) + " cannot have <when>: it shares bytes with its neighbours in a "
+                             "bit group (an 'if' keeps its bits in the group)");
+    else if (bit_field && n.otherwise && !n.bit_alternative)
+        diags_.error(n.line, "bit field " + quote(n) + " has 'otherwise' but means no bits of a conditional bit field "
+                             "before it: in a bit group, 'otherwise' follows bit fields with an 'if'");
     if (n.otherwise) {
         const Node* prev = previous_sibling(proto_, n);
         if (!prev)

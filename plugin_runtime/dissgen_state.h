@@ -396,19 +396,26 @@ static inline proto_item *add_numeric_item(const dg_state *st, const dg_node *n,
     }
 }
 
+/* The first member of a bit group reads the group's bytes; FALSE when they are not all there. */
+static inline __attribute__((always_inline)) gboolean group_read(dg_state *st, const dg_node *n, proto_tree *tree,
+                                                                 gint offset, gint end)
+{
+    if (!(n->flags & DG_GROUP_FIRST)) return TRUE;
+    if ((gint)n->length > end - offset) {
+        report(st, tree, &st->p->ei->truncated, offset, -1, "Truncated: '%s' needs %u bytes, only %d left", n->name,
+               n->length, end - offset);
+        return FALSE;
+    }
+    st->group_value = read_uint(st->tvb, offset, n->length, encoding_of(n));
+    return TRUE;
+}
+
 /* A member of a bit group: the first reads the group's bytes, each adds
  * its item and keeps its bits, the last moves past the bytes. */
 static inline __attribute__((always_inline)) void dissect_bit_field(dg_state *st, const dg_node *n, proto_tree *tree,
                                                                     gint *offset, gint end)
 {
-    if (n->flags & DG_GROUP_FIRST) {
-        if ((gint)n->length > end - *offset) {
-            report(st, tree, &st->p->ei->truncated, *offset, -1, "Truncated: '%s' needs %u bytes, only %d left",
-                   n->name, n->length, end - *offset);
-            return;
-        }
-        st->group_value = read_uint(st->tvb, *offset, n->length, encoding_of(n));
-    }
+    if (!group_read(st, n, tree, *offset, end)) return;
     /* No tree (e.g. tshark's summary lines): only values later nodes read are
      * wanted. proto_tree_add_item() would check the length and return NULL. */
     if (tree) {
@@ -417,6 +424,14 @@ static inline __attribute__((always_inline)) void dissect_bit_field(dg_state *st
     }
     if (value_wanted(st, n)) store(st, n, bit_field(st->group_value, n->shift, n->bits), *offset, n->length);
     if (n->flags & DG_GROUP_LAST) *offset += n->length;
+}
+
+/* A member of a bit group whose condition does not hold: no item and no
+ * value, but the group's bytes are read and passed as if it were there. */
+static inline __attribute__((always_inline)) void pass_bit_field(dg_state *st, const dg_node *n, proto_tree *tree,
+                                                                 gint *offset, gint end)
+{
+    if (group_read(st, n, tree, *offset, end) && (n->flags & DG_GROUP_LAST)) *offset += n->length;
 }
 
 /* The value and item of a numeric leaf (not a time or an address) whose
@@ -462,7 +477,10 @@ static inline __attribute__((always_inline)) void dissect_child(dg_state *st, co
                                                                 proto_tree *tree, gint *offset, gint end,
                                                                 gboolean in_summary, gboolean *chain_taken)
 {
-    if (!selected(st, c, n, *offset, chain_taken)) return;
+    if (!selected(st, c, n, *offset, chain_taken)) {
+        if (n->flags & DG_GROUP) pass_bit_field(st, n, tree, offset, end); /* its bits stay in the group */
+        return;
+    }
     if (quiet_within(st, n, end - *offset)) {
         *offset += (gint)n->quiet_size; /* nobody would see it, and it cannot be malformed */
         return;

@@ -166,8 +166,8 @@ def widths_frames():
     return [m.frame(c.data) for c in m.cases(m.Gen(15), 40)]
 
 
-def packed_bits_frames():
-    import test_packed_bits as m
+def bit_fields_frames():
+    import test_bit_fields as m
     return [m.frame(x.data) for x in m.messages(7, 30)]
 
 
@@ -396,7 +396,7 @@ CAPTURES = {
     "tests/rules/no_padding.xml": no_padding_frames,
     "tests/rules/findings.xml": rule_findings_frames,
     "tests/rules/dates_guids_shared.xml": dates_guids_frames,
-    "tests/rules/packed_bits.xml": packed_bits_frames,
+    "tests/rules/bit_fields.xml": bit_fields_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,

@@ -84,7 +84,7 @@ TESTS = {
     "rules_err": unit("Files/RulesErr.*:Files/RulesOk.*:RuleFolders.*"),
     "field_types": unit("FieldType.*:Emit.*:ListFields.*"),
     "widths": integration("test_widths.py"),
-    "packed_bits": integration("test_packed_bits.py"),
+    "bit_fields": integration("test_bit_fields.py"),
     "everything": integration("test_everything.py"),
     "malformed": integration("test_malformed.py"),
     "enip": integration("test_enip.py"),

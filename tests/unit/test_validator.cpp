@@ -316,7 +316,7 @@ TEST(BitGroups, Errors) {
         {"<node name=\"a\" length=\"4bit\" displaytype=\"numberhex\" byteorder=\"little\"/><node name=\"b\" length=\"4bit\" displaytype=\"numberhex\"/>",
          "bit field 'b' has another byte order than its bit group starting at 'a'"},
         {"<node name=\"a\" length=\"4bit\" displaytype=\"numberhex\"/><node name=\"b\" length=\"4bit\" displaytype=\"bool\" repeat=\".\"/>",
-         "bit field 'b' cannot have 'repeat' or 'if'"},
+         "bit field 'b' cannot have 'repeat'"},
     };
     for (const Case& c : cases) {
         Front f = front_end(rules("  " + std::string(c.body) + "\n"));

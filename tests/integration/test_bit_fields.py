@@ -1,17 +1,23 @@
 #!/usr/bin/env python3
-"""Packed lists of bit fields decode as the bytes say (tests/rules/packed_bits.xml).
+"""Conditional and repeated bit fields decode as the bytes say (tests/rules/bit_fields.xml).
 
-A bit field of 1, 2 or 4 bits with `count` is a packed list (docs/manual.md, "Bit
-fields"): `count` values packed into whole bytes, least significant bits first in a
-little-endian node (Coil, Offset), most significant first otherwise (State, Flag). This
-test writes random messages (counts from 0 to past two bytes, values random, the bits
-after the last value random too), each also cut short at every byte, and checks every
-value of every field in -T fields against its own reading of the bytes, the Info column
-(a summary naming the last Coil), and the expert infos: a list the data ends inside says
-`'Coil' should occur N times, but the data ends after K` and the walk goes on; a
-one-byte field with no byte left is truncated and ends it. One pass and -2 alike.
+docs/manual.md, "Bit fields": a member of a bit group with an `if` keeps its bits in the
+group and shows only when its condition holds (Ready); members that are never decoded
+together (a chain of `otherwise` alternatives: Port, Slot, Raw; or `if`s on one field
+with lists that share no value: Low, Low other) are meanings of the same bits. A bit
+field of 1, 2 or 4 bits with `count` is a packed list: `count` values packed into whole
+bytes, least significant bits first in a little-endian node (Coil, Offset), most
+significant first otherwise (State, Flag).
 
-    test_packed_bits.py --dissgen build/bin/dissgen --source-dir .
+This test writes random messages of three kinds (counts from 0 to past two bytes, values
+random, the bits after a list's last value random too), each also cut short at random
+bytes, and checks every value of every field in -T fields against its own reading of the
+bytes, the Info column (a summary naming the last Coil), and the expert infos: a list the
+data ends inside says `'Coil' should occur N times, but the data ends after K` and the
+walk goes on; a one-byte field or bit group with no byte left is truncated (named by the
+group's first member, shown or not) and ends it. One pass and -2 alike.
+
+    test_bit_fields.py --dissgen build/bin/dissgen --source-dir .
 """
 import os
 import random
@@ -25,11 +31,11 @@ from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 from test_everything import pcap  # noqa: E402
 
 ARGS = None
-PROTO = "pkb"
-RULES = os.path.join("tests", "rules", "packed_bits.xml")
+PROTO = "bitf"
+RULES = os.path.join("tests", "rules", "bit_fields.xml")
 ETHERTYPE = 0x88B6
 P = PROTO + ".message."
-FIELDS = ["kind", "coils", "coil", "pairs", "state", "nibbles", "offset_count", "offset", "flag", "tail"]
+FIELDS = ["kind", "head", "port", "slot", "raw", "ready", "spare", "low", "low_other", "high", "coils", "coil", "pairs", "state", "nibbles", "offset_count", "offset", "flag", "tail"]
 
 
 class Message:
@@ -62,7 +68,13 @@ def layout(rng):
     coils = rng.choice([0, 1, 7, 8, 9, 15, 16, 17, rng.randrange(0, 40)])
     pairs = rng.choice([0, 1, 3, 4, 5, rng.randrange(0, 12)])
     nibbles = rng.choice([0, 1, 2, rng.randrange(0, 9)])
-    parts = [("kind", "byte", kind), ("coils", "byte", coils),
+    b1, b2, b3 = rng.randrange(256), rng.randrange(256), rng.randrange(256)
+    low_name = {0: "raw", 1: "port", 2: "slot"}[kind]
+    group1 = [("head", b1 >> 4), (low_name, b1 & 15)]
+    group2 = ([("ready", b2 >> 7)] if kind in (1, 2) else []) + [("spare", b2 & 0x7F)]
+    group3 = [("low" if kind == 1 else "low_other", b3 & 15), ("high", b3 >> 4)]
+    parts = [("kind", "byte", kind), ("group", "Head", b1, group1), ("group", "Ready", b2, group2),
+             ("group", "Low", b3, group3), ("coils", "byte", coils),
              ("coil", "list", coils, 1, True, packed(rng, coils, 1)[1]),
              ("pairs", "byte", pairs), ("state", "list", pairs, 2, False, packed(rng, pairs, 2)[1]),
              ("nibbles", "byte", nibbles), ("offset_count", "computed", nibbles + kind),
@@ -74,9 +86,9 @@ def layout(rng):
 
 
 def shown(name, value, bits):
-    if name in ("coil",):
+    if name in ("coil", "ready"):
         return "1" if value else "0"
-    if name in ("state", "flag", "tail"):
+    if name in ("state", "flag", "tail", "slot", "raw", "spare", "low_other"):
         return "0x%02x" % value
     if name == "offset":
         return "%d" % (value - (1 << bits) if value >= 1 << (bits - 1) else value)
@@ -87,7 +99,7 @@ def build(parts, cut=None):
     """The message's bytes cut to `cut` bytes, and what the plugin must show for them."""
     whole = bytearray()
     for p in parts:
-        whole += bytes([p[2]]) if p[1] == "byte" else p[5] if p[1] == "list" else b""
+        whole += bytes([p[2]]) if p[0] == "group" or p[1] == "byte" else p[5] if p[1] == "list" else b""
     m = Message("whole" if cut is None else "cut to %d bytes" % cut)
     m.data = whole if cut is None else whole[:cut]
     at, left = 0, len(m.data)
@@ -96,7 +108,14 @@ def build(parts, cut=None):
     last_coil = None
     for p in parts:
         name, what = p[0], p[1]
-        if what == "computed":
+        if name == "group":
+            if left < 1:
+                m.experts.append("Truncated: '%s' needs 1 bytes, only 0 left" % what)
+                break
+            for member, value in p[3]:
+                m.fields[member] = [shown(member, value, 4)]
+            at, left = at + 1, left - 1
+        elif what == "computed":
             m.fields[name] = ["%d" % p[2]]
         elif what == "byte":
             if left < 1:
@@ -139,7 +158,7 @@ def frame(payload):
     return b"\x02\xee\xee\xee\xee\xee\x02\x00\x00\x00\x00\x01" + struct.pack("!H", ETHERTYPE) + bytes(payload)
 
 
-class PackedBits(TsharkTestCase, unittest.TestCase):
+class BitFields(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
         cls.install(RULES, PROTO)
@@ -172,8 +191,11 @@ class PackedBits(TsharkTestCase, unittest.TestCase):
                       % (len(self.messages), passes, "".join("\n  " + b for b in bad[:10])))
 
     def test_every_shape_is_there(self):
-        """Empty lists, lists ending inside a byte and on its boundary, and each list cut short."""
+        """Each alternative of the bits, the flag there and not, empty lists, lists ending
+        inside a byte and on its boundary, and each list cut short."""
         whole = [m for m in self.messages if m.note == "whole"]
+        for f in ("port", "slot", "raw", "ready", "low", "low_other"):
+            self.assertTrue(any(f in m.fields for m in whole) and any(f not in m.fields for m in whole), f)
         for f, per_byte in (("coil", 8), ("state", 4), ("offset", 2), ("flag", 8)):
             sizes = {len(m.fields.get(f, [])) for m in whole}
             self.assertIn(0, sizes, f)
