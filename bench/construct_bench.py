@@ -25,6 +25,12 @@ machine, so differences of a few percent show.
                raised), one on the status word (a note in a quarter of the packets)
     cycles     base + <cycles>: a stream per function and sender, the transaction as its
                sequence count (every packet is in a cycle, timed, none lost)
+    bitgroup   base with the status word as a bit group of four fields (Ready, Error, Code,
+               State): the reference of bitif
+    bitif      bitgroup with Ready under an `if` (always true) and a Fault meaning its bit
+               otherwise (a conditional member, and an alternative never decoded)
+    bitlist    base with the status word as a packed list of 16 one-bit flags (count from
+               a computed value): 16 items where base has one
 
 Each row gives the instructions per packet that tshark spends in
 epan_dissect_run_with_taps (the dissection of a packet, from the frame through Ethernet,
@@ -75,6 +81,21 @@ def rules(kind):
             '  <node name="Status" length="2byte" displaytype="numberhex">\n'
             '    <finding name="fault" severity="note" condition="{Status} &gt;= 0xc000" text="status {Status}"/>\n'
             '  </node>\n')
+    if kind in ("bitgroup", "bitif", "bitlist"):  # the status word as bit fields instead
+        status = {
+            "bitgroup": '  <node name="Ready" length="1bit" displaytype="bool"/>\n',
+            "bitif": '  <node name="Ready" length="1bit" displaytype="bool" if="../node[@name=\'Function\']" in="3"/>\n'
+                     '  <node name="Fault" length="1bit" displaytype="bool" otherwise="true"/>\n',
+        }.get(kind, "")
+        if kind == "bitlist":
+            status = ('  <node name="Sixteen" value="16" displaytype="nondisplay"/>\n'
+                      '  <node name="Flag" length="1bit" count="../node[@name=\'Sixteen\']" displaytype="bool"'
+                      ' byteorder="little"/>\n')
+        else:
+            status += ('  <node name="Error" length="1bit" displaytype="bool"/>\n'
+                       '  <node name="Code" length="6bit" displaytype="numberdec"/>\n'
+                       '  <node name="State" length="8bit" displaytype="numberdec"/>\n')
+        out[-1] = out[-1].replace('  <node name="Status" length="2byte" displaytype="numberhex"/>\n', status)
     if kind == "overlay":
         out.append('  <node name="Status bits" filter="bits" overlay="../node[@name=\'Status\']">\n'
                    '    <node name="Ready" length="1bit" displaytype="bool"/>\n'
@@ -107,8 +128,9 @@ def rules(kind):
     return "".join(out)
 
 
-KINDS = ["base", "branch", "unused", "validity", "computed", "overlay", "pairing", "request", "finding", "cycles"]
-REFERENCE = {"request": "pairing", "unused": "branch"}
+KINDS = ["base", "branch", "unused", "validity", "computed", "overlay", "pairing", "request", "finding", "cycles",
+         "bitgroup", "bitif", "bitlist"]
+REFERENCE = {"request": "pairing", "unused": "branch", "bitif": "bitgroup"}
 
 
 def udp_frame(payload, sport, dport):
