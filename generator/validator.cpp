@@ -361,7 +361,8 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
         group.push_back(&n);
         // The group ends on a byte boundary, unless the next sibling means these bits too.
         const Node* next = &child != &children.back() ? (&child + 1)->get() : nullptr;
-        if (group_bits % 8 == 0 && !(next && is_bit_leaf(*next) && means_same_bits(*next, alternatives))) {
+        if (group_bits % 8 == 0 &&
+            !(next && is_bit_leaf(*next) && !next->count && means_same_bits(*next, alternatives))) {
             close_group(group, group_bits);
             group.clear();
             group_bits = 0;
@@ -492,12 +493,12 @@ void Validator::check_reference(Node& n, const FieldRef& ref, const std::string&
 // Finds the byte offset of `t` (of its bit group, for a bit field) from the
 // start of `nodes`. `blocker` is set to the first node that keeps the offset
 // from being fixed: a container of `t` (or `t`) that is repeated or has an
-// `if`, or a field before it without a fixed size.
+// `if` or `otherwise`, or a field before it without a fixed size.
 bool Validator::offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const Node* t, uint64_t& offset,
                           const Node*& blocker) const {
     for (const auto& c : nodes) {
         if (is_ancestor_or_self(c.get(), t)) {
-            if (!blocker && (c->is_repeated() || c->if_field || c->is_overlay())) blocker = c.get();
+            if (!blocker && (c->is_repeated() || c->if_field || c->otherwise || c->is_overlay())) blocker = c.get();
             return c.get() == t || offset_of(c->children, t, offset, blocker);
         }
         if (c->in_bit_group) {
@@ -519,6 +520,8 @@ std::string pdulength_blocker(const Node& blocker, const Node& t) {
     if (blocker.is_repeated())
         return encloses ? self + " is repeated" : where + " before it is repeated";
     if (encloses && blocker.is_overlay()) return self + " is an overlay: its bytes are another node's";
+    if (encloses && !blocker.if_field)
+        return self + " is an 'otherwise' alternative: a message without it would have no length";
     if (encloses) return self + " has an 'if': a message without it would have no length";
     if (blocker.is_conditional()) return where + " before it is decoded only under a condition";
     return where + " before it has no fixed length";
@@ -1457,6 +1460,9 @@ void Validator::check_offsets(Node& n) {
         else if (!t->count && !t->repeat && !t->repeat_rest)
             diags_.error(n.line, field + " is not repeated: it must have 'count' (or 'repeat'), one offset per "
                                          "instance of " + quote(n));
+        else if (t->packed_bits)
+            diags_.error(n.line, field + " is a packed list of bit fields: an offset table is a repeated field "
+                                         "of whole bytes");
         else if (t->doc_index >= n.doc_index)
             diags_.error(n.line, field + " is not decoded before " + quote(n) + "; it must come earlier in the file");
         else if (outside)

@@ -435,7 +435,7 @@ void dissect_packed_bits(dg_state *st, const dg_node *n, proto_tree *tree, gint 
     gint64 wanted = 0;
     if (!ref_value(st, &n->count, n, "count", tree, *offset, &wanted)) return;
     const guint per_byte = 8u / n->bits;
-    const gint64 bytes = (wanted + per_byte - 1) / per_byte;
+    const gint64 bytes = wanted / per_byte + (wanted % per_byte != 0); /* rounded up, no overflow */
     const gint64 have = MIN(bytes, (gint64)(end - *offset));
     const gint64 instances = MIN(wanted, have * per_byte);
     const guint mask = (1u << n->bits) - 1;
