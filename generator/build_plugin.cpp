@@ -144,11 +144,11 @@ std::string build_and_install(const BuildRequest& req, std::string& installed_pa
     std::vector<std::string> link_inputs = sources;
     // The coverage notes name each plugin's folder: compiled in one go, nothing cached.
     if (!coverage) {
-        // The Wireshark headers the objects are compiled against, by version.
-        std::string version;
-        run_command({"pkg-config", "--modversion", "wireshark"}, &version);
+        // The Wireshark and GLib headers the objects are compiled against, by version.
+        std::string versions;
+        run_command({"pkg-config", "--modversion", "wireshark", "glib-2.0"}, &versions);
         CompileJob job{cmd, sources, runtime_headers(req.runtime_dir), default_cache_dir(), dir.string(),
-                       "Wireshark " + trimmed(version)};
+                       "Wireshark, GLib " + trimmed(versions)};
         if (std::string error = compile_objects(job, link_inputs); !error.empty()) return error;
     }
     cmd.insert(cmd.end(), link_inputs.begin(), link_inputs.end());

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "object_cache.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <mutex>
 #include <sstream>
 #include <string_view>
+#include <system_error>
 #include <thread>
 
 #include "wireshark_env.h"
@@ -69,6 +71,12 @@ std::string job_key(const CompileJob& job, std::string& error) {
     }
     key.add(version);
     key.add(job.salt);
+    // What the compiler reads from its environment beyond its options.
+    for (const char* name : {"CPATH", "CPLUS_INCLUDE_PATH", "C_INCLUDE_PATH", "GCC_EXEC_PREFIX", "COMPILER_PATH",
+                             "SOURCE_DATE_EPOCH"}) {
+        const char* value = std::getenv(name);
+        key.add(std::string(name) + "=" + (value ? value : "(unset)"));
+    }
     for (std::string word : job.compiler) {
         for (size_t at; !job.work_dir.empty() && (at = word.find(job.work_dir)) != std::string::npos;)
             word.replace(at, job.work_dir.size(), "<work>");
@@ -95,6 +103,15 @@ std::string object_name(const std::string& job_key, const std::string& source, c
 bool usable_dir(const std::string& dir) {
     if (dir.empty()) return false;
     std::error_code ec;
+    // root (sudo with the user's HOME kept) must not leave root-owned folders in another
+    // user's home: no cache where the nearest existing folder is someone else's.
+    if (geteuid() == 0) {
+        fs::path existing = fs::absolute(dir, ec);
+        while (!existing.empty() && !fs::exists(existing, ec) && existing != existing.parent_path())
+            existing = existing.parent_path();
+        struct stat st;
+        if (stat(existing.c_str(), &st) != 0 || st.st_uid != 0) return false;
+    }
     fs::create_directories(dir, ec);
     return !ec && access(dir.c_str(), W_OK | X_OK) == 0;
 }
@@ -157,7 +174,13 @@ std::string compile_objects(const CompileJob& job, std::vector<std::string>& obj
     };
     size_t threads = std::min<size_t>(missing.size(), std::max(1u, std::thread::hardware_concurrency()));
     std::vector<std::thread> pool;
-    for (size_t t = 1; t < threads; ++t) pool.emplace_back(worker);
+    for (size_t t = 1; t < threads; ++t) {
+        try {
+            pool.emplace_back(worker);
+        } catch (const std::system_error&) {
+            break;  // no more threads: the ones started (and this one) do the rest
+        }
+    }
     worker();
     for (std::thread& t : pool) t.join();
     return failed;

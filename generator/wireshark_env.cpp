@@ -22,7 +22,11 @@ int run_command(const std::vector<std::string>& argv, std::string* output, bool 
     int pipefd[2];
     if (pipe2(pipefd, O_CLOEXEC) != 0) return -1;
     pid_t pid = fork();
-    if (pid < 0) return -1;
+    if (pid < 0) {
+        close(pipefd[0]);
+        close(pipefd[1]);
+        return -1;
+    }
     if (pid == 0) {
         dup2(pipefd[1], STDOUT_FILENO);
         if (merge_stderr) {
