@@ -451,7 +451,7 @@ void dissect_packed_bits(dg_state *st, const dg_node *n, proto_tree *tree, gint 
             if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
         }
         if (value_wanted(st, n))
-            store(st, n, (tvb_get_guint8(st->tvb, at) >> (8 - from_msb - n->bits)) & mask, at, 1);
+            store(st, n, (dg_tvb_get_uint8(st->tvb, at) >> (8 - from_msb - n->bits)) & mask, at, 1);
     }
     st->instance = outer_instance;
     *offset += (gint)have;
