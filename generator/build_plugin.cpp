@@ -12,6 +12,7 @@
 
 #include "object_cache.h"
 #include "runtime_list.h"
+#include "text_util.h"
 #include "wireshark_env.h"
 
 namespace fs = std::filesystem;
@@ -45,11 +46,6 @@ std::vector<std::string> runtime_headers(const std::string& runtime_dir) {
         if (it->path().extension() == ".h") headers.push_back(it->path().string());
     std::sort(headers.begin(), headers.end());
     return headers;
-}
-
-std::string trimmed(const std::string& s) {
-    size_t end = s.find_last_not_of(" \t\r\n");
-    return end == std::string::npos ? "" : s.substr(0, end + 1);
 }
 
 }  // namespace
@@ -148,7 +144,7 @@ std::string build_and_install(const BuildRequest& req, std::string& installed_pa
         std::string versions;
         run_command({"pkg-config", "--modversion", "wireshark", "glib-2.0"}, &versions);
         CompileJob job{cmd, sources, runtime_headers(req.runtime_dir), default_cache_dir(), dir.string(),
-                       "Wireshark, GLib " + trimmed(versions)};
+                       "Wireshark, GLib " + trim(versions)};
         if (std::string error = compile_objects(job, link_inputs); !error.empty()) return error;
     }
     cmd.insert(cmd.end(), link_inputs.begin(), link_inputs.end());

@@ -381,12 +381,11 @@ void Validator::layout_packed_bits(Node& n) {
         diags_.error(n.line, "bit field " + quote(n) + " with 'count' is " + std::to_string(n.fixed_bits) +
                                  " bits; a packed list of bit fields takes 1, 2 or 4 bits a value");
     if (n.display == Display::Origin && !n.display_given) n.display = Display::NumberHex;
-    if (is_byte_display(n.display) || n.display == Display::Float)
+    if (is_byte_display(n.display))
         diags_.error(n.line, std::string(display_name(n.display)) + " display needs whole bytes; bit field " +
                                  quote(n) + " is a packed list (use numberhex, numberdec, bool, enum or int)");
     n.packed_bits = true;
 }
-
 
 // n means the bits of the members in `alternatives` (means_same_bits): it takes
 // none of its own, and must have their width.
