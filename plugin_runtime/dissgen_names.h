@@ -103,7 +103,7 @@
     X(stream_duplicate_expert, "expert.cycle_duplicate", PI_SEQUENCE, PI_NOTE,                              \
       "Message of the stream repeated (its sequence count did not advance)")
 
-/* --- The ethercat-esc analysis: ESC forwarding (ethercat_esc.cpp) ---------- */
+/* --- The ethercat-esc analysis (ethercat_analysis.cpp) ------------------------ */
 
 #define DG_ANALYSIS_ETHERCAT_ESC "ethercat-esc"
 

@@ -1043,7 +1043,8 @@ void show(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, proto_t
             proto_tree_add_expert_format(tree, pinfo, &ei_out_of_order, tvb, 0, 0,
                                          "Response to frame %u came back after the response to a later request",
                                          t->request_frame);
-        if (analysis && analysis->show && fp->analysis) analysis->show(fp->analysis, tvb, pinfo, tree);
+        if (analysis && analysis->show && fp->analysis)
+            analysis->show(current_capture()->analysis, fp->analysis, tvb, pinfo, tree);
         break;
     case DG_ROLE_ORPHAN:
         item = proto_tree_add_item(tree, hf_no_request, tvb, 0, 0, ENC_NA);
@@ -1056,7 +1057,7 @@ void show(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, proto_t
     default: break;
     }
     if (fp->role == DG_ROLE_REQUEST && analysis && analysis->show_sent && fp->analysis)
-        analysis->show_sent(fp->analysis, tvb, pinfo, tree);
+        analysis->show_sent(current_capture()->analysis, fp->analysis, tvb, pinfo, tree);
     if (fp->lost_count) show_lost(fp, tvb, pinfo, tree);
 }
 
@@ -1159,7 +1160,7 @@ void dg_pairing_stats_packet(const dg_protocol *, stats_tree *st, packet_info *,
         avg_stat_node_add_value_float(st, st_rtt, st_pairing_id, FALSE,
                                       (gfloat)(nstime_to_sec(&fp->txn->round_trip) * 1000.0));
         if (analysis && analysis->stats_response && fp->analysis)
-            analysis->stats_response(st, st_pairing_id, fp->analysis);
+            analysis->stats_response(current_capture()->analysis, st, st_pairing_id, fp->analysis);
         break;
     case DG_ROLE_DUPLICATE:
         tick_stat_node(st, st_duplicates, st_pairing_id, FALSE);

@@ -17,7 +17,7 @@
  * Later passes (tshark -2, the GUI in any order, display filters) only read
  * what the first pass stored, so they show the same items. A protocol
  * analysis (dg_analysis, each in its own folder, named by the generated
- * code in dg_pairing; EtherCAT's is ethercat/ethercat_esc.cpp) adds what
+ * code in dg_pairing; EtherCAT's is ethercat/ethercat_analysis.cpp) adds what
  * one protocol knows about how its responses relate to its requests.
  */
 #pragma once
@@ -132,16 +132,17 @@ typedef struct dg_analysis {
      * bytes, `txn` the pair (its request frame, its round trip). */
     guint32 (*compare)(void *capture, tvbuff_t *request, const dg_view *request_view, tvbuff_t *response,
                        const dg_view *response_view, const dg_transaction *txn, packet_info *pinfo);
-    /* Every pass: shows a compare() result on the response. */
-    void (*show)(guint32 result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+    /* Every pass: shows a compare() result on the response. `capture` is
+     * capture_new()'s state, complete after the first pass. */
+    void (*show)(const void *capture, guint32 result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
     /* Statistics (tshark -z FILTER,tree): nodes under the pairing's own. */
     void (*stats_init)(stats_tree *st, int parent);
-    void (*stats_response)(stats_tree *st, int parent, guint32 result);
+    void (*stats_response)(const void *capture, stats_tree *st, int parent, guint32 result);
     /* First pass, a request: the number of the analysis's result for it (as
      * compare's), or 0. */
     guint32 (*sent)(void *capture, tvbuff_t *tvb, const dg_view *view, packet_info *pinfo);
     /* Every pass: shows a sent() result. */
-    void (*show_sent)(guint32 result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+    void (*show_sent)(const void *capture, guint32 result, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
     /* First pass, before pairing: what the message's own bytes and source say
      * it is, DG_DIR_REQUEST or DG_DIR_RESPONSE, or DG_DIR_ANY when they cannot
      * tell. With this callback a message that cannot tell is a request unless

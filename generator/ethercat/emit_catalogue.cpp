@@ -10,6 +10,7 @@
 
 #include "network_reader.h"
 #include "../../plugin_runtime/dissgen_names.h"
+#include "../../plugin_runtime/ethercat/ethercat_commands.h"
 
 namespace dissgen {
 
@@ -270,9 +271,8 @@ BusLayout make_bus_layout(const Catalogue& cat, const BusOptions& opt, const std
 constexpr const char* kEmptyRow = "    {}\n";
 
 std::string command_name(uint8_t cmd) {
-    static const char* const kNames[] = {"NOP", "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD",
-                                         "BWR", "BRW",  "LRD",  "LWR",  "LRW",  "ARMW", "FRMW"};
-    return cmd < sizeof kNames / sizeof kNames[0] ? kNames[cmd] : "command " + std::to_string(cmd);
+    const char* name = dg_ecat_commands::command_name_of(cmd);
+    return name ? name : "command " + std::to_string(cmd);
 }
 
 }  // namespace

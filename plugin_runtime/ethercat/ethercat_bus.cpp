@@ -22,6 +22,7 @@
  * frame where the capture showed them, so every pass shows the same ones.
  */
 #include "ethercat_bus.h"
+#include "ethercat_commands.h"
 #include "ethercat_cycles.h"
 #include "dissgen_label.h"
 
@@ -174,16 +175,8 @@ int hf_process_data = -1, hf_wkc_expected = -1, hf_slave = -1, hf_position = -1,
 gint ett_slave = -1, ett_process_data = -1, ett_pdo_entry = -1;
 expert_field ei_count = EI_INIT, ei_model = EI_INIT, ei_ok = EI_INIT, ei_wkc = EI_INIT;
 
-const char *const command_names[] = {"NOP",  "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD",
-                                     "BWR",  "BRW",  "LRD",  "LWR",  "LRW",  "ARMW", "FRMW"};
-
-enum { APRD = 1, APWR, APRW, FPRD, FPWR, FPRW, BRD, BWR, BRW, LRD, LWR, LRW, ARMW, FRMW };
-
-gboolean by_position(guint8 cmd) { return cmd == APRD || cmd == APWR || cmd == APRW || cmd == ARMW; }
-gboolean by_station(guint8 cmd) { return cmd == FPRD || cmd == FPWR || cmd == FPRW || cmd == FRMW; }
-gboolean reads(guint8 cmd) { return cmd == APRD || cmd == APRW || cmd == FPRD || cmd == FPRW || cmd == BRD || cmd == BRW; }
-gboolean logical(guint8 cmd) { return cmd == LRD || cmd == LWR || cmd == LRW; }
-gboolean writes(guint8 cmd) { return cmd == APWR || cmd == APRW || cmd == FPWR || cmd == FPRW || cmd == BWR || cmd == BRW; }
+/* Command numbers and classes: ethercat_commands.h. */
+using namespace dg_ecat_commands;
 
 /* The position an auto-increment datagram as sent addresses. */
 guint16 position_of(guint16 adp) { return (guint16)(0x10000u - adp); }
@@ -414,7 +407,7 @@ guint shares_of(const bus_model *m, const datagram *d, share *out, guint max)
 gint32 expected_wkc(const bus_model *m, const datagram *d, share *shares, guint *share_count)
 {
     *share_count = 0;
-    if (!logical(d->cmd)) return -1;
+    if (!is_logical(d->cmd)) return -1;
     const dg_bus *b = m->design;
     guint32 start = d->adp | (guint32)d->ado << 16;
     if (b && b->cyclic)
@@ -613,10 +606,10 @@ void learn_object(slave_state *st, tvbuff_t *tvb, const sdo_data *sd, guint32 fr
 void learn_coe(slave_state *st, const datagram *s, const datagram *b, tvbuff_t *sent, tvbuff_t *back, guint32 frame)
 {
     sdo_data sd;
-    if (writes(s->cmd) && !reads(s->cmd) && st->mailbox_length[0] && s->ado == st->mailbox_start[0] &&
+    if (writes_registers(s->cmd) && !reads_registers(s->cmd) && st->mailbox_length[0] && s->ado == st->mailbox_start[0] &&
         sdo_transfer(sent, data_offset(s), s->length, 2, 1, &sd))
         learn_object(st, sent, &sd, frame);
-    if (reads(s->cmd) && !writes(s->cmd) && st->mailbox_length[1] && s->ado == st->mailbox_start[1] &&
+    if (reads_registers(s->cmd) && !writes_registers(s->cmd) && st->mailbox_length[1] && s->ado == st->mailbox_start[1] &&
         sdo_transfer(back, data_offset(b), b->length, 3, 2, &sd))
         learn_object(st, back, &sd, frame);
 }
@@ -642,23 +635,23 @@ guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagr
     guint8 flags = is_mailbox(st, s) ? ST_MAILBOX : 0;
     if (b->wkc <= s->wkc) return flags | ST_WKC_ERROR;
     gint at;
-    if (writes(s->cmd) && by_position(s->cmd) && (at = register_at(s, 0x0010, 2)) >= 0) {
+    if (writes_registers(s->cmd) && is_auto_increment(s->cmd) && (at = register_at(s, 0x0010, 2)) >= 0) {
         st->station = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
         st->station_known = TRUE;
         wmem_map_insert(m->stations, GUINT_TO_POINTER((guint)st->station), GUINT_TO_POINTER(position + 1));
     }
     if ((at = register_at(s, 0x0012, 2)) >= 0) {
-        if (writes(s->cmd)) st->alias = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
+        if (writes_registers(s->cmd)) st->alias = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
         else st->alias = dg_tvb_get_uint16(back, b->offset + (at - s->offset), ENC_LITTLE_ENDIAN);
         st->alias_known = TRUE;
     }
-    if (writes(s->cmd) && s->cmd != APRW && s->cmd != FPRW) {
+    if (writes_registers(s->cmd) && s->cmd != APRW && s->cmd != FPRW) {
         learn_sii_address(st, s, sent);
         learn_fmmus(m, st, s, sent);
         learn_mailboxes(st, s, sent);
     }
     learn_coe(st, s, b, sent, back, frame);
-    if (reads(s->cmd) && !writes(s->cmd)) {
+    if (reads_registers(s->cmd) && !writes_registers(s->cmd)) {
         learn_sii_data(m, position, st, b, back, ev);
         if (al_changed(st, b, back)) flags |= ST_AL_CHANGE;
     }
@@ -671,13 +664,13 @@ addressed address_of(const bus_model *m, const datagram *s)
     addressed a = {};
     a.dgram = *s;
     a.position = -1;
-    a.logical = logical(s->cmd);
+    a.logical = is_logical(s->cmd);
     guint shares;
     a.expected_wkc = expected_wkc(m, s, NULL, &shares);
-    if (by_position(s->cmd)) {
+    if (is_auto_increment(s->cmd)) {
         guint16 p = position_of(s->adp);
         if (p < max_positions) a.position = (gint16)p;
-    } else if (by_station(s->cmd)) {
+    } else if (is_configured(s->cmd)) {
         a.by_station = TRUE;
         a.station = s->adp;
         a.position = (gint16)station_position(m, s->adp);
@@ -1078,7 +1071,7 @@ void show_process_data(const bus_model *m, const datagram *d, gboolean returned,
                        proto_tree *tree)
 {
     const dg_bus *b = m->design;
-    if (!logical(d->cmd)) return;
+    if (!is_logical(d->cmd)) return;
     gboolean output = !returned;
     if ((output && d->cmd == LRD) || (!output && d->cmd == LWR)) return;
     if (b && b->slaves) {
@@ -1111,7 +1104,11 @@ void show_process_data(const bus_model *m, const datagram *d, gboolean returned,
 
 } /* namespace */
 
-const char *command_name(guint8 cmd) { return cmd < G_N_ELEMENTS(command_names) ? command_names[cmd] : "unknown"; }
+const char *command_name(guint8 cmd)
+{
+    const char *name = command_name_of(cmd);
+    return name ? name : "unknown";
+}
 
 /* One value of the view into its datagram. */
 static void place_input(datagram *d, const dg_view_value *x)
@@ -1237,12 +1234,12 @@ void bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *
     guint8 flags[max_datagrams];
     memset(flags, 0, n * sizeof flags[0]);
     for (guint i = 0; i < n; i++) {
-        if (logical(s[i].cmd) && s[i].cmd == b[i].cmd && s[i].adp == b[i].adp && s[i].ado == b[i].ado &&
+        if (is_logical(s[i].cmd) && s[i].cmd == b[i].cmd && s[i].adp == b[i].adp && s[i].ado == b[i].ado &&
             s[i].length == b[i].length)
             check_wkc(m, &s[i], &b[i], &ev);
         if (s[i].cmd != b[i].cmd || s[i].ado != b[i].ado || s[i].length != b[i].length) continue;
-        gint32 position = by_position(s[i].cmd) ? position_of(s[i].adp)
-                          : by_station(s[i].cmd) ? station_position(m, s[i].adp) : -1;
+        gint32 position = is_auto_increment(s[i].cmd) ? position_of(s[i].adp)
+                          : is_configured(s[i].cmd) ? station_position(m, s[i].adp) : -1;
         if (position >= 0) flags[i] = learn_slave(m, (guint)position, &s[i], &b[i], sent, back, pinfo->num, &ev);
         if (b[i].wkc <= s[i].wkc) continue;
         guint added = (guint)(b[i].wkc - s[i].wkc);

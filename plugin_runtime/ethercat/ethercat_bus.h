@@ -1,5 +1,5 @@
-/* The EtherCAT bus as the capture shows it: what ethercat_esc.cpp
- * and ethercat_bus.cpp share. ethercat_esc.cpp compares each returned frame
+/* The EtherCAT bus as the capture shows it: what ethercat_analysis.cpp
+ * and ethercat_bus.cpp share. ethercat_analysis.cpp compares each returned frame
  * with the one sent; ethercat_bus.cpp learns the slaves from the same frames
  * (count, positions, station addresses, identities from the SII EEPROM) and
  * checks them against the network design embedded with `--network`.
@@ -48,7 +48,7 @@ const char *command_name(guint8 cmd);
 
 /* d with every byte set (padding 0), its index only with `index`: how the
  * shapes of frames (what the frames of a cycle share, interned by
- * ethercat_bus.cpp and ethercat_esc.cpp) keep a datagram, so that frames
+ * ethercat_bus.cpp and ethercat_analysis.cpp) keep a datagram, so that frames
  * alike compare equal byte for byte. */
 datagram kept_datagram(const datagram *d, gboolean index);
 /* FNV-1a of n bytes (32-bit words, then the bytes left), on from h (2166136261 to start). */

@@ -28,13 +28,14 @@
  *    minus the nominal period.
  *
  * Memory: each sent frame's mark lives in its frame's record
- * (ethercat_esc.cpp: the cycle number with what the frames of the cycle
+ * (ethercat_analysis.cpp: the cycle number with what the frames of the cycle
  * share, the periods in the frame's own 8 bytes); the
  * model keeps per cycle its periods (4 bytes each, in two heaps for the
  * running median) and the round trips of its returned frames (4 bytes each),
  * for `-z ecatr,cycles`.
  */
 #include "ethercat_cycles.h"
+#include "ethercat_commands.h"
 
 #include "../dissgen_periods.h"
 
@@ -122,7 +123,9 @@ struct cycle_model {
 
 namespace {
 
-cycle_model *current; /* the open capture's, for -z ecatr,cycles and long periods */
+/* The open capture's model, for -z ecatr,cycles and the statistics tree:
+ * Wireshark's tap and stats-tree callbacks carry no capture state. */
+cycle_model *current;
 
 guint sig_hash(gconstpointer p) { return ((const signature *)p)->hash; }
 
@@ -142,7 +145,7 @@ gboolean overlaps(guint from, guint length, guint lo, guint hi) { return from <=
 /* Mailbox transfers and SII reads: never cyclic process data. */
 gboolean mailbox_or_sii(const sig_datagram *d)
 {
-    if (d->cmd == 0 || (d->cmd >= 10 && d->cmd <= 12)) return FALSE; /* NOP, LRD/LWR/LRW */
+    if (d->cmd == dg_ecat_commands::NOP || dg_ecat_commands::is_logical(d->cmd)) return FALSE;
     guint ado = d->ado, len = d->length;
     return ado + len > 0x1000 || overlaps(ado, len, 0x0805, 0x0805) || overlaps(ado, len, 0x080D, 0x080D) ||
            overlaps(ado, len, 0x0500, 0x050F) || overlaps(ado, len, 0x0900, 0x090F);
@@ -353,10 +356,10 @@ namespace {
 
 int hf_cycle = -1, hf_period = -1, hf_jitter = -1, hf_systime = -1, hf_drift = -1;
 
-gint64 period_of(const cycle_mark *c, guint32 frame)
+gint64 period_of(const cycle_model *m, const cycle_mark *c, guint32 frame)
 {
-    if (c->period_ns != G_MAXUINT32 || !current || !current->long_periods) return c->period_ns;
-    const gint64 *exact = (const gint64 *)wmem_map_lookup(current->long_periods, GUINT_TO_POINTER(frame));
+    if (c->period_ns != G_MAXUINT32 || !m || !m->long_periods) return c->period_ns;
+    const gint64 *exact = (const gint64 *)wmem_map_lookup(m->long_periods, GUINT_TO_POINTER(frame));
     return exact ? *exact : c->period_ns;
 }
 
@@ -386,13 +389,13 @@ void dc_show(const datagram *b, double drift, tvbuff_t *tvb, proto_tree *tree)
     proto_item_set_generated(it);
 }
 
-void cycles_show(const cycle_mark *c, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+void cycles_show(const cycle_model *m, const cycle_mark *c, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     const int cycle_fields[] = {hf_cycle, hf_period, hf_jitter};
     if (!tree || !c->cycle || !any_referenced(tree, cycle_fields, G_N_ELEMENTS(cycle_fields))) return;
     proto_item *it = proto_tree_add_uint(tree, hf_cycle, tvb, 0, 0, c->cycle);
     proto_item_set_generated(it);
-    gint64 period = period_of(c, pinfo->num);
+    gint64 period = period_of(m, c, pinfo->num);
     nstime_t t = nstime_of(period);
     it = proto_tree_add_time(tree, hf_period, tvb, 0, 0, &t);
     proto_item_set_generated(it);
@@ -453,7 +456,7 @@ char *signature_text(const cycle *c)
     for (guint i = 0; i < c->count; i++) {
         const sig_datagram *d = &c->sig[i];
         if (i) g_string_append(t, ", ");
-        if (d->cmd >= 10 && d->cmd <= 12)
+        if (dg_ecat_commands::is_logical(d->cmd))
             g_string_append_printf(t, "%s 0x%08x", command_name(d->cmd), (guint32)d->ado << 16 | d->adp);
         else
             g_string_append_printf(t, "%s 0x%04x:0x%04x", command_name(d->cmd), d->adp, d->ado);

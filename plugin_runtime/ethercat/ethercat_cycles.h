@@ -1,6 +1,6 @@
 /* The cycles of an EtherCAT capture: sent frames whose datagram signature
  * (commands, addresses, lengths) repeats at regular periods, e.g. LRW +
- * FRMW 0x0910 every millisecond. ethercat_esc.cpp calls it for every frame
+ * FRMW 0x0910 every millisecond. ethercat_analysis.cpp calls it for every frame
  * sent and every frame returned on the first pass; each sent frame of a
  * cycle keeps its mark (cycle number, period, nominal period) in its
  * bus_frame. The rules: ethercat_cycles.cpp and the manual, "Cycles".
@@ -39,8 +39,8 @@ double dc_returned(cycle_model *m, const datagram *s, const datagram *b, guint n
 gboolean dc_datagram(const datagram *s, const datagram *b);
 /* Every pass: ecatr.dc.systime over b (a dc_datagram) and the drift unless NAN. */
 void dc_show(const datagram *b, double drift, tvbuff_t *tvb, proto_tree *tree);
-/* Every pass: the cycle items of a sent frame. */
-void cycles_show(const cycle_mark *c, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+/* Every pass: the cycle items of a sent frame of m's capture. */
+void cycles_show(const cycle_model *m, const cycle_mark *c, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
 void cycles_register(int proto, const char *filter);
 
 } /* namespace dg_ecat */

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "emit_cpp.h"
+#include "../../plugin_runtime/ethercat/ethercat_commands.h"
 #include "runtime_names.h"
 #include "test_support.h"
 
@@ -518,6 +519,41 @@ TEST(Pairing, ResponsesInAnyOrder) {
                               "  <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
     EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 0 };"));
+}
+
+// The analyses' table of EtherCAT commands (ethercat_commands.h) names each
+// number as the rule file's Command enum does: one vocabulary, kept equal.
+TEST(EthercatCommands, TableIsTheRuleFilesEnum) {
+    Front f = front_end(read_file(source_path("rules/ethercat.xml")));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Node* command = find(*f.proto, "Command");
+    ASSERT_NE(command, nullptr);
+    ASSERT_EQ(command->enums.size(), dg_ecat_commands::command_count);
+    for (const EnumItem& e : command->enums) {
+        ASSERT_LT(e.value, dg_ecat_commands::command_count) << e.name;
+        EXPECT_EQ(e.name, dg_ecat_commands::command_name_of(static_cast<unsigned>(e.value))) << e.value;
+    }
+    EXPECT_EQ(dg_ecat_commands::command_name_of(dg_ecat_commands::command_count), nullptr);
+}
+
+// The classes the analyses ask about, by their definition in ETG.1000.4.
+TEST(EthercatCommands, Classes) {
+    using namespace dg_ecat_commands;
+    std::string advancing, write_only, register_reads, register_writes, logical;
+    for (unsigned c = 0; c <= 0xff; ++c) {
+        std::string name = command_name_of(c) ? command_name_of(c) : "";
+        if (advances_address(c)) advancing += name + " ";
+        if (is_write_only(c)) write_only += name + " ";
+        if (reads_registers(c)) register_reads += name + " ";
+        if (writes_registers(c)) register_writes += name + " ";
+        if (is_logical(c)) logical += name + " ";
+    }
+    EXPECT_EQ(advancing, "APRD APWR APRW BRD BWR BRW ARMW ");
+    EXPECT_EQ(write_only, "APWR FPWR BWR LWR ");
+    EXPECT_EQ(register_reads, "APRD APRW FPRD FPRW BRD BRW ");
+    EXPECT_EQ(register_writes, "APWR APRW FPWR FPRW BWR BRW ");
+    EXPECT_EQ(logical, "LRD LWR LRW ");
+    EXPECT_TRUE(is_auto_increment(ARMW) && is_configured(FRMW) && !is_broadcast(NOP));
 }
 
 }  // namespace

@@ -127,10 +127,10 @@ const char kScript[] = R"JS(
   data.lost.forEach(e => rows.push([e[0], null, [top, top, top], null]));
   data.wkc_errors.forEach(e => rows.push([e[0], null, null, [top * 0.95, top * 0.95, top * 0.95]]));
   rows.sort((a, b) => a[0] - b[0]);
-  chart('round-trip', rows, Object.assign({labels: ['t', 'Round trip (µs)', 'Lost frame', 'WKC differs'],
+  chart('round-trip', rows, Object.assign({labels: ['t', 'Round trip (µs)', 'Lost frame', 'Unexpected WKC'],
       ylabel: 'Round trip (µs)', title: 'Round trip over time',
       series: {'Lost frame': {strokeWidth: 0, drawPoints: true, pointSize: 4, color: '#d62728'},
-               'WKC differs': {strokeWidth: 0, drawPoints: true, pointSize: 4, color: '#ff7f0e'}}}, common));
+               'Unexpected WKC': {strokeWidth: 0, drawPoints: true, pointSize: 4, color: '#ff7f0e'}}}, common));
   // AL states: one step line per slave.
   if (data.slaves.length) {
     const times = new Set([data.duration]);

@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "../../runtime_names.h"
+#include "../../../plugin_runtime/ethercat/ethercat_commands.h"
 
 namespace dissgen {
 
@@ -21,7 +22,6 @@ const char kCommandField[] = "datagram.cmd";
 const char kAddressField[] = "datagram.adp";
 const char kOffsetField[] = "datagram.ado";
 const char* const kRuleFields[] = {kAlStatusField, kCommandField, kAddressField, kOffsetField};
-constexpr uint64_t kFprd = 4, kFirstLogical = 10, kLastLogical = 12;
 constexpr uint64_t kAlStatusRegister = 0x0130;
 
 // The runtime's fields the report reads (runtime_names.h), each optional:
@@ -242,12 +242,12 @@ void TimingModelBuilder::add_station_states(const FieldRow& row, const std::vect
     for (std::string_view text : commands) {
         uint64_t cmd = 0, station = 0, offset = 0;
         if (!parse_uint(text, cmd)) return;
-        if (cmd >= kFirstLogical && cmd <= kLastLogical) continue;
+        if (cmd <= 0xff && dg_ecat_commands::is_logical(static_cast<unsigned>(cmd))) continue;
         if (addressed >= addresses.size() || addressed >= offsets.size()) return;
         if (!parse_uint(addresses[addressed], station) || !parse_uint(offsets[addressed], offset)) return;
         addressed++;
         if (offset != kAlStatusRegister) continue;
-        if (cmd != kFprd) return;
+        if (cmd != dg_ecat_commands::FPRD) return;
         stations.push_back(static_cast<unsigned>(station));
     }
     if (stations.size() != statuses.size()) return;

@@ -1,7 +1,12 @@
-/* EtherCAT slave controller (ESC) forwarding rules: everything dissgen knows
- * about what the segment does to a frame between the master sending it and
- * the frame coming back. Used as the "ethercat-esc" analysis of a <pairing>;
- * the pairing itself (which frame answers which) is generic.
+/* The "ethercat-esc" analysis of a <pairing>: the hub of EtherCAT's
+ * analyses. It receives each frame's dg_view (the datagrams the walk decoded),
+ * compares a returned frame with the frame as sent by the slave controllers'
+ * (ESC) forwarding rules below, hands both to the bus model
+ * (ethercat_bus.cpp) and the cycles (ethercat_cycles.cpp), keeps what a frame
+ * shows as a small record per frame (interned shapes), shows it on every
+ * pass, and registers the fields, experts, preference and statistics. The
+ * pairing itself (which frame answers which) is generic; the commands and
+ * their classes are ethercat_commands.h's.
  *
  * The frame (IEC 61158-4-12): a 16-bit little-endian header (length of the
  * datagrams in bits 0-10, type in bits 12-15; type 1 = datagrams), then
@@ -26,8 +31,9 @@
  * (0x02 in the first byte) of the frame it returns; simulators may not, so
  * the bit is a hint for the pairing, not a rule.
  */
-#include "ethercat_esc.h"
+#include "ethercat_analysis.h"
 #include "ethercat_bus.h"
+#include "ethercat_commands.h"
 #include "ethercat_cycles.h"
 #include "dissgen_label.h"
 
@@ -109,28 +115,13 @@ struct capture_hints {
     } recent[recent_slots];
 };
 
-/* The capture's hints: what a record's kind indexes. (A record is shown
- * only for a frame of the capture it was made in, the current one.) */
-capture_hints *hints;
-
 int hf_esc = -1, hf_datagram = -1, hf_wkc_added = -1, hf_slaves_passed = -1, hf_data_changed = -1;
 gint ett_esc = -1, ett_datagram = -1;
 expert_field ei_changed = EI_INIT, ei_frame_length = EI_INIT, ei_write_changed = EI_INIT, ei_wkc_down = EI_INIT,
              ei_forwarding = EI_INIT;
 
-gboolean advances_adp(guint8 cmd)
-{
-    switch (cmd) {
-    case 1: case 2: case 3: case 13: /* APRD APWR APRW ARMW */
-    case 7: case 8: case 9:          /* BRD BWR BRW */
-        return TRUE;
-    default: return FALSE;
-    }
-}
-
-gboolean is_logical(guint8 cmd) { return cmd >= 10 && cmd <= 12; }
-
-gboolean is_write(guint8 cmd) { return cmd == 2 || cmd == 5 || cmd == 8 || cmd == 11; }
+/* Command numbers and classes: ethercat_commands.h. */
+using namespace dg_ecat_commands;
 
 void compare_datagram(compared *c, const datagram *s, const datagram *b, tvbuff_t *request, tvbuff_t *response)
 {
@@ -141,7 +132,7 @@ void compare_datagram(compared *c, const datagram *s, const datagram *b, tvbuff_
     if (s->length != b->length) c->changed |= CHANGED_LEN;
     if (is_logical(s->cmd)) {
         if (s->adp != b->adp || s->ado != b->ado) c->changed |= CHANGED_ADDR;
-    } else if (advances_adp(s->cmd)) {
+    } else if (advances_address(s->cmd)) {
         if (s->ado != b->ado) c->changed |= CHANGED_ADDR;
         c->has_advance = TRUE;
         c->advance = (guint16)(b->adp - s->adp);
@@ -266,11 +257,11 @@ guint32 new_record(capture_hints *h, const shape *esc, const bus_frame *f)
 }
 
 /* What record `number` keeps: its frame's slaves and timing, and its comparison. */
-bus_frame frame_of(guint32 number, const shape **esc)
+bus_frame frame_of(const capture_hints *h, guint32 number, const shape **esc)
 {
     guint32 n = number - 1;
-    const record *r = &(*(record **)wmem_array_index(hints->records, n >> records_shift))[n % records_per_chunk];
-    const kind *k = (const kind *)wmem_array_index(hints->kinds, r->kind);
+    const record *r = &(*(record **)wmem_array_index(h->records, n >> records_shift))[n % records_per_chunk];
+    const kind *k = (const kind *)wmem_array_index(h->kinds, r->kind);
     if (esc) *esc = k->esc;
     bus_frame f;
     f.shape = k->bus;
@@ -282,7 +273,6 @@ bus_frame frame_of(guint32 number, const shape **esc)
 void *esc_capture_new(const dg_protocol *p)
 {
     capture_hints *h = wmem_new0(wmem_file_scope(), capture_hints);
-    hints = h;
     h->shapes = wmem_map_new(wmem_file_scope(), shape_hash, shape_equal);
     h->kinds = wmem_array_new(wmem_file_scope(), sizeof(kind));
     h->kind_ids = wmem_map_new(wmem_file_scope(), kind_hash, kind_equal);
@@ -346,7 +336,7 @@ gboolean esc_unchanged(tvbuff_t *request, const dg_view *request_view, tvbuff_t 
     const guint8 *sent = (const guint8 *)tvb_get_ptr(request, 0, (gint)length);
     guint from = 0; /* bytes before `from` are compared */
     for (guint i = 0; i < n; i++) {
-        if (!advances_adp(d[i].cmd)) continue;
+        if (!advances_address(d[i].cmd)) continue;
         guint adp = (guint)d[i].address_offset;
         if (tvb_memeql(message, (gint)from, sent + from, adp - from) != 0) return FALSE;
         from = adp + 2;
@@ -364,7 +354,7 @@ gboolean esc_key_changed(const dg_view *request, const dg_view *message)
     guint n = frame_datagrams(request, &sent_length, s, max_datagrams);
     if (frame_datagrams(message, &back_length, b, max_datagrams) != n) return FALSE;
     for (guint i = 0; i < n; i++)
-        if (s[i].cmd != b[i].cmd || s[i].ado != b[i].ado || (!advances_adp(s[i].cmd) && s[i].adp != b[i].adp))
+        if (s[i].cmd != b[i].cmd || s[i].ado != b[i].ado || (!advances_address(s[i].cmd) && s[i].adp != b[i].adp))
             return FALSE;
     return TRUE;
 }
@@ -449,7 +439,7 @@ void show_datagram_experts(const compared *c, guint i, tvbuff_t *tvb, packet_inf
         proto_tree_add_expert_format(tree, pinfo, &ei_changed, tvb, c->back.offset, datagram_span(&c->back), "Datagram %u (%s)%s", i + 1,
                                      cmd, wmem_strbuf_get_str(what));
     }
-    if (is_write(c->sent.cmd) && c->data_changed && !(c->changed & CHANGED_LEN))
+    if (is_write_only(c->sent.cmd) && c->data_changed && !(c->changed & CHANGED_LEN))
         proto_tree_add_expert_format(tree, pinfo, &ei_write_changed, tvb, data_offset(&c->back), c->back.length,
                                      "Datagram %u (%s): the written data came back changed", i + 1, cmd);
     if (wkc_added(c) < 0)
@@ -480,13 +470,14 @@ gboolean comparison_wanted(proto_tree *tree)
 /* What an expert info of show_datagram_experts() says: worth printing. */
 gboolean unusual(const compared *c)
 {
-    return c->changed || (is_write(c->sent.cmd) && c->data_changed) || wkc_added(c) < 0 || c->forwarding;
+    return c->changed || (is_write_only(c->sent.cmd) && c->data_changed) || wkc_added(c) < 0 || c->forwarding;
 }
 
-void esc_show(guint32 data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+void esc_show(const void *capture, guint32 data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
+    const capture_hints *h = (const capture_hints *)capture;
     const shape *r;
-    const bus_frame frame = frame_of(data, &r);
+    const bus_frame frame = frame_of(h, data, &r);
     /* Printed: every datagram with the preference, else the unusual ones. The
      * others are added hidden (filterable, not printed) for whoever may read
      * them. Expert infos always. */
@@ -538,11 +529,12 @@ guint32 esc_sent(void *capture, tvbuff_t *, const dg_view *view, packet_info *pi
     return new_record(h, NULL, &f);
 }
 
-void esc_show_sent(guint32 data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+void esc_show_sent(const void *capture, guint32 data, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
-    const bus_frame f = frame_of(data, NULL);
+    const capture_hints *h = (const capture_hints *)capture;
+    const bus_frame f = frame_of(h, data, NULL);
     cycle_mark c = bus_cycle(&f);
-    cycles_show(&c, tvb, pinfo, tree);
+    cycles_show(h->cycles, &c, tvb, pinfo, tree);
     bus_show(&f, tvb, pinfo, tree, show_details);
 }
 
@@ -557,10 +549,10 @@ void esc_stats_init(stats_tree *st, int parent)
     bus_stats_init(st, parent);
 }
 
-void esc_stats_response(stats_tree *st, int parent, guint32 data)
+void esc_stats_response(const void *capture, stats_tree *st, int parent, guint32 data)
 {
     const shape *r;
-    const bus_frame frame = frame_of(data, &r);
+    const bus_frame frame = frame_of((const capture_hints *)capture, data, &r);
     char label[32];
     for (guint i = 0; i < r->count; i++) {
         const compared *c = &r->d[i];
@@ -596,22 +588,26 @@ void esc_register(int proto, const char *filter)
     cycles_register(proto, filter);
 }
 
+/* The analysis, callback by callback. */
+constexpr dg_analysis esc_analysis(void)
+{
+    dg_analysis a = {};
+    a.name = DG_ANALYSIS_ETHERCAT_ESC;
+    a.register_info = esc_register;
+    a.capture_new = esc_capture_new;
+    a.is_response = esc_is_response;  /* is_returned: none, esc_direction() says so, marked or not */
+    a.compare = esc_compare;
+    a.show = esc_show;
+    a.stats_init = esc_stats_init;
+    a.stats_response = esc_stats_response;
+    a.sent = esc_sent;
+    a.show_sent = esc_show_sent;
+    a.direction = esc_direction;
+    a.unchanged = esc_unchanged;
+    a.key_changed = esc_key_changed;
+    return a;
+}
+
 } /* namespace */
 
-extern "C" const dg_analysis dg_ethercat_esc = {
-    DG_ANALYSIS_ETHERCAT_ESC,
-    esc_register,
-    esc_capture_new,
-    NULL, /* see */
-    esc_is_response,
-    NULL, /* is_returned: esc_direction() says so, marked or not */
-    esc_compare,
-    esc_show,
-    esc_stats_init,
-    esc_stats_response,
-    esc_sent,
-    esc_show_sent,
-    esc_direction,
-    esc_unchanged,
-    esc_key_changed,
-};
+extern "C" const dg_analysis dg_ethercat_esc = esc_analysis();
