@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Whether two builds of dissgen decode the EtherCAT captures byte for byte alike: tshark -V, -2 -V,
--T fields of the pairing's and the analysis' fields (one pass and two) and -z ecatr,tree, on every
-corpus capture and both samples, with each tree's own rules/ethercat.xml.
+-T fields of the pairing's and the analysis' fields (one pass and two), -z ecatr,tree,
+-z ecatr,cycles and -z ecatr.cycles,tree, on every corpus capture and both samples, with each
+tree's own rules/ethercat.xml.
 
 A change meant to leave the output alone (e.g. the analysis reading the walk instead of the bytes)
 is checked against the build before it:
@@ -54,6 +55,8 @@ def views(fields):
         "-2 fields": ["-2"] + field_args,
         "-z ecatr,tree": ["-q", "-z", "ecatr,tree"],
         "-2 -z ecatr,tree": ["-2", "-q", "-z", "ecatr,tree"],
+        "-z ecatr,cycles": ["-q", "-z", "ecatr,cycles"],
+        "-2 -z ecatr.cycles,tree": ["-2", "-q", "-z", "ecatr.cycles,tree"],
     }
 
 
