@@ -756,7 +756,8 @@ void Emitter::cycles_tables() {
     o_ << "static const dg_cycles " << f << "_cycles = { " << c.window << ", " << c.sequence_bits << ", "
        << (c.by_sender ? 1 : 0) << ", " << c.only.size() << ", "
        << (tests.empty() ? std::string("NULL") : f + "_cycle_tests") << ", "
-       << (tests.empty() ? std::string("NULL") : f + "_cycle_ranges") << ", " << c.sequence_step << "u };\n";
+       << (tests.empty() ? std::string("NULL") : f + "_cycle_ranges") << ", " << c.sequence_step << "u"
+       << (c.lost_by_period ? ", 1 /* lost=\"period\" */" : "") << " };\n";
 }
 
 // request{...}: the key fields where a response reads them before it is

@@ -301,6 +301,8 @@ struct Cycles {
     unsigned sequence_bits = 0;            // its width (bits="..."; default: the field's)
     uint64_t sequence_step = 1;            // how much it advances per message (step="..."); 0: learned
     std::vector<CycleField> only, never;   // conditions
+    bool lost_by_period = false;           // lost="period": a cycle's gap of n periods is n - 1 lost
+    int lost_line = 0;                     // the line of lost="sequence" (0: not given)
 };
 
 struct Protocol {

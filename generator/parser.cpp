@@ -56,7 +56,7 @@ const std::vector<std::string> kFindingAttributes = {"name", "severity", "group"
 const std::vector<std::string> kPairingAttributes = {"timeout", "analysis", "order"};
 const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kInputAttributes = {"name", "field"};
-const std::vector<std::string> kCyclesAttributes = {"window", "sender"};
+const std::vector<std::string> kCyclesAttributes = {"window", "sender", "lost"};
 const std::vector<std::string> kCycleFieldAttributes = {"field"};
 const std::vector<std::string> kSequenceAttributes = {"field", "bits", "step"};
 const std::vector<std::string> kCycleTestAttributes = {"field", "in"};
@@ -551,7 +551,7 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
         defer(input.field, el->parent, input.line, "field");
 }
 
-// Periodic traffic: <cycles window="8" sender="yes"><signature field="XPATH"/>...
+// Periodic traffic: <cycles window="8" sender="yes" lost="sequence|period"><signature field="XPATH"/>...
 // [<sequence field="XPATH" bits="N"/>] [<only field="XPATH" in="LIST"/>]... [<never .../>]...</cycles>
 void Parser::parse_cycles(xmlNode* el, Protocol& proto) {
     int line = line_of(el);
@@ -580,6 +580,17 @@ void Parser::parse_cycles(xmlNode* el, Protocol& proto) {
         else
             diags_.error(line, "bad sender '" + attrs["sender"] +
                                    "': expected yes (the sender's address and port are part of the signature) or no");
+    }
+    if (attrs.count("lost")) {
+        const std::string v = trim(attrs["lost"]);
+        if (v == "period")
+            cycles.lost_by_period = true;
+        else if (v == "sequence")
+            cycles.lost_line = line;
+        else
+            diags_.error(line, "bad lost '" + attrs["lost"] +
+                                   "': expected sequence (the <sequence> count tells the messages lost) or period (a "
+                                   "cycle's period of about n nominal periods means n - 1 messages lost)");
     }
     for (xmlNode* c = el->children; c; c = c->next) {
         if (c->type != XML_ELEMENT_NODE) {

@@ -803,6 +803,13 @@ void Validator::check_cycles() {
         diags_.error(c.line, "<cycles> cannot be used with <pairing analysis=\"" DG_ANALYSIS_ETHERCAT_ESC
                              "\">, which finds EtherCAT's cycles itself (" +
                                  proto_.filter + ".cycle)");
+    if (c.lost_by_period && c.sequence)
+        diags_.error(c.line, "lost=\"period\" and the <sequence> count (line " + std::to_string(c.sequence->line) +
+                                 ") would both tell the messages lost: a stream with a count is judged by its count; "
+                                 "keep one");
+    if (c.lost_line && !c.sequence)
+        diags_.error(c.lost_line, "lost=\"sequence\" needs a <sequence field=\"XPATH\"/> in <cycles> (or "
+                                  "lost=\"period\": losses told by the period)");
     std::map<const Node*, int> seen;
     for (const CycleField& f : c.signature) check_cycle_field(f, "signature", 1, 0, seen);
     int test = 0;

@@ -12,6 +12,9 @@
  *    1 <= d < 2^(bits-1), d - 1 messages lost right before this one
  *    (P.cycle.lost); a larger d, the count went back (a restart, or a
  *    message overtaken): nothing lost.
+ *  - With lost="period" (no count), a cycle's period rounded to n >= 2 whole
+ *    nominal periods means n - 1 messages lost right before this one; more
+ *    than max_gap_periods is a pause: nothing lost, not regular.
  *  - A period is the time since the stream's previous message (duplicates
  *    aside). It is regular when it is above 0 and no message was lost and
  *    the count did not go back in between.
@@ -196,6 +199,21 @@ guint32 lost_before(guint64 advance, guint64 step, guint64 mask)
     return (guint32)MIN(advance / step - 1, (guint64)G_MAXUINT32 - 1);
 }
 
+/* lost="period": the messages lost in a gap of `period` in a cycle whose
+ * nominal period is `nominal`: the period rounded to whole nominal periods,
+ * minus one; G_MAXUINT32 for a gap of more than max_gap_periods (a pause: the
+ * stream stopped and came back; nothing is counted, as for a count that went
+ * back). Further out, a gap in whole periods depends on ppm of clock drift. */
+const guint64 max_gap_periods = 16;
+
+guint32 lost_in_gap(gint64 period, guint32 nominal)
+{
+    if (period <= 0 || !nominal) return 0;
+    const guint64 periods = ((guint64)period + nominal / 2) / nominal;
+    if (periods > max_gap_periods) return G_MAXUINT32;
+    return periods >= 2 ? (guint32)(periods - 1) : 0;
+}
+
 /* The sequence count's advance since the stream's previous message: FALSE
  * when it is a duplicate; else *lost messages lost (G_MAXUINT32: the count
  * went back). A learned step (`step` 0) is the stream's first advance, or a
@@ -235,13 +253,14 @@ mark *time_message(capture_state *c, const dg_cycle_input *in, const packet_info
         m.cycle = s->cyc ? s->cyc->number : 0;
         return (mark *)wmem_memdup(wmem_file_scope(), &m, sizeof m);
     }
+    const gboolean first = s->last_frame == 0;
+    const gint64 period = first ? 0 : ns_of(&pinfo->abs_ts) - ns_of(&s->last_time);
+    if (cy->lost_by_period && s->cyc) lost = lost_in_gap(period, s->cyc->periods.median());
     const gboolean went_back = lost == G_MAXUINT32;
     if (!went_back) {
         m.lost = lost;
         s->lost += lost;
     }
-    const gboolean first = s->last_frame == 0;
-    const gint64 period = first ? 0 : ns_of(&pinfo->abs_ts) - ns_of(&s->last_time);
     s->last_frame = pinfo->num;
     s->last_time = pinfo->abs_ts;
     const gboolean regular = !first && period > 0 && lost == 0;
@@ -373,10 +392,9 @@ void cycles_draw(void *)
         printf("  nominal period (ns): %u\n", f.nominal);
         print_quantiles("period", &f.period);
         printf("  jitter std dev (ns): %.1f\n", f.jitter_sd);
-        if (protocol->cycles->sequence_bits) {
+        if (protocol->cycles->sequence_bits || protocol->cycles->lost_by_period)
             printf("  messages lost: %u\n", c->s->lost);
-            printf("  duplicates: %u\n", c->s->duplicates);
-        }
+        if (protocol->cycles->sequence_bits) printf("  duplicates: %u\n", c->s->duplicates);
     }
     printf("===================================================================\n");
 }
@@ -399,6 +417,7 @@ tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *
     if (!st_fill_now(&st_filled, capture != NULL, pinfo->num, capture ? capture->last_frame : 0))
         return TAP_PACKET_DONT_REDRAW;
     const gboolean counted = protocol->cycles->sequence_bits > 0;
+    const gboolean lost_counted = counted || protocol->cycles->lost_by_period;
     for (const cycle *c = capture->first; c; c = c->next) {
         figures f = figures_of(c);
         char *text = stream_text(c->s);
@@ -408,10 +427,8 @@ tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *
         st_cycle_row(st, c->number, "nominal period (ns)", id, f.nominal);
         st_quantile_rows(st, c->number, "period", &f.period, id);
         st_cycle_row(st, c->number, "jitter std dev (ns)", id, (guint64)(f.jitter_sd + 0.5));
-        if (counted) {
-            st_cycle_row(st, c->number, "messages lost", id, c->s->lost);
-            st_cycle_row(st, c->number, "duplicates", id, c->s->duplicates);
-        }
+        if (lost_counted) st_cycle_row(st, c->number, "messages lost", id, c->s->lost);
+        if (counted) st_cycle_row(st, c->number, "duplicates", id, c->s->duplicates);
     }
     return TAP_PACKET_REDRAW;
 }

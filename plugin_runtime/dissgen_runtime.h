@@ -282,6 +282,7 @@ typedef struct dg_cycles {
     const dg_cycle_test *tests;
     const dg_range *ranges;
     guint64 sequence_step; /* how much the count advances per message; 0: learned from the stream */
+    guint8 lost_by_period; /* lost="period": a cycle's period of n nominal ones means n - 1 lost */
 } dg_cycles;
 
 typedef struct dg_pairing {

@@ -20,9 +20,13 @@ def clamp(ns):
     return 0 if ns < 0 else min(ns, 0xFFFFFFFF)
 
 
-def model(messages, window, bits, step=1):
+MAX_GAP_PERIODS = 16  # lost="period": a longer gap is a pause, nothing lost
+
+
+def model(messages, window, bits, step=1, lost_by_period=False):
     """messages: (frame, time ns, stream key, sequence count) in capture order; step: how
-    much the count advances per message, 0 when learned from the stream (step="learned").
+    much the count advances per message, 0 when learned from the stream (step="learned");
+    lost_by_period: lost="period", a cycle's period of n whole nominal periods is n - 1 lost.
     Returns ({frame: mark}, [cycle]) as the manual describes them."""
     mask = (1 << bits) - 1
     streams, cycles, marks = {}, [], {}
@@ -46,9 +50,17 @@ def model(messages, window, bits, step=1):
                 else:
                     back = True
             s["last_seq"] = seq
-        s["lost"] += lost
         first = s["last_frame"] == 0
         period = 0 if first else ts - s["last_ts"]
+        if lost_by_period and s["cycle"] and period > 0:
+            periods = sorted(s["cycle"]["periods"])
+            nominal = periods[(len(periods) - 1) // 2]
+            gap = (period + nominal // 2) // nominal
+            if gap > MAX_GAP_PERIODS:
+                back = True
+            elif gap >= 2:
+                lost = gap - 1
+        s["lost"] += lost
         s["last_frame"], s["last_ts"] = frame, ts
         regular = not first and period > 0 and lost == 0 and not back
         if not first and s["cycle"] is None:

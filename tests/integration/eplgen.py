@@ -161,11 +161,11 @@ def pcap(frames, base_ts=1704067200):
     return b"".join(out)
 
 
-def cycle(rng, cycles=40, period_ns=400_000, nodes=(1, 2, 3), jitter_ns=2_000, dropped=(2, 17)):
+def cycle(rng, cycles=40, period_ns=400_000, nodes=(1, 2, 3), jitter_ns=2_000, dropped=(2, 17), missing=()):
     """A regular POWERLINK cycle: an SoC every period_ns (each moved by a known jitter of up to
     jitter_ns either way), then a PReq and a PRes per node 20 µs apart, then an SoA. The PRes of
-    `dropped` = (node, cycle) is missing. Returns [(t_ns, frame)] in time order and a dict:
-    'soc' [t_ns], 'pres' {node: [t_ns]}."""
+    `dropped` = (node, cycle) is missing, and those of every (node, cycle) in `missing`.
+    Returns [(t_ns, frame)] in time order and a dict: 'soc' [t_ns], 'pres' {node: [t_ns]}."""
     packets = []
     truth = {"soc": [], "pres": {n: [] for n in nodes}}
     start = 10**9
@@ -176,7 +176,7 @@ def cycle(rng, cycles=40, period_ns=400_000, nodes=(1, 2, 3), jitter_ns=2_000, d
         for k, node in enumerate(nodes):
             t_req = t + 10_000 + k * 40_000
             packets.append((t_req, ethernet(PREQ, MN, preq(rng, node))))
-            if (node, c) == tuple(dropped):
+            if (node, c) == tuple(dropped) or (node, c) in missing:
                 continue
             t_res = t_req + 20_000
             truth["pres"][node].append(t_res)

@@ -25,7 +25,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import cyclemodel  # noqa: E402
 import differential  # noqa: E402
 import eplgen  # noqa: E402
-from tshark_env import TsharkTestCase, relative_time_ns, run_unittests  # noqa: E402
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 
 FEATURES = ["isochronous", "sdo_udp", "sdo_asnd", "sdo_pdo", "nmt_info", "ext_nmt_commands", "dynamic_pdo_mapping",
             "nmt_udp", "configuration_manager", "multiplexed_access", "node_id_by_sw", "mn_basic_ethernet",
@@ -280,7 +280,7 @@ class CyclesOfTheIsochronousPhase(TsharkTestCase, unittest.TestCase):
     """<cycles> in rules/powerlink.xml: the SoC stream and each node's PRes stream are
     cycles, timed to the ns as the manual says (cyclemodel) and as the generator made them
     (its SoC times, with their jitter); the dropped PRes is a gap in its node's stream: a
-    period of two cycles, one cycle of jitter."""
+    period of two cycles, one message lost (lost="period"), no jitter."""
 
     @classmethod
     def prepare(cls):
@@ -298,19 +298,19 @@ class CyclesOfTheIsochronousPhase(TsharkTestCase, unittest.TestCase):
                 if f[14] & 0x7F in (eplgen.SOC, eplgen.PRES)]
 
     def marks(self, two_pass):
-        rows = self.env.field_rows(self.capture, ["frame.number", "eplr.cycle", "eplr.cycle.period",
-                                                  "eplr.cycle.jitter"], two_pass=two_pass)
-        out = {}
-        for frame, row in rows.items():
-            if row["eplr.cycle"]:
-                got = {"cycle": int(row["eplr.cycle"][0]), "period": relative_time_ns(row["eplr.cycle.period"][0])}
-                if row["eplr.cycle.jitter"]:
-                    got["jitter"] = relative_time_ns(row["eplr.cycle.jitter"][0])
-                out[frame] = got
-        return out
+        rows = self.env.field_rows(self.capture, ["frame.number"] + cyclemodel.mark_fields("eplr"),
+                                   two_pass=two_pass)
+        return {frame: got for frame, got in ((f, cyclemodel.mark_of(row, "eplr")) for f, row in rows.items())
+                if got}
+
+    def lost_experts(self, two_pass):
+        """{frame: the cycle_lost expert's count} (its text says how many)."""
+        rows = self.env.field_rows(self.capture, ["frame.number", "eplr.expert.cycle_lost", "_ws.expert.message"],
+                                   two_pass=two_pass)
+        return {f: row["_ws.expert.message"] for f, row in rows.items() if row["eplr.expert.cycle_lost"]}
 
     def test_marks_follow_the_manuals_model(self):
-        marks, cycles = cyclemodel.model(self.timed(), window=8, bits=0)
+        marks, cycles = cyclemodel.model(self.timed(), window=8, bits=0, lost_by_period=True)
         with self.checks() as check:
             check(len(cycles) == 1 + len(self.nodes), "%d cycles: the SoC's and one per node" % len(cycles))
             for two_pass in (False, True):
@@ -345,13 +345,43 @@ class CyclesOfTheIsochronousPhase(TsharkTestCase, unittest.TestCase):
                 check(got.get("period") == t - pres[after - 1][1],
                       "the PRes after the gap: period %s, generated %d" % (got.get("period"), t - pres[after - 1][1]))
                 check(abs(got.get("period", 0) - 2 * self.period) < self.period // 10, "about two cycles")
-                # Without a sequence count the gap is a regular period: its jitter is about
-                # one whole cycle late.
-                check(abs(got.get("jitter", 0) - self.period) < self.period // 10,
-                      "jitter of about one cycle: %s" % got)
+                # lost="period": two whole cycles are one PRes lost, and the gap has no jitter
+                check(got.get("lost") == 1 and "jitter" not in got, "one lost, no jitter: %s" % got)
+                experts = self.lost_experts(two_pass)
+                check(list(experts) == [frame], "the lost expert only on frame %d: %s" % (frame, experts))
+
+    def test_gaps_of_whole_cycles_and_a_pause(self):
+        """lost="period" beyond one PRes: node 1 misses two cycles in a row (2 lost), node 3 is
+        silent for 18 cycles (a gap of 19 periods, past 16: a pause, nothing lost, no jitter);
+        every mark as the model says, and the lost expert only where the model has a loss."""
+        missing = {(1, 20), (1, 21)} | {(3, c) for c in range(30, 48)}
+        packets, _truth = eplgen.cycle(random.Random(89), cycles=60, period_ns=self.period, nodes=self.nodes,
+                                       dropped=(0, 0), missing=missing)
+        path = self.env.add_file("gaps.pcap", cyclemodel.pcap_ns(packets))
+        timed = [(n, t, (f[14] & 0x7F, f[16]), None) for n, (t, f) in enumerate(packets, 1)
+                 if f[14] & 0x7F in (eplgen.SOC, eplgen.PRES)]
+        marks, _cycles = cyclemodel.model(timed, window=8, bits=0, lost_by_period=True)
+        pres = {node: [n for n, (t, f) in enumerate(packets, 1) if f[14] & 0x7F == eplgen.PRES and f[16] == node]
+                for node in (1, 3)}
+        after_two = next(n for n in pres[1] if marks.get(n, {}).get("lost"))
+        time_of = {n: t for n, (t, _f) in enumerate(packets, 1)}
+        after_pause = next(n for before, n in zip(pres[3], pres[3][1:]) if time_of[n] - time_of[before] > 16 * self.period)
+        with self.checks() as check:
+            check(marks[after_two].get("lost") == 2, "the model: 2 lost after node 1's gap: %s" % marks[after_two])
+            check("lost" not in marks[after_pause] and "jitter" not in marks[after_pause],
+                  "the model: the pause loses nothing and has no jitter: %s" % marks[after_pause])
+            want_experts = sorted(f for f, m in marks.items() if m.get("lost"))
+            for two_pass in (False, True):
+                rows = self.env.field_rows(path, ["frame.number"] + cyclemodel.mark_fields("eplr"), two_pass=two_pass)
+                got = {f: m for f, m in ((f, cyclemodel.mark_of(row, "eplr")) for f, row in rows.items()) if m}
+                for frame in sorted(set(got) | set(marks)):
+                    check(got.get(frame) == marks.get(frame), "frame %d %s: %s, expected %s" % (
+                        frame, "-2" if two_pass else "one pass", got.get(frame), marks.get(frame)))
+                experts = sorted(f for f, row in rows.items() if row["eplr.expert.cycle_lost"])
+                check(experts == want_experts, "lost experts on %s, expected %s" % (experts, want_experts))
 
     def test_cycles_report(self):
-        _marks, cycles = cyclemodel.model(self.timed(), window=8, bits=0)
+        _marks, cycles = cyclemodel.model(self.timed(), window=8, bits=0, lost_by_period=True)
         with self.checks() as check:
             for two_pass in (False, True):
                 out = self.env.tshark(["-r", self.capture, "-q", "-z", "eplr,cycles"] + (["-2"] if two_pass else []))
@@ -362,7 +392,7 @@ class CyclesOfTheIsochronousPhase(TsharkTestCase, unittest.TestCase):
                     name = "MessageType 0x%x, Source %d" % (mtyp, source)
                     check(g["name"] == name, "cycle %d is %r, expected %r" % (c["number"], g["name"], name))
                     want = cyclemodel.figures(c)
-                    del want["lost"], want["duplicates"]  # no sequence count: not printed
+                    del want["duplicates"]  # no sequence count: not printed
                     check(g["figures"] == want, "cycle %s: %s, expected %s" % (g["name"], g["figures"], want))
 
 

@@ -65,6 +65,17 @@ TEST(Emit, CyclesGiveEachFieldItsRoleAndTheTestsTheirRanges) {
     EXPECT_FALSE(contains(emit_cpp(*without.proto, "rules.xml"), "cycle"));  // costs nothing where absent
 }
 
+// lost="period": the one flag more, only where given (other files' tables stay as they were).
+TEST(Emit, CyclesLostByPeriod) {
+    const std::string nodes = "  <node name=\"Stream\" length=\"2byte\" displaytype=\"numberhex\"/>\n</root>\n";
+    Front f = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n"
+                        "  <cycles lost=\"period\"><signature field=\"node[@name='Stream']\"/></cycles>\n" + nodes);
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "rules.xml"),
+                         "static const dg_cycles t_cycles = { 8, 0, 0, 0, NULL, NULL, 1u, 1 /* lost=\"period\" */ };"))
+        << emit_cpp(*f.proto, "rules.xml");
+}
+
 TEST(FieldType, EveryDisplayTypeOnWholeBytes) {
     Front f = front_end(rules("  <node name=\"mac\" length=\"6byte\" displaytype=\"address\"/>\n"
                               "  <node name=\"ip\" length=\"4byte\" displaytype=\"address\"/>\n"

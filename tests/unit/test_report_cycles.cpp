@@ -101,12 +101,37 @@ TEST(ReportCyclesModel, FiguresAsTheStatisticPrintsThem) {
     EXPECT_EQ(a.period.max, 10500004);
     EXPECT_EQ(a.jitter_sd, "812.4") << "the text printed, not a number reformatted";
     EXPECT_TRUE(a.counted);
+    EXPECT_TRUE(a.duplicates_counted);
     EXPECT_EQ(a.lost, 4u);
     EXPECT_EQ(a.duplicates, 1u);
     const StreamCycleFigures& b = m.cycles.at(2).figures;
     EXPECT_FALSE(b.has_period) << "period: none";
     EXPECT_FALSE(b.counted) << "a stream without a sequence count prints no losses";
+    EXPECT_FALSE(b.duplicates_counted);
     EXPECT_EQ(b.jitter_sd, "0.0");
+}
+
+// lost="period": the statistic prints the messages lost and no duplicates,
+// and the page leaves the duplicates cell empty rather than showing 0.
+TEST(ReportCyclesModel, LossesByPeriodPrintNoDuplicates) {
+    Rows r;
+    r.statistics = {"===================================================================",
+                    "Ethernet POWERLINK (rules) cycles (eplr)",
+                    "Cycle 1: MessageType 0x4, Source 2",
+                    "  first frame: 40",
+                    "  messages: 31",
+                    "  nominal period (ns): 400000",
+                    "  period min/median/p99/max (ns): 398000 400000 402000 402000",
+                    "  jitter std dev (ns): 1154.7",
+                    "  messages lost: 1",
+                    "==================================================================="};
+    CyclesModel m;
+    r.feed(m);
+    ASSERT_EQ(m.cycles.size(), 1u);
+    const StreamCycleFigures& f = m.cycles.at(1).figures;
+    EXPECT_TRUE(f.counted);
+    EXPECT_FALSE(f.duplicates_counted);
+    EXPECT_EQ(f.lost, 1u);
 }
 
 TEST(ReportCyclesModel, SeriesLossesRepeatsAndRoundTrips) {

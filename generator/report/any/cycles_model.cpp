@@ -46,7 +46,7 @@ bool set_figure(StreamCycleFigures& f, std::string_view label, std::string_view 
     if (label == "period min/median/p99/max (ns)") return (f.has_period = parse_quantiles(text, f.period));
     if (label == "jitter std dev (ns)") return (f.jitter_sd = std::string(text), true);
     if (label == "messages lost") return (f.counted = true) && parse_uint(text, f.lost, 10);
-    if (label == "duplicates") return (f.counted = true) && parse_uint(text, f.duplicates, 10);
+    if (label == "duplicates") return (f.duplicates_counted = true) && parse_uint(text, f.duplicates, 10);
     return false;
 }
 

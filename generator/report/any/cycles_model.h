@@ -28,7 +28,8 @@ struct StreamCycleFigures {
     bool has_period = false;       // false: "period: none" (no regular period yet)
     Quantiles period;
     std::string jitter_sd = "";    // jitter std dev (ns), the text printed ("812.4")
-    bool counted = false;          // the stream has a sequence count: lost and duplicates are printed
+    bool counted = false;          // losses are told (a sequence count, or lost="period"): lost is printed
+    bool duplicates_counted = false;  // the stream has a sequence count: duplicates are printed
     uint64_t lost = 0, duplicates = 0;
 };
 

@@ -52,7 +52,7 @@ void cycle_table(const CyclesModel& m, std::ostream& out) {
             << "</td><td>" << f.first_frame << "</td><td>" << f.messages << "</td><td>" << f.nominal << "</td>";
         quantile_cells(f, out);
         out << "<td>" << escape_html(f.jitter_sd) << "</td><td>" << (f.counted ? std::to_string(f.lost) : "")
-            << "</td><td>" << (f.counted ? std::to_string(f.duplicates) : "") << "</td></tr>\n";
+            << "</td><td>" << (f.duplicates_counted ? std::to_string(f.duplicates) : "") << "</td></tr>\n";
     }
     out << "</tbody></table>\n";
 }
@@ -100,8 +100,7 @@ void losses_section(const CyclesModel& m, std::ostream& out) {
     if (!m.has_cycles) return;
     out << "<h2>Losses</h2>\n";
     if (m.lost.empty() && m.duplicates.empty()) {
-        out << "<p class=\"note\" id=\"no-losses\">No message lost or repeated: every stream's sequence count "
-               "advanced by one.</p>\n";
+        out << "<p class=\"note\" id=\"no-losses\">No message lost or repeated in any stream.</p>\n";
         return;
     }
     out << "<div class=\"chart wide\" id=\"loss-events\"></div>\n";
