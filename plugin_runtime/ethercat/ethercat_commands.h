@@ -64,25 +64,44 @@ constexpr const char *command_name_of(unsigned cmd) { return cmd < command_count
 constexpr addressing addressing_of(unsigned cmd) { return cmd < command_count ? commands[cmd].addressed_by : ADDRESSING_NONE; }
 constexpr access access_of(unsigned cmd) { return cmd < command_count ? commands[cmd].does : ACCESS_NONE; }
 
-constexpr bool is_logical(unsigned cmd) { return addressing_of(cmd) == ADDRESSING_LOGICAL; }
-constexpr bool is_auto_increment(unsigned cmd) { return addressing_of(cmd) == ADDRESSING_AUTO_INCREMENT; }
-constexpr bool is_configured(unsigned cmd) { return addressing_of(cmd) == ADDRESSING_CONFIGURED; }
-constexpr bool is_broadcast(unsigned cmd) { return addressing_of(cmd) == ADDRESSING_BROADCAST; }
+/* The commands of one class as a set (bit n: command n), worked out from the
+ * table when compiling: a class test on every datagram is a shift and a mask. */
+template <typename Test>
+constexpr uint32_t commands_where(Test test)
+{
+    uint32_t set = 0;
+    for (unsigned c = 0; c < command_count; c++)
+        if (test(commands[c])) set |= 1u << c;
+    return set;
+}
+static_assert(command_count <= 32, "a class is a 32-bit set");
+constexpr bool in_set(uint32_t set, unsigned cmd) { return cmd < 32 && ((set >> cmd) & 1u); }
+
+constexpr uint32_t logical_set = commands_where([](const command_info &i) { return i.addressed_by == ADDRESSING_LOGICAL; });
+constexpr uint32_t auto_increment_set =
+    commands_where([](const command_info &i) { return i.addressed_by == ADDRESSING_AUTO_INCREMENT; });
+constexpr uint32_t configured_set = commands_where([](const command_info &i) { return i.addressed_by == ADDRESSING_CONFIGURED; });
+constexpr uint32_t broadcast_set = commands_where([](const command_info &i) { return i.addressed_by == ADDRESSING_BROADCAST; });
+constexpr uint32_t write_only_set = commands_where([](const command_info &i) { return i.does == ACCESS_WRITE; });
+/* Physically addressed (not logical), not ARMW/FRMW: the data is a register's. */
+constexpr uint32_t register_read_set = commands_where([](const command_info &i) {
+    return i.addressed_by != ADDRESSING_LOGICAL && (i.does == ACCESS_READ || i.does == ACCESS_READ_WRITE);
+});
+constexpr uint32_t register_write_set = commands_where([](const command_info &i) {
+    return i.addressed_by != ADDRESSING_LOGICAL && (i.does == ACCESS_WRITE || i.does == ACCESS_READ_WRITE);
+});
+
+constexpr bool is_logical(unsigned cmd) { return in_set(logical_set, cmd); }
+constexpr bool is_auto_increment(unsigned cmd) { return in_set(auto_increment_set, cmd); }
+constexpr bool is_configured(unsigned cmd) { return in_set(configured_set, cmd); }
+constexpr bool is_broadcast(unsigned cmd) { return in_set(broadcast_set, cmd); }
 /* Each slave the datagram passes adds 1 to its slave address (ADP). */
-constexpr bool advances_address(unsigned cmd) { return is_auto_increment(cmd) || is_broadcast(cmd); }
+constexpr bool advances_address(unsigned cmd) { return in_set(auto_increment_set | broadcast_set, cmd); }
 /* Writes only: its data comes back as the master sent it. */
-constexpr bool is_write_only(unsigned cmd) { return access_of(cmd) == ACCESS_WRITE; }
-/* Reads (or reads and writes) a slave's registers, addressed physically
- * (not logical, not ARMW/FRMW): the data that comes back is a register's. */
-constexpr bool reads_registers(unsigned cmd)
-{
-    return !is_logical(cmd) && (access_of(cmd) == ACCESS_READ || access_of(cmd) == ACCESS_READ_WRITE);
-}
-/* Writes (or reads and writes) a slave's registers, addressed physically:
- * the data sent is what the registers take. */
-constexpr bool writes_registers(unsigned cmd)
-{
-    return !is_logical(cmd) && (access_of(cmd) == ACCESS_WRITE || access_of(cmd) == ACCESS_READ_WRITE);
-}
+constexpr bool is_write_only(unsigned cmd) { return in_set(write_only_set, cmd); }
+/* Reads (or reads and writes) a slave's registers: the data that comes back is a register's. */
+constexpr bool reads_registers(unsigned cmd) { return in_set(register_read_set, cmd); }
+/* Writes (or reads and writes) a slave's registers: the data sent is what the registers take. */
+constexpr bool writes_registers(unsigned cmd) { return in_set(register_write_set, cmd); }
 
 }  // namespace dg_ecat_commands
