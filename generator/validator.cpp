@@ -53,6 +53,7 @@ private:
     void check_root();
     void inherit_and_check_node(Node& n, ByteOrder inherited);
     void check_leaf_display(Node& n);
+    void unaligned_group(const Node& first, unsigned bits, const std::string& next);
     void layout_children(std::vector<std::unique_ptr<Node>>& children);
     void close_group(std::vector<Node*>& group, unsigned bits);
     void layout_packed_bits(Node& n);
@@ -297,6 +298,13 @@ bool means_same_bits(const Node& n, const std::vector<const Node*>& alternatives
 
 }  // namespace
 
+// "bit group starting at X ends after N bits, not on a byte boundary" and,
+// when a node ends the group, what it is.
+void Validator::unaligned_group(const Node& first, unsigned bits, const std::string& next) {
+    diags_.error(first.line, "bit group starting at " + quote(first) + " ends after " + std::to_string(bits) +
+                                 " bits, not on a byte boundary" + (next.empty() ? "" : " (next is " + next + ")"));
+}
+
 // Groups consecutive bit fields into whole-byte integers (docs/manual.md,
 // "Lengths, bit fields, repetition, conditions"); recurses into containers.
 void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
@@ -315,10 +323,8 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
             // count="..." on a bit field: a packed list, which starts and ends on a byte
             // boundary of its own.
             if (!group.empty()) {
-                diags_.error(group.front()->line, "bit group starting at " + quote(*group.front()) + " ends after " +
-                                                      std::to_string(group_bits) +
-                                                      " bits, not on a byte boundary (next is " + quote(n) + at_line(n) +
-                                                      ", a packed list of bit fields, which starts a byte)");
+                unaligned_group(*group.front(), group_bits,
+                                quote(n) + at_line(n) + ", a packed list of bit fields, which starts a byte");
                 group.clear();
                 group_bits = 0;
             }
@@ -326,9 +332,7 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
             continue;
         }
         if (!bit_leaf) {
-            diags_.error(group.front()->line, "bit group starting at " + quote(*group.front()) + " ends after " +
-                                                  std::to_string(group_bits) +
-                                                  " bits, not on a byte boundary (next is " + quote(n) + at_line(n) + ")");
+            unaligned_group(*group.front(), group_bits, quote(n) + at_line(n));
             group.clear();
             group_bits = 0;
             if (n.is_container()) layout_children(n.children);
@@ -368,9 +372,7 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
             group_bits = 0;
         }
     }
-    if (!group.empty())
-        diags_.error(group.front()->line, "bit group starting at " + quote(*group.front()) + " ends after " +
-                                              std::to_string(group_bits) + " bits, not on a byte boundary");
+    if (!group.empty()) unaligned_group(*group.front(), group_bits, "");
 }
 
 // A bit field with count="...": its values are packed into whole bytes, N per byte
