@@ -68,6 +68,22 @@ def unit(gtest_filter):
     return command
 
 
+# The runner builds dissgen, unit_tests and the runtime; a test that also reads the plugins
+# CMake builds from rules/ (build/plugins/) gets them built first, from the copy as it is.
+BUILD_CMAKE_PLUGINS = ("import os, subprocess, sys\n"
+                       "r = subprocess.run(['cmake', '--build', sys.argv[1], '--target', 'dissgen_enip',\n"
+                       "                    'dissgen_ethercat'], stdout=subprocess.DEVNULL)\n"
+                       "if r.returncode:\n"
+                       "    sys.exit('cannot build the CMake plugins')\n"
+                       "os.execv(sys.argv[2], sys.argv[2:])\n")
+
+
+def with_cmake_plugins(test):
+    def command(src, build):
+        return [sys.executable, "-c", BUILD_CMAKE_PLUGINS, build] + test(src, build)
+    return command
+
+
 def corpus_differential(src, build):
     return integration("ecat_differential.py", "--corpus",
                        os.path.join(src, "..", "shared", "corpus", "ethercat"))(src, build)
@@ -135,7 +151,7 @@ TESTS = {
     "losses_corpus": integration("test_losses.py", "--with-corpus"),
     "findings": integration("test_findings.py"),
     "corpus_padding": integration("test_corpus_padding.py"),
-    "plugin_contents": integration("test_plugin_contents.py"),
+    "plugin_contents": with_cmake_plugins(integration("test_plugin_contents.py")),
     "reserved_names": integration("test_reserved_names.py"),
     "cycles": integration("test_cycles.py"),
     "compiled_walk": integration("test_compiled_walk.py", "CompiledWalk.test_every_rule_file"),
