@@ -65,6 +65,21 @@ TEST(Emit, CyclesGiveEachFieldItsRoleAndTheTestsTheirRanges) {
     EXPECT_FALSE(contains(emit_cpp(*without.proto, "rules.xml"), "cycle"));  // costs nothing where absent
 }
 
+// bits="1" to bits="64": the range's ends are sequence counts too (a 1-bit toggle).
+TEST(Emit, CyclesSequenceWidthsAtTheEnds) {
+    for (const std::string width : {"1", "64"}) {
+        Front f = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n"
+                            "  <cycles><signature field=\"node[@name='Stream']\"/>"
+                            "<sequence field=\"node[@name='Count']\" bits=\"" + width + "\"/></cycles>\n"
+                            "  <node name=\"Stream\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+                            "  <node name=\"Count\" length=\"8byte\" displaytype=\"numberdec\"/>\n</root>\n");
+        ASSERT_TRUE(f.ok()) << width << ": " << f.messages();
+        EXPECT_TRUE(contains(emit_cpp(*f.proto, "rules.xml"),
+                             "static const dg_cycles t_cycles = { 8, " + width + ", 0, 0, NULL, NULL, 1u, 0 };"))
+            << width;
+    }
+}
+
 // lost="period": the table's last flag.
 TEST(Emit, CyclesLostByPeriod) {
     const std::string nodes = "  <node name=\"Stream\" length=\"2byte\" displaytype=\"numberhex\"/>\n</root>\n";
