@@ -288,6 +288,8 @@ TEST(EsiOk, ModuleFileWithBomAndDeclaration) {
 TEST(EsiOk, NumbersAsEsiFilesWriteThem) {
     uint64_t v = 0;
     EXPECT_TRUE(parse_esi_number("#x1A00", v) && v == 0x1a00);
+    EXPECT_TRUE(parse_esi_number("#X1A00", v) && v == 0x1a00) << "upper-case #X, as some ESI files write it";
+    EXPECT_TRUE(parse_esi_number(" #x10", v) && v == 0x10);
     EXPECT_TRUE(parse_esi_number("0x1a00", v) && v == 0x1a00);
     EXPECT_TRUE(parse_esi_number(" 6656 ", v) && v == 6656);
     EXPECT_FALSE(parse_esi_number("#x", v));
