@@ -38,7 +38,7 @@ struct command_info {
     access does;
 };
 
-constexpr command_info commands[] = {
+inline constexpr command_info commands[] = {
     {"NOP", ADDRESSING_NONE, ACCESS_NONE},
     {"APRD", ADDRESSING_AUTO_INCREMENT, ACCESS_READ},
     {"APWR", ADDRESSING_AUTO_INCREMENT, ACCESS_WRITE},
@@ -55,14 +55,11 @@ constexpr command_info commands[] = {
     {"ARMW", ADDRESSING_AUTO_INCREMENT, ACCESS_READ_MULTIPLE_WRITE},
     {"FRMW", ADDRESSING_CONFIGURED, ACCESS_READ_MULTIPLE_WRITE},
 };
-constexpr unsigned command_count = sizeof commands / sizeof commands[0];
+inline constexpr unsigned command_count = sizeof commands / sizeof commands[0];
 static_assert(command_count == FRMW + 1, "one row per command, in number order");
 
 /* The command's name, or nullptr for a number no command has. */
 constexpr const char *command_name_of(unsigned cmd) { return cmd < command_count ? commands[cmd].name : nullptr; }
-
-constexpr addressing addressing_of(unsigned cmd) { return cmd < command_count ? commands[cmd].addressed_by : ADDRESSING_NONE; }
-constexpr access access_of(unsigned cmd) { return cmd < command_count ? commands[cmd].does : ACCESS_NONE; }
 
 /* The commands of one class as a set (bit n: command n), worked out from the
  * table when compiling: a class test on every datagram is a shift and a mask. */
@@ -77,17 +74,17 @@ constexpr uint32_t commands_where(Test test)
 static_assert(command_count <= 32, "a class is a 32-bit set");
 constexpr bool in_set(uint32_t set, unsigned cmd) { return cmd < 32 && ((set >> cmd) & 1u); }
 
-constexpr uint32_t logical_set = commands_where([](const command_info &i) { return i.addressed_by == ADDRESSING_LOGICAL; });
-constexpr uint32_t auto_increment_set =
+inline constexpr uint32_t logical_set = commands_where([](const command_info &i) { return i.addressed_by == ADDRESSING_LOGICAL; });
+inline constexpr uint32_t auto_increment_set =
     commands_where([](const command_info &i) { return i.addressed_by == ADDRESSING_AUTO_INCREMENT; });
-constexpr uint32_t configured_set = commands_where([](const command_info &i) { return i.addressed_by == ADDRESSING_CONFIGURED; });
-constexpr uint32_t broadcast_set = commands_where([](const command_info &i) { return i.addressed_by == ADDRESSING_BROADCAST; });
-constexpr uint32_t write_only_set = commands_where([](const command_info &i) { return i.does == ACCESS_WRITE; });
+inline constexpr uint32_t configured_set = commands_where([](const command_info &i) { return i.addressed_by == ADDRESSING_CONFIGURED; });
+inline constexpr uint32_t broadcast_set = commands_where([](const command_info &i) { return i.addressed_by == ADDRESSING_BROADCAST; });
+inline constexpr uint32_t write_only_set = commands_where([](const command_info &i) { return i.does == ACCESS_WRITE; });
 /* Physically addressed (not logical), not ARMW/FRMW: the data is a register's. */
-constexpr uint32_t register_read_set = commands_where([](const command_info &i) {
+inline constexpr uint32_t register_read_set = commands_where([](const command_info &i) {
     return i.addressed_by != ADDRESSING_LOGICAL && (i.does == ACCESS_READ || i.does == ACCESS_READ_WRITE);
 });
-constexpr uint32_t register_write_set = commands_where([](const command_info &i) {
+inline constexpr uint32_t register_write_set = commands_where([](const command_info &i) {
     return i.addressed_by != ADDRESSING_LOGICAL && (i.does == ACCESS_WRITE || i.does == ACCESS_READ_WRITE);
 });
 
