@@ -376,6 +376,11 @@ char *stream_text(const stream *s)
     return g_string_free(t, FALSE);
 }
 
+/* What -z P,cycles and the statistics tree count beside the timing: losses
+ * with a sequence count or lost="period", duplicates only with a count. */
+gboolean losses_counted(void) { return protocol->cycles->sequence_bits || protocol->cycles->lost_by_period; }
+gboolean duplicates_counted(void) { return protocol->cycles->sequence_bits > 0; }
+
 /* At the end of the capture, from the capture's state (complete by then). */
 void cycles_draw(void *)
 {
@@ -392,9 +397,8 @@ void cycles_draw(void *)
         printf("  nominal period (ns): %u\n", f.nominal);
         print_quantiles("period", &f.period);
         printf("  jitter std dev (ns): %.1f\n", f.jitter_sd);
-        if (protocol->cycles->sequence_bits || protocol->cycles->lost_by_period)
-            printf("  messages lost: %u\n", c->s->lost);
-        if (protocol->cycles->sequence_bits) printf("  duplicates: %u\n", c->s->duplicates);
+        if (losses_counted()) printf("  messages lost: %u\n", c->s->lost);
+        if (duplicates_counted()) printf("  duplicates: %u\n", c->s->duplicates);
     }
     printf("===================================================================\n");
 }
@@ -416,8 +420,6 @@ tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *
 {
     if (!st_fill_now(&st_filled, capture != NULL, pinfo->num, capture ? capture->last_frame : 0))
         return TAP_PACKET_DONT_REDRAW;
-    const gboolean counted = protocol->cycles->sequence_bits > 0;
-    const gboolean lost_counted = counted || protocol->cycles->lost_by_period;
     for (const cycle *c = capture->first; c; c = c->next) {
         figures f = figures_of(c);
         char *text = stream_text(c->s);
@@ -427,8 +429,8 @@ tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *
         st_cycle_row(st, c->number, "nominal period (ns)", id, f.nominal);
         st_quantile_rows(st, c->number, "period", &f.period, id);
         st_cycle_row(st, c->number, "jitter std dev (ns)", id, (guint64)(f.jitter_sd + 0.5));
-        if (lost_counted) st_cycle_row(st, c->number, "messages lost", id, c->s->lost);
-        if (counted) st_cycle_row(st, c->number, "duplicates", id, c->s->duplicates);
+        if (losses_counted()) st_cycle_row(st, c->number, "messages lost", id, c->s->lost);
+        if (duplicates_counted()) st_cycle_row(st, c->number, "duplicates", id, c->s->duplicates);
     }
     return TAP_PACKET_REDRAW;
 }
