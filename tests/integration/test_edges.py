@@ -21,6 +21,9 @@ offsets   tests/rules/offsets_from.xml: offsets= counted from the container arou
           single byte, the last one ending with the message; no expert info. A first offset
           one byte inside the table, or a second one before the first, gives
           offs.expert.bad_offset and no entry, and its message names the entry and the reason.
+          Offsets counted from a field (from="../node[@name='Base']"), after a byte of its
+          container: from its first byte; when an if= left that field out, no entry and
+          offs.expert.bad_length, which says so.
 
     test_edges.py --dissgen build/bin/dissgen --source-dir . [TestEdges.test_handoff_...|-k peek|-k offsets]
 """
@@ -280,7 +283,9 @@ KINDS = {  # kind: (filter prefix, bytes from the base to the table's count, off
     1: ("offs.near", 0, 1),
     2: ("offs.two.inner", 2, 1),
     3: ("offs.three.middle.inner", 4, 2),
+    4: ("offs.field", 2, 1),    # from the field Base (2 bytes), after one byte of its container
 }
+LEAD = {4: b"\x5a"}   # bytes of the container before the base
 
 
 def offsets_message(kind, entries, gap, first_shift=0, second_before_first=False):
@@ -296,7 +301,7 @@ def offsets_message(kind, entries, gap, first_shift=0, second_before_first=False
     offsets[0] -= first_shift
     if second_before_first:
         offsets[1] = offsets[0] - 1
-    head = bytes(range(0xA0, 0xA0 + heads))
+    head = LEAD.get(kind, b"") + bytes(range(0xA0, 0xA0 + heads))
     fmt = "<B" + ("B" if size == 1 else "H") * n
     return (bytes([kind, 0xEE]) + head + struct.pack(fmt, n, *offsets) + bytes(gap)
             + b"".join(bytes([tag]) + body for tag, body in entries)), entries
@@ -321,7 +326,12 @@ def offsets_checks(check, dissgen, source_dir):
         payload, _ = offsets_message(kind, [(0x77, b"\x01\x02"), (0x78, b"")], 1, second_before_first=True)
         cases.append((kind, payload, [], "'Entry' 2 of 2: offset %d (byte %d) is smaller than the one before it",
                       "kind %d, the second offset before the first" % kind))
-    names = ["_ws.expert", "_ws.expert.message", "offs.expert.bad_offset"]
+    # kind 5: the same container without its Base, which the offsets count from
+    payload, _ = offsets_message(4, [(0x77, b"\x01"), (0x78, b"")], 0)
+    cases.append((4, bytes([5]) + payload[1:3] + payload[5:], [],
+                  "The offsets of 'Entry' count from a field that is not in this packet",
+                  "kind 5, the field the offsets count from left out"))
+    names = ["_ws.expert", "_ws.expert.message", "offs.expert.bad_offset", "offs.expert.bad_length"]
     for prefix, _h, _s in KINDS.values():
         names += [prefix + ".entry.tag", prefix + ".entry.body"]
     with TsharkEnv() as env:
@@ -333,18 +343,20 @@ def offsets_checks(check, dissgen, source_dir):
         for (kind, _payload, entries, bad, what), r in zip(cases, rows):
             prefix = KINDS[kind][0]
             got = ([int(t, 16) for t in r[prefix + ".entry.tag"]],
-                   [b.replace(" ", "").replace(":", "") for b in r[prefix + ".entry.body"]], bool(r["offs.expert.bad_offset"]),
-                   len(r["_ws.expert"]))
+                   [b.replace(" ", "").replace(":", "") for b in r[prefix + ".entry.body"]],
+                   bool(r["offs.expert.bad_offset"] or r["offs.expert.bad_length"]), len(r["_ws.expert"]))
             want = ([t for t, _b in entries], [b.hex() for _t, b in entries if b], bool(bad), 1 if bad else 0)
             check(got == want, "%s: entries where the table says, %s%s" % (
-                what, "offs.expert.bad_offset" if bad else "no expert info",
+                what, ("offs.expert.bad_length" if "not in this packet" in bad else "offs.expert.bad_offset") if bad
+                else "no expert info",
                 "" if got == want else "\n       got  %s\n       want %s" % (got, want)))
             if bad:
                 # which entry is wrong, and how: the number and the reason
                 pattern = re.escape(bad).replace("%d", r"\d+")
                 message = " ".join(r["_ws.expert.message"])
                 check(re.match(pattern, message) is not None, "%s: the message says %r (%s)" % (
-                    what, bad.split(": ", 1)[0] + ": ... " + bad.rsplit(" is ", 1)[1], message))
+                    what, bad.split(": ", 1)[0] + ": ... " + bad.rsplit(" is ", 1)[1] if ": " in bad else bad,
+                    message))
 
 
 class TestEdges(TsharkTestCase, unittest.TestCase):
