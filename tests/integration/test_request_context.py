@@ -10,7 +10,8 @@ out of order). Function 3: each register's number is the request's reference plu
 function 1 (one byte per coil): as many coils as the request's quantity, numbered the same way;
 both show the request's reference as the first register, right after the keys, also in a response
 that ends there (and none when it ends inside them).
-Checked against the bytes in one pass and with -2. The same capture without its requests:
+Checked against the bytes in one pass and with -2, also over TCP with up to three messages in a
+segment. The same capture without its requests:
 every response decodes what it can (register values, no numbers, no coils), says so with
 rqc.expert.no_request_context once, and raises no malformed expert. And a field of a repeated
 node read by position (tests/rules/request_by_position.xml): each answer of a batch decoded by
@@ -163,8 +164,6 @@ class TestRequestContext(TsharkTestCase, unittest.TestCase):
         """A server answers each connection in order, not the capture's connections among
         themselves: a request from one client port answered after 30 transactions of another
         is paired, neither lost nor out of order."""
-        if self.CLIENT is not None:
-            self.skipTest("the plain rule file shows it")
         slow, quick = self.txns[0], self.txns[1:31]
         frames = [frame("request", payload("request", slow), 40001)]
         for t in quick:
@@ -180,6 +179,51 @@ class TestRequestContext(TsharkTestCase, unittest.TestCase):
                       % ("-2" if two_pass else "one pass", last["rqc.request_in"]))
                 flagged = [n for n, r in rows.items() if r["rqc.expert.no_response"] or r["rqc.expert.out_of_order"]]
                 check(not flagged, "%s: nothing lost or out of order (%s)" % ("-2" if two_pass else "one pass", flagged))
+
+    def test_several_messages_in_one_tcp_segment(self):
+        """Over TCP a segment carries one to three messages (pdulength): each response finds
+        its own request, and a second pass reads what the first found for each of them, not
+        only for a segment's first message."""
+        rng = random.Random(5)
+        segments, seq = [], {"request": 1000, "response": 50000}
+        i = 0
+        while i < len(self.order):
+            d = self.order[i][0]
+            run = 1
+            while run < 3 and i + run < len(self.order) and self.order[i + run][0] == d and rng.random() < 0.7:
+                run += 1
+            segments.append((d, [k for _d, k in self.order[i:i + run]]))
+            i += run
+        frames = []
+        for d, ks in segments:
+            data = b"".join(modbus(d, self.txns[k]) for k in ks)
+            sport, dport = (40000, PORT) if d == "request" else (PORT, 40000)
+            src, dst = (CLIENT, SERVER) if d == "request" else (SERVER, CLIENT)
+            frames.append(pcapgen.tcp_ethernet_frame(data, sport, dport, seq[d], src, dst))
+            seq[d] += len(data)
+        path = self.env.add_file("tcp.pcap", pcapgen.raw_pcap_bytes(frames))
+        shared = sum(1 for d, ks in segments if d == "response" and len(ks) > 1)
+        with self.checks() as check:
+            check(shared > 10, "%d segments carry two or three responses" % shared)
+            for two_pass in (False, True):
+                rows = self.env.field_rows(path, ["frame.number", "rqc.first_register",
+                                                  "rqc.registers.values.register.number", "rqc.coils.coil.number",
+                                                  "rqc.expert.no_request_context"], two_pass)
+                wrong = []
+                for n, (d, ks) in enumerate(segments, 1):
+                    if d != "response":
+                        continue
+                    r = rows[n]
+                    want_first = [str(self.txns[k][3]) for k in ks]
+                    want_numbers = [str(self.txns[k][3] + j) for k in ks for j in range(self.txns[k][4])]
+                    got_numbers = r["rqc.registers.values.register.number"] + r["rqc.coils.coil.number"]
+                    want_sorted = sorted(want_numbers, key=int)
+                    if r["rqc.first_register"] != want_first or sorted(got_numbers, key=int) != want_sorted \
+                            or r["rqc.expert.no_request_context"]:
+                        wrong.append((n, r["rqc.first_register"], want_first))
+                check(not wrong, "%s: every response of a segment of several shows its own request's first "
+                      "register and numbers%s" % ("-2" if two_pass else "one pass",
+                                                  "" if not wrong else " (wrong: %s)" % wrong[:3]))
 
     def test_responses_without_their_requests(self):
         with self.checks() as check:
@@ -241,6 +285,9 @@ class TestRequestContextDecodedKeys(TestRequestContext):
     decoded before its first request{...}."""
     RULES = "request_context_decoded_keys.xml"
     CLIENT = staticmethod(client_name)
+    # Shown by the plain rule file alone: they do not depend on where the keys are.
+    test_connections_are_ordered_apart = None
+    test_several_messages_in_one_tcp_segment = None
 
 
 class TestRequestByPath(TsharkTestCase, unittest.TestCase):
