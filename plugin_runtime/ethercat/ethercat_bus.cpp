@@ -565,7 +565,8 @@ void add_config(slave_state *st, const pdo_object *o, guint32 frame)
  * (32 bits). One subindex at a time, the object is complete when subindex 0
  * is written non-zero; a complete-access transfer from subindex 0 holds
  * subindex 0 padded to 16 bits, then the entries (from subindex 1: the
- * entries alone), and completes it. */
+ * entries alone), and completes it; one from subindex 0 that holds no entry
+ * (the count alone) sets the count of the entries written before. */
 void learn_object(slave_state *st, tvbuff_t *tvb, const sdo_data *sd, guint32 frame)
 {
     if (!is_pdo_object(sd->index)) return;
@@ -583,7 +584,7 @@ void learn_object(slave_state *st, tvbuff_t *tvb, const sdo_data *sd, guint32 fr
         for (; n < count && n < max_object_entries && at + size <= sd->length; n++, at += size)
             o->value[n] = size == 2 ? dg_tvb_get_uint16(tvb, sd->offset + (gint)at, ENC_LITTLE_ENDIAN)
                                     : dg_tvb_get_uint32(tvb, sd->offset + (gint)at, ENC_LITTLE_ENDIAN);
-        o->count = (guint8)n;
+        o->count = (guint8)(n == 0 && at == 2 ? MIN(count, max_object_entries) : n);
         o->complete = TRUE;
         add_config(st, o, frame);
         return;

@@ -746,6 +746,77 @@ def coe_design_checks(check, dissgen, source_dir):
                   "design: the entry named from the ESI file, under the design's slave name%s" % tag)
 
 
+SIGNED_IO = (BECKHOFF, 0x0C1E3052, 0x00100000)   # tests/esi_ok/signed_entries.xml
+
+
+def signed(v, bits):
+    return v - (1 << bits) if v >> (bits - 1) & 1 else v
+
+
+def signed_inputs(data, bit=0):
+    """signed_entries.xml's 0x1A00 from `bit`: Status (BIT3), then INT, SINT, DINT and LINT, each
+    starting 3 bits past a byte boundary."""
+    p = "ecatr.pdo.el3104.ai."
+    return {p + "status": [bits_of(data, bit, 3)], p + "value": [signed(bits_of(data, bit + 3, 16), 16)],
+            p + "small": [signed(bits_of(data, bit + 19, 8), 8)], p + "wide": [signed(bits_of(data, bit + 27, 32), 32)],
+            p + "huge": [signed(bits_of(data, bit + 59, 64), 64)]}
+
+
+def signed_entries_checks(check, dissgen, source_dir):
+    """Signed entries off byte boundaries (tests/esi_ok/signed_entries.xml), each value against
+    its bits; and a complete access from subindex 0 holding the count alone, which assigns the
+    PDOs written one subindex at a time before it."""
+    print("\n== signed entries off byte boundaries, and a complete access of the count alone")
+    p = "ecatr.pdo.el3104.ai."
+    fields = [p + f for f in ("status", "value", "small", "wide", "huge")] + ["ecatr.pdo.entry", "ecatr.pdo.value"]
+
+    def place(bit, *parts):  # (value, width) pairs from `bit` on, as a slave's inputs
+        v, at = 0, bit
+        for value, width in parts:
+            v |= (value & ((1 << width) - 1)) << at
+            at += width
+        return v.to_bytes(24, "little")
+
+    extremes = place(0, (5, 3), (-2, 16), (-128, 8), (-2 ** 31, 32), (-2 ** 63 + 1, 64))
+    positive = place(0, (2, 3), (0x7FFF, 16), (127, 8), (2 ** 31 - 1, 32), (2 ** 63 - 1, 64))
+    rng = random.Random(9)
+    noise = bytes(rng.randrange(256) for _ in range(24))
+
+    def norm(row):
+        return {f: [int(v, 0) if f != "ecatr.pdo.entry" else v for v in row[f]] for f in fields if row[f]}
+
+    # (case, configuration steps, inputs of the LRD after them, expected)
+    def count_alone(padded):   # a complete access of 0x1C13 from subindex 0 holding its count, 2
+        data = b"\x02\x00" if padded else b"\x02"
+        return coe_mailbox(2, struct.pack("<BHBI", 0x21 | 0x10, 0x1C13, 0, len(data)) + data)
+
+    one_at_a_time = [(sdo_expedited(0x1C13, 0, 0, 1), 1), (sdo_expedited(0x1C13, 1, 0x1A01, 2), 1),
+                     (sdo_expedited(0x1C13, 2, 0x1A00, 2), 1)]
+    counter_first = {"ecatr.pdo.entry": ["0x6010:01"], "ecatr.pdo.value": [bits_of(noise, 0, 16)],
+                     **signed_inputs(noise, 16)}
+    cases = (
+        ("the defaults, every value negative", [], extremes, signed_inputs(extremes)),
+        ("the defaults, every value at its positive end", [], positive, signed_inputs(positive)),
+        ("0x1C13's entries one at a time, then its count alone by complete access",
+         one_at_a_time + [(count_alone(False), 1)], noise, counter_first),
+        ("the same with the count padded to 16 bits", one_at_a_time + [(count_alone(True), 1)], noise,
+         counter_first),
+        ("0x1C13 by complete access of one entry", [(sdo_complete_access(0x1C13, [0x1A01], 2), 1)], noise,
+         {"ecatr.pdo.entry": ["0x6010:01"], "ecatr.pdo.value": [bits_of(noise, 0, 16)]}),
+    )
+    with TsharkEnv() as env:
+        env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"),
+                           ["--esi", os.path.join(source_dir, "tests", "esi_ok", "signed_entries.xml")])
+        for k, (case, steps, inputs, want) in enumerate(cases):
+            frames, lrds = coe_frames(steps, noise, inputs, identity=SIGNED_IO)
+            path = env.add_file("signed-%d.pcap" % k, pg.pcap_bytes(frames))
+            for two_pass in (False, True):
+                rows = dict(decode(env, path, fields, two_pass))
+                got = norm(rows[lrds[-1]])
+                check(got == want, "%s%s: %s" % (case, " (-2)" if two_pass else "",
+                                                 "as the bits say" if got == want else "%s, expected %s" % (got, want)))
+
+
 class TestBusModel(TsharkTestCase, unittest.TestCase):
     """cls.env: the plugin with the EK11xx and EL1xxx ESI files, the corpus captures in its HOME."""
 
@@ -826,6 +897,11 @@ class TestBusModel(TsharkTestCase, unittest.TestCase):
         """Part 7 (generated frames), with tests/network/small_design.xml."""
         with self.checks() as check:
             coe_design_checks(check, ARGS.dissgen, ARGS.source_dir)
+
+    def test_signed_entries_and_a_count_alone(self):
+        """Part 7 (generated frames), with tests/esi_ok/signed_entries.xml."""
+        with self.checks() as check:
+            signed_entries_checks(check, ARGS.dissgen, ARGS.source_dir)
 
     def test_process_data_as_mapped_over_coe_on_an_el1252(self):
         """Part 7 (generated frames), the EL1252 of the corpus's Beckhoff_EL1xxx.xml."""
