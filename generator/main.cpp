@@ -28,6 +28,7 @@
 #include "emit_cpp.h"
 #include "ethercat/esi_reader.h"
 #include "ethercat/network_reader.h"
+#include "packaged_plugins.h"
 #include "parser.h"
 #include "report/any/cycles_model.h"
 #include "report/any/cycles_page.h"
@@ -172,30 +173,6 @@ void check_names_against_wireshark(const Protocol& p, Diagnostics& diags, bool a
     }
 }
 
-// The dissgen package installs a plugin per shipped rule file into Wireshark's
-// global folder as dissgen-packaged-STEM.so, built from share/dissgen/rules/STEM.xml.
-// Returns the one whose protocol shares a name with `p`, and that protocol's filter name.
-struct Packaged {
-    std::string plugin, filter;
-};
-Packaged packaged_plugin_for(const Protocol& p, const std::string& system_dir, const std::string& argv0) {
-    const std::string prefix = "dissgen-packaged-", suffix = ".so";
-    std::error_code ec;
-    fs::path rules_dir = fs::path(share_dir(argv0)) / "rules";
-    for (fs::directory_iterator it(system_dir, ec), end; !ec && it != end; it.increment(ec)) {
-        std::string f = it->path().filename().string();
-        if (f.size() <= prefix.size() + suffix.size() || f.rfind(prefix, 0) != 0 ||
-            f.compare(f.size() - suffix.size(), suffix.size(), suffix) != 0)
-            continue;
-        fs::path rules = rules_dir / (f.substr(prefix.size(), f.size() - prefix.size() - suffix.size()) + ".xml");
-        Diagnostics ignored;
-        auto other = fs::exists(rules, ec) ? parse_rule_file(rules.string(), ignored) : nullptr;
-        if (other && (other->filter == p.filter || other->abbreviation == p.abbreviation || other->name == p.name))
-            return {it->path().string(), other->filter};
-    }
-    return {};
-}
-
 int cmd_check(const std::string& path, BusInput& bus) {
     Diagnostics diags;
     Loaded l = load(path, diags);
@@ -276,7 +253,8 @@ int cmd_install(const std::string& path, const std::string& dir, bool system, co
     if (auto sys = system_plugin_dir()) {
         std::error_code ec;
         bool into_system = system || fs::equivalent(target_dir, *sys, ec);
-        auto [packaged, packaged_filter] = packaged_plugin_for(*l.proto, *sys, argv0);
+        auto [packaged, packaged_filter] =
+            packaged_plugin_for(*l.proto, *sys, (fs::path(share_dir(argv0)) / "rules").string());
         if (!packaged.empty() && into_system) {
             std::cerr << "dissgen: the dissgen package's " << packaged << " already provides protocol '"
                       << packaged_filter << "' in Wireshark's global plugin folder, and Wireshark would load "
