@@ -123,6 +123,7 @@ TESTS = {
     "bus_slave_line": integration("test_bus_model.py", "TestBusModel.test_one_line_per_slave_details_filterable"),
     "bus_pdo": integration("test_bus_model.py", "TestBusModel.test_process_data_by_name"),
     "bus_coe": integration("test_bus_model.py", "-k", "test_process_data_as_mapped_over_coe_"),
+    "bus_signed": integration("test_bus_model.py", "TestBusModel.test_signed_entries_and_a_count_alone"),
     "pairing": integration("test_pairing.py", "--quick"),
     "pairing_full": integration("test_pairing.py"),
     "esc_commands": integration("test_esc_commands.py"),
