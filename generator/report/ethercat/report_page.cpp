@@ -125,7 +125,7 @@ const char kScript[] = R"JS(
   const top = data.round_trip.reduce((m, p) => Math.max(m, p[1][2]), 0) * 1.05 || 1;
   const rows = bars(data.round_trip).map(p => [p[0], p[1], null, null]);
   data.lost.forEach(e => rows.push([e[0], null, [top, top, top], null]));
-  data.wkc_errors.forEach(e => rows.push([e[0], null, null, [top * 0.95, top * 0.95, top * 0.95]]));
+  data.unexpected_wkc.forEach(e => rows.push([e[0], null, null, [top * 0.95, top * 0.95, top * 0.95]]));
   rows.sort((a, b) => a[0] - b[0]);
   chart('round-trip', rows, Object.assign({labels: ['t', 'Round trip (µs)', 'Lost frame', 'Unexpected WKC'],
       ylabel: 'Round trip (µs)', title: 'Round trip over time',
@@ -196,7 +196,7 @@ std::string write_report_html(const TimingModel& m, const std::string& tool_vers
     // The data the charts draw.
     out << "<script type=\"application/json\" id=\"report-data\">{\"duration\":" << num(m.duration, 6)
         << ",\"cycles\":" << cycles_json(m.cycles, kPlotBuckets) << ",\"round_trip\":" << series_json(m.round_trip, kPlotBuckets) << ",\"lost\":" << events_json(m.lost)
-        << ",\"wkc_errors\":" << events_json(m.wkc_differs) << ",\"slaves\":" << slaves_json(slaves) << "}</script>\n";
+        << ",\"unexpected_wkc\":" << events_json(m.wkc_differs) << ",\"slaves\":" << slaves_json(slaves) << "}</script>\n";
     out << "<script>" << kChartScript << kScript << "</script>\n</body></html>\n";
     return out ? "" : "cannot write the report";
 }
