@@ -7,8 +7,9 @@
 From --help: the commands of the usage lines ("dissgen CMD ...") and of the "commands:"
 list, the options of the usage lines and of the "options:" list (each must be in both).
 From the man page: the items (.TP) of COMMANDS and of OPTIONS, and what SYNOPSIS names.
-Every command and option of one must be in the other; and the binary knows each command
-(it does not answer "unknown command").  Prints "N passed, N failed".
+Every command and option of one must be in the other; the binary knows each command
+(it does not answer "unknown command"); --version says the man page header's version, and
+no command at all prints the usage and exits 2.  Prints "N passed, N failed".
 """
 
 import argparse
@@ -129,6 +130,16 @@ def main(argv=None):
         if "unknown command" in p.stderr:
             unknown.add(cmd)
     check("dissgen knows every command --help lists (%s)" % ", ".join(sorted(all_cmds)), unknown)
+    # --version says the version the man page's header names; no argument prints the usage and fails.
+    with open(args.man, encoding="utf-8") as fh:
+        header = re.search(r'^\.TH .*"(dissgen [^"]+)"', fh.read(), re.M)
+    p = subprocess.run([args.dissgen, "--version"], capture_output=True, text=True)
+    check("dissgen --version prints %r and exits 0 (it printed %r, exit %d)" % (
+        header.group(1) if header else "?", p.stdout.strip(), p.returncode),
+        set() if header and p.returncode == 0 and p.stdout.strip() == header.group(1) else {"--version"})
+    p = subprocess.run([args.dissgen], capture_output=True, text=True)
+    check("dissgen without a command prints the usage and exits 2 (exit %d)" % p.returncode,
+          set() if p.returncode == 2 and p.stdout.startswith("usage:") else {"(no command)"})
     print("commands: %s; options: %s" % (" ".join(sorted(all_cmds)), " ".join(sorted(all_opts))))
     print("%d passed, %d failed" % (passed, failed))
     return 0 if failed == 0 else 1

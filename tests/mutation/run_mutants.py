@@ -84,6 +84,11 @@ def with_cmake_plugins(test):
     return command
 
 
+def help_matches_man(src, build):
+    return [sys.executable, os.path.join(src, "tests", "cli", "help_vs_man.py"),
+            "--dissgen", os.path.join(build, "bin", "dissgen"), "--man", os.path.join(src, "packaging", "dissgen.1")]
+
+
 def corpus_differential(src, build):
     return integration("ecat_differential.py", "--corpus",
                        os.path.join(src, "..", "shared", "corpus", "ethercat"))(src, build)
@@ -97,6 +102,7 @@ def corpus_differential(src, build):
 # one test catches must be able to name that test.
 TESTS = {
     "unit": unit("-Golden*"),
+    "help_matches_man": help_matches_man,
     "rules_err": unit("Files/RulesErr.*:Files/RulesOk.*:RuleFolders.*"),
     "field_types": unit("FieldType.*:Emit.*:ListFields.*"),
     "widths": integration("test_widths.py"),

@@ -97,7 +97,7 @@ TESTS_BY_FILE = {
     "generator/wireshark_env.cpp": ["loading", "everything"],
     "generator/packaged_plugins.cpp": ["unit"],
     "generator/object_cache.cpp": ["unit", "loading", "everything"],
-    "generator/main.cpp": ["unit", "loading", "everything", "plugin_contents"],
+    "generator/main.cpp": ["unit", "help_matches_man", "loading", "everything", "plugin_contents"],
     "generator/ethercat/": ["esi", "bus_tables", "bus_pdo", "bus_coe", "bus_signed"],
     "generator/report/": ["unit", "report"],
     "generator/": ["unit", "rules_err", "widths", "everything"],
