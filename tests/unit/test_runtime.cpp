@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "dissgen_label.h"
 #include "dissgen_state.h"
 
 namespace {
@@ -119,6 +120,25 @@ TEST(RuntimeText, DecimalAsPrintf) {
         append_dec(&t, v);
         EXPECT_EQ(std::string(t.data, t.len), printed("%" PRIu64, v));
         EXPECT_EQ(strlen(t.data), t.len) << "NUL-terminated";
+    }
+}
+
+// The labels' appends (dissgen_label.h) write what printf would: "%d", "%+d", "%u".
+TEST(RuntimeLabel, IntegersAsPrintf) {
+    const gint64 signed_edges[] = {0, 1, -1, 9, -9, 10, -10, 255, -256, G_MAXINT32, G_MININT32,
+                                   G_MAXINT64, G_MININT64, G_MININT64 + 1};
+    for (gint64 v : signed_edges)
+        for (int plus = 0; plus < 2; plus++) {
+            dg_label l = {"", 0};
+            dg_label_int(&l, v, plus);
+            char want[32];
+            std::snprintf(want, sizeof want, plus ? "%+" PRId64 : "%" PRId64, v);
+            EXPECT_EQ(std::string(l.text, l.len), want);
+        }
+    for (guint64 v : kEdges) {
+        dg_label l = {"", 0};
+        dg_label_uint(&l, v);
+        EXPECT_EQ(std::string(l.text), printed("%" PRIu64, v));
     }
 }
 
