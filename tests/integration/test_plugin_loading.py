@@ -215,12 +215,29 @@ class PluginLoading(unittest.TestCase):
         check = dissgen("check", paper)
         self.assertRegex(check.stderr, r"paper_example\.xml:\d+: warning: the protocol filter name 'ecat' is "
                                        r"already used by Wireshark's 'EtherCAT datagram\(s\)'")
-        self.env.install_plugin(ARGS.dissgen, paper)
-        p = self.env.tshark(["-r", self.capture, "-T", "fields", "-e", "_ws.col.Protocol"], check=False)
-        self.assertEqual(p.returncode, 0, p.stderr)
-        self.assertIn('The dissgen plugin for "EtherCAT" was not loaded: another protocol already has the '
-                      'filter name "ecat"', p.stderr)
-        self.assertEqual(p.stdout.split(), ["ECAT", "ECAT", "ECAT"])
+        with open(paper, encoding="utf-8") as fh:
+            text = fh.read()
+        # Each of the three names clashing in turn (Wireshark's ecat is "EtherCAT datagram(s)", ECAT,
+        # ecat); the message names the attribute to change.
+        root = '<root name="EtherCAT" abbreviation="ECAT"'
+        for kind, name, attribute, value, header in (
+                ("filter name", "EtherCAT", "filter", "ecat", root),
+                ("abbreviation", "EtherCAT", "abbreviation", "ECAT", root + ' filter="paperx"'),
+                ("name", "EtherCAT datagram(s)", "name", "EtherCAT datagram(s)",
+                 '<root name="EtherCAT datagram(s)" abbreviation="PAPX" filter="paperx"')):
+            with self.subTest(clash=kind):
+                folder = os.path.join(self.env.home, "clash-" + attribute)
+                os.makedirs(folder, exist_ok=True)
+                variant = os.path.join(folder, "paper_example.xml")
+                with open(variant, "w", encoding="utf-8") as fh:
+                    fh.write(text.replace(root, header, 1))
+                self.env.install_plugin(ARGS.dissgen, variant)
+                p = self.env.tshark(["-r", self.capture, "-T", "fields", "-e", "_ws.col.Protocol"], check=False)
+                self.assertEqual(p.returncode, 0, p.stderr)
+                self.assertIn('The dissgen plugin for "%s" was not loaded: another protocol already has the %s "%s". '
+                              'Change it in the rule file (<root %s=...>) and regenerate the plugin.'
+                              % (name, kind, value, attribute), p.stderr)
+                self.assertEqual(p.stdout.split(), ["ECAT", "ECAT", "ECAT"])
 
     def test_editing_rules_and_installing_again_changes_the_decode(self):
         edited = os.path.join(self.env.home, "ethercat.xml")
