@@ -1187,6 +1187,14 @@ class PipelinedReplies(TsharkTestCase, unittest.TestCase):
                     check(got == values, "%s: frame %d as its request says: %s" % (
                         "-2" if two_pass else "one pass", frame,
                         "ok" if got == values else "%s, want %s" % (got, values)))
+                # order="any": replies in another order than their requests are neither out of
+                # order nor do they leave a request unanswered
+                flagged = fields(ENV, cap, ["frame.number", "enipr.expert.out_of_order", "enipr.expert.no_response"],
+                                 extra=["-2"] if two_pass else [])
+                flagged = [r["frame.number"] for r in flagged
+                           if r["enipr.expert.out_of_order"] or r["enipr.expert.no_response"]]
+                check(not flagged, "%s: no reply out of order, no request unanswered (order=\"any\"): %s" % (
+                    "-2" if two_pass else "one pass", flagged or "none"))
 
 
 def corpus_dir():

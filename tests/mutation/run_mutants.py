@@ -89,6 +89,11 @@ def help_matches_man(src, build):
             "--dissgen", os.path.join(build, "bin", "dissgen"), "--man", os.path.join(src, "packaging", "dissgen.1")]
 
 
+def usage_errors(src, build):
+    return [sys.executable, os.path.join(src, "tests", "cli", "usage_errors.py"),
+            "--dissgen", os.path.join(build, "bin", "dissgen")]
+
+
 def corpus_differential(src, build):
     return integration("ecat_differential.py", "--corpus",
                        os.path.join(src, "..", "shared", "corpus", "ethercat"))(src, build)
@@ -103,6 +108,7 @@ def corpus_differential(src, build):
 TESTS = {
     "unit": unit("-Golden*"),
     "help_matches_man": help_matches_man,
+    "usage_errors": usage_errors,
     "rules_err": unit("Files/RulesErr.*:Files/RulesOk.*:RuleFolders.*"),
     "field_types": unit("FieldType.*:Emit.*:ListFields.*"),
     "widths": integration("test_widths.py"),
@@ -110,6 +116,7 @@ TESTS = {
     "everything": integration("test_everything.py"),
     "malformed": integration("test_malformed.py"),
     "enip": integration("test_enip.py"),
+    "enip_pipelined": integration("test_enip.py", "PipelinedReplies"),
     "profinet": integration("test_profinet.py"),
     "powerlink": integration("test_powerlink.py"),
     "validity": integration("test_validity.py"),

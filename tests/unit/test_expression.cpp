@@ -66,6 +66,10 @@ TEST(Expression, MistakesSayWhere) {
     EXPECT_EQ(parsed("indexes"), "error: expected a number, {field}, index or '(' but found 'i' at character 1");
     EXPECT_EQ(parsed("9223372036854775808"), "error: number '9223372036854775808' is above 9223372036854775807 at character 1");
     EXPECT_EQ(parsed("A + 1"), "error: expected a number, {field}, index or '(' but found 'A' at character 1");
+    // A number after the first character: the message quotes that number, not what follows it.
+    EXPECT_EQ(parsed("{A} + 12ab - 3"), "error: bad number '12a' at character 7");
+    EXPECT_EQ(parsed("2 * 9223372036854775808 + 1"),
+              "error: number '9223372036854775808' is above 9223372036854775807 at character 5");
 }
 
 TEST(Expression, DeepNestingIsRefusedNotOverflowed) {
