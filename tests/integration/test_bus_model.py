@@ -803,6 +803,12 @@ def signed_entries_checks(check, dissgen, source_dir):
          counter_first),
         ("0x1C13 by complete access of one entry", [(sdo_complete_access(0x1C13, [0x1A01], 2), 1)], noise,
          {"ecatr.pdo.entry": ["0x6010:01"], "ecatr.pdo.value": [bits_of(noise, 0, 16)]}),
+        # An expedited download of 1 byte (its size bits say so; the next byte holds 0x1A) to
+        # a 16-bit subindex: not a PDO index, not taken; the entries written before stay.
+        ("a 16-bit subindex written with 1 byte",
+         one_at_a_time[:2] + [(sdo_expedited(0x1C13, 2, 0x1A00, 4)[:8] + bytes([0x2F]) +
+                               sdo_expedited(0x1C13, 2, 0x1A00, 4)[9:], 1), (sdo_expedited(0x1C13, 0, 2, 1), 1)],
+         noise, {"ecatr.pdo.entry": ["0x6010:01"], "ecatr.pdo.value": [bits_of(noise, 0, 16)]}),
     )
     with TsharkEnv() as env:
         env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"),

@@ -18,13 +18,17 @@ TEST(DatesAndGuids, FieldTypesAndEncodings) {
                               "ethertype=\"0x88b5\" byteorder=\"little\""));
     ASSERT_TRUE(f.ok()) << f.messages();
     const Protocol& p = *f.proto;
+    // No bitmask on either (Wireshark refuses one on a field that is no integer).
     for (const char* name : {"net", "ns", "us", "ms", "s"}) {
         EXPECT_EQ(field_type(*find(p, name)).type, "FT_ABSOLUTE_TIME") << name;
         EXPECT_EQ(field_type(*find(p, name)).display, "ABSOLUTE_TIME_UTC") << name;
+        EXPECT_EQ(field_type(*find(p, name)).mask, 0u) << name;
         // not numbers: no length, count or condition may read them
         EXPECT_FALSE(find(p, name)->is_numeric()) << name;
     }
     EXPECT_EQ(field_type(*find(p, "id")).type, "FT_GUID");
+    EXPECT_EQ(field_type(*find(p, "id")).display, "BASE_NONE");
+    EXPECT_EQ(field_type(*find(p, "id")).mask, 0u);
     EXPECT_FALSE(find(p, "id")->is_numeric());
 
     std::string code = emit_cpp(p, "t.xml");

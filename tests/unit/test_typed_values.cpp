@@ -36,6 +36,8 @@ TEST(TypedValues, FieldTypesOfTheTypedDisplays) {
     EXPECT_EQ(type_of(p, "z").type, "FT_STRINGZ");
     EXPECT_EQ(type_of(p, "zfixed").type, "FT_STRINGZ");
     EXPECT_EQ(type_of(p, "ip").type, "FT_IPv4");
+    for (const char* name : {"text", "z", "zfixed", "ip", "real", "lreal", "t", "ts", "i8", "i64"})
+        EXPECT_EQ(type_of(p, name).mask, 0u) << name << ": no bitmask on a whole field";
     EXPECT_EQ(type_of(p, "i8").type, "FT_INT8");
     EXPECT_EQ(type_of(p, "i24").type, "FT_INT24");
     EXPECT_EQ(type_of(p, "i64").type, "FT_INT64");
