@@ -1018,6 +1018,34 @@ class Everything(TsharkTestCase, unittest.TestCase):
             described += "description" in node.attrib
         self.assertGreaterEqual(described, 8)
 
+    def test_statistics_tree_counts_what_the_fields_show(self):
+        """-z evry,tree: messages; each enum field's values as -T fields shows them (the total and
+        how often each value occurs); each repeated node's instances per message add up."""
+        out = self.env.tshark(["-r", self.capture, "-q", "-z", PROTO + ",tree"]).stdout
+        rows, current = {}, None
+        for line in out.splitlines():
+            m = re.match(r"^(\S.*?)\s{2,}(\d+)\s", line)
+            child = re.match(r"^ (\S.*?)\s{2,}(\d+)\s", line)
+            if m and not line.startswith(" "):
+                current = rows.setdefault(m.group(1), [int(m.group(2)), []])
+            elif child and current is not None:
+                current[1].append(int(child.group(2)))
+        self.assertEqual(rows.get("Messages", [None])[0], len(self.cases), out[:2000])
+        checked = 0
+        for label, (total, children) in rows.items():
+            f = re.search(r"\((%s\.[\w.]+)\)$" % PROTO, label)
+            if not f:
+                continue
+            self.assertEqual(sum(children), total, "%s: the values add up to the total" % label)
+            if " per message " in label:
+                continue
+            values = [v for r in self.rows for v in (r[f.group(1)].split("|") if r[f.group(1)] else [])]
+            counts = sorted((values.count(v) for v in set(values)), reverse=True)
+            self.assertEqual((total, sorted(children, reverse=True)), (len(values), counts),
+                             "%s: as often as -T fields shows it, each value as often" % label)
+            checked += 1
+        self.assertGreaterEqual(checked, 10, "enum fields in the tree: %d" % checked)
+
     def test_hooks(self):
         p = self.env.tshark(["-G", "decodes"])
         ours = {tuple(line.split("\t")[:2]) for line in p.stdout.splitlines() if line.endswith("\t" + PROTO)}
