@@ -56,9 +56,8 @@ SMALL = 64   # integer literals up to this value are constants that get +1 and -
 TESTS_BY_FILE = {
     "plugin_runtime/dissgen_values.h": ["unit", "widths", "everything"],
     "plugin_runtime/dissgen_text.h": ["unit", "typed_values", "widths"],
-    "plugin_runtime/dissgen_label.h": ["unit", "typed_values", "widths"],
     "plugin_runtime/dissgen_text.cpp": ["typed_values", "widths", "everything", "computed", "dates_guids_shared_names"],
-    "plugin_runtime/dissgen_label.h": ["typed_values", "widths", "everything"],
+    "plugin_runtime/dissgen_label.h": ["unit", "typed_values", "widths", "everything"],
     "plugin_runtime/dissgen_walk.cpp": ["widths", "everything", "malformed", "layout", "typed_values"],
     "plugin_runtime/dissgen_conditions.cpp": ["unit", "layout", "widths", "everything", "edges_peek"],
     "plugin_runtime/dissgen_handoff.cpp": ["typed_values", "edges_handoff", "enip"],

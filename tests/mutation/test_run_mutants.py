@@ -2,7 +2,8 @@
 """The mutation runner's decisions on fake test outcomes: what a run of a test says
 (classify), how long a test may take (time_limit), the verdict of a mutant from its
 tests' runs (decide), the tests a coverage map adds (choose_tests), when the map is
-stale (coverage_map.stale), and which tests need the corpus (needs_corpus)."""
+stale (coverage_map.stale), which tests need the corpus (needs_corpus), and that no
+table names a key twice."""
 
 import os
 import sys
@@ -189,6 +190,20 @@ class CoverageMapStale(unittest.TestCase):
         data = self.current()
         del data["sources"]["plugin_runtime/dissgen_walk.cpp"]
         self.assertEqual(coverage_map.stale(SOURCE_DIR, data), ["source plugin_runtime/dissgen_walk.cpp"])
+
+
+class Tables(unittest.TestCase):
+    def test_no_key_written_twice(self):
+        """A dict literal keeps the last of two equal keys without a word: the first list of
+        tests would be silently lost."""
+        import ast
+        for name, table in (("run_mutants.py", "TESTS"), ("systematic.py", "TESTS_BY_FILE")):
+            with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), name), encoding="utf-8") as fh:
+                tree = ast.parse(fh.read())
+            for node in ast.walk(tree):
+                if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == table for t in node.targets):
+                    keys = [k.value for k in node.value.keys if isinstance(k, ast.Constant)]
+                    self.assertEqual(sorted({k for k in keys if keys.count(k) > 1}), [], "%s: %s" % (name, table))
 
 
 class Corpus(unittest.TestCase):
