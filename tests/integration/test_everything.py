@@ -28,7 +28,7 @@ import unittest
 import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
+from tshark_env import TsharkEnv, TsharkTestCase, run_unittests  # noqa: E402
 
 ARGS = None
 PROTO = "evry"
@@ -1045,6 +1045,35 @@ class Everything(TsharkTestCase, unittest.TestCase):
                              "%s: as often as -T fields shows it, each value as often" % label)
             checked += 1
         self.assertGreaterEqual(checked, 10, "enum fields in the tree: %d" % checked)
+
+    def test_statistics_tree_of_a_rule_file_ending_in_a_counted_node(self):
+        """The tree's rows are kept per node: the last node of the file counted too (an enum
+        after a repeated node), each value and each number of instances as often as sent."""
+        rules = ('<root name="Counted last" abbreviation="CLAST" filter="clast" byteorder="big">\n'
+                 '  <hook table="udp.port" value="%d"/>\n'
+                 '  <node name="Count" length="1byte" displaytype="numberdec"/>\n'
+                 '  <node name="Item" count="../node[@name=\'Count\']">\n'
+                 '    <node name="Value" length="1byte" displaytype="numberhex"/>\n'
+                 '  </node>\n'
+                 '  <node name="Kind" length="1byte" displaytype="enum">'
+                 '<enum value="1" name="One"/><enum value="2" name="Two"/></node>\n'
+                 '</root>\n' % UDP_PORT)
+        rng = random.Random(7)
+        sent = [(rng.randrange(1, 4), rng.choice([1, 1, 2])) for _ in range(40)]
+        with TsharkEnv() as env:
+            path = os.path.join(env.home, "counted_last.xml")
+            with open(path, "w", encoding="utf-8") as fh:
+                fh.write(rules)
+            env.install_plugin(ARGS.dissgen, path)
+            frames = [(f, len(f)) for f in (eth_frame(bytes([n] + [0xAA] * n + [kind]), udp=True) for n, kind in sent)]
+            cap = env.add_file("counted_last.pcap", pcap(frames))
+            out = env.tshark(["-r", cap, "-q", "-z", "clast,tree"]).stdout
+        rows = {m.group(1).strip(): int(m.group(2)) for m in re.finditer(r"^(\S.*?|\s\S.*?)\s{2,}(\d+)\s", out, re.M)}
+        want = {"Messages": len(sent), "Kind (clast.kind)": len(sent),
+                "One": sum(k == 1 for _n, k in sent), "Two": sum(k == 2 for _n, k in sent),
+                "Item per message (clast.item)": len(sent)}
+        want.update({str(c): sum(n == c for n, _k in sent) for c in (1, 2, 3)})
+        self.assertEqual({k: rows.get(k) for k in want}, want, out)
 
     def test_hooks(self):
         p = self.env.tshark(["-G", "decodes"])
