@@ -63,7 +63,7 @@ bool same_chain(const Protocol& proto, const Node& x, const Node& y) {
 }
 
 std::string type_text(const FieldType& t) {
-    char mask[24];
+    char mask[32];  // " mask 0x" and up to 16 digits
     std::snprintf(mask, sizeof mask, " mask 0x%llx", static_cast<unsigned long long>(t.mask));
     return t.type + " " + t.display + (t.mask ? mask : "");
 }
