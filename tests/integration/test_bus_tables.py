@@ -100,6 +100,7 @@ class BusTables(unittest.TestCase):
             "0x00000002 0x044c2c52 0x00120000 EtherCAT Coupler",
             "0x00000002 0x07d43052 0x00100000 EL2004 4Ch. Dig. Output 24V, 0.5A",
             "0x00000002 0x07d43052 0x00110000 EL2004 4Ch. Dig. Output 24V, 0.5A",
+            "0x00000002 0x0c1e3052 0x00100000 EL3104 4Ch. Ana. Input, signed values",
             "0x0000001a 0x00000101 0x00000002 \u4e1c\u897f",
             "0x0000001a 0x00000102 0x00000000 Eing\u00e4nge",
         ])
