@@ -197,6 +197,8 @@ def statements(masked):
 
 
 TEMPLATE_INSIDE = re.compile(r"^[\w:\s\*&,<>\[\]]*$")
+# A template's own parameter list may give defaults: template <typename R = T>.
+TEMPLATE_PARAMETERS = re.compile(r"^[\w:\s\*&,<>\[\]=]*$")
 
 
 def template_brackets(masked):
@@ -221,7 +223,8 @@ def template_brackets(masked):
         if depth != 0 or j >= len(masked) or masked[j] == "\n":
             continue
         inside = masked[lt + 1:j]
-        if "&&" in inside or not TEMPLATE_INSIDE.match(inside) or not inside.strip():
+        pattern = TEMPLATE_PARAMETERS if word == "template" else TEMPLATE_INSIDE
+        if "&&" in inside or not pattern.match(inside) or not inside.strip():
             continue
         out.add(lt)
         # every > closing a nested level inside, and the last
