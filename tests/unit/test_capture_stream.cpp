@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "report/capture_stream.h"
+#include "test_support.h"
 
 namespace fs = std::filesystem;
 using namespace dissgen;
@@ -33,12 +34,7 @@ std::set<int> open_descriptors() {
 
 class CaptureStreamTest : public ::testing::Test {
 protected:
-    void SetUp() override {
-        char tmpl[] = "/tmp/dissgen-stream-test-XXXXXX";
-        ASSERT_NE(mkdtemp(tmpl), nullptr);
-        root = tmpl;
-    }
-    void TearDown() override { fs::remove_all(root); }
+    void SetUp() override { ASSERT_FALSE(root.empty()); }
 
     // A stand-in for tshark: a shell script.
     std::string fake_tshark(const std::string& body) {
@@ -48,7 +44,8 @@ protected:
         return p.string();
     }
 
-    fs::path root;
+    dissgen::testing::TempDir tmp{"dissgen-stream-test"};
+    fs::path root = tmp.path();
 };
 
 TEST_F(CaptureStreamTest, RowsOfTheFieldsAskedFor) {

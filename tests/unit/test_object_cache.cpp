@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "object_cache.h"
+#include "test_support.h"
 
 namespace fs = std::filesystem;
 using dissgen::CompileJob;
@@ -19,14 +20,11 @@ namespace {
 class ObjectCache : public ::testing::Test {
 protected:
     void SetUp() override {
-        char tmpl[] = "/tmp/dissgen-cache-test-XXXXXX";
-        ASSERT_NE(mkdtemp(tmpl), nullptr);
-        root = tmpl;
+        ASSERT_FALSE(root.empty());
         fs::create_directories(root / "runtime");
         write("runtime/shared.h", "#define ANSWER 42\n");
         write("runtime/part.cpp", "#include \"shared.h\"\nint part() { return ANSWER; }\n");
     }
-    void TearDown() override { fs::remove_all(root); }
 
     void write(const std::string& rel, const std::string& text) { std::ofstream(root / rel) << text; }
 
@@ -50,7 +48,8 @@ protected:
         return objects;
     }
 
-    fs::path root;
+    dissgen::testing::TempDir tmp{"dissgen-cache-test"};
+    fs::path root = tmp.path();
 };
 
 TEST_F(ObjectCache, SameInputsInAnotherWorkFolderReuseTheObjects) {

@@ -3,7 +3,6 @@
 // with (generator/packaged_plugins.cpp): the one built from a rule file whose
 // protocol shares a name, never a file set aside or another protocol's.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -20,15 +19,12 @@ namespace {
 class PackagedPlugins : public ::testing::Test {
 protected:
     void SetUp() override {
-        char tmpl[] = "/tmp/dissgen-packaged-test-XXXXXX";
-        ASSERT_NE(mkdtemp(tmpl), nullptr);
-        root = tmpl;
+        ASSERT_FALSE(root.empty());
         fs::create_directories(root / "plugins");
         fs::create_directories(root / "rules");
         fs::copy_file(source_path("rules/enip.xml"), root / "rules" / "enip.xml");
         fs::copy_file(source_path("rules/profinet.xml"), root / "rules" / "profinet.xml");
     }
-    void TearDown() override { fs::remove_all(root); }
 
     void plugin(const std::string& name) { std::ofstream(root / "plugins" / name) << "ELF"; }
     PackagedPlugin lookup(const std::string& rules) {
@@ -38,7 +34,8 @@ protected:
         return packaged_plugin_for(*p, (root / "plugins").string(), (root / "rules").string());
     }
 
-    fs::path root;
+    dissgen::testing::TempDir tmp{"dissgen-packaged-test"};
+    fs::path root = tmp.path();
 };
 
 TEST_F(PackagedPlugins, TheOneOfTheSameProtocol) {

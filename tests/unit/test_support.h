@@ -3,6 +3,9 @@
 // file or on text, and read files of the source tree.
 #pragma once
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -54,6 +57,26 @@ inline const Node* find(const Protocol& proto, const std::string& name) {
     });
     return found;
 }
+
+// A fresh folder under /tmp, removed with all it holds when it goes out of scope;
+// an empty path when it could not be made.
+class TempDir {
+public:
+    explicit TempDir(const std::string& prefix) {
+        std::string tmpl = "/tmp/" + prefix + "-XXXXXX";
+        if (mkdtemp(tmpl.data())) path_ = tmpl;
+    }
+    ~TempDir() {
+        std::error_code ec;
+        if (!path_.empty()) std::filesystem::remove_all(path_, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    const std::filesystem::path& path() const { return path_; }
+
+private:
+    std::filesystem::path path_;
+};
 
 inline bool contains(const std::string& haystack, const std::string& needle) {
     return haystack.find(needle) != std::string::npos;
