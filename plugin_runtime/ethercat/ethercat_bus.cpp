@@ -584,7 +584,7 @@ void learn_object(slave_state *st, tvbuff_t *tvb, const sdo_data *sd, guint32 fr
         for (; n < count && n < max_object_entries && at + size <= sd->length; n++, at += size)
             o->value[n] = size == 2 ? dg_tvb_get_uint16(tvb, sd->offset + (gint)at, ENC_LITTLE_ENDIAN)
                                     : dg_tvb_get_uint32(tvb, sd->offset + (gint)at, ENC_LITTLE_ENDIAN);
-        o->count = (guint8)(n == 0 && at == 2 ? MIN(count, max_object_entries) : n);
+        o->count = (guint8)(sd->subindex == 0 && n == 0 ? MIN(count, max_object_entries) : n);
         o->complete = TRUE;
         add_config(st, o, frame);
         return;
