@@ -496,9 +496,10 @@ def coe_mailbox(service, sdo, counter=1):
     return (struct.pack("<HHBB", len(body), 0, 0, 3 | (counter & 7) << 4) + body).ljust(128, b"\0")
 
 
-def sdo_expedited(index, sub, value, size):
-    """An expedited SDO download request of `size` bytes (1, 2 or 4)."""
-    cmd = 0x20 | 0x02 | 0x01 | (4 - size) << 2
+def sdo_expedited(index, sub, value, size, declared=None):
+    """An expedited SDO download request of `size` bytes (1, 2 or 4) whose size bits say
+    `declared` bytes (default: `size`)."""
+    cmd = 0x20 | 0x02 | 0x01 | (4 - (declared or size)) << 2
     return coe_mailbox(2, struct.pack("<BHB", cmd, index, sub) + value.to_bytes(size, "little").ljust(4, b"\0"))
 
 
@@ -806,8 +807,7 @@ def signed_entries_checks(check, dissgen, source_dir):
         # An expedited download of 1 byte (its size bits say so; the next byte holds 0x1A) to
         # a 16-bit subindex: not a PDO index, not taken; the entries written before stay.
         ("a 16-bit subindex written with 1 byte",
-         one_at_a_time[:2] + [(sdo_expedited(0x1C13, 2, 0x1A00, 4)[:8] + bytes([0x2F]) +
-                               sdo_expedited(0x1C13, 2, 0x1A00, 4)[9:], 1), (sdo_expedited(0x1C13, 0, 2, 1), 1)],
+         one_at_a_time[:2] + [(sdo_expedited(0x1C13, 2, 0x1A00, 2, declared=1), 1), (sdo_expedited(0x1C13, 0, 2, 1), 1)],
          noise, {"ecatr.pdo.entry": ["0x6010:01"], "ecatr.pdo.value": [bits_of(noise, 0, 16)]}),
     )
     with TsharkEnv() as env:
