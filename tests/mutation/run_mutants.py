@@ -84,14 +84,12 @@ def with_cmake_plugins(test):
     return command
 
 
-def help_matches_man(src, build):
-    return [sys.executable, os.path.join(src, "tests", "cli", "help_vs_man.py"),
-            "--dissgen", os.path.join(build, "bin", "dissgen"), "--man", os.path.join(src, "packaging", "dissgen.1")]
-
-
-def usage_errors(src, build):
-    return [sys.executable, os.path.join(src, "tests", "cli", "usage_errors.py"),
-            "--dissgen", os.path.join(build, "bin", "dissgen")]
+def cli(script, *extra):
+    """A script of tests/cli/ run on the copy's dissgen; "{src}" in `extra` is the copy."""
+    def command(src, build):
+        return [sys.executable, os.path.join(src, "tests", "cli", script),
+                "--dissgen", os.path.join(build, "bin", "dissgen")] + [e.format(src=src) for e in extra]
+    return command
 
 
 def corpus_differential(src, build):
@@ -107,8 +105,8 @@ def corpus_differential(src, build):
 # one test catches must be able to name that test.
 TESTS = {
     "unit": unit("-Golden*"),
-    "help_matches_man": help_matches_man,
-    "usage_errors": usage_errors,
+    "help_matches_man": cli("help_vs_man.py", "--man", "{src}/packaging/dissgen.1"),
+    "usage_errors": cli("usage_errors.py"),
     "rules_err": unit("Files/RulesErr.*:Files/RulesOk.*:RuleFolders.*"),
     "field_types": unit("FieldType.*:Emit.*:ListFields.*:TypedValues.*:DatesAndGuids.*"),
     "widths": integration("test_widths.py"),
