@@ -206,7 +206,8 @@ class InfoColumn(unittest.TestCase):
 
 class SummaryParts(unittest.TestCase):
     """tests/rules_ok/summary_parts.xml: `{Operation} {Target}{? value {Value}}{? status
-    {Status}{? (code {Code})}} {?more}`, Target summarised as `{Block}.{Register}`."""
+    {Status}{? (code {Code})}} {?more}`, Target summarised as `{Block}.{Register}`; the
+    compiled summaries and the table walk's (DISSGEN_TABLE_WALK=1) give the same texts."""
 
     @classmethod
     def setUpClass(cls):
@@ -233,9 +234,12 @@ class SummaryParts(unittest.TestCase):
         frames.append(ethernet(b"", ethertype=0x88B6)[:14] + struct.pack("!BBHB", 6, 1, 0x0030, 1))
         expected = [text for _, text in messages] + ["read 0x0030.1 6"]
         cap = self.env.add_file("parts.pcap", pcap(frames))
-        for extra in ([], ["-2"]):
-            out = self.env.tshark(["-r", cap, "-T", "fields", "-e", "_ws.col.Info"] + extra).stdout
-            self.assertEqual(out.splitlines(), expected)
+        # the compiled summaries and the runtime's own builder (DISSGEN_TABLE_WALK=1)
+        for walk in ({}, {"DISSGEN_TABLE_WALK": "1"}):
+            for extra in ([], ["-2"]):
+                out = self.env.tshark(["-r", cap, "-T", "fields", "-e", "_ws.col.Info"] + extra,
+                                      extra_env=walk).stdout
+                self.assertEqual(out.splitlines(), expected, "%s %s" % (walk, extra))
         # the tree: each summarised container's item carries its own text
         tree = self.env.tshark(["-r", cap, "-V", "-O", "sump"]).stdout
         self.assertIn("Target: 0x0010.2", tree)

@@ -10,7 +10,9 @@ was not captured is linked to nothing, and the request that follows with the sam
 for its own response. A request sent again with the same key gives up the first one, which is
 reported lost (with -2 on itself, in one pass on the request that proved it), and so is one the
 capture goes on for longer than the timeout after; one the capture ends exactly the timeout after
-is still in flight. Needs no corpus.
+is still in flight. A protocol whose only key is a computed value (its walk reads no byte)
+still tells a message sent again with other bytes from a duplicate by the message's bytes.
+Needs no corpus.
 """
 
 import os
@@ -138,6 +140,52 @@ class TestTransactionsDecimalKey(TestTransactions):
         with open(path, "w", encoding="utf-8") as f:
             f.write(decimal)
         cls.install(path, "txnp")
+
+
+class TestComputedKey(TsharkTestCase, unittest.TestCase):
+    """Keyed by a computed value alone, the walk decodes no byte of the message: whether a
+    message from the same sender soon after is the same again (a duplicate) or a new request
+    is still told by all of its bytes, not by the none the walk read."""
+
+    RULES = """<root name="Transactions Protocol" abbreviation="TXNP" byteorder="big">
+  <hook table="udp.port" value="%d"/>
+  <pairing timeout="1"><key field="node[@name='Channel']"/></pairing>
+  <node name="Channel" value="7" displaytype="numberdec"/>
+</root>
+""" % PORT
+    # (ms, direction, n): n is the payload's last field, so equal n means equal bytes
+    CAPTURE = [(0, "request", 1),   # 1: given up: 2 is a new request with other bytes
+               (1, "request", 2),   # 2
+               (2, "response", 3),  # 3: answers 2
+               (100, "request", 4), # 4
+               (101, "request", 4), # 5: the same bytes again at once: a duplicate of 4
+               (102, "response", 5)]  # 6: answers 4
+
+    @classmethod
+    def prepare(cls):
+        path = cls.env.path("computed_key.xml")
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(cls.RULES)
+        cls.install(path, "txnp")
+
+    def test_other_bytes_are_a_new_request_the_same_bytes_a_duplicate(self):
+        path = self.env.path("computed_key.pcap")
+        out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
+        for ms, direction, n in self.CAPTURE:
+            data = frame(direction, 1, 1, n)
+            out.append(struct.pack("<IIII", 1_700_000_000, ms * 1000, len(data), len(data)) + data)
+        with open(path, "wb") as fh:
+            fh.write(b"".join(out))
+        os.chmod(path, 0o644)
+        with self.checks() as check:
+            for two_pass in (True, False):
+                rows = self.env.field_rows(path, ["frame.number", "txnp.request_in", "txnp.expert.duplicate"],
+                                           two_pass)
+                pairs = {n: int(r["txnp.request_in"][0]) for n, r in rows.items() if r["txnp.request_in"]}
+                duplicates = {n for n, r in rows.items() if r["txnp.expert.duplicate"]}
+                mode = "-2" if two_pass else "one pass"
+                check(pairs == {3: 2, 6: 4}, "%s: responses answer 2 and 4 (%s)" % (mode, pairs))
+                check(duplicates == {5}, "%s: only frame 5 is a duplicate (%s)" % (mode, sorted(duplicates)))
 
 
 if __name__ == "__main__":
