@@ -108,12 +108,16 @@ struct Layout {
     // <finding>s in document order: their rows, and each node's first
     std::vector<std::string> findings;
     std::map<const Node*, int> finding_first;
+    // <learn>s in document order (Learn::index): their rows, their keys' rows, each node's first
+    std::vector<std::string> learns, learn_keys;
+    std::map<const Node*, int> learn_first;
     bool uses_layout_tables() const { return !whens.empty() || !windows.empty(); }
     bool node_uses_layout_columns(const Node& n) const { return when_first.count(&n) || window_index.count(&n) || n.otherwise; }
 };
 
 void layout_conditions_and_windows(Layout& l, const std::map<const Node*, uint64_t>& quiet);
 void layout_findings(Layout& l, const std::string& filter);
+void layout_learns(Layout& l);
 
 std::string ident_for(const Protocol& proto, const Node& n) {
     std::string base = n.filter_name.empty() ? proto.filter + "_" + (n.segment.empty() ? n.name : n.segment)
@@ -172,7 +176,34 @@ Layout make_layout(const Protocol& proto, const std::map<const Node*, uint64_t>&
         l.exprs.insert(l.exprs.end(), rows.begin(), rows.end());
     }
     layout_findings(l, proto.filter);
+    layout_learns(l);
     return l;
+}
+
+// Each <learn>: its value, condition and keys' operations (after the
+// findings'), the sender flag; each key its value and lookup.
+void layout_learns(Layout& l) {
+    auto add = [&](const Expr* e) -> std::string {
+        if (!e) return "0, 0";
+        std::vector<ExprRow> rows = compile_expression(*e, false);
+        const size_t first = l.exprs.size();
+        l.exprs.insert(l.exprs.end(), rows.begin(), rows.end());
+        return std::to_string(first) + ", " + std::to_string(rows.size());
+    };
+    for (const Node* n : l.nodes) {
+        if (n->learns.empty()) continue;
+        l.learn_first[n] = static_cast<int>(l.learns.size());
+        for (const Learn& learn : n->learns) {
+            const size_t key_first = l.learn_keys.size();
+            for (const LearnKey& k : learn.keys)
+                l.learn_keys.push_back("{ " + add(&k.value) + ", " + add(k.lookup ? &*k.lookup : nullptr) + " }");
+            const std::string value = add(&learn.value);
+            const std::string condition = add(learn.condition ? &*learn.condition : nullptr);
+            l.learns.push_back("/* " + learn.name + ", line " + std::to_string(learn.line) + " */ { " + value + ", " +
+                               condition + ", " + std::to_string(key_first) + ", " +
+                               std::to_string(learn.keys.size()) + ", " + (learn.sender ? "TRUE" : "FALSE") + " }");
+        }
+    }
 }
 
 // Each <finding>: its expert field, condition (after every computed value's
@@ -206,6 +237,7 @@ std::string expr_row(const ExprRow& r) {
     }
     if (r.code.rfind("DG_OP_FIELD", 0) == 0 || r.code.rfind("DG_OP_REQUEST_FIELD", 0) == 0)
         row = "dg_op_field(" + r.code + ", " + std::to_string(r.slot) + ", " + std::to_string(r.bits) + ")";
+    if (r.code == "DG_OP_LEARNED") row = "dg_op_learned(" + std::to_string(r.slot) + ")";
     return row;
 }
 
@@ -370,6 +402,7 @@ private:
     void cycles_tables();
     std::string extra_row(const Node& n) const;
     void condition_and_window_tables();
+    void learn_tables();
     void protocol_struct();
     void register_functions();
     void expert_entries();
@@ -488,6 +521,7 @@ void Emitter::tables() {
     }
     o_ << "\n};\n\n";
     condition_and_window_tables();
+    learn_tables();
     if (extra_) o_ << extra_->tables;
 }
 
@@ -524,6 +558,15 @@ void Emitter::condition_and_window_tables() {
     o_ << "/* <finding>s: expert info, condition (first, count in exprs), text (first, count in summary). */\n"
        << "static expert_field " << p_.filter << "_finding_ei[" << l_.findings.size() << "];\n";
     o_ << c_array("static const dg_finding " + p_.filter + "_findings", l_.findings);
+}
+
+void Emitter::learn_tables() {
+    if (l_.learns.empty()) return;
+    o_ << "/* <learn>s: value, if (first, count in exprs; 0, 0: none), keys (first, count), by sender. */\n";
+    o_ << c_array("static const dg_learn " + p_.filter + "_learns", l_.learns);
+    if (l_.learn_keys.empty()) return;
+    o_ << "/* Their keys: value, lookup (first, count in exprs; 0, 0: as the value). */\n";
+    o_ << c_array("static const dg_learn_key " + p_.filter + "_learn_keys", l_.learn_keys);
 }
 
 void Emitter::node_table() {
@@ -722,6 +765,9 @@ std::string Emitter::protocol_row() const {
     if (!l_.exprs.empty()) set.push_back("exprs(" + f + "_exprs)");
     if (p_.no_padding) set.push_back("no_padding()");
     if (!l_.findings.empty()) set.push_back("findings(" + f + "_findings)");
+    if (!l_.learns.empty())
+        set.push_back("learns(" + f + "_learns, " + (l_.learn_keys.empty() ? std::string("NULL") : f + "_learn_keys") +
+                      ", " + std::to_string(l_.learns.size()) + ")");
     if (p_.pairing) set.push_back("pairing(&" + f + "_pairing)");
     if (p_.pairing && !p_.request_fields.empty()) set.push_back("request_context(&" + f + "_request_context)");
     if (p_.cycles) set.push_back("cycles(&" + f + "_cycles)");
@@ -926,7 +972,7 @@ bool needs_extra(const Node& n) {
            (n.is_leaf() && n.display == Display::DateTime && n.datetime_unit() != "s+ns") ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
            n.keeps_values || n.keeps_instances || n.is_computed() || n.has_unit_label() || n.is_overlay() ||
-           !n.findings.empty() || n.analysis_input >= 0 || n.cycle_role != 0;
+           !n.findings.empty() || !n.learns.empty() || n.analysis_input >= 0 || n.cycle_role != 0;
 }
 
 void Emitter::extra_table() {
@@ -970,6 +1016,7 @@ std::string Emitter::extra_row(const Node& n) const {
         add("value", std::to_string(l_.expr_span.at(&n).first) + ", " + std::to_string(l_.expr_span.at(&n).second));
     if (slot(n.covers) >= 0) add("covers", std::to_string(slot(n.covers)));
     if (!n.findings.empty()) add("findings", std::to_string(l_.finding_first.at(&n)) + ", " + std::to_string(n.findings.size()));
+    if (!n.learns.empty()) add("learns", std::to_string(l_.learn_first.at(&n)) + ", " + std::to_string(n.learns.size()));
     if (n.analysis_input >= 0) add("input", std::to_string(n.analysis_input));
     if (n.cycle_role) add("cycle_role", std::to_string(n.cycle_role) + ", " + std::to_string(n.cycle_test));
     return named_row("dg_node_extra()", set);

@@ -150,6 +150,12 @@ private:
             out.op = ExprOp::RequestField;
             return true;
         }
+        if (s_.compare(pos_, 8, "learned{") == 0) {
+            pos_ += 7;  // past "learned": the name is read from its brace
+            if (!operand(out)) return false;
+            out.op = ExprOp::Learned;
+            return true;
+        }
         if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return number(out);
         if (s_.compare(pos_, 5, "index") == 0 &&
             (pos_ + 5 >= s_.size() || !std::isalnum(static_cast<unsigned char>(s_[pos_ + 5])))) {
@@ -284,6 +290,12 @@ void compile_into(const Expr& e, bool as_float, std::vector<ExprRow>& out) {
     case ExprOp::Defined:  // of a value of any type, giving an integer
         compile_into(e.args[0], e.args[0].is_float, out);
         out.push_back({"DG_OP_DEFINED"});
+        if (as_float) out.push_back({"DG_OP_TO_FLOAT"});
+        return;
+    case ExprOp::Learned:  // an integer
+        row.code = "DG_OP_LEARNED";
+        row.slot = e.learn_index;
+        out.push_back(row);
         if (as_float) out.push_back({"DG_OP_TO_FLOAT"});
         return;
     case ExprOp::Field:

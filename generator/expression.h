@@ -9,8 +9,10 @@
 // {Name} (the value of an earlier numeric field), index (the instance number
 // of the innermost repeated node, from 0), request{Name} (the value of a
 // field of the paired request message, in a protocol with <pairing>),
-// defined({Name}) / defined(request{Name}) (1 when that value is defined:
-// the field was decoded, the request was captured; else 0).
+// learned{Name} (the value a <learn> of that name learned in an earlier
+// message under this message's keys), defined({Name}) / defined(request{Name})
+// / defined(learned{Name}) (1 when that value is defined: the field was
+// decoded, the request was captured, a value was learned; else 0).
 // Operators as in C, with C's
 // precedence: unary - ! ~; * / %; + -; << >>; < <= > >=; == !=; &; ^; |;
 // &&; ||; and parentheses.
@@ -27,6 +29,7 @@ struct Node;
 
 enum class ExprOp {
     Int, Float, Field, Index, RequestField,    // operands
+    Learned,                                   // learned{Name}: a <learn>'s value from earlier messages
     Neg, Not, BitNot, Defined,                 // unary; Defined: defined(X), 1 when X is, else 0
     Mul, Div, Mod, Add, Sub, Shl, Shr,         // binary, arithmetic
     Lt, Le, Gt, Ge, Eq, Ne,                    // binary, comparisons (0 or 1)
@@ -37,9 +40,10 @@ struct Expr {
     ExprOp op = ExprOp::Int;
     int64_t integer = 0;            // Int
     double real = 0;                // Float
-    std::string name;               // Field, RequestField: the name between the braces
+    std::string name;               // Field, RequestField, Learned: the name between the braces
     Node* target = nullptr;         // Field, RequestField: resolved by the validator
     int request_index = -1;         // RequestField: its place among the values a request keeps
+    int learn_index = -1;           // Learned: the <learn>'s row (Learn::index)
     std::vector<Expr> args;         // one (unary) or two (binary) operands
     bool is_float = false;          // derived by the validator: evaluated in double
 };
@@ -49,7 +53,8 @@ struct Expr {
 struct ExprRow {
     std::string code;
     unsigned bits = 0;   // DG_OP_FIELD_SIGNED, DG_OP_REQUEST_FIELD_SIGNED
-    int slot = -1;       // DG_OP_FIELD*; DG_OP_REQUEST_FIELD*: the index into the request's kept values
+    int slot = -1;       // DG_OP_FIELD*; DG_OP_REQUEST_FIELD*: the index into the request's kept values;
+                         // DG_OP_LEARNED*: the <learn>'s row
     int64_t integer = 0; // DG_OP_INT
     double real = 0;     // DG_OP_FLOAT
 };

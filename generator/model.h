@@ -101,6 +101,31 @@ struct Finding {
     std::string filter_name;
 };
 
+// <learn name="..." value="EXPR" [if="EXPR"] [sender="yes"]> <key value="EXPR"
+// [lookup="EXPR"]/>... </learn> inside a node: once an instance of the node
+// is decoded (first pass), the value is learned under the keys' values (and
+// the sender's address); learned{NAME} in a later message reads the latest
+// value learned under its own keys (lookup, else value) in an earlier one.
+struct LearnKey {
+    Expr value;
+    std::optional<Expr> lookup;  // how a reader computes the key, when not as the learner does
+    std::string value_text, lookup_text;
+    int line = 0;
+};
+
+struct Learn {
+    std::string name;
+    Expr value;
+    std::string value_text;
+    std::optional<Expr> condition;  // if="EXPR": learned only when it holds
+    std::string condition_text;
+    bool sender = false;            // sender="yes": the source address is a key too
+    std::vector<LearnKey> keys;
+    int line = 0;
+    // derived by the validator
+    int index = -1;                 // its row in the plugin's table of learns
+};
+
 struct Node {
     // --- as written ---
     std::string name;
@@ -178,6 +203,7 @@ struct Node {
     // --- alternatives, multi-field conditions, look-ahead, register maps ---
     std::vector<When> whens;                // <when field|peek="XPATH" in="LIST"/> children, ANDed
     std::vector<Finding> findings;          // <finding> children: expert infos the rules raise
+    std::vector<Learn> learns;              // <learn> children: values later messages read (learned{Name})
     bool otherwise = false;                 // otherwise="true": member of the previous sibling's chain
     bool skip_malformed = false;            // malformed="skip": a malformed spot inside spoils only this container
     std::optional<FieldRef> base;           // base="XPATH [+-* N]": this container is a window
@@ -332,6 +358,8 @@ struct Protocol {
     std::vector<const Node*> request_fields;
     // the first node (document order) whose value reads request{...}
     const Node* first_request_reader = nullptr;
+    // every <learn>, in document order (Learn::index)
+    std::vector<Learn*> learns;
 };
 
 // Calls fn(node) for every node in document order.

@@ -53,6 +53,8 @@ const std::vector<std::string> kHookAttributes = {"table", "value"};
 const std::vector<std::string> kHeuristicAttributes = {"table", "enabled"};
 const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};
 const std::vector<std::string> kFindingAttributes = {"name", "severity", "group", "condition", "text"};
+const std::vector<std::string> kLearnAttributes = {"name", "value", "if", "sender"};
+const std::vector<std::string> kLearnKeyAttributes = {"value", "lookup"};
 const std::vector<std::string> kPairingAttributes = {"timeout", "analysis", "order"};
 const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kInputAttributes = {"name", "field"};
@@ -281,6 +283,8 @@ private:
     bool parse_enum_range(const std::string& text, EnumItem& item);
     void parse_when(xmlNode* el, Node& node, xmlNode* node_el);
     void parse_finding(xmlNode* el, Node& node);
+    void parse_learn(xmlNode* el, Node& node);
+    bool parse_expression_attribute(const std::string& text, int line, const std::string& what, Expr& out);
     void parse_layout_attributes(std::map<std::string, std::string>& attrs, Node& node);
     void parse_pairing(xmlNode* el, Protocol& proto);
     void parse_cycles(xmlNode* el, Protocol& proto);
@@ -714,8 +718,10 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
             parse_when(c, *node, el);
         else if (c->type == XML_ELEMENT_NODE && element_name(c) == "finding")
             parse_finding(c, *node);
+        else if (c->type == XML_ELEMENT_NODE && element_name(c) == "learn")
+            parse_learn(c, *node);
         else
-            unexpected_child(c, "node", {"node", "enum", "when", "finding"});
+            unexpected_child(c, "node", {"node", "enum", "when", "finding", "learn"});
     }
     for (When& w : node->whens) defer(w.ref, el, w.line, w.peek ? "peek" : "field");
     if (node->base) defer(*node->base, el, node->line, "base");
@@ -796,6 +802,68 @@ void Parser::parse_finding(xmlNode* el, Node& node) {
     }
     f.text = attrs["text"];
     node.findings.push_back(std::move(f));
+}
+
+// An expression in an attribute; false (reported) when it does not parse.
+bool Parser::parse_expression_attribute(const std::string& text, int line, const std::string& what, Expr& out) {
+    std::string error;
+    if (parse_expression(text, out, error)) return true;
+    diags_.error(line, "bad " + what + " '" + excerpt(text) + "': " + error);
+    return false;
+}
+
+// <learn name="..." value="EXPR" [if="EXPR"] [sender="yes|no"]> <key value="EXPR"
+// [lookup="EXPR"]/>... </learn>; the validator resolves the names.
+void Parser::parse_learn(xmlNode* el, Node& node) {
+    Learn l;
+    l.line = line_of(el);
+    auto attrs = attributes(el, kLearnAttributes);
+    for (const char* required : {"name", "value"})
+        if (!attrs.count(required)) {
+            diags_.error(l.line, std::string("<learn> needs a '") + required + "' attribute");
+            return;
+        }
+    l.name = attrs["name"];
+    const std::string what = "learn '" + l.name + "'";
+    l.value_text = attrs["value"];
+    bool ok = parse_expression_attribute(l.value_text, l.line, "value of " + what, l.value);
+    if (attrs.count("if")) {
+        l.condition_text = attrs["if"];
+        l.condition.emplace();
+        ok = parse_expression_attribute(l.condition_text, l.line, "if of " + what, *l.condition) && ok;
+    }
+    if (attrs.count("sender")) {
+        const std::string v = trim(attrs["sender"]);
+        if (v == "yes" || v == "no")
+            l.sender = v == "yes";
+        else
+            diags_.error(l.line, "bad sender '" + attrs["sender"] + "' of " + what +
+                                     ": expected yes (the sender's address and port are a key too) or no");
+    }
+    for (xmlNode* c = el->children; c; c = c->next) {
+        if (c->type != XML_ELEMENT_NODE || element_name(c) != "key") {
+            unexpected_child(c, "learn", {"key"});
+            continue;
+        }
+        LearnKey k;
+        k.line = line_of(c);
+        auto key_attrs = attributes(c, kLearnKeyAttributes);
+        for (xmlNode* g = c->children; g; g = g->next) unexpected_child(g, "key", {});
+        if (!key_attrs.count("value")) {
+            diags_.error(k.line, "<key> of " + what + " needs a 'value' attribute: the expression the key is");
+            ok = false;
+            continue;
+        }
+        k.value_text = key_attrs["value"];
+        ok = parse_expression_attribute(k.value_text, k.line, "key of " + what, k.value) && ok;
+        if (key_attrs.count("lookup")) {
+            k.lookup_text = key_attrs["lookup"];
+            k.lookup.emplace();
+            ok = parse_expression_attribute(k.lookup_text, k.line, "lookup of " + what, *k.lookup) && ok;
+        }
+        l.keys.push_back(std::move(k));
+    }
+    if (ok) node.learns.push_back(std::move(l));
 }
 
 // Alternatives and register windows: otherwise="true", base="XPATH [op N]", at="ADDR", stride="N", instances="M".

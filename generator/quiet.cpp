@@ -12,6 +12,7 @@ namespace {
 bool feeds_others(const Node& n, const std::function<bool(const Node&)>& is_key) {
     if (n.slot >= 0 || !n.summary_pieces.empty() || n.dissector || n.reassembles() || is_key(n)) return true;
     if (!n.findings.empty()) return true;  // raises its expert infos
+    if (!n.learns.empty()) return true;    // learns values for later messages
     for (const auto& c : n.children)
         if (feeds_others(*c, is_key)) return true;
     return false;

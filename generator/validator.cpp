@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <functional>
 #include <map>
 #include <optional>
 
@@ -78,6 +79,11 @@ private:
     void check_findings(Node& n);
     void parse_finding_text(Node& n, Finding& f, const ExprSite& at);
     void name_findings();
+    // <learn>s and learned{Name}: values from earlier messages
+    void collect_learns();
+    void check_learns(Node& n);
+    bool check_learned(Node& n, Expr& e, const ExprSite& at);
+    bool check_integer_expr(Node& n, Expr& e, const ExprSite& at, const std::string& what);
     bool check_request_field(Node& n, Expr& e);
     const Node* request_field_target(const Node& n, const std::string& text, const std::string& what);
     bool check_defined(const Node& n, Expr& e);
@@ -126,6 +132,7 @@ private:
 
 void Validator::run() {
     check_root();
+    collect_learns();
     for (auto& n : proto_.nodes) inherit_and_check_node(*n, proto_.byteorder);
     layout_children(proto_.nodes);
     for_each_node(proto_.nodes, [&](Node& n) {
@@ -146,6 +153,7 @@ void Validator::run() {
         if (n.is_computed()) check_computed(n);
         if (n.unit_given) check_unit(n);  // after check_computed, which settles a computed value's display
         if (!n.findings.empty()) check_findings(n);
+        if (!n.learns.empty()) check_learns(n);
     });
     check_pdulength();
     check_validity();
@@ -179,6 +187,13 @@ void Validator::check_table_sizes() {
         over(n, ranges, max_rows, "values in 'in', 'ifhook', 'valid' and <when> lists");
         if (n.is_computed()) operations += compile_expression(*n.value, n.display == Display::Float).size();
         for (const Finding& f : n.findings) operations += compile_expression(f.condition, false).size();
+        for (const Learn& l : n.learns) {
+            operations += compile_expression(l.value, false).size();
+            if (l.condition) operations += compile_expression(*l.condition, false).size();
+            for (const LearnKey& k : l.keys)
+                operations += compile_expression(k.value, false).size() +
+                              (k.lookup ? compile_expression(*k.lookup, false).size() : 0);
+        }
         over(n, operations, max_rows, "operations in computed values");
         if (n.slot >= 0) over(n, static_cast<size_t>(n.slot) + 1, 32767, "fields whose values are read");
     });
@@ -916,6 +931,7 @@ bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
         diags_.error(at.line, "'index'" + in + ": it is not inside a repeated node, so there is no instance to count");
         return false;
     case ExprOp::RequestField: return check_request_field(n, e);
+    case ExprOp::Learned: return check_learned(n, e, at);
     case ExprOp::Defined: return check_defined(n, e);
     case ExprOp::Field: {
         const Node* t = find_before(at.reach, e.name);
@@ -1119,9 +1135,9 @@ bool Validator::check_request_field(Node& n, Expr& e) {
 // expression is undefined exactly when a field in it is: ask about that.
 bool Validator::check_defined(const Node& n, Expr& e) {
     const Expr& x = e.args[0];
-    if (x.op != ExprOp::Field && x.op != ExprOp::RequestField) {
+    if (x.op != ExprOp::Field && x.op != ExprOp::RequestField && x.op != ExprOp::Learned) {
         diags_.error(n.line, "defined(...) in the value of " + quote(n) +
-                                 " asks about one field, {Name} or request{Name}: " +
+                                 " asks about one field, {Name}, request{Name} or learned{Name}: " +
                                  (x.op == ExprOp::Int || x.op == ExprOp::Float || x.op == ExprOp::Index
                                       ? "a number or index is always defined"
                                       : "an expression is undefined exactly when a field it reads is; ask about that "
@@ -1809,6 +1825,111 @@ void Validator::name_findings() {
                                          quote(*owner->second) + at_line(*owner->second) + "; rename one of them");
         }
     });
+}
+
+// --- values learned from earlier messages ------------------------------------
+
+// The most keys a <learn> has (the runtime's DG_MAX_LEARN_KEYS).
+constexpr size_t kMaxLearnKeys = 16;
+
+// Every <learn>, numbered in document order, before any expression reads
+// learned{Name} (a reader may come before its <learn>: it reads earlier
+// messages). Names are what learned{...} says between its braces: each once.
+void Validator::collect_learns() {
+    std::map<std::string, int> seen;
+    for_each_node(proto_.nodes, [&](Node& n) {
+        for (Learn& l : n.learns) {
+            if (l.name.empty() || l.name.find_first_of("{}") != std::string::npos) {
+                diags_.error(l.line, "bad learn name '" + l.name + "': learned{Name} reads it, so it is not empty and "
+                                     "has no brace");
+                continue;
+            }
+            auto [it, inserted] = seen.emplace(l.name, l.line);
+            if (!inserted) {
+                diags_.error(l.line, "duplicate learn name '" + l.name + "' (also line " + std::to_string(it->second) +
+                                         ")");
+                continue;
+            }
+            l.index = static_cast<int>(proto_.learns.size());
+            proto_.learns.push_back(&l);
+        }
+    });
+}
+
+// An expression that must give an integer (a learned value, a key, a
+// condition): checked as any, then its type.
+bool Validator::check_integer_expr(Node& n, Expr& e, const ExprSite& at, const std::string& what) {
+    if (!check_expr(n, e, at)) return false;
+    if (!e.is_float) return true;
+    diags_.error(at.line, what + " is a real number; a learned value, its keys and its condition are integers");
+    return false;
+}
+
+// A <learn> is evaluated once an instance of its node is decoded: its value,
+// condition and keys read the node itself, what is inside it and what comes
+// before it. A key's lookup is how a reader computes the key: it may read any
+// field (a reader that has not decoded it finds nothing). Keys never read
+// learned{...}: looking a value up would need another lookup first.
+void Validator::check_learns(Node& n) {
+    int reach = n.doc_index + 1;
+    for_each_node(n.children, [&](Node& c) { reach = std::max(reach, c.doc_index + 1); });
+    int everywhere = reach;
+    for_each_node(proto_.nodes, [&](Node& c) { everywhere = std::max(everywhere, c.doc_index + 1); });
+    auto reads_learned = [](const Expr& e) {
+        std::function<bool(const Expr&)> any = [&](const Expr& x) {
+            if (x.op == ExprOp::Learned) return true;
+            for (const Expr& a : x.args)
+                if (any(a)) return true;
+            return false;
+        };
+        return any(e);
+    };
+    for (Learn& l : n.learns) {
+        const std::string what = "learn '" + l.name + "'";
+        if (l.keys.size() > kMaxLearnKeys)
+            diags_.error(l.keys[kMaxLearnKeys].line, what + " has more than " + std::to_string(kMaxLearnKeys) +
+                                                         " keys; combine some into one value");
+        check_integer_expr(n, l.value, ExprSite{reach, l.line, " in the value of " + what}, "the value of " + what);
+        if (l.condition)
+            check_integer_expr(n, *l.condition, ExprSite{reach, l.line, " in the if of " + what}, "the if of " + what);
+        auto check_key = [&](Expr& e, int line, const std::string& word, int key_reach) {
+            const std::string where = " in the " + word + " of " + what;
+            if (reads_learned(e)) {
+                diags_.error(line, "learned{...}" + where +
+                                       ": a key is computed before anything learned is looked up, so it reads "
+                                       "fields only");
+                return;
+            }
+            check_integer_expr(n, e, ExprSite{key_reach, line, where}, "the " + word + " of " + what);
+        };
+        for (LearnKey& k : l.keys) {
+            check_key(k.value, k.line, "key", reach);
+            if (k.lookup) check_key(*k.lookup, k.line, "lookup", everywhere);
+        }
+    }
+}
+
+// learned{Name}: the value the <learn> Name learned, under the keys this
+// message gives, in an earlier message. Its reader is evaluated on every
+// pass, a computed value too (its slot makes the walk compute it without a
+// tree), so that each pass reads it alike.
+bool Validator::check_learned(Node& n, Expr& e, const ExprSite& at) {
+    const Learn* found = nullptr;
+    std::vector<std::string> names;
+    for (const Learn* l : proto_.learns) {
+        if (l->name == e.name) found = l;
+        names.push_back(l->name);
+    }
+    if (!found) {
+        const std::string near = closest_match(e.name, names);
+        diags_.error(at.line, "learned{" + e.name + "}" + at.in + ": no <learn> has that name" +
+                                 (near.empty() ? "" : " (did you mean learned{" + near + "}?)"));
+        return false;
+    }
+    e.learn_index = found->index;
+    e.is_float = false;
+    if (n.is_computed()) mark_slot(&n);
+    return true;
 }
 
 }  // namespace dissgen

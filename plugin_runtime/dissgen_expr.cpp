@@ -13,17 +13,19 @@ dg_expr_value undefined_value() { return {FALSE, FALSE, 0, 0}; }
 /* Arithmetic on the unsigned bit pattern: wraps instead of overflowing. */
 gint64 wrap(guint64 v) { return (gint64)v; }
 
-dg_expr_value operand(const dg_expr_op *op, dg_slot_reader read, dg_slot_reader read_request, const void *context,
-                      guint32 index) {
+dg_expr_value operand(const dg_expr_op *op, const dg_expr_readers *readers, const void *context, guint32 index) {
     guint64 raw;
     switch (op->code) {
     case DG_OP_INT: return integer_value(op->integer);
     case DG_OP_FLOAT: return real_value(op->real);
     case DG_OP_INDEX: return integer_value(index);
+    case DG_OP_LEARNED:
+        if (!readers->learned || !readers->learned(context, op->slot, &raw)) return undefined_value();
+        return integer_value(wrap(raw));
     default: break;
     }
     const gboolean from_request = op->code >= DG_OP_REQUEST_FIELD;
-    const dg_slot_reader reader = from_request ? read_request : read;
+    const dg_slot_reader reader = from_request ? readers->request : readers->field;
     if (!reader || !reader(context, op->slot, &raw)) return undefined_value();
     const guint8 kind = from_request ? op->code - (DG_OP_REQUEST_FIELD - DG_OP_FIELD) : op->code;
     if (kind == DG_OP_FIELD_FLOAT) {
@@ -112,15 +114,15 @@ dg_expr_value real_binary(guint8 code, dg_expr_value a, dg_expr_value b) {
 
 }  // namespace
 
-dg_expr_value dg_expr_eval(const dg_expr_op *ops, guint count, dg_slot_reader read, dg_slot_reader read_request,
-                           const void *context, guint32 index) {
+dg_expr_value dg_expr_eval(const dg_expr_op *ops, guint count, const dg_expr_readers *readers, const void *context,
+                           guint32 index) {
     dg_expr_value stack[DG_EXPR_STACK];
     guint depth = 0;
     for (guint k = 0; k < count; ++k) {
         const guint8 code = ops[k].code;
         if (code <= DG_OP_INDEX) {
             if (depth == DG_EXPR_STACK) return undefined_value();
-            stack[depth++] = operand(&ops[k], read, read_request, context, index);
+            stack[depth++] = operand(&ops[k], readers, context, index);
         } else if (code <= DG_OP_DEFINED) {
             if (depth < 1) return undefined_value();
             stack[depth - 1] = unary(code, stack[depth - 1]);

@@ -3,8 +3,9 @@
  * dissgen into operations in postfix order, evaluated here on a small stack.
  *
  * Pure: no packet, no tree. The walk hands in how to read a slot's value, how
- * to read a value the paired request kept (request{Name}), and the current
- * instance index (dissgen_walk's computed leaves).
+ * to read a value the paired request kept (request{Name}) and one learned
+ * from earlier messages (learned{Name}), and the current instance index
+ * (dissgen_walk's computed leaves).
  *
  * Integers are 64-bit two's complement and wrap; a shift by 64 or more gives
  * 0 (>> shifts the bit pattern, as for unsigned values). A value is
@@ -27,6 +28,7 @@ enum dg_expr_code {
     /* request{Name}: as the three above, `slot` the index of the value the
      * paired request kept */
     DG_OP_REQUEST_FIELD, DG_OP_REQUEST_FIELD_SIGNED, DG_OP_REQUEST_FIELD_FLOAT,
+    DG_OP_LEARNED,      /* learned{Name}: an integer, `slot` the <learn>'s row */
     DG_OP_INDEX,        /* the instance number of the innermost repeat */
     DG_OP_TO_FLOAT,     /* the integer on top becomes a double */
     /* unary, on integers (F: on doubles) */
@@ -44,7 +46,8 @@ enum dg_expr_code {
 typedef struct dg_expr_op {
     guint8 code;    /* dg_expr_code */
     guint8 bits;    /* DG_OP_*FIELD_SIGNED: the field's width */
-    gint16 slot;    /* DG_OP_FIELD*: where the field's value is kept; DG_OP_REQUEST_FIELD*: its index */
+    gint16 slot;    /* DG_OP_FIELD*: where the field's value is kept; DG_OP_REQUEST_FIELD*: its index;
+                     * DG_OP_LEARNED: the <learn>'s row */
     gint64 integer; /* DG_OP_INT */
     gdouble real;   /* DG_OP_FLOAT */
 } dg_expr_op;
@@ -64,8 +67,13 @@ typedef struct dg_expr_value {
     gdouble real;
 } dg_expr_value;
 
-/* Evaluates ops[0 .. count); the result's is_float tells which member holds
- * it. read_request reads the request's kept values (DG_OP_REQUEST_FIELD*);
- * NULL: they are undefined. */
-dg_expr_value dg_expr_eval(const dg_expr_op *ops, guint count, dg_slot_reader read, dg_slot_reader read_request,
-                           const void *context, guint32 index);
+/* How an expression reads what is not in its operations: the message's
+ * fields, the paired request's kept values (DG_OP_REQUEST_FIELD*) and what
+ * earlier messages taught (DG_OP_LEARNED); a NULL reader: those are undefined. */
+typedef struct dg_expr_readers {
+    dg_slot_reader field, request, learned;
+} dg_expr_readers;
+
+/* Evaluates ops[0 .. count); the result's is_float tells which member holds it. */
+dg_expr_value dg_expr_eval(const dg_expr_op *ops, guint count, const dg_expr_readers *readers, const void *context,
+                           guint32 index);

@@ -92,6 +92,9 @@ struct dg_extra_row {
     constexpr dg_extra_row &findings(guint16 first, guint16 count) {
         e.finding_first = first; e.finding_count = count; return *this;
     }
+    constexpr dg_extra_row &learns(guint16 first, guint16 count) {
+        e.learn_first = first; e.learn_count = count; return *this;
+    }
     constexpr dg_extra_row &input(gint8 number) { e.input = number; return *this; }
     constexpr dg_extra_row &cycle_role(guint8 role, guint8 test) { e.cycle_role = role; e.cycle_test = test; return *this; }
     constexpr dg_extra_row &time_encoding(guint32 v) { e.time_encoding = v; return *this; }
@@ -155,6 +158,9 @@ struct dg_protocol_row {
     constexpr dg_protocol_row &exprs(const dg_expr_op *v) { p.exprs = v; return *this; }
     constexpr dg_protocol_row &request_context(const dg_request_context *v) { p.request_context = v; return *this; }
     constexpr dg_protocol_row &findings(const dg_finding *v) { p.findings = v; return *this; }
+    constexpr dg_protocol_row &learns(const dg_learn *v, const dg_learn_key *keys, guint16 count) {
+        p.learns = v; p.learn_keys = keys; p.learn_count = count; return *this;
+    }
     constexpr dg_protocol_row &top_walk(dg_list_walk fn) { p.top_walk = fn; return *this; }
     constexpr dg_protocol_row &no_padding() { p.no_padding = 1; return *this; }
     constexpr dg_protocol_row &cycles(const dg_cycles *v) { p.cycles = v; return *this; }
@@ -166,6 +172,7 @@ constexpr dg_expr_op dg_op(guint8 code) { return dg_expr_op{code, 0, -1, 0, 0}; 
 constexpr dg_expr_op dg_op_int(gint64 v) { return dg_expr_op{DG_OP_INT, 0, -1, v, 0}; }
 constexpr dg_expr_op dg_op_real(gdouble v) { return dg_expr_op{DG_OP_FLOAT, 0, -1, 0, v}; }
 constexpr dg_expr_op dg_op_field(guint8 code, gint16 slot, guint8 bits) { return dg_expr_op{code, bits, slot, 0, 0}; }
+constexpr dg_expr_op dg_op_learned(gint16 learn) { return dg_expr_op{DG_OP_LEARNED, 0, learn, 0, 0}; }
 
 constexpr dg_protocol_row dg_protocol_of(const char *name, const char *short_name, const char *filter) {
     dg_protocol_row r{};

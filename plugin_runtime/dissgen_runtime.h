@@ -105,6 +105,9 @@ typedef struct dg_extra {
     /* <finding> children: dg_protocol.findings[finding_first ..], checked
      * once each instance of the node is decoded */
     guint16 finding_first = 0, finding_count = 0;
+    /* <learn> children: dg_protocol.learns[learn_first ..], evaluated once
+     * each instance of the node is decoded, on the first pass */
+    guint16 learn_first = 0, learn_count = 0;
     /* <pairing><input>: the number of the pairing analysis' input this leaf
      * is (its value goes to the message's dg_view); -1: none */
     gint8 input = -1;
@@ -124,6 +127,28 @@ typedef struct dg_finding {
     guint16 expr_first, expr_count;
     guint16 text_first, text_count;
 } dg_finding;
+
+/* A <learn>: once an instance of its node is decoded on the first pass, when
+ * its condition (exprs[if_first ..], none when if_count is 0) holds, the
+ * value exprs[value_first ..] is learned under its keys
+ * (dg_protocol.learn_keys[key_first ..]) and, with by_sender, the sender's
+ * address and port (dissgen_learned.cpp). */
+typedef struct dg_learn {
+    guint16 value_first, value_count;
+    guint16 if_first, if_count;
+    guint16 key_first, key_count;
+    gboolean by_sender;
+} dg_learn;
+
+/* The most keys a <learn> has (the generator refuses more). */
+#define DG_MAX_LEARN_KEYS 16
+
+/* A key of a <learn>: its value as the learner computes it, and as a reader
+ * of learned{...} does (lookup; lookup_count 0: as the learner). */
+typedef struct dg_learn_key {
+    guint16 value_first, value_count;
+    guint16 lookup_first, lookup_count;
+} dg_learn_key;
 
 /* The most entries an offset table may have; longer ones are malformed. */
 #define DG_MAX_TABLE 1024
@@ -360,6 +385,11 @@ typedef struct dg_protocol {
     const dg_request_context *request_context = nullptr;
     /* <finding>s, addressed by dg_extra.finding_first/count; NULL when none */
     const dg_finding *findings = nullptr;
+    /* <learn>s, addressed by dg_extra.learn_first/count and by learned{...}
+     * (DG_OP_LEARNED); NULL when none */
+    const dg_learn *learns = nullptr;
+    const dg_learn_key *learn_keys = nullptr;
+    guint16 learn_count = 0;
     dg_list_walk top_walk = nullptr; /* the top-level nodes, compiled (NULL: the table walk) */
     /* padding="none": zero bytes a length leaves over are not padding but
      * P.expert.unused, like any others. Generated code gives it only when set. */

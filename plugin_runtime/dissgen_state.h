@@ -117,6 +117,10 @@ struct dg_state {
 
 /* --- dissgen_walk.cpp ---------------------------------------------------- */
 
+/* How computed values, findings and learns read fields, the request and
+ * what was learned (dissgen_expr.h). */
+extern const dg_expr_readers message_readers;
+
 /* Reports a malformed spot at `offset` (clamped into the packet) and stops decoding. */
 void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format, ...)
     G_GNUC_PRINTF(6, 7);
@@ -189,6 +193,15 @@ void dissect_handoff(dg_state *st, const dg_node *n, proto_tree *tree, gint offs
 
 /* At handoff: the dissectors that dissector= names, the reassembled sources' names. */
 void find_handoff_dissectors(const dg_protocol *p);
+
+/* --- dissgen_learned.cpp ------------------------------------------------- */
+
+/* The evaluator's reader of learned{...} values (dissgen_expr.h). */
+gboolean read_learned(const void *context, gint16 index, guint64 *value);
+/* n's <learn>s, once an instance of it is decoded (first pass). */
+void learn_values(dg_state *st, const dg_node *n);
+/* At registration, for a protocol with <learn>s. */
+void learned_register(const dg_protocol *p);
 
 /* --- dissgen_request.cpp ------------------------------------------------- */
 

@@ -175,7 +175,7 @@ void dissect_computed(dg_state *st, const dg_node *n, proto_tree *tree, gint off
 {
     if (!tree && !value_wanted(st, n)) return;
     const dg_extra *x = n->extra;
-    dg_expr_value v = dg_expr_eval(&st->p->exprs[x->expr_first], x->expr_count, read_slot, read_request, st,
+    dg_expr_value v = dg_expr_eval(&st->p->exprs[x->expr_first], x->expr_count, &message_readers, st,
                                    st->instance);
     if (!v.defined) return;
     guint64 bits = (guint64)v.integer;
@@ -560,7 +560,7 @@ void raise_findings(dg_state *st, const dg_node *n, proto_tree *tree, gint start
     const dg_protocol *p = st->p;
     for (guint i = 0; i < n->extra->finding_count; i++) {
         const dg_finding *f = &p->findings[n->extra->finding_first + i];
-        dg_expr_value v = dg_expr_eval(&p->exprs[f->expr_first], f->expr_count, read_slot, read_request, st,
+        dg_expr_value v = dg_expr_eval(&p->exprs[f->expr_first], f->expr_count, &message_readers, st,
                                        st->instance);
         if (!v.defined || (v.is_float ? v.real == 0.0 : v.integer == 0)) continue;
         char buf[256];
@@ -587,6 +587,7 @@ void dissect_overlay(dg_state *st, const dg_node *n, proto_tree *tree, gboolean 
     gint at = t->offset;
     dissect_container(st, n, tree, &at, t->offset + t->length, in_summary, NULL);
     if (n->extra->finding_count) raise_findings(st, n, tree, t->offset, at);
+    if (n->extra->learn_count) learn_values(st, n);
 }
 
 /* --- lists of siblings --------------------------------------------------- */
@@ -748,6 +749,8 @@ namespace dg_rt {
 
 gboolean table_walk_only = FALSE;
 
+const dg_expr_readers message_readers = {read_slot, read_request, read_learned};
+
 void dissect_node(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary)
 {
     if (n->extra && (n->extra->offsets_slot >= 0 || n->extra->overlay_slot >= 0)) {
@@ -773,6 +776,7 @@ void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
         dissect_container(st, n, tree, offset, end, in_summary, sink);
     /* Only a node decoded whole: one that reported a malformed spot has no value to judge. */
     if (n->extra && n->extra->finding_count && !st->stopped) raise_findings(st, n, tree, start, *offset);
+    if (n->extra && n->extra->learn_count && !st->stopped) learn_values(st, n);
 }
 
 } // namespace dg_rt
@@ -793,6 +797,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     proto_item *root = tree ? proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA) : NULL;
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
     gint offset = 0;
+    st.message = messages - 1;
     if (p->request_context) request_begin(&st, messages - 1);
     walk_list(&st, p->top_walk, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
     show_message_tail(&st, subtree, offset, on_ethertype);

@@ -274,7 +274,7 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
                 rows = self.env.tshark(["-r", cap, "-Y", "pnr.expert.bad_length", "-T", "fields",
                                         "-e", "frame.number"] + two_pass).stdout.split()
                 check(rows == [str(short)], "bad_length %s on frame %d only: %s" % (two_pass, short, rows))
-            clean = self.env.tshark(["-r", self.capture, "-Y", "_ws.expert && !(pnr.finding.provider_stopped || pnr.finding.station_problem || pnr.finding.data_invalid)", "-T", "fields",
+            clean = self.env.tshark(["-r", self.capture, "-Y", "_ws.expert && !(pnr.finding.provider_stopped || pnr.finding.station_problem || pnr.finding.data_invalid || pnr.finding.data_status_changed)", "-T", "fields",
                                      "-e", "frame.number"]).stdout.split()
             check(clean == [], "no expert info but the status findings on the generated captures: %s" % clean[:5])
 
@@ -314,6 +314,45 @@ class ProfinetAgainstWireshark(TsharkTestCase, unittest.TestCase):
                           if got.get(k) != want.get(k)]
                 check(got == want, "%s: findings on %d frames, the bytes say %d; first differences %s"
                       % (two_pass or "one pass", len(got), len(want), differ[:4]))
+
+    def test_data_status_changes_on_the_frame_of_the_change(self):
+        """Three devices (one with two frame IDs, one sharing a frame ID with another) whose
+        DataStatus bytes change now and then: pnr.cyclic.previous_data_status is the byte the same
+        sender last sent with that frame ID, and pnr.finding.data_status_changed fires exactly
+        on the frames whose byte differs from it (never on a stream's first frame), in one
+        pass, with -2 and with -2 and a display filter that keeps every other frame."""
+        rng = random.Random(12)
+        streams = [(1, 0xC001), (1, 0xC002), (2, 0x8003), (3, 0xC001)]
+        status = {s: 0x35 for s in streams}
+        frames, want_previous, want_changed = [], {}, set()
+        for number in range(1, 301):
+            device, frame_id = stream = rng.choice(streams)
+            before = status.get(stream) if any(f[0] == stream for f in frames) else None
+            if rng.random() < 0.15:
+                status[stream] = rng.choice([0x35, 0x25, 0x15, 0x31, 0x34, 0xB5])
+            body = bytes(40) + struct.pack(">HBB", number * 32 & 0xFFFF, status[stream], 0)
+            mac = bytes([0x00, 0x0E, 0xCF, 0, 0, device])
+            frames.append((stream, bytes([0x01, 0x0E, 0xCF, 0, 0, 0]) + mac +
+                           struct.pack(">HH", pngen.ETHERTYPE, frame_id) + body))
+            if before is not None:
+                want_previous[number] = before
+                if before != status[stream]:
+                    want_changed.add(number)
+        cap = self.env.add_file("status_changes.pcap", pngen.pcap([f for _, f in frames]))
+        fields = ["frame.number", "pnr.cyclic.previous_data_status", "pnr.finding.data_status_changed"]
+        with self.checks() as check:
+            check(len(want_changed) > 10, "the capture changes status often (%d)" % len(want_changed))
+            for two_pass, display_filter in ((False, None), (True, None), (True, "frame.number % 2 == 0")):
+                rows = self.env.field_rows(cap, fields, two_pass, display_filter=display_filter)
+                kept = set(rows) if display_filter else set(range(1, len(frames) + 1))
+                previous = {n: int(r["pnr.cyclic.previous_data_status"][0], 16) for n, r in rows.items()
+                            if r["pnr.cyclic.previous_data_status"]}
+                changed = {n for n, r in rows.items() if r["pnr.finding.data_status_changed"]}
+                mode = "%s%s" % ("-2" if two_pass else "one pass", " -Y " + display_filter if display_filter else "")
+                check(previous == {n: v for n, v in want_previous.items() if n in kept},
+                      "%s: each frame's previous DataStatus is its stream's last byte" % mode)
+                check(changed == want_changed & kept, "%s: data_status_changed on %s, the bytes say %s" % (
+                    mode, sorted(changed)[:8], sorted(want_changed & kept)[:8]))
 
     def test_trailer_of_a_frame_cut_by_the_capture_is_not_taken_from_its_data(self):
         """A cyclic frame the capture cut short (its wire length kept) has its trailer past

@@ -318,6 +318,13 @@ def dates_guids_frames():
     return [m.frame(p) for p in payloads * 4]
 
 
+def learned_frames():
+    """tests/rules/learned.xml: test_learned.py's configurations and data of two senders."""
+    import test_learned as m
+    messages = m.scripted() + m.random_messages(random.Random(10), 80)
+    return [m.frame(sender, m.configure(*f) if kind == "configure" else m.data(*f)) for sender, kind, f in messages]
+
+
 def overlays_frames():
     """tests/rules/overlays.xml: test_overlays.py's messages, well-formed and malformed."""
     import test_overlays as m
@@ -397,6 +404,7 @@ CAPTURES = {
     "tests/rules/findings.xml": rule_findings_frames,
     "tests/rules/dates_guids_shared.xml": dates_guids_frames,
     "tests/rules/bit_fields.xml": bit_fields_frames,
+    "tests/rules/learned.xml": learned_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,

@@ -154,6 +154,7 @@ TESTS = {
     "corpus_differential": corpus_differential,
     "transactions": integration("test_transactions.py"),
     "computed": integration("test_computed.py"),
+    "learned": integration("test_learned.py"),
     "rule_findings": integration("test_rule_findings.py"),
     "rule_cycles": integration("test_rule_cycles.py"),
     "overlays": integration("test_overlays.py"),

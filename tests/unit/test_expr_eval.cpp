@@ -20,7 +20,7 @@ guint8 code_of(const std::string& name) {
     static const std::map<std::string, guint8> codes = {
         {"DG_OP_INT", DG_OP_INT}, {"DG_OP_FLOAT", DG_OP_FLOAT}, {"DG_OP_FIELD", DG_OP_FIELD},
         {"DG_OP_FIELD_SIGNED", DG_OP_FIELD_SIGNED}, {"DG_OP_FIELD_FLOAT", DG_OP_FIELD_FLOAT},
-        {"DG_OP_INDEX", DG_OP_INDEX}, {"DG_OP_TO_FLOAT", DG_OP_TO_FLOAT}, {"DG_OP_NEG", DG_OP_NEG},
+        {"DG_OP_INDEX", DG_OP_INDEX}, {"DG_OP_LEARNED", DG_OP_LEARNED}, {"DG_OP_TO_FLOAT", DG_OP_TO_FLOAT}, {"DG_OP_NEG", DG_OP_NEG},
         {"DG_OP_NOT", DG_OP_NOT}, {"DG_OP_BITNOT", DG_OP_BITNOT}, {"DG_OP_FNEG", DG_OP_FNEG},
         {"DG_OP_FNOT", DG_OP_FNOT}, {"DG_OP_DEFINED", DG_OP_DEFINED}, {"DG_OP_MUL", DG_OP_MUL}, {"DG_OP_DIV", DG_OP_DIV}, {"DG_OP_MOD", DG_OP_MOD},
         {"DG_OP_ADD", DG_OP_ADD}, {"DG_OP_SUB", DG_OP_SUB}, {"DG_OP_SHL", DG_OP_SHL}, {"DG_OP_SHR", DG_OP_SHR},
@@ -85,7 +85,8 @@ Evaluated evaluate(const std::string& expr, const Slots& by_name, guint32 index 
         const Node* n = find(*f.proto, names[name]);
         if (n->slot >= 0) slots[static_cast<gint16>(n->slot)] = value;
     }
-    out.v = dg_expr_eval(ops.data(), static_cast<guint>(ops.size()), read_slot, nullptr, &slots, index);
+    const dg_expr_readers readers = {read_slot, nullptr, nullptr};
+    out.v = dg_expr_eval(ops.data(), static_cast<guint>(ops.size()), &readers, &slots, index);
     return out;
 }
 
@@ -185,7 +186,7 @@ TEST(ComputedEval, DefinedAsksWhetherAFieldWasDecoded) {
     EXPECT_EQ(integer("defined({A}) && {A} / 0", {{C, 3}}), 0);  // the left side decides
     EXPECT_DOUBLE_EQ(real("defined({A}) * 0.5"), 0.5);
     // a field only: a number, index or expression is an error, and so is a missing '('
-    EXPECT_NE(evaluate("defined(3)", kFields).error.find("asks about one field, {Name} or request{Name}: a number "
+    EXPECT_NE(evaluate("defined(3)", kFields).error.find("asks about one field, {Name}, request{Name} or learned{Name}: a number "
                                                          "or index is always defined"), std::string::npos);
     EXPECT_NE(evaluate("defined({A} + 1)", kFields).error.find("ask about that field"), std::string::npos);
     EXPECT_NE(evaluate("defined {A}", kFields).error.find("expected '(' after 'defined'"), std::string::npos);
@@ -207,7 +208,8 @@ TEST(ComputedEval, RealsWhenADecimalTakesPart) {
 // field of the request (DG_OP_REQUEST_FIELD*), over a reader that has it or not.
 dg_expr_value request_operand(guint8 code, guint8 bits, const Slots& request) {
     const dg_expr_op op{code, bits, 0, 0, 0.0};
-    return dg_expr_eval(&op, 1, read_slot, read_slot, &request, 0);
+    const dg_expr_readers readers = {read_slot, read_slot, nullptr};
+    return dg_expr_eval(&op, 1, &readers, &request, 0);
 }
 
 TEST(ComputedEval, RequestFieldsSignedLikeTheMessagesOwn) {
@@ -223,6 +225,49 @@ TEST(ComputedEval, RequestFieldTheRequestLacksIsUndefinedNotZero) {
     // The reader has no value (the request's instance lacks the field): undefined, never 0.
     EXPECT_FALSE(request_operand(DG_OP_REQUEST_FIELD_SIGNED, 16, {}).defined);
     EXPECT_FALSE(request_operand(DG_OP_REQUEST_FIELD, 16, {}).defined);
+}
+
+// learned{X}: the runtime op over a reader that knows a value for the <learn>'s row or not.
+TEST(ComputedEval, LearnedValuesReadByTheirRowAndUndefinedWhenNotLearned) {
+    Front f = front_end(rules("  <node name=\"A\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"Scaled\" value=\"{A} * learned{Scale} + learned{Offset}\"/>\n"
+                              "  <node name=\"Known\" value=\"defined(learned{Scale})\"/>\n"
+                              "  <node name=\"Setup\">\n"
+                              "    <node name=\"B\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "    <learn name=\"Offset\" value=\"{B} - 10\"/>\n"
+                              "    <learn name=\"Scale\" value=\"{B}\"/>\n"
+                              "  </node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    auto ops_of = [&](const char* name) {
+        const Node* n = find(*f.proto, name);
+        std::vector<dg_expr_op> ops;
+        for (const ExprRow& r : compile_expression(*n->value, false))
+            ops.push_back({code_of(r.code), static_cast<guint8>(r.bits), static_cast<gint16>(r.slot), r.integer, r.real});
+        return ops;
+    };
+    // the rows by document order: Offset 0, Scale 1; learned values by row, as read_slot reads slots
+    Slots learned = {{0, static_cast<guint64>(-3)}, {1, 7}};
+    Slots fields;
+    fields[static_cast<gint16>(find(*f.proto, "A")->slot)] = 5;
+    struct Context {
+        const Slots* fields;
+        const Slots* learned;
+    } context{&fields, &learned};
+    const dg_expr_readers readers = {
+        [](const void* c, gint16 slot, guint64* v) { return read_slot(static_cast<const Context*>(c)->fields, slot, v); },
+        nullptr,
+        [](const void* c, gint16 row, guint64* v) { return read_slot(static_cast<const Context*>(c)->learned, row, v); }};
+    std::vector<dg_expr_op> scaled = ops_of("Scaled"), known = ops_of("Known");
+    dg_expr_value v = dg_expr_eval(scaled.data(), static_cast<guint>(scaled.size()), &readers, &context, 0);
+    ASSERT_TRUE(v.defined);
+    EXPECT_EQ(v.integer, 5 * 7 - 3);  // a learned value is a signed 64-bit integer
+    EXPECT_EQ(dg_expr_eval(known.data(), static_cast<guint>(known.size()), &readers, &context, 0).integer, 1);
+    learned.erase(1);  // Scale not learned: undefined, and defined() says 0
+    EXPECT_FALSE(dg_expr_eval(scaled.data(), static_cast<guint>(scaled.size()), &readers, &context, 0).defined);
+    EXPECT_EQ(dg_expr_eval(known.data(), static_cast<guint>(known.size()), &readers, &context, 0).integer, 0);
+    const dg_expr_readers without = {readers.field, nullptr, nullptr};  // no reader: undefined
+    learned[1] = 7;
+    EXPECT_FALSE(dg_expr_eval(scaled.data(), static_cast<guint>(scaled.size()), &without, &context, 0).defined);
 }
 
 }  // namespace

@@ -38,6 +38,8 @@ TEST(Golden, TypedValues) { check_golden("tests/rules/typed_values.xml", "dissge
 TEST(Golden, LayoutRules) { check_golden("tests/rules/layout.xml", "dissgen_layout.cpp.golden"); }
 // Summaries naming summarised containers, optional parts {?...}.
 TEST(Golden, SummaryParts) { check_golden("tests/rules_ok/summary_parts.xml", "dissgen_summary_parts.cpp.golden"); }
+// <learn> and learned{Name}: values from earlier frames.
+TEST(Golden, LearnedValues) { check_golden("tests/rules/learned.xml", "dissgen_learned.cpp.golden"); }
 
 TEST(Golden, OutputIsDeterministicAndHasNoPaths) {
     Front f = front_end(read_file(source_path("rules/ethercat.xml")));
