@@ -4,6 +4,7 @@
 // <!-- expect: LINE: error: MESSAGE -->) rejected with that diagnostic.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <regex>
 #include <vector>
 
@@ -74,6 +75,23 @@ void check_examples(const std::string& doc, size_t at_least) {
 TEST(Docs, ManualExamplesBehaveAsDocumented) { check_examples("docs/manual.md", 10); }
 
 TEST(Docs, ReadmeExamplesBehaveAsDocumented) { check_examples("README.md", 1); }
+
+// A merge left unresolved leaves both sides and its markers in the text.
+TEST(Docs, NoMergeConflictMarkers) {
+    std::vector<std::string> docs = {"README.md"};
+    for (const auto& e : std::filesystem::directory_iterator(source_path("docs")))
+        if (e.path().extension() == ".md") docs.push_back("docs/" + e.path().filename().string());
+    ASSERT_GT(docs.size(), 2u);
+    for (const std::string& doc : docs) {
+        std::istringstream in(read_file(source_path(doc)));
+        int number = 0;
+        for (std::string line; std::getline(in, line);) {
+            ++number;
+            const bool marker = line.rfind("<<<<<<< ", 0) == 0 || line.rfind(">>>>>>> ", 0) == 0 || line == "=======";
+            EXPECT_FALSE(marker) << doc << ":" << number << ": a merge conflict marker: " << line;
+        }
+    }
+}
 
 TEST(Docs, ManualBitGroupMasksAreTheOnesItStates) {
     auto examples = examples_in("docs/manual.md");
