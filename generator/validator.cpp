@@ -1744,11 +1744,22 @@ bool validate(Protocol& proto, Diagnostics& diags) {
 
 // --- findings from the rules -------------------------------------------------
 
+namespace {
+
+// What is checked once n is decoded (a finding, a learn) reads n, what is
+// inside it and what comes before it: the doc_index reach past its last node.
+int reach_after(const Node& n) {
+    int reach = n.doc_index + 1;
+    for_each_node(n.children, [&](Node& c) { reach = std::max(reach, c.doc_index + 1); });
+    return reach;
+}
+
+}  // namespace
+
 // A finding is checked once its node is decoded: its condition and text read
 // the node itself, what is inside it and what comes before it.
 void Validator::check_findings(Node& n) {
-    int reach = n.doc_index + 1;
-    for_each_node(n.children, [&](Node& c) { reach = std::max(reach, c.doc_index + 1); });
+    const int reach = reach_after(n);
     for (Finding& f : n.findings) {
         const std::string what = "finding '" + f.name + "'";
         if (severity_constant(f.severity).empty()) {
@@ -1871,8 +1882,7 @@ bool Validator::check_integer_expr(Node& n, Expr& e, const ExprSite& at, const s
 // field (a reader that has not decoded it finds nothing). Keys never read
 // learned{...}: looking a value up would need another lookup first.
 void Validator::check_learns(Node& n) {
-    int reach = n.doc_index + 1;
-    for_each_node(n.children, [&](Node& c) { reach = std::max(reach, c.doc_index + 1); });
+    const int reach = reach_after(n);
     int everywhere = reach;
     for_each_node(proto_.nodes, [&](Node& c) { everywhere = std::max(everywhere, c.doc_index + 1); });
     auto reads_learned = [](const Expr& e) {

@@ -823,6 +823,61 @@ def signed_entries_checks(check, dissgen, source_dir):
                                                  "as the bits say" if got == want else "%s, expected %s" % (got, want)))
 
 
+def twin(product, name):
+    """An ESI device that assigns a 0x1A00 of its own: a neighbour of the EL3104 in the catalogue."""
+    return """      <Device Physics="KK">
+        <Type ProductCode="#x%08x" RevisionNo="#x00100000">%s</Type>
+        <Name LcId="1033">%s</Name>
+        <Sm DefaultSize="16" StartAddress="#x1100" ControlByte="#x20" Enable="1">Inputs</Sm>
+        <TxPdo Fixed="1" Mandatory="1" Sm="0">
+          <Index>#x1a00</Index>
+          <Name>Twin</Name>
+          <Entry><Index>#x6020</Index><SubIndex>1</SubIndex><BitLen>16</BitLen><Name>Twin</Name><DataType>UINT</DataType></Entry>
+        </TxPdo>
+      </Device>
+""" % (product, name, name)
+
+
+def neighbour_checks(check, dissgen, source_dir):
+    """The EL3104 of tests/esi_ok/signed_entries.xml between two devices of its own 0x1A00 in
+    one ESI file: configured over CoE without an assignment (a mapping of 0x1A01 only, which it
+    does not assign), it keeps its own default PDOs, never a neighbour's."""
+    print("\n== default PDOs of a configured slave between two other devices")
+    with open(os.path.join(source_dir, "tests", "esi_ok", "signed_entries.xml"), encoding="utf-8") as f:
+        esi = f.read()
+    device = esi.index("      <Device ")
+    esi = esi[:device] + twin(0x0C1E3051, "EL3103") + esi[device:]
+    end = esi.index("    </Devices>")
+    esi = esi[:end] + twin(0x0C1E3053, "EL3105") + esi[end:]
+    rng = random.Random(4)
+    noise = bytes(rng.randrange(256) for _ in range(24))
+    fields = ["ecatr.pdo.el3104.ai." + f for f in ("status", "value", "small", "wide", "huge")] + \
+        ["ecatr.pdo.entry", "ecatr.pdo.value"]
+    steps = [(sdo_expedited(0x1A01, 0, 0, 1), 1), (sdo_expedited(0x1A01, 1, 0x60100110, 4), 1),
+             (sdo_expedited(0x1A01, 0, 1, 1), 1),
+             (sdo_expedited(0x8000, 1, 7, 2), 0)]   # a write the slave did not take (working counter 0)
+    frames, lrds = coe_frames(steps, noise, noise, identity=SIGNED_IO)
+    with TsharkEnv() as env:
+        path = env.add_file("neighbours.xml", esi.encode())
+        env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"), ["--esi", path])
+        cap = env.add_file("neighbours.pcap", pg.pcap_bytes(frames))
+        for two_pass in (False, True):
+            rows = dict(decode(env, cap, fields, two_pass))
+            got = {f: [int(v, 0) for v in rows[lrds[-1]][f]] for f in fields if rows[lrds[-1]][f]}
+            check(got == signed_inputs(noise), "configured without an assignment, its own defaults only%s: %s" % (
+                " (-2)" if two_pass else "", got))
+
+        # -z ecatr,tree per slave, from the frames written: the slave at position 1 (station
+        # 0x1002) is addressed by every datagram but the LRDs; four of them are mailbox writes,
+        # and one (the refused write) came back with its working counter not raised.
+        addressed = [d for f in frames[0::2] for d in f.datagrams if d.cmd != 10]
+        want = {"Datagrams": len(addressed), "Working counter not raised": 1, "Mailbox datagrams": len(steps)}
+        for two_pass in (False, True):
+            got = slave_stats(env, cap, two_pass)
+            check(got == {1: want}, "per-slave statistics from the frames%s: %s, expected %s" % (
+                " (-2)" if two_pass else "", got, {1: want}))
+
+
 class TestBusModel(TsharkTestCase, unittest.TestCase):
     """cls.env: the plugin with the EK11xx and EL1xxx ESI files, the corpus captures in its HOME."""
 
@@ -908,6 +963,11 @@ class TestBusModel(TsharkTestCase, unittest.TestCase):
         """Part 7 (generated frames), with tests/esi_ok/signed_entries.xml."""
         with self.checks() as check:
             signed_entries_checks(check, ARGS.dissgen, ARGS.source_dir)
+
+    def test_default_pdos_of_a_configured_slave_are_its_own(self):
+        """Part 7 (generated frames), signed_entries.xml's EL3104 between two other devices."""
+        with self.checks() as check:
+            neighbour_checks(check, ARGS.dissgen, ARGS.source_dir)
 
     def test_process_data_as_mapped_over_coe_on_an_el1252(self):
         """Part 7 (generated frames), the EL1252 of the corpus's Beckhoff_EL1xxx.xml."""

@@ -59,6 +59,13 @@ class BusTables(unittest.TestCase):
             "ecatr.pdo.entry": ("FT_STRING", "PDO entry"),
             "ecatr.pdo.value": ("FT_UINT64", "Value"),
         })
+        # Each says in its description where it comes from: PDO, object, data type and width.
+        # (-G fields: F, name, filter, type, protocol, base, bitmask, description)
+        blurbs = {cols[2]: cols[7] for cols in (line.split("\t") for line in self.env.tshark(["-G", "fields"]).stdout.splitlines())
+                  if len(cols) > 7 and cols[0] == "F" and cols[2].startswith("ecatr.pdo.el")}
+        self.assertEqual(blurbs["ecatr.pdo.el1004.channel_1.input"], "Input of PDO 0x1a00, object 0x6000:0x01, BOOL, 1 bit")
+        self.assertEqual(blurbs["ecatr.pdo.el2004.channel_1.setpoint"],
+                         "Output of PDO 0x1600, object 0x7000:0x03, INT, 16 bit")
         # The fields are usable in display filters.
         p = self.env.tshark(["-Y", "ecatr.pdo.el1004.channel_1.input", "-r",
                              self.env.add_file("empty.pcap", bytes.fromhex(

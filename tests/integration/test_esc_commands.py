@@ -201,6 +201,70 @@ class TestEscCommands(TsharkTestCase, unittest.TestCase):
     def prepare(cls):
         cls.install(os.path.join("rules", "ethercat.xml"), "ecatr")
 
+    def test_unprocessed_return_of_an_unmarked_source_is_paired(self):
+        """A simulator that does not mark returned frames: an auto-increment read of a position
+        no slave has comes back from the master's own MAC with its working counter 0 and only its
+        address advanced (by the slaves passed); each is its request come back, paired with it
+        (one pass and -2), whatever follows the address in the frame."""
+        frames, t = [], 1704067200.0
+        for k, passed in enumerate((3, 1, 7)):
+            d = datagram(1, 10 + k, adp=(-20) & 0xFFFF, ado=0x0130, data=bytes(2 + 2 * k), wkc=0)
+            frames += [pg.Frame([d], src_mac=MASTER, ts=t),
+                       pg.Frame([returned(d, wkc=0, advance=passed, data=d.data)], src_mac=MASTER, ts=t + 0.000150)]
+            t += 0.001
+        path = self.env.add_file("unprocessed.pcap", pg.pcap_bytes(frames))
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = self.env.field_rows(path, ["frame.number", "ecatr.request_in"], two_pass)
+                got = {n: int(r["ecatr.request_in"][0]) for n, r in rows.items() if r["ecatr.request_in"]}
+                check(got == {2: 1, 4: 3, 6: 5}, "%s: each return answers its request: %s" % (
+                    "-2" if two_pass else "one pass", got))
+
+    def test_segment_items_lie_over_their_bytes(self):
+        """On a returned APRD (Ethernet header 14 bytes, EtherCAT header 2, the datagram's
+        header 10, 4 bytes of data, the working counter 2): ecatr.esc.slaves_passed over the
+        ADP's 2 bytes, ecatr.esc.wkc_added over the working counter, ecatr.esc.data_changed
+        over the data, in tshark's PDML."""
+        import xml.etree.ElementTree as ET
+        d = datagram(1, 40, adp=0, ado=0x0130)
+        frames = [pg.Frame([d], src_mac=MASTER), pg.Frame([returned(d, advance=3)], src_mac=RETURNED)]
+        path = self.env.add_file("items.pcap", pg.pcap_bytes(frames))
+        packet = ET.fromstring(self.env.tshark(["-r", path, "-T", "pdml"]).stdout).findall("packet")[1]
+        got = {f.get("name"): (int(f.get("pos")), int(f.get("size"))) for f in packet.iter("field")
+               if f.get("name") in ("ecatr.esc.slaves_passed", "ecatr.esc.wkc_added", "ecatr.esc.data_changed")}
+        self.assertEqual(got, {"ecatr.esc.slaves_passed": (18, 2), "ecatr.esc.wkc_added": (30, 2),
+                               "ecatr.esc.data_changed": (26, 4)})
+
+    def test_changed_says_what_came_back_changed(self):
+        """ecatr.expert.changed names exactly what came back other than sent: the command, the
+        index (a return whose index changed, while its frame alone waits), the address, each
+        alone, in one pass and with -2."""
+        fprd = lambda idx: datagram(4, idx, adp=0x1001, ado=0x0130)  # noqa: E731
+        pairs = [(fprd(1), returned(fprd(1)), None)]   # a clean pair first: the capture has shown one
+        d = fprd(2)
+        back = returned(d)
+        back.cmd = 1
+        pairs.append((d, back, "Datagram 1 (FPRD), command FPRD came back as APRD"))
+        d = fprd(3)
+        back = returned(d)
+        back.idx = 0x33
+        pairs.append((d, back, "Datagram 1 (FPRD), index 0x03 came back as 0x33"))
+        d = fprd(4)
+        pairs.append((d, returned(d, ado=0x0140), "Datagram 1 (FPRD), address 0x01301001 came back as 0x01401001"))
+        frames, t = [], 1704067200.0
+        for sent, back, _ in pairs:
+            frames += [pg.Frame([sent], src_mac=MASTER, ts=t), pg.Frame([back], src_mac=RETURNED, ts=t + 0.000150)]
+            t += 0.001
+        path = self.env.add_file("changed.pcap", pg.pcap_bytes(frames))
+        want = {2 * k + 2: [text] for k, (_, _, text) in enumerate(pairs) if text}
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = self.env.field_rows(path, ["frame.number", "ecatr.expert.changed", "_ws.expert.message"],
+                                           two_pass, aggregator="|")
+                got = {n: [m for m in r["_ws.expert.message"] if m.startswith("Datagram 1 (")]
+                       for n, r in rows.items() if r["ecatr.expert.changed"]}
+                check(got == want, "%s: %s" % ("-2" if two_pass else "one pass", got))
+
     def test_every_command_returned_as_the_rules_say(self):
         env = self.env
         with self.checks() as check:

@@ -56,7 +56,8 @@ SMALL = 64   # integer literals up to this value are constants that get +1 and -
 TESTS_BY_FILE = {
     "plugin_runtime/dissgen_values.h": ["unit", "widths", "everything"],
     "plugin_runtime/dissgen_text.h": ["unit", "typed_values", "widths"],
-    "plugin_runtime/dissgen_text.cpp": ["typed_values", "widths", "everything", "computed", "dates_guids_shared_names"],
+    "plugin_runtime/dissgen_text.cpp": ["typed_values", "widths", "everything", "computed", "dates_guids_shared_names",
+                                        "info_column"],
     "plugin_runtime/dissgen_label.h": ["unit", "typed_values", "widths", "everything"],
     "plugin_runtime/dissgen_walk.cpp": ["widths", "everything", "malformed", "layout", "typed_values"],
     "plugin_runtime/dissgen_conditions.cpp": ["unit", "layout", "widths", "everything", "edges_peek"],
@@ -78,7 +79,7 @@ TESTS_BY_FILE = {
     "plugin_runtime/ethercat/ethercat_analysis.cpp": ["esc_commands", "pairing", "ecat_figures"],
     "plugin_runtime/ethercat/ethercat_analysis.h": ["esc_commands", "pairing"],
     "plugin_runtime/ethercat/ethercat_bus.cpp": ["bus_pdo", "bus_wkc", "bus_stats", "bus_identities", "bus_coe",
-                                                 "bus_signed", "bus_slave_line"],
+                                                 "bus_signed", "bus_slave_line", "bus_network"],
     "plugin_runtime/ethercat/ethercat_cycles.cpp": ["cycles", "report"],
     "plugin_runtime/ethercat/": ["bus_pdo", "bus_tables", "bus_wkc"],
     "generator/validator.cpp": ["rules_err", "unit", "widths", "everything"],

@@ -116,6 +116,20 @@ TEST(TypedValues, DirectionIsAConditionAndIsEmitted) {
     EXPECT_TRUE(contains(code, "DG_DIR_RESPONSE"));
 }
 
+// A dissector name is printable ASCII without blanks, quotes or backslashes (it is
+// written into the generated C++ as a string): every character from 0x20 to 0x7e
+// inside a name, accepted exactly when it is one of those.
+TEST(TypedValues, DissectorNameCharacters) {
+    for (int c = 0x20; c <= 0x7e; ++c) {
+        const std::string ch = c == '"' ? "&quot;" : c == '<' ? "&lt;" : c == '&' ? "&amp;" : std::string(1, static_cast<char>(c));
+        Front f = front_end(rules("  <node name=\"frame\" length=\"rest\" dissector=\"eth" + ch + "x\"/>\n"));
+        const bool allowed = c > 0x20 && c != '"' && c != '\\';
+        EXPECT_EQ(f.ok(), allowed) << "character 0x" << std::hex << c << ": " << f.messages();
+        if (!allowed) EXPECT_TRUE(contains(f.messages(), "bad dissector name")) << f.messages();
+    }
+    EXPECT_FALSE(front_end(rules("  <node name=\"frame\" length=\"rest\" dissector=\"eth\u00e9x\"/>\n")).ok());  // not ASCII
+}
+
 TEST(TypedValues, HandOffAndReassemblyTables) {
     Front f = front_end(rules("  <node name=\"id\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
                               "  <node name=\"offset\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
