@@ -587,7 +587,7 @@ void dissect_overlay(dg_state *st, const dg_node *n, proto_tree *tree, gboolean 
     gint at = t->offset;
     dissect_container(st, n, tree, &at, t->offset + t->length, in_summary, NULL);
     if (n->extra->finding_count) raise_findings(st, n, tree, t->offset, at);
-    if (n->extra->learn_count) learn_values(st, n);
+    if (n->extra->learn_count && !st->stopped) learn_values(st, n);
 }
 
 /* --- lists of siblings --------------------------------------------------- */
