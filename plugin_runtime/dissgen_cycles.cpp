@@ -36,6 +36,7 @@
 
 #include "dissgen_compat.h"
 #include "dissgen_periods.h"
+#include "dissgen_values.h"
 
 #include <epan/addr_resolv.h>
 #include <epan/expert.h>
@@ -134,15 +135,6 @@ capture_state *current_capture(void)
     return capture;
 }
 
-/* A hash of 64-bit words (each value, node and port of the signature). */
-guint32 mix(guint32 h, guint64 v)
-{
-    v ^= v >> 33;
-    v *= G_GUINT64_CONSTANT(0xff51afd7ed558ccd);
-    v ^= v >> 33;
-    return (h ^ (guint32)v) * 16777619u;
-}
-
 stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info *pinfo)
 {
     stream probe; /* what the map's hash and equality read, no more */
@@ -156,8 +148,8 @@ stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info 
         probe.port = pinfo->srcport;
     }
     guint32 h = 2166136261u;
-    for (guint i = 0; i < in->count; i++) h = mix(h, in->values[i] ^ ((guint64)in->nodes[i] << 48));
-    h = mix(h, probe.port);
+    for (guint i = 0; i < in->count; i++) h = dg_rt::hash_mix(h, in->values[i] ^ ((guint64)in->nodes[i] << 48));
+    h = dg_rt::hash_mix(h, probe.port);
     if (probe.src.type != AT_NONE) h = add_address_to_hash(h, &probe.src);
     probe.hash = h;
     stream *s = (stream *)wmem_map_lookup(c->streams, &probe);

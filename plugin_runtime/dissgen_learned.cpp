@@ -56,14 +56,6 @@ gboolean entry_equal(gconstpointer a, gconstpointer b)
            addresses_equal(&x->src, &y->src) && memcmp(x->keys, y->keys, x->key_count * sizeof(guint64)) == 0;
 }
 
-guint32 mix(guint32 h, guint64 v)
-{
-    v ^= v >> 33;
-    v *= G_GUINT64_CONSTANT(0xff51afd7ed558ccd);
-    v ^= v >> 33;
-    return (h ^ (guint32)v) * 16777619u;
-}
-
 dg_expr_value evaluate(const dg_state *st, guint16 first, guint16 count)
 {
     return dg_expr_eval(&st->p->exprs[first], count, &message_readers, st, st->instance);
@@ -86,12 +78,12 @@ gboolean probe_of(const dg_state *st, guint16 index, gboolean lookup, guint64 *k
                                                     : evaluate(st, k->value_first, k->value_count);
         if (!v.defined) return FALSE;
         keys[i] = (guint64)v.integer;
-        h = mix(h, keys[i]);
+        h = hash_mix(h, keys[i]);
     }
     if (l->by_sender) {
         probe->src = st->pinfo->src; /* shallow: copied when the entry is made */
         probe->port = st->pinfo->srcport;
-        h = mix(h, probe->port);
+        h = hash_mix(h, probe->port);
         h = add_address_to_hash(h, &probe->src);
     }
     probe->hash = h;

@@ -111,9 +111,9 @@ const dg_request_values *keep_values(const dg_state *st)
 
 namespace dg_rt {
 
-void request_begin(dg_state *st, guint message)
+void request_begin(dg_state *st)
 {
-    st->message = message;
+    const guint message = st->message;
     const dg_request_values *v;
     if (PINFO_FD_VISITED(st->pinfo)) {
         v = (const dg_request_values *)p_get_proto_data(wmem_file_scope(), st->pinfo, *st->p->proto,

@@ -207,7 +207,7 @@ void learned_register(const dg_protocol *p);
 
 /* Before the walk: the request this message answers, or none (st->request);
  * with keys from the walk, on the first pass, it is looked up later. */
-void request_begin(dg_state *st, guint message);
+void request_begin(dg_state *st);
 /* After the walk, before the pairing (first pass, keys from the walk): a
  * message that read no request value looks its request up now, so that later
  * passes, which may decode more of it, read the same. */

@@ -79,4 +79,15 @@ static inline gboolean is_repeated(const dg_node *n)
            (n->extra && (n->extra->repeat_rest || n->extra->offsets_slot >= 0));
 }
 
+/* Folds a 64-bit word into a 32-bit hash (a stream's signature, a learn's
+ * keys): the word's bits mixed (MurmurHash3's finaliser step), then FNV's
+ * multiply. Start from 2166136261u. */
+static inline guint32 hash_mix(guint32 h, guint64 v)
+{
+    v ^= v >> 33;
+    v *= G_GUINT64_CONSTANT(0xff51afd7ed558ccd);
+    v ^= v >> 33;
+    return (h ^ (guint32)v) * 16777619u;
+}
+
 } // namespace dg_rt

@@ -798,7 +798,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
     gint offset = 0;
     st.message = messages - 1;
-    if (p->request_context) request_begin(&st, messages - 1);
+    if (p->request_context) request_begin(&st);
     walk_list(&st, p->top_walk, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
     show_message_tail(&st, subtree, offset, on_ethertype);
     proto_item_set_len(root, offset);
