@@ -455,10 +455,13 @@ int main(int argc, char** argv) {
     BusInput bus;
     for (size_t i = 1; i < args.size(); ++i) {
         const std::string& a = args[i];
-        if ((a == "-o" || a == "--dir" || a == "--esi" || a == "--network" || a == "--rules" ||
-             a == "--protocol") &&
-            i + 1 < args.size()) {
-            const std::string& v = args[++i];
+        if (a == "-o" || a == "--dir" || a == "--esi" || a == "--network" || a == "--rules" ||
+            a == "--protocol") {
+            if (i + 1 >= args.size()) {
+                std::cerr << "dissgen: " << a << " needs a value\n";
+                return 2;
+            }
+            const std::string& v = args.at(++i);
             if (a == "-o") out_dir = v;
             else if (a == "--rules") rules = v;
             else if (a == "--protocol") protocol = v;

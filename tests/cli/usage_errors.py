@@ -28,6 +28,8 @@ def misuses(rules, out):
         (["check"], "dissgen: check needs a rule file"),
         (["check", rules, rules], "dissgen: one rule file at a time ('%s' is extra)" % rules),
         (["generate", rules], "dissgen: generate needs -o DIR"),
+        (["generate", rules, "-o"], "dissgen: -o needs a value"),
+        (["check", rules, "--network"], "dissgen: --network needs a value"),
         (["install", rules, "--system", "--dir", out], "dissgen: use either --dir or --system"),
         (["check", rules, "--network", "a.xml", "--network", "b.xml"], "dissgen: one --network at a time"),
         (["check", rules, "--rules", rules], "dissgen: --rules is an option of report"),
