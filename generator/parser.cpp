@@ -959,10 +959,9 @@ void Parser::parse_length(const std::string& raw, int line, Node& node, xmlNode*
 // "rest - N": to the end but the last N bytes, which a trailer after the
 // node takes (PROFINET's cycle counter and status bytes end the frame).
 void Parser::parse_rest_minus(const std::string& raw, const std::string& tail, int line, Node& node) {
-    std::string t = trim(tail), digits = t.size() > 1 && t[0] == '-' ? trim(t.substr(1)) : "";
-    bool number = !digits.empty() && digits.size() <= 8 &&
-                  std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); });
-    uint64_t n = number ? std::stoull(digits) : 0;
+    std::string t = trim(tail);
+    uint64_t n = 0;
+    bool number = t.size() > 1 && t[0] == '-' && parse_number(trim(t.substr(1)), n);
     if (!number || n == 0 || n > (1u << 20)) {
         diags_.error(line, "bad length '" + raw + "': after 'rest' only '- N' may follow, N from 1 to 1048576 "
                            "(the bytes left to what follows the node)");

@@ -112,6 +112,25 @@ TEST(Length, AbsentEmptyAndRest) {
     EXPECT_EQ(find(*p.proto, "tail")->length_kind, LengthKind::Rest);
 }
 
+TEST(Length, RestMinusTheBytesOfATrailer) {
+    Parsed p = parse(rules("  <node name=\"a\" length=\"rest - 2\"/>\n"
+                           "  <node name=\"b\" length=\"rest-1048576\"/>\n"
+                           "  <node name=\"c\" length=\"rest - 00000004\"/>\n"
+                           "  <node name=\"d\" length=\"rest - 0x10\"/>\n"));
+    ASSERT_TRUE(p.ok()) << p.messages();
+    EXPECT_EQ(find(*p.proto, "a")->length_kind, LengthKind::Rest);
+    EXPECT_EQ(find(*p.proto, "a")->rest_keep, 2u);
+    EXPECT_EQ(find(*p.proto, "b")->rest_keep, 1048576u);
+    EXPECT_EQ(find(*p.proto, "c")->rest_keep, 4u);
+    EXPECT_EQ(find(*p.proto, "d")->rest_keep, 16u);
+    for (const char* bad : {"rest - 0", "rest - 1048577", "rest - 99999999999999999999999", "rest -", "rest - -1",
+                            "rest + 4", "rest 4", "rest - 4byte"}) {
+        Parsed q = parse(rules(std::string("  <node name=\"x\" length=\"") + bad + "\"/>\n"));
+        EXPECT_FALSE(q.ok()) << bad;
+        EXPECT_TRUE(contains(q.messages(), "N from 1 to 1048576")) << bad << ": " << q.messages();
+    }
+}
+
 TEST(Length, XPathWithoutArithmetic) {
     Parsed p = parse(rules("  <node name=\"Len\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
                            "  <node name=\"Data\" length=\"../node[@name='Len']\"/>\n"));
