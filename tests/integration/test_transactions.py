@@ -63,13 +63,19 @@ def frame(direction, transaction, unit, n):
     return macs + b"\x08\x00" + ip + u
 
 
-def write(path):
+def write_frames(path, frames):
+    """A pcap file of (ms, bytes), readable by the unprivileged tshark."""
     out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
-    for n, (ms, direction, transaction, unit) in enumerate(MESSAGES):
-        data = frame(direction, transaction, unit, n + 1)
+    for ms, data in frames:
         out.append(struct.pack("<IIII", 1_700_000_000, ms * 1000, len(data), len(data)) + data)
     with open(path, "wb") as fh:
         fh.write(b"".join(out))
+    os.chmod(path, 0o644)
+
+
+def write(path, messages=MESSAGES):
+    write_frames(path, [(ms, frame(direction, transaction, unit, n + 1))
+                        for n, (ms, direction, transaction, unit) in enumerate(messages)])
 
 
 def decode(env, path, two_pass):
@@ -89,7 +95,6 @@ class TestTransactions(TsharkTestCase, unittest.TestCase):
     def test_no_response_note_names_the_key_as_its_field_shows_it(self):
         path = self.env.path("notes.pcap")
         write(path)
-        os.chmod(path, 0o644)
         rows = self.env.field_rows(path, ["frame.number", "_ws.expert.message"], False, aggregator="|")
         notes = {n: [m for m in r["_ws.expert.message"] if m.startswith("No response to")] for n, r in rows.items()}
         want = {proof: ["No response to frame %d (Transaction %s), sent %.3f ms before" % (
@@ -101,7 +106,6 @@ class TestTransactions(TsharkTestCase, unittest.TestCase):
         env = self.env
         path = env.path("transactions.pcap")
         write(path)
-        os.chmod(path, 0o644)
         with self.checks() as check:
             for two_pass in (True, False):
                 mode = "-2" if two_pass else "one pass"
@@ -142,6 +146,45 @@ class TestTransactionsDecimalKey(TestTransactions):
         cls.install(path, "txnp")
 
 
+class TestOvertaken(TsharkTestCase, unittest.TestCase):
+    """A request waits for its response while the responses to at most 16 later requests come
+    first (a reordering): the response after 16 answers it; after 17 the request was given up
+    (lost) and the late response answers nothing."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "transactions.xml"), "txnp")
+
+    @staticmethod
+    def overtaken_by(later):
+        """Request 0x100, `later` requests each answered at once, then 0x100's response."""
+        messages = [(0, "request", 0x100, 1)]
+        for k in range(later):
+            messages += [(1 + 2 * k, "request", k + 1, 1), (2 + 2 * k, "response", k + 1, 1)]
+        return messages + [(2 * later + 1, "response", 0x100, 1)]
+
+    def test_sixteen_later_answers_wait_seventeen_give_up(self):
+        with self.checks() as check:
+            for later in (16, 17):
+                messages = self.overtaken_by(later)
+                path = self.env.path("overtaken_%d.pcap" % later)
+                write(path, messages)
+                last = len(messages)
+                for two_pass in (True, False):
+                    rows = decode(self.env, path, two_pass)
+                    mode = "-2" if two_pass else "one pass"
+                    answered = rows[last]["txnp.request_in"]
+                    lost = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
+                    if later == 16:
+                        check(answered == "1" and not lost, "%s: overtaken by 16, frame %d answers frame 1, "
+                              "nothing lost (request_in %r, lost %s)" % (mode, last, answered, sorted(lost)))
+                    else:
+                        proof = last if not two_pass else 1
+                        check(answered == "" and lost == {proof}, "%s: overtaken by 17, frame 1 lost (noted on "
+                              "frame %d), frame %d an orphan (request_in %r, lost %s)" % (
+                                  mode, proof, last, answered, sorted(lost)))
+
+
 class TestComputedKey(TsharkTestCase, unittest.TestCase):
     """Keyed by a computed value alone, the walk decodes no byte of the message: whether a
     message from the same sender soon after is the same again (a duplicate) or a new request
@@ -170,13 +213,7 @@ class TestComputedKey(TsharkTestCase, unittest.TestCase):
 
     def test_other_bytes_are_a_new_request_the_same_bytes_a_duplicate(self):
         path = self.env.path("computed_key.pcap")
-        out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
-        for ms, direction, n in self.CAPTURE:
-            data = frame(direction, 1, 1, n)
-            out.append(struct.pack("<IIII", 1_700_000_000, ms * 1000, len(data), len(data)) + data)
-        with open(path, "wb") as fh:
-            fh.write(b"".join(out))
-        os.chmod(path, 0o644)
+        write_frames(path, [(ms, frame(direction, 1, 1, n)) for ms, direction, n in self.CAPTURE])
         with self.checks() as check:
             for two_pass in (True, False):
                 rows = self.env.field_rows(path, ["frame.number", "txnp.request_in", "txnp.expert.duplicate"],
