@@ -188,6 +188,23 @@ gint register_at(const datagram *d, guint32 reg, guint32 n)
     return data_offset(d) + (gint)(reg - d->ado);
 }
 
+/* The bytes of the 16-bit register at `reg` that a datagram covers, put into
+ * `value`: a slave controller takes each byte written, and a master may write
+ * (or read) one of the two alone. `shift` moves from the sent datagram's data
+ * to the bytes read (the returned frame's). FALSE when it covers neither. */
+gboolean take_register16(const datagram *s, tvbuff_t *tvb, gint shift, guint32 reg, guint16 *value)
+{
+    gboolean any = FALSE;
+    for (guint32 k = 0; k < 2; k++) {
+        gint at = register_at(s, reg + k, 1);
+        if (at < 0) continue;
+        guint byte = dg_tvb_get_uint8(tvb, at + shift);
+        *value = (guint16)((*value & ~(0xffu << (8 * k))) | byte << (8 * k));
+        any = TRUE;
+    }
+    return any;
+}
+
 slave_state *slave_at(bus_model *m, guint32 position)
 {
     if (position >= max_positions) return NULL;
@@ -635,17 +652,17 @@ guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagr
     if (!st) return 0;
     guint8 flags = is_mailbox(st, s) ? ST_MAILBOX : 0;
     if (b->wkc <= s->wkc) return flags | ST_WKC_ERROR;
-    gint at;
-    if (writes_registers(s->cmd) && is_auto_increment(s->cmd) && (at = register_at(s, 0x0010, 2)) >= 0) {
-        st->station = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
+    guint16 was = st->station;
+    if (writes_registers(s->cmd) && is_auto_increment(s->cmd) && take_register16(s, sent, 0, 0x0010, &st->station)) {
+        /* a station given anew: the old address no longer reaches this slave */
+        if (st->station_known && was != st->station && station_position(m, was) == (gint32)position)
+            wmem_map_remove(m->stations, GUINT_TO_POINTER((guint)was));
         st->station_known = TRUE;
         wmem_map_insert(m->stations, GUINT_TO_POINTER((guint)st->station), GUINT_TO_POINTER(position + 1));
     }
-    if ((at = register_at(s, 0x0012, 2)) >= 0) {
-        if (writes_registers(s->cmd)) st->alias = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
-        else st->alias = dg_tvb_get_uint16(back, b->offset + (at - s->offset), ENC_LITTLE_ENDIAN);
-        st->alias_known = TRUE;
-    }
+    gboolean alias_taken = writes_registers(s->cmd) ? take_register16(s, sent, 0, 0x0012, &st->alias)
+                                                    : take_register16(s, back, b->offset - s->offset, 0x0012, &st->alias);
+    if (alias_taken) st->alias_known = TRUE;
     if (writes_registers(s->cmd) && s->cmd != APRW && s->cmd != FPRW) {
         learn_sii_address(st, s, sent);
         learn_fmmus(m, st, s, sent);

@@ -878,6 +878,38 @@ def neighbour_checks(check, dissgen, source_dir):
                 " (-2)" if two_pass else "", got, {1: want}))
 
 
+def station_byte_checks(check, dissgen, source_dir):
+    """A slave controller takes each byte written to a register: a master that sets the station
+    address (0x0010) or reads the alias (0x0012) one byte at a time gives the slave the whole
+    value, and a later write of one byte changes that byte only."""
+    print("\n== station address and alias a byte at a time")
+    steps = [(pg.Datagram(2, adp=0, ado=0x0010, data=b"\x05"), None),           # position 0: low byte
+             (pg.Datagram(2, adp=0, ado=0x0011, data=b"\x10"), None),           # high byte: 0x1005
+             (pg.Datagram(2, adp=0xFFFF, ado=0x0010, data=b"\x01\x20"), None),   # position 1: 0x2001
+             (pg.Datagram(2, adp=0xFFFF, ado=0x0010, data=b"\x07"), None),       # its low byte: 0x2007
+             (pg.Datagram(4, adp=0x1005, ado=0x0012, data=bytes(1)), b"\x34"),   # alias read, low byte
+             (pg.Datagram(4, adp=0x1005, ado=0x0013, data=bytes(1)), b"\x12"),   # high byte: 0x1234
+             (pg.Datagram(4, adp=0x1005, ado=0x0130, data=bytes(2)), None),
+             (pg.Datagram(4, adp=0x2007, ado=0x0130, data=bytes(2)), None),
+             (pg.Datagram(4, adp=0x2001, ado=0x0130, data=bytes(2)), None)]
+    frames = []
+    for i, (d, data) in enumerate(steps):
+        d.idx = i
+        back = pg.Datagram(d.cmd, idx=i, adp=d.adp, ado=d.ado, data=data or d.data, wkc=1)
+        frames += [pg.Frame([d], src_mac=b"\x00\x00\x00\x00\x00\x01"),
+                   pg.Frame([back], src_mac=b"\x02\x00\x00\x00\x00\x01")]
+    with TsharkEnv() as env:
+        env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"))
+        cap = env.add_file("station_bytes.pcap", pg.pcap_bytes(frames))
+        fields = ["ecatr.slave.position", "ecatr.slave.station", "ecatr.slave.alias"]
+        for two_pass in (False, True):
+            rows = dict(decode(env, cap, fields, two_pass))
+            got = {n: tuple(rows[n][f] for f in fields) for n in (14, 16, 18)}
+            want = {14: (["0"], ["0x1005"], ["0x1234"]), 16: (["1"], ["0x2007"], []), 18: ([], [], [])}
+            check(got == want, "FPRDs to 0x1005, 0x2007 and 0x2001 (no longer a station)%s: %s, expected %s" % (
+                " (-2)" if two_pass else "", got, want))
+
+
 class TestBusModel(TsharkTestCase, unittest.TestCase):
     """cls.env: the plugin with the EK11xx and EL1xxx ESI files, the corpus captures in its HOME."""
 
@@ -968,6 +1000,11 @@ class TestBusModel(TsharkTestCase, unittest.TestCase):
         """Part 7 (generated frames), signed_entries.xml's EL3104 between two other devices."""
         with self.checks() as check:
             neighbour_checks(check, ARGS.dissgen, ARGS.source_dir)
+
+    def test_station_address_and_alias_a_byte_at_a_time(self):
+        """Generated frames, no ESI."""
+        with self.checks() as check:
+            station_byte_checks(check, ARGS.dissgen, ARGS.source_dir)
 
     def test_process_data_as_mapped_over_coe_on_an_el1252(self):
         """Part 7 (generated frames), the EL1252 of the corpus's Beckhoff_EL1xxx.xml."""

@@ -133,6 +133,8 @@ TESTS = {
     "bus_eni": integration("test_bus_model.py", "TestBusModel.test_eni_cyclic_commands_expected_wkc"),
     "bus_slave_line": integration("test_bus_model.py", "TestBusModel.test_one_line_per_slave_details_filterable"),
     "bus_pdo": integration("test_bus_model.py", "TestBusModel.test_process_data_by_name"),
+    "bus_station_bytes": integration("test_bus_model.py",
+                                     "TestBusModel.test_station_address_and_alias_a_byte_at_a_time"),
     "bus_coe": integration("test_bus_model.py", "-k", "test_process_data_as_mapped_over_coe_"),
     "bus_signed": integration("test_bus_model.py", "TestBusModel.test_signed_entries_and_a_count_alone",
                               "TestBusModel.test_default_pdos_of_a_configured_slave_are_its_own"),

@@ -79,7 +79,7 @@ TESTS_BY_FILE = {
     "plugin_runtime/ethercat/ethercat_analysis.cpp": ["esc_commands", "pairing", "ecat_figures"],
     "plugin_runtime/ethercat/ethercat_analysis.h": ["esc_commands", "pairing"],
     "plugin_runtime/ethercat/ethercat_bus.cpp": ["bus_pdo", "bus_wkc", "bus_stats", "bus_identities", "bus_coe",
-                                                 "bus_signed", "bus_slave_line", "bus_network"],
+                                                 "bus_signed", "bus_slave_line", "bus_network", "bus_station_bytes"],
     "plugin_runtime/ethercat/ethercat_cycles.cpp": ["cycles", "report"],
     "plugin_runtime/ethercat/": ["bus_pdo", "bus_tables", "bus_wkc"],
     "generator/validator.cpp": ["rules_err", "unit", "widths", "everything"],
