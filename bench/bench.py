@@ -41,7 +41,7 @@ itself. In one run it
 
 CPU time is user+sys of the tshark process (os.wait4), peak memory its ru_maxrss.
 As root, tshark runs as uid 65534 (Wireshark ignores per-user plugins for root), see
-tests/integration/tshark_env.py. Other load on the machine shows up as spread between
+tests/integration/lib/tshark_env.py. Other load on the machine shows up as spread between
 runs: compare medians, and prefer more --runs on a busy machine. "net" ratios subtract the
 floor; they are left out ("-") when the reference is within 2% of the floor.
 Defaults take about 6 minutes (10 with --instructions 3000) on 2 cores.
@@ -62,7 +62,8 @@ import time
 sys.dont_write_bytecode = True  # no __pycache__ in bench/ or tests/integration/
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-sys.path.insert(0, os.path.join(ROOT, "tests", "integration"))
+sys.path.insert(0, os.path.join(ROOT, "tests", "integration", "lib"))
+import testpaths  # noqa: E402,F401  (the integration tests' folders: their captures)
 
 import pcapgen  # noqa: E402
 from tshark_env import TsharkEnv, TsharkError  # noqa: E402

@@ -5,7 +5,7 @@ counted by valgrind (callgrind), as bench/profinet_cost.py counts PROFINET's.
 
     python3 bench/powerlink_cost.py [--dissgen build/bin/dissgen] [--frames 2000]
 
-Generates --frames POWERLINK frames (tests/integration/eplgen.py: every message type and
+Generates --frames POWERLINK frames (tests/integration/lib/eplgen.py: every message type and
 ASnd service), installs the plugin into a temporary HOME and counts one tshark run per
 cell: summary lines (`-r`) and packet details (`-V`), each with
     ours       eplr (the default for ethertype 0x88AB once installed)
@@ -18,7 +18,8 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-sys.path.insert(0, os.path.join(HERE, "..", "tests", "integration"))
+sys.path.insert(0, os.path.join(HERE, "..", "tests", "integration", "lib"))
+import testpaths  # noqa: E402,F401  (the integration tests' folders: their captures)
 import eplgen  # noqa: E402
 from profinet_cost import main_for  # noqa: E402
 

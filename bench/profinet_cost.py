@@ -5,7 +5,7 @@ instructions counted by valgrind (callgrind): immune to the other load of a shar
 
     python3 bench/profinet_cost.py [--dissgen build/bin/dissgen] [--frames 2000]
 
-Generates --frames PROFINET frames (tests/integration/pngen.py: DCP of every service,
+Generates --frames PROFINET frames (tests/integration/lib/pngen.py: DCP of every service,
 cyclic RT frames, alarms, PTCP), installs the plugin into a temporary HOME and counts one tshark
 run per cell: summary lines (`-r`) and packet details (`-V`), each with
     ours       pnr (the default for ethertype 0x8892 once installed)
@@ -22,7 +22,8 @@ import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "tests", "integration"))
+sys.path.insert(0, os.path.join(HERE, "..", "tests", "integration", "lib"))
+import testpaths  # noqa: E402,F401  (the integration tests' folders: their captures)
 import pngen  # noqa: E402
 from tshark_env import TsharkEnv  # noqa: E402
 

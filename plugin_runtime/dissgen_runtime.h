@@ -400,7 +400,7 @@ typedef struct dg_protocol {
 } dg_protocol;
 
 /* The entry points generated code calls. C linkage: plain symbol
- * names in every plugin (tests/integration/test_plugin_contents.py reads
+ * names in every plugin (tests/integration/plugin/test_plugin_contents.py reads
  * them), whatever the compiler's name mangling. */
 extern "C" {
 

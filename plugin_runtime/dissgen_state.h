@@ -136,7 +136,7 @@ void dissect_node(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset
 
 /* DISSGEN_TABLE_WALK set when the plugin registered: containers walk their
  * children and build their summaries from the tables even when the generator
- * compiled them (to compare the two; tests/integration/test_compiled_walk.py). */
+ * compiled them (to compare the two; tests/integration/language/test_compiled_walk.py). */
 extern gboolean table_walk_only;
 
 /* P.padding (dissgen_names.h): registered with the protocol, added by containers. */

@@ -21,7 +21,8 @@ import struct
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "integration"))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "integration", "lib"))
+import testpaths  # noqa: E402,F401  (the integration tests' folders: their captures)
 from tshark_env import TsharkEnv  # noqa: E402
 
 TIMEOUT = 120

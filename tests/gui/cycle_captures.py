@@ -18,7 +18,8 @@ import random
 import sys
 
 here = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(here, "..", "integration"))
+sys.path.insert(0, os.path.join(here, "..", "integration", "lib"))
+import testpaths  # noqa: E402,F401  (the integration tests' folders: their captures)
 import cyclemodel  # noqa: E402
 import eplgen  # noqa: E402
 import pngen  # noqa: E402

@@ -55,9 +55,15 @@ TIMEOUT_FACTOR = 3   # ... unless the test's unmutated run took more than a thir
 BASELINE_TIMEOUT = 3600   # the unmutated run is the yardstick: it gets all the time it needs
 
 
+def integration_script(src, script):
+    """tests/integration/AREA/SCRIPT: the scripts live by what they test (language/, ethercat/, ...)."""
+    found = glob.glob(os.path.join(src, "tests", "integration", "*", script))
+    return found[0] if len(found) == 1 else os.path.join(src, "tests", "integration", script)
+
+
 def integration(script, *extra):
     def command(src, build):
-        return [sys.executable, os.path.join(src, "tests", "integration", script),
+        return [sys.executable, integration_script(src, script),
                 "--dissgen", os.path.join(build, "bin", "dissgen"), "--source-dir", src] + list(extra)
     return command
 
@@ -192,7 +198,7 @@ def check_coverage(source_dir):
     commands = [c("SRC", "BUILD") for c in TESTS.values()]
     folder = os.path.join(source_dir, "tests", "integration")
     missing = []
-    for path in sorted(glob.glob(os.path.join(folder, "test_*.py"))) + [os.path.join(folder, "ecat_differential.py")]:
+    for path in sorted(glob.glob(os.path.join(folder, "*", "test_*.py"))) + [integration_script(source_dir, "ecat_differential.py")]:
         script = os.path.basename(path)
         runs = [c[c.index(x) + 1:] for c in commands for x in c if x.endswith("/" + script)]
         if not runs:
@@ -479,7 +485,7 @@ def needs_corpus(test, source_dir):
     command = TESTS[test]("SRC", "BUILD")
     for arg in command:
         if arg.startswith("SRC/tests/integration/"):
-            path = os.path.join(source_dir, arg[len("SRC/"):])
+            path = integration_script(source_dir, os.path.basename(arg))
             return "corpus" in open(path, encoding="utf-8").read()
         if arg.startswith("--gtest_filter="):
             positive = arg[len("--gtest_filter="):].split("-")[0]

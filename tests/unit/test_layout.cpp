@@ -1,7 +1,7 @@
 // <when> conditions, peek look-ahead, otherwise chains and
 // register windows, through the parser, the validator and the emitter.
 // (Misuses: one file each in tests/rules_err; behaviour with tshark:
-// tests/integration/test_layout.py.)
+// tests/integration/language/test_layout.py.)
 #include <gtest/gtest.h>
 
 #include "emit_cpp.h"

@@ -1,7 +1,7 @@
 // Offset tables (offsets="XPATH" from="XPATH"): instances of a node
 // placed by the values of an earlier repeated leaf, through the parser, the
 // validator and the emitter. (Misuses: tests/rules_err/offsets_*.xml and
-// from_*.xml; behaviour with tshark: tests/integration/test_enip.py.)
+// from_*.xml; behaviour with tshark: tests/integration/protocols/test_enip.py.)
 #include <gtest/gtest.h>
 
 #include "emit_cpp.h"

@@ -1,7 +1,7 @@
 // Overlays (overlay="XPATH"): a container decoding the bytes of an earlier
 // node, through the parser, the validator, the emitter and the quiet walk.
 // (Misuses: tests/rules_err/overlay_*.xml; behaviour with tshark:
-// tests/integration/test_overlays.py.)
+// tests/integration/language/test_overlays.py.)
 #include <gtest/gtest.h>
 
 #include "emit_cpp.h"

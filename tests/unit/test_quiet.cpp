@@ -1,6 +1,6 @@
 // Which nodes a walk with no tree and no tap steps over, and how
 // many bytes it steps (generator/quiet.cpp). Behaviour with tshark: summary
-// lines against the bytes in tests/integration/test_info_column.py and
+// lines against the bytes in tests/integration/language/test_info_column.py and
 // test_quiet.py.
 #include <gtest/gtest.h>
 

@@ -1,0 +1,176 @@
+#!/usr/bin/env python3
+"""Absolute dates and times, GUIDs and filter names shared by alternatives, with real
+tshark: tests/rules/dates_guids_shared.xml.
+
+UDP messages to port 47490 carry, by their first byte: every datetime encoding (seconds
+and nanoseconds in both byte orders, 64-bit counts of ns, us and ms, 32-bit seconds) and
+a GUID in both byte orders (1); or one of three alternative layouts (2, 3, 4-9) whose
+Option (and When) fields share one filter name. Every value is checked against the
+bytes this script wrote, as tshark prints it and through display filters, in one pass
+and with -2; cut messages give our expert info, never an exception.
+
+    test_dates_guids_shared_names.py --dissgen build/bin/dissgen --source-dir .
+"""
+import datetime
+import os
+import struct
+import sys
+import unittest
+import uuid
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
+from tshark_env import SANITIZE, TsharkTestCase, run_unittests  # noqa: E402
+from test_enip import pcap, udp  # noqa: E402
+
+RULES = os.path.join("tests", "rules", "dates_guids_shared.xml")
+PORT = 47490
+EPOCH = datetime.datetime(1970, 1, 1, tzinfo=datetime.timezone.utc)
+
+# seconds since 1970 and nanoseconds: 2024-01-01 00:00:00.5, and odd digits to the last place
+NET_TIME = (1704067200, 500000000)
+NET_TIME_BIG = (1718454896, 123456789)
+STAMP_NS = 1700000000 * 10 ** 9 + 987654321      # nanoseconds: none may be lost
+STAMP_US = 1600000000 * 10 ** 6 + 654321
+STAMP_MS = 1500000000 * 10 ** 3 + 321
+BOOT_S = 1234567890
+OBJECT = bytes(range(0x10, 0x20))
+OBJECT_BIG = bytes.fromhex("00112233445566778899aabbccddeeff")
+
+
+def shown(secs, nsecs):
+    """An FT_ABSOLUTE_TIME in UTC as tshark prints it: 'Jan  1, 2024 00:00:00.500000000 UTC'."""
+    t = EPOCH + datetime.timedelta(seconds=secs)
+    return "%s %2d, %d %s.%09d UTC" % (t.strftime("%b"), t.day, t.year, t.strftime("%H:%M:%S"), nsecs)
+
+
+def times_message():
+    return (bytes([1]) + struct.pack("<II", *NET_TIME) + struct.pack(">II", *NET_TIME_BIG)
+            + struct.pack("<Q", STAMP_NS) + struct.pack("<Q", STAMP_US) + struct.pack("<Q", STAMP_MS)
+            + struct.pack("<I", BOOT_S) + OBJECT + OBJECT_BIG)
+
+
+def short_message(option, secs, nsecs):
+    return bytes([2, option]) + struct.pack("<II", secs, nsecs)
+
+
+def long_message(option, ns):
+    return bytes([3, 1, option]) + struct.pack(">Q", ns)
+
+
+def other_message(kind, option):
+    return bytes([kind, option])
+
+
+def frame(payload):
+    return udp(50000, PORT, payload)
+
+
+class DatesGuidsSharedNames(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        cls.install(RULES, "dtgd")
+
+    def capture(self, name, payloads):
+        return self.env.add_file(name, pcap([frame(p) for p in payloads]))
+
+    def rows(self, path, fields, display_filter=None):
+        """The rows of -2, after checking one pass gives the same."""
+        one = self.env.field_rows(path, ["frame.number"] + fields, display_filter=display_filter, aggregator="|")
+        two = self.env.field_rows(path, ["frame.number"] + fields, two_pass=True, display_filter=display_filter,
+                                  aggregator="|")
+        self.assertEqual(one, two, "one pass and -2 differ")
+        return two
+
+    def test_dates_and_guids_match_the_bytes(self):
+        cap = self.capture("times.pcap", [times_message()])
+        fields = ["dtgd.times.net_time", "dtgd.times.net_time_big", "dtgd.times.stamp", "dtgd.times.stamp_us",
+                  "dtgd.times.stamp_ms", "dtgd.times.boot", "dtgd.times.object", "dtgd.times.object_big"]
+        row = self.rows(cap, fields)[1]
+        self.assertEqual(row["dtgd.times.net_time"], [shown(*NET_TIME)])
+        self.assertEqual(row["dtgd.times.net_time_big"], [shown(*NET_TIME_BIG)])
+        self.assertEqual(row["dtgd.times.stamp"], [shown(STAMP_NS // 10 ** 9, STAMP_NS % 10 ** 9)])
+        self.assertEqual(row["dtgd.times.stamp_us"], [shown(STAMP_US // 10 ** 6, STAMP_US % 10 ** 6 * 1000)])
+        self.assertEqual(row["dtgd.times.stamp_ms"], [shown(STAMP_MS // 1000, STAMP_MS % 1000 * 10 ** 6)])
+        self.assertEqual(row["dtgd.times.boot"], [shown(BOOT_S, 0)])
+        # little: Microsoft's mixed-endian form, as Python's bytes_le; big: wire order
+        self.assertEqual(row["dtgd.times.object"], [str(uuid.UUID(bytes_le=OBJECT))])
+        self.assertEqual(row["dtgd.times.object_big"], [str(uuid.UUID(bytes=OBJECT_BIG))])
+        self.assertEqual(row["dtgd.times.object_big"], ["00112233-4455-6677-8899-aabbccddeeff"])
+
+    def test_filters_compare_dates_and_guids(self):
+        later = (NET_TIME[0] + 86400, 0)
+        cap = self.capture("filters.pcap", [times_message(), times_message()[:1] + struct.pack("<II", *later)
+                                            + times_message()[9:]])
+        cases = {
+            'dtgd.times.net_time == "2024-01-01 00:00:00.5Z"': [1],
+            'dtgd.times.net_time == "2024-01-01 00:00:00Z"': [],
+            'dtgd.times.net_time > "2024-01-01 12:00:00Z"': [2],
+            'dtgd.times.stamp == "2023-11-14 22:13:20.987654321Z"': [1, 2],
+            'dtgd.times.stamp == "2023-11-14 22:13:20.987654320Z"': [],
+            "dtgd.times.object_big == 00112233-4455-6677-8899-aabbccddeeff": [1, 2],
+            "dtgd.times.object == %s" % uuid.UUID(bytes_le=OBJECT): [1, 2],
+            "dtgd.times.object == %s" % uuid.UUID(bytes=OBJECT): [],
+        }
+        for flt, frames in cases.items():
+            with self.subTest(filter=flt):
+                self.assertEqual(sorted(self.rows(cap, ["dtgd.kind"], display_filter=flt)), frames)
+
+    def test_summary_and_tree_show_the_values(self):
+        cap = self.capture("tree.pcap", [times_message()])
+        out = self.env.tshark(["-r", cap, "-V", "-O", "dtgd"]).stdout
+        date, guid = shown(*NET_TIME), str(uuid.UUID(bytes_le=OBJECT))
+        self.assertIn("Net time: %s" % date, out)
+        self.assertIn("Object: %s" % guid, out)
+        self.assertIn("Times: %s %s" % (date, guid), out)   # the summary shows what the items show
+
+    def test_alternatives_share_one_field(self):
+        payloads = [short_message(0x11, *NET_TIME), long_message(0x22, STAMP_NS), other_message(4, 0x33),
+                    other_message(9, 0x44), bytes([1])]
+        cap = self.capture("shared.pcap", payloads)
+        rows = self.rows(cap, ["dtgd.option", "dtgd.when", "dtgd.length"])
+        self.assertEqual([rows[i]["dtgd.option"] for i in range(1, 6)], [["0x11"], ["0x22"], ["0x33"], ["0x44"], []])
+        self.assertEqual(rows[1]["dtgd.when"], [shown(*NET_TIME)])
+        self.assertEqual(rows[2]["dtgd.when"], [shown(STAMP_NS // 10 ** 9, STAMP_NS % 10 ** 9)])
+        self.assertEqual(rows[2]["dtgd.length"], ["1"])
+        self.assertEqual(sorted(self.rows(cap, ["dtgd.kind"], display_filter="dtgd.option")), [1, 2, 3, 4])
+        self.assertEqual(sorted(self.rows(cap, ["dtgd.kind"], display_filter="dtgd.option == 0x22")), [2])
+        self.assertEqual(sorted(self.rows(cap, ["dtgd.kind"], display_filter="dtgd.when")), [1, 2])
+        # Wireshark knows one field of each name
+        names = [l.split("\t")[2] for l in self.env.tshark(["-G", "fields"]).stdout.splitlines()
+                 if l.startswith("F\t") and l.count("\t") >= 2]
+        self.assertEqual(names.count("dtgd.option"), 1)
+        self.assertEqual(names.count("dtgd.when"), 1)
+
+    def test_cut_dates_and_guids_give_our_expert_info(self):
+        m = times_message()
+        obj = m.index(OBJECT)
+        cap = self.capture("cut.pcap", [m[:5], m[:obj + 10], short_message(0x11, *NET_TIME)[:7]])
+        rows = self.rows(cap, ["dtgd.times.net_time", "dtgd.times.boot", "dtgd.times.object", "dtgd.when",
+                               "_ws.expert.message"])
+        self.assertEqual(rows[1]["dtgd.times.net_time"], [])
+        self.assertIn("Truncated: 'Net time' needs 8 bytes, only 4 left", rows[1]["_ws.expert.message"])
+        self.assertEqual(rows[2]["dtgd.times.boot"], [shown(BOOT_S, 0)])
+        self.assertEqual(rows[2]["dtgd.times.object"], [])
+        self.assertIn("Truncated: 'Object' needs 16 bytes, only 10 left", rows[2]["_ws.expert.message"])
+        self.assertIn("Truncated: 'When' needs 8 bytes, only 5 left", rows[3]["_ws.expert.message"])
+        out = self.env.tshark(["-r", cap, "-V", "-2"]).stdout
+        self.assertNotIn("Malformed Packet", out)
+        # and the clean messages raise none
+        clean = self.capture("clean.pcap", [times_message(), short_message(1, 2, 3), long_message(4, 5)])
+        rows = self.rows(clean, ["_ws.expert"])
+        self.assertEqual([r["_ws.expert"] for r in rows.values()], [[], [], []])
+
+    def test_every_cut_decodes_without_exception(self):
+        step = 1 if not SANITIZE else 3
+        messages = [times_message(), short_message(1, 2, 3), long_message(4, 5)]
+        cap = self.capture("cuts.pcap", [m[:n] for m in messages for n in range(1, len(m) + 1, step)])
+        p = self.env.tshark(["-r", cap, "-V", "-2"], check=False)
+        self.assertEqual(p.returncode, 0, p.stderr[-2000:])
+        self.assertNotIn("Dissector bug", p.stdout)
+        self.assertNotIn("Malformed Packet", p.stdout)
+
+
+if __name__ == "__main__":
+    ARGS, status = run_unittests()
+    sys.exit(status)

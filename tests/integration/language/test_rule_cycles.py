@@ -1,0 +1,214 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Cycles declared in the rules (<cycles>) with real tshark: EtherNet/IP's class-1 I/O
+as rules/enip.xml declares it (per connection ID and sender, window 1, the 32-bit
+sequence number of the Sequenced Address item).
+
+Every message's enipr.cycle, .period, .jitter, .lost and .duplicate, the expert infos
+(exactly on the frames with a gap or a repeat, nowhere else) and `-z enipr,cycles` are
+checked against a model of the manual's rules ("Cycles of any protocol") computed here
+from the bytes and timestamps of the capture, to the nanosecond, in one pass and with -2,
+and so is the statistics tree of the Statistics menu (`-2 -z enipr.cycles,tree`):
+
+- a generated capture (nanosecond timestamps): several connections at different RPIs with
+  known injected jitter, drops of one and of three packets, a packet sent twice, a
+  sequence number wrapping past 2^32-1, a connection that starts mid-capture, one whose
+  count restarts, and two adapters using the same connection ID;
+- ../shared/corpus/enip/enip_cip_example.pcap (24 I/O connections, 398 packets), when
+  the corpus is there.
+
+    test_rule_cycles.py --dissgen build/bin/dissgen --source-dir .
+"""
+
+import os
+import re
+import random
+import struct
+import sys
+import unittest
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
+from pcapgen import ip_checksum  # noqa: E402
+from cyclemodel import figures, mark_fields, mark_of, model, parse_report, pcap_ns, read_pcap  # noqa: E402
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
+
+ARGS = None
+IO_PORT = 2222
+FIELDS = ["frame.number"] + mark_fields("enipr")
+
+
+# --- captures: writing and reading ----------------------------------------------------
+
+def io_payload(connection, sequence, data=b"\x01\x00\x2a\x00"):
+    items = [(0x8002, struct.pack("<II", connection, sequence)), (0x00B1, data)]
+    return struct.pack("<H", len(items)) + b"".join(struct.pack("<HH", t, len(d)) + d for t, d in items)
+
+
+def udp_frame(payload, src_ip, dst_ip=(10, 0, 0, 100), sport=IO_PORT, dport=IO_PORT):
+    u = struct.pack("!HHHH", sport, dport, 8 + len(payload), 0) + payload
+    ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, bytes(src_ip), bytes(dst_ip))
+    ip = ip[:10] + struct.pack("!H", ip_checksum(ip)) + ip[12:]
+    return b"\x02\0\0\0\0\x64\x02\0\0\0\0" + bytes([src_ip[3]]) + b"\x08\x00" + ip + u
+
+
+def io_messages(packets):
+    """The class-1 I/O messages of Ethernet/IPv4/UDP frames, from their bytes:
+    (frame, time ns, (connection ID, sender address, sender port), sequence number)."""
+    out = []
+    for number, (ts, f) in enumerate(packets, 1):
+        if len(f) < 42 or f[12:14] != b"\x08\x00" or f[23] != 17:
+            continue
+        ihl = (f[14] & 0x0F) * 4
+        udp = 14 + ihl
+        sport, dport = struct.unpack("!HH", f[udp:udp + 4])
+        if IO_PORT not in (sport, dport):
+            continue
+        cpf = udp + 8
+        count = struct.unpack("<H", f[cpf:cpf + 2])[0]
+        pos, connection, sequence = cpf + 2, None, None
+        for _ in range(count):
+            kind, length = struct.unpack("<HH", f[pos:pos + 4])
+            if kind == 0x8002 and length >= 8:
+                connection, sequence = struct.unpack("<II", f[pos + 4:pos + 12])
+            pos += 4 + length
+        if connection is not None:
+            out.append((number, ts, (connection, bytes(f[26:30]), sport), sequence))
+    return out
+
+
+def generated_capture(seed=2222):
+    """(packets, description): the connections below, each packet at its RPI plus a
+    jitter drawn from the seed, merged in time order."""
+    rng = random.Random(seed)
+    ms = 10**6
+    plan = [
+        # connection, sender, RPI, start, packets, jitter (ns, either way), first count, faults
+        (0x00110001, (10, 0, 0, 1), 10 * ms, 0, 70, 300_000, 2**32 - 25,
+         {"drop": {20, 35, 36, 37}, "repeat": {45}}),
+        (0x00220002, (10, 0, 0, 2), 4 * ms, 100 * ms, 120, 100_000, 1000, {"restart": {60}, "drop": {90}}),
+        # the same connection ID from another adapter: another stream
+        (0x00110001, (10, 0, 0, 3), 25 * ms, 3 * ms, 28, 2_000, 7, {}),
+        (0x00330003, (10, 0, 0, 4), 1 * ms, 50 * ms, 300, 20_000, 0, {"repeat": {100, 101}}),
+    ]
+    packets = []
+    for connection, sender, rpi, start, count, jitter, first_count, faults in plan:
+        seq = first_count
+        for i in range(count):
+            if i in faults.get("restart", ()):
+                seq = 0
+            t = start + i * rpi + rng.randint(-jitter, jitter) + 1_000_000_000  # odd nanoseconds
+            if i not in faults.get("drop", ()):
+                frame = udp_frame(io_payload(connection, seq & 0xFFFFFFFF), sender)
+                packets.append((t, frame))
+                if i in faults.get("repeat", ()):
+                    packets.append((t + 40_000 + rng.randint(0, 999), frame))
+            seq += 1
+    packets.sort(key=lambda p: p[0])
+    return packets
+
+
+class TestRuleCycles(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("rules", "enip.xml"), "enipr")
+        cls.generated = cls.env.add_file("io_cycles.pcap", pcap_ns(generated_capture()))
+
+    def run_fields(self, path, two_pass):
+        return self.env.field_rows(path, FIELDS, two_pass=two_pass)
+
+    def assert_marks(self, path, messages, check):
+        marks, cycles = model(messages, window=1, bits=32)
+        for two_pass in (False, True):
+            rows = self.run_fields(path, two_pass)
+            how = "-2" if two_pass else "one pass"
+            for frame, row in sorted(rows.items()):
+                want = marks.get(frame, {})
+                got = mark_of(row, "enipr")
+                if not check(got == want, "%s frame %d: %s, expected %s" % (how, frame, got, want)):
+                    continue
+                # the expert infos sit exactly where the marks say
+                check(bool(row["enipr.expert.cycle_lost"]) == ("lost" in want),
+                      "%s frame %d: cycle_lost expert %s" % (how, frame, row["enipr.expert.cycle_lost"]))
+                check(bool(row["enipr.expert.cycle_duplicate"]) == ("duplicate" in want),
+                      "%s frame %d: cycle_duplicate expert %s" % (how, frame, row["enipr.expert.cycle_duplicate"]))
+        return marks, cycles
+
+    def assert_report(self, path, cycles, check):
+        for two_pass in (False, True):
+            out = self.env.tshark(["-r", path, "-q", "-z", "enipr,cycles"] + (["-2"] if two_pass else [])).stdout
+            got = parse_report(out)
+            check(len(got) == len(cycles), "-z enipr,cycles lists %d cycles, expected %d" % (len(got), len(cycles)))
+            for c, g in zip(cycles, got):
+                connection, address, port = c["stream"]["key"]
+                name = "Connection ID 0x%x, sender %s:%d" % (connection, ".".join(map(str, address)), port)
+                check(g["name"] == name, "cycle %d is %r, expected %r" % (c["number"], g["name"], name))
+                want = figures(c)
+                check(g["figures"] == want, "cycle %d figures %s, expected %s" % (c["number"], g["figures"], want))
+        self.assert_statistics_tree(path, cycles, check)
+
+    def assert_statistics_tree(self, path, cycles, check):
+        """The statistics tree (Statistics menu; tshark -2 -z enipr.cycles,tree) holds the model's
+        figures, row by row (the jitter's standard deviation rounded to the ns)."""
+        out = self.env.tshark(["-2", "-r", path, "-q", "-z", "enipr.cycles,tree"]).stdout
+        have = {}
+        for line in out.splitlines():
+            m = re.match(r"^\s*Cycle (\d+) (\S.*?)\s{2,}(\d+)\s", line)
+            if m:
+                have[(int(m.group(1)), m.group(2))] = int(m.group(3))
+        want = {}
+        for c in cycles:
+            f, n = figures(c), c["number"]
+            want[(n, "messages")] = f["messages"]
+            want[(n, "nominal period (ns)")] = f["nominal"]
+            for name, value in zip(("min", "median", "p99", "max"), f["period"] or ()):
+                want[(n, "period %s (ns)" % name)] = min(value, 2**31 - 1)
+            want[(n, "jitter std dev (ns)")] = int(float(f["jitter sd"]) + 0.5)
+            want[(n, "messages lost")] = f["lost"]
+            want[(n, "duplicates")] = f["duplicates"]
+        differ = sorted(k for k in set(have) | set(want) if k not in have or k not in want or
+                        abs(have[k] - want[k]) > (1 if k[1].startswith("jitter") else 0))  # sd: rounding
+        check(not differ, "-2 -z enipr.cycles,tree: %d rows as the model computes%s" % (
+            len(want), "" if not differ else " (differ: %s)" % [(k, have.get(k), want.get(k)) for k in differ[:5]]))
+
+    def test_generated_capture_to_the_nanosecond(self):
+        messages = io_messages(read_pcap(self.generated))
+        with self.checks() as check:
+            marks, cycles = self.assert_marks(self.generated, messages, check)
+            # the capture holds what the test means to check
+            check(sum(1 for m in marks.values() if m.get("lost") == 1) == 2, "two single drops")
+            check(sum(1 for m in marks.values() if m.get("lost") == 3) == 1, "one drop of three")
+            check(sum(1 for m in marks.values() if "duplicate" in m) == 3, "three repeats")
+            check(len(cycles) == 4, "four streams (the same ID from two senders is two)")
+            self.assert_report(self.generated, cycles, check)
+
+    def test_expert_infos_only_at_faults(self):
+        """A clean capture (no drop, no repeat, a wrap) raises no cycle expert info."""
+        ms = 10**6
+        packets = [(10**9 + i * 2 * ms + (i * 7919) % 50_000, udp_frame(io_payload(0x44, (2**32 - 3 + i) & 0xFFFFFFFF),
+                                                                        (10, 0, 0, 9)))
+                   for i in range(40)]
+        path = self.env.add_file("io_clean.pcap", pcap_ns(packets))
+        with self.checks() as check:
+            for two_pass in ([], ["-2"]):
+                out = self.env.tshark(["-r", path, "-q", "-z", "expert"] + two_pass).stdout
+                check("cycle" not in out.lower() and "lost" not in out.lower(),
+                      "expert infos on a clean capture %s:\n%s" % (two_pass, out))
+            marks, _cycles = self.assert_marks(path, io_messages(read_pcap(path)), check)
+            check(all("lost" not in m and "duplicate" not in m for m in marks.values()), "model: clean")
+
+    def test_corpus_capture(self):
+        path = os.path.abspath(os.path.join(ARGS.source_dir, "..", "shared", "corpus", "enip", "enip_cip_example.pcap"))
+        if not os.path.exists(path):
+            self.skipTest("no ../shared/corpus/enip/enip_cip_example.pcap")
+        messages = io_messages(read_pcap(path))
+        staged = self.env.readable(path)
+        with self.checks() as check:
+            check(len(messages) == 398, "%d I/O packets in the capture" % len(messages))
+            _marks, cycles = self.assert_marks(staged, messages, check)
+            check(len(cycles) == 24, "%d cycles, expected one per connection (24)" % len(cycles))
+            self.assert_report(staged, cycles, check)
+
+
+if __name__ == "__main__":
+    sys.exit(run_unittests()[1])

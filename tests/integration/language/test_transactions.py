@@ -1,0 +1,230 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The generic pairing knows direction: a message to the hooked port is a request, one from it
+a response (tests/rules/transactions.xml, UDP port 47480, keys: transaction and unit).
+
+  test_transactions.py --dissgen build/bin/dissgen --source-dir .
+
+A response never opens a transaction and a request never answers one: a response whose request
+was not captured is linked to nothing, and the request that follows with the same key waits
+for its own response. A request sent again with the same key gives up the first one, which is
+reported lost (with -2 on itself, in one pass on the request that proved it), and so is one the
+capture goes on for longer than the timeout after; one the capture ends exactly the timeout after
+is still in flight. A protocol whose only key is a computed value (its walk reads no byte)
+still tells a message sent again with other bytes from a duplicate by the message's bytes.
+Needs no corpus.
+"""
+
+import os
+import struct
+import sys
+import unittest
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
+import pcapgen  # noqa: E402
+
+ARGS = None
+PORT = 47480
+CLIENT, SERVER = b"\x0a\x00\x00\x01", b"\x0a\x00\x00\x02"
+
+# (ms, direction, transaction, unit): the capture, frame by frame.
+MESSAGES = [
+    (0, "response", 1, 1),    # 1: its request was not captured: an orphan
+    (10, "request", 1, 1),    # 2: a new request, not an answer to 1
+    (11, "response", 1, 1),   # 3: answers 2
+    (20, "request", 2, 1),    # 4: lost: sent again as 5
+    (30, "request", 2, 1),    # 5
+    (31, "response", 2, 1),   # 6: answers 5
+    (50, "request", 4, 1),    # 7
+    (51, "request", 4, 2),    # 8: another unit, another key
+    (52, "response", 4, 2),   # 9: answers 8
+    (53, "response", 4, 1),   # 10: answers 7
+    (60, "response", 5, 1),   # 11: an orphan
+    (70, "response", 5, 1),   # 12: another orphan (a response never answers a response)
+    (80, "request", 5, 1),    # 13
+    (81, "response", 5, 1),   # 14: answers 13
+    (100, "request", 7, 1),   # 15: lost: 17 comes more than the timeout (1 s) after it
+    (101, "request", 6, 1),   # 16: in flight: 17 comes exactly the timeout after it
+    (1101, "response", 8, 1), # 17: an orphan, the capture's last message
+]
+PAIRS = {3: 2, 6: 5, 9: 8, 10: 7, 14: 13}
+LOST = {4: 5, 15: 17}  # lost request: the frame that proves it
+
+
+def frame(direction, transaction, unit, n):
+    payload = struct.pack(">HBBI", transaction, unit, 3, n)
+    sport, dport = (40000, PORT) if direction == "request" else (PORT, 40000)
+    src, dst = (CLIENT, SERVER) if direction == "request" else (SERVER, CLIENT)
+    u = struct.pack("!HHHH", sport, dport, 8 + len(payload), 0) + payload
+    ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src, dst)
+    ip = ip[:10] + struct.pack("!H", pcapgen.ip_checksum(ip)) + ip[12:]
+    macs = b"\x02\x00\x00\x00\x00\x02\x02\x00\x00\x00\x00\x01"
+    return macs + b"\x08\x00" + ip + u
+
+
+def write_frames(path, frames):
+    """A pcap file of (ms, bytes), readable by the unprivileged tshark."""
+    out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
+    for ms, data in frames:
+        out.append(struct.pack("<IIII", 1_700_000_000, ms * 1000, len(data), len(data)) + data)
+    with open(path, "wb") as fh:
+        fh.write(b"".join(out))
+    os.chmod(path, 0o644)
+
+
+def write(path, messages=MESSAGES):
+    write_frames(path, [(ms, frame(direction, transaction, unit, n + 1))
+                        for n, (ms, direction, transaction, unit) in enumerate(messages)])
+
+
+def decode(env, path, two_pass):
+    """{frame number: {field: its values, comma-separated}}."""
+    fields = ["frame.number", "txnp.request_in", "txnp.response_in", "txnp.expert.no_response",
+              "txnp.no_response_to", "txnp.time"]
+    return {n: {f: ",".join(v) for f, v in r.items()} for n, r in env.field_rows(path, fields, two_pass).items()}
+
+
+class TestTransactions(TsharkTestCase, unittest.TestCase):
+    KEY_TEXT = "0x%04x"  # the transaction in the no-response note, as its field shows it
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "transactions.xml"), "txnp")
+
+    def test_no_response_note_names_the_key_as_its_field_shows_it(self):
+        path = self.env.path("notes.pcap")
+        write(path)
+        rows = self.env.field_rows(path, ["frame.number", "_ws.expert.message"], False, aggregator="|")
+        notes = {n: [m for m in r["_ws.expert.message"] if m.startswith("No response to")] for n, r in rows.items()}
+        want = {proof: ["No response to frame %d (Transaction %s), sent %.3f ms before" % (
+                    lost, self.KEY_TEXT % MESSAGES[lost - 1][2], MESSAGES[proof - 1][0] - MESSAGES[lost - 1][0])]
+                for lost, proof in LOST.items()}
+        self.assertEqual({n: m for n, m in notes.items() if m}, want)
+
+    def test_requests_and_responses_paired_by_direction(self):
+        env = self.env
+        path = env.path("transactions.pcap")
+        write(path)
+        with self.checks() as check:
+            for two_pass in (True, False):
+                mode = "-2" if two_pass else "one pass"
+                rows = decode(env, path, two_pass)
+                got = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
+                check(got == PAIRS, "%s: each response answers its own request, orphans answer nothing "
+                      "(%s)" % (mode, got))
+                if two_pass:
+                    back = {int(r["txnp.response_in"]): n for n, r in rows.items() if r["txnp.response_in"]}
+                    check(back == PAIRS, "%s: each answered request links its response (%s)" % (mode, back))
+                    flagged = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
+                    check(flagged == set(LOST), "%s: no_response exactly on the lost requests %s (%s)" % (
+                        mode, sorted(LOST), sorted(flagged)))
+                else:
+                    flagged = {n: r["txnp.no_response_to"] for n, r in rows.items() if r["txnp.expert.no_response"]}
+                    want = {proof: str(lost) for lost, proof in LOST.items()}
+                    check(flagged == want, "%s: no_response on the frame that proves the loss, naming it "
+                          "(%s, want %s)" % (mode, flagged, want))
+                times = {n: r["txnp.time"] for n, r in rows.items() if r["txnp.time"]}
+                want = {n: "%.9f" % ((MESSAGES[n - 1][0] - MESSAGES[m - 1][0]) / 1000) for n, m in PAIRS.items()}
+                check(times == want, "%s: round trips are the timestamps' differences (%s)" % (mode, times))
+
+
+class TestTransactionsDecimalKey(TestTransactions):
+    """The same protocol with its transaction shown in decimal: so is it in the note."""
+    KEY_TEXT = "%d"
+
+    @classmethod
+    def prepare(cls):
+        with open(os.path.join(cls.args.source_dir, "tests", "rules", "transactions.xml"), encoding="utf-8") as f:
+            text = f.read()
+        decimal = text.replace('name="Transaction" length="2byte" displaytype="numberhex"',
+                               'name="Transaction" length="2byte" displaytype="numberdec"')
+        assert decimal != text
+        path = cls.env.path("transactions_decimal.xml")
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(decimal)
+        cls.install(path, "txnp")
+
+
+class TestOvertaken(TsharkTestCase, unittest.TestCase):
+    """A request waits for its response while the responses to at most 16 later requests come
+    first (a reordering): the response after 16 answers it; after 17 the request was given up
+    (lost) and the late response answers nothing."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "transactions.xml"), "txnp")
+
+    @staticmethod
+    def overtaken_by(later):
+        """Request 0x100, `later` requests each answered at once, then 0x100's response."""
+        messages = [(0, "request", 0x100, 1)]
+        for k in range(later):
+            messages += [(1 + 2 * k, "request", k + 1, 1), (2 + 2 * k, "response", k + 1, 1)]
+        return messages + [(2 * later + 1, "response", 0x100, 1)]
+
+    def test_sixteen_later_answers_wait_seventeen_give_up(self):
+        with self.checks() as check:
+            for later in (16, 17):
+                messages = self.overtaken_by(later)
+                path = self.env.path("overtaken_%d.pcap" % later)
+                write(path, messages)
+                last = len(messages)
+                for two_pass in (True, False):
+                    rows = decode(self.env, path, two_pass)
+                    mode = "-2" if two_pass else "one pass"
+                    answered = rows[last]["txnp.request_in"]
+                    lost = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
+                    if later == 16:
+                        check(answered == "1" and not lost, "%s: overtaken by 16, frame %d answers frame 1, "
+                              "nothing lost (request_in %r, lost %s)" % (mode, last, answered, sorted(lost)))
+                    else:
+                        proof = last if not two_pass else 1
+                        check(answered == "" and lost == {proof}, "%s: overtaken by 17, frame 1 lost (noted on "
+                              "frame %d), frame %d an orphan (request_in %r, lost %s)" % (
+                                  mode, proof, last, answered, sorted(lost)))
+
+
+class TestComputedKey(TsharkTestCase, unittest.TestCase):
+    """Keyed by a computed value alone, the walk decodes no byte of the message: whether a
+    message from the same sender soon after is the same again (a duplicate) or a new request
+    is still told by all of its bytes, not by the none the walk read."""
+
+    RULES = """<root name="Transactions Protocol" abbreviation="TXNP" byteorder="big">
+  <hook table="udp.port" value="%d"/>
+  <pairing timeout="1"><key field="node[@name='Channel']"/></pairing>
+  <node name="Channel" value="7" displaytype="numberdec"/>
+</root>
+""" % PORT
+    # (ms, direction, n): n is the payload's last field, so equal n means equal bytes
+    CAPTURE = [(0, "request", 1),   # 1: given up: 2 is a new request with other bytes
+               (1, "request", 2),   # 2
+               (2, "response", 3),  # 3: answers 2
+               (100, "request", 4), # 4
+               (101, "request", 4), # 5: the same bytes again at once: a duplicate of 4
+               (102, "response", 5)]  # 6: answers 4
+
+    @classmethod
+    def prepare(cls):
+        path = cls.env.path("computed_key.xml")
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(cls.RULES)
+        cls.install(path, "txnp")
+
+    def test_other_bytes_are_a_new_request_the_same_bytes_a_duplicate(self):
+        path = self.env.path("computed_key.pcap")
+        write_frames(path, [(ms, frame(direction, 1, 1, n)) for ms, direction, n in self.CAPTURE])
+        with self.checks() as check:
+            for two_pass in (True, False):
+                rows = self.env.field_rows(path, ["frame.number", "txnp.request_in", "txnp.expert.duplicate"],
+                                           two_pass)
+                pairs = {n: int(r["txnp.request_in"][0]) for n, r in rows.items() if r["txnp.request_in"]}
+                duplicates = {n for n, r in rows.items() if r["txnp.expert.duplicate"]}
+                mode = "-2" if two_pass else "one pass"
+                check(pairs == {3: 2, 6: 4}, "%s: responses answer 2 and 4 (%s)" % (mode, pairs))
+                check(duplicates == {5}, "%s: only frame 5 is a duplicate (%s)" % (mode, sorted(duplicates)))
+
+
+if __name__ == "__main__":
+    sys.exit(run_unittests()[1])
