@@ -884,15 +884,20 @@ def station_byte_checks(check, dissgen, source_dir):
     address (0x0010) or reads the alias (0x0012) one byte at a time gives the slave the whole
     value, and a later write of one byte changes that byte only."""
     print("\n== station address and alias a byte at a time")
-    steps = [(pg.Datagram(2, adp=0, ado=0x0010, data=b"\x05"), None),           # position 0: low byte
-             (pg.Datagram(2, adp=0, ado=0x0011, data=b"\x10"), None),           # high byte: 0x1005
-             (pg.Datagram(2, adp=0xFFFF, ado=0x0010, data=b"\x01\x20"), None),   # position 1: 0x2001
-             (pg.Datagram(2, adp=0xFFFF, ado=0x0010, data=b"\x07"), None),       # its low byte: 0x2007
-             (pg.Datagram(4, adp=0x1005, ado=0x0012, data=bytes(1)), b"\x34"),   # alias read, low byte
-             (pg.Datagram(4, adp=0x1005, ado=0x0013, data=bytes(1)), b"\x12"),   # high byte: 0x1234
-             (pg.Datagram(4, adp=0x1005, ado=0x0130, data=bytes(2)), None),
-             (pg.Datagram(4, adp=0x2007, ado=0x0130, data=bytes(2)), None),
-             (pg.Datagram(4, adp=0x2001, ado=0x0130, data=bytes(2)), None)]
+    steps = [(pg.Datagram(2, adp=0, ado=0x0010, data=b"\x85"), None),           # position 0: low byte
+             (pg.Datagram(2, adp=0, ado=0x0011, data=b"\x10"), None),           # high byte: 0x1085
+             (pg.Datagram(2, adp=0xFFFF, ado=0x0010, data=b"\x01\xA0"), None),   # position 1: 0xA001
+             (pg.Datagram(2, adp=0xFFFF, ado=0x0010, data=b"\x07"), None),       # its low byte: 0xA007
+             (pg.Datagram(4, adp=0x1085, ado=0x0012, data=bytes(1)), b"\x34"),   # alias read, low byte
+             (pg.Datagram(4, adp=0x1085, ado=0x0013, data=bytes(1)), b"\x12"),   # high byte: 0x1234
+             (pg.Datagram(4, adp=0x1085, ado=0x0130, data=bytes(2)), None),
+             (pg.Datagram(4, adp=0xA007, ado=0x0130, data=bytes(2)), None),
+             (pg.Datagram(4, adp=0xA001, ado=0x0130, data=bytes(2)), None),      # no longer a station
+             # re-addressed: position 2 takes 0x1085 from position 0, which then gets 0x3000
+             (pg.Datagram(2, adp=0xFFFE, ado=0x0010, data=b"\x85\x10"), None),
+             (pg.Datagram(2, adp=0, ado=0x0010, data=b"\x00\x30"), None),
+             (pg.Datagram(4, adp=0x1085, ado=0x0130, data=bytes(2)), None),
+             (pg.Datagram(4, adp=0x3000, ado=0x0130, data=bytes(2)), None)]
     frames = []
     for i, (d, data) in enumerate(steps):
         d.idx = i
@@ -905,10 +910,12 @@ def station_byte_checks(check, dissgen, source_dir):
         fields = ["ecatr.slave.position", "ecatr.slave.station", "ecatr.slave.alias"]
         for two_pass in (False, True):
             rows = dict(decode(env, cap, fields, two_pass))
-            got = {n: tuple(rows[n][f] for f in fields) for n in (14, 16, 18)}
-            want = {14: (["0"], ["0x1005"], ["0x1234"]), 16: (["1"], ["0x2007"], []), 18: ([], [], [])}
-            check(got == want, "FPRDs to 0x1005, 0x2007 and 0x2001 (no longer a station)%s: %s, expected %s" % (
-                " (-2)" if two_pass else "", got, want))
+            got = {n: tuple(rows[n][f] for f in fields) for n in (14, 16, 18, 24, 26)}
+            want = {14: (["0"], ["0x1085"], ["0x1234"]), 16: (["1"], ["0xa007"], []), 18: ([], [], []),
+                    24: (["2"], ["0x1085"], []), 26: (["0"], ["0x3000"], ["0x1234"])}
+            check(got == want, "FPRDs to 0x1085, 0xa007, 0xa001 (no longer a station), then 0x1085 (given to "
+                  "position 2) and 0x3000 (position 0's new address)%s: %s, expected %s" % (
+                      " (-2)" if two_pass else "", got, want))
 
 
 class TestBusModel(TsharkTestCase, unittest.TestCase):
