@@ -897,7 +897,10 @@ def station_byte_checks(check, dissgen, source_dir):
              (pg.Datagram(2, adp=0xFFFE, ado=0x0010, data=b"\x85\x10"), None),
              (pg.Datagram(2, adp=0, ado=0x0010, data=b"\x00\x30"), None),
              (pg.Datagram(4, adp=0x1085, ado=0x0130, data=bytes(2)), None),
-             (pg.Datagram(4, adp=0x3000, ado=0x0130, data=bytes(2)), None)]
+             (pg.Datagram(4, adp=0x3000, ado=0x0130, data=bytes(2)), None),
+             # position 3: its alias written, its station never: no station
+             (pg.Datagram(2, adp=0xFFFD, ado=0x0012, data=b"\x78\x56"), None),
+             (pg.Datagram(1, adp=0xFFFD, ado=0x0130, data=bytes(2)), None)]
     frames = []
     for i, (d, data) in enumerate(steps):
         d.idx = i
@@ -910,11 +913,11 @@ def station_byte_checks(check, dissgen, source_dir):
         fields = ["ecatr.slave.position", "ecatr.slave.station", "ecatr.slave.alias"]
         for two_pass in (False, True):
             rows = dict(decode(env, cap, fields, two_pass))
-            got = {n: tuple(rows[n][f] for f in fields) for n in (14, 16, 18, 24, 26)}
+            got = {n: tuple(rows[n][f] for f in fields) for n in (14, 16, 18, 24, 26, 30)}
             want = {14: (["0"], ["0x1085"], ["0x1234"]), 16: (["1"], ["0xa007"], []), 18: ([], [], []),
-                    24: (["2"], ["0x1085"], []), 26: (["0"], ["0x3000"], ["0x1234"])}
+                    24: (["2"], ["0x1085"], []), 26: (["0"], ["0x3000"], ["0x1234"]), 30: (["3"], [], ["0x5678"])}
             check(got == want, "FPRDs to 0x1085, 0xa007, 0xa001 (no longer a station), then 0x1085 (given to "
-                  "position 2) and 0x3000 (position 0's new address)%s: %s, expected %s" % (
+                  "position 2) and 0x3000 (position 0's new address), and an APRD to position 3 (an alias, no station)%s: %s, expected %s" % (
                       " (-2)" if two_pass else "", got, want))
 
 
