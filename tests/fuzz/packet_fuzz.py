@@ -327,7 +327,8 @@ def main():
     caps = []
     for c in a.captures:
         caps += make_mutants(c, a.out, finder, a.seed, a.max_frames)
-    field = "ecatr.datagram.cmd" if a.proto == "ecatr" else "enipr.command"
+    # -T fields prints one field: one of the protocol's own where known, else the protocol itself
+    field = {"ecatr": "ecatr.datagram.cmd", "enipr": "enipr.command"}.get(a.proto, a.proto)
     modes = {"V": ["-V"], "2V": ["-2", "-V"], "fields": ["-T", "fields", "-e", field],
              "stats": ["-z", "%s,tree" % a.proto, "-q"], "pdml": ["-T", "pdml"]}
     wanted = a.modes.split(",")

@@ -526,6 +526,9 @@ def load_coverage(path):
         return json.load(fh)
 
 
+CONSTANT = re.compile(r"^\s*(static\s+)?(const|constexpr)\s")
+
+
 def tests_running(coverage, file, lines, text):
     """Names of the tests that the coverage map says execute a line of lines in file
     (any line of file when its text changed since the map was written: its line numbers
@@ -534,8 +537,15 @@ def tests_running(coverage, file, lines, text):
         return []
     moved = coverage["sources"][file] != hashlib.sha256(text.encode("utf-8")).hexdigest()
     first, last = lines
-    return [t for t, row in coverage.get("tests", {}).items() if t in TESTS and file in row["lines"] and
-            (moved or any(first <= l <= last for l in row["lines"][file]))]
+    runs_file = [t for t, row in coverage.get("tests", {}).items() if t in TESTS and file in row["lines"]]
+    if moved:
+        return runs_file
+    running = [t for t in runs_file if any(first <= l <= last for l in coverage["tests"][t]["lines"][file])]
+    # A constant is run through its uses, and gcov counts no line for its definition:
+    # every test of its file, then.
+    if not running and any(CONSTANT.match(l) for l in text.splitlines()[first - 1:last]):
+        return runs_file
+    return running
 
 
 def choose_tests(m, coverage, source_dir):

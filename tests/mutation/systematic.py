@@ -78,6 +78,7 @@ TESTS_BY_FILE = {
     "plugin_runtime/dissgen_names.h": ["loading", "reserved_names"],
     "plugin_runtime/ethercat/ethercat_analysis.cpp": ["esc_commands", "pairing", "ecat_figures"],
     "plugin_runtime/ethercat/ethercat_analysis.h": ["esc_commands", "pairing"],
+    "plugin_runtime/ethercat/ethercat_bus.h": ["esc_commands", "bus_pdo", "bus_wkc", "bus_tables"],
     "plugin_runtime/ethercat/ethercat_bus.cpp": ["bus_pdo", "bus_wkc", "bus_stats", "bus_identities", "bus_coe",
                                                  "bus_signed", "bus_slave_line", "bus_network", "bus_station_bytes"],
     "plugin_runtime/ethercat/ethercat_cycles.cpp": ["cycles", "report"],

@@ -152,6 +152,15 @@ class ChosenByCoverage(unittest.TestCase):
         self.assertEqual(rm.tests_running(self.coverage(), "generator/y.cpp", (2, 2), self.TEXT), [])
         self.assertEqual(rm.tests_running(None, "plugin_runtime/x.cpp", (2, 2), self.TEXT), [])
 
+    def test_a_constant_no_line_counts_takes_every_test_of_its_file(self):
+        text = "line one\nconst gint width = 2;\nline three\nline four\n"
+        coverage = self.coverage(text)
+        coverage["tests"]["overlays"]["lines"]["plugin_runtime/x.cpp"] = [3]
+        coverage["tests"]["widths"]["lines"]["plugin_runtime/x.cpp"] = [3]
+        self.assertEqual(sorted(rm.tests_running(coverage, "plugin_runtime/x.cpp", (2, 2), text)),
+                         ["edges_offsets", "overlays", "widths"])
+        self.assertEqual(rm.tests_running(coverage, "plugin_runtime/x.cpp", (1, 1), text), [])
+
     def test_a_file_changed_since_the_map_takes_every_test_of_it(self):
         moved = "new first line\n" + self.TEXT
         self.assertEqual(sorted(rm.tests_running(self.coverage(), "plugin_runtime/x.cpp", (1, 1), moved)),
