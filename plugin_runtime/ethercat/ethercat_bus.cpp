@@ -99,8 +99,9 @@ struct pdo_config {
 enum ident_word { W_VENDOR = 0x08, W_PRODUCT = 0x0a, W_REVISION = 0x0c, W_SERIAL = 0x0e, SII_WORDS = 0x10 };
 
 struct slave_state {
-    gboolean station_known, alias_known, sii_address_known;
+    gboolean station_known, sii_address_known;
     guint16 station, alias;
+    guint8 alias_bytes;            /* bit per byte of the alias (0x0012, 0x0013) read back */
     guint32 sii_address;           /* in words, the last one the master asked for */
     guint16 sii[SII_WORDS];        /* SII words 0x0000..0x000F as read */
     guint32 sii_known;             /* bit per word of sii[] */
@@ -191,18 +192,18 @@ gint register_at(const datagram *d, guint32 reg, guint32 n)
 /* The bytes of the 16-bit register at `reg` that a datagram covers, put into
  * `value`: a slave controller takes each byte written, and a master may write
  * (or read) one of the two alone. `shift` moves from the sent datagram's data
- * to the bytes read (the returned frame's). FALSE when it covers neither. */
-gboolean take_register16(const datagram *s, tvbuff_t *tvb, gint shift, guint32 reg, guint16 *value)
+ * to the bytes read (the returned frame's). Returns a bit per byte taken. */
+guint take_register16(const datagram *s, tvbuff_t *tvb, gint shift, guint32 reg, guint16 *value)
 {
-    gboolean any = FALSE;
+    guint taken = 0;
     for (guint32 k = 0; k < 2; k++) {
         gint at = register_at(s, reg + k, 1);
         if (at < 0) continue;
         guint byte = dg_tvb_get_uint8(tvb, at + shift);
         *value = (guint16)((*value & ~(0xffu << (8 * k))) | byte << (8 * k));
-        any = TRUE;
+        taken |= 1u << k;
     }
-    return any;
+    return taken;
 }
 
 slave_state *slave_at(bus_model *m, guint32 position)
@@ -660,9 +661,10 @@ guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagr
         st->station_known = TRUE;
         wmem_map_insert(m->stations, GUINT_TO_POINTER((guint)st->station), GUINT_TO_POINTER(position + 1));
     }
-    gboolean alias_taken = writes_registers(s->cmd) ? take_register16(s, sent, 0, 0x0012, &st->alias)
-                                                    : take_register16(s, back, b->offset - s->offset, 0x0012, &st->alias);
-    if (alias_taken) st->alias_known = TRUE;
+    /* The alias is loaded from the EEPROM: the segment only reads it (a write
+     * leaves it), and it is known once both its bytes came back. */
+    if (reads_registers(s->cmd))
+        st->alias_bytes |= (guint8)take_register16(s, back, b->offset - s->offset, 0x0012, &st->alias);
     if (writes_registers(s->cmd) && s->cmd != APRW && s->cmd != FPRW) {
         learn_sii_address(st, s, sent);
         learn_fmmus(m, st, s, sent);
@@ -812,7 +814,7 @@ void show_slave(const bus_model *m, const addressed *a, tvbuff_t *tvb, packet_in
     add(proto_tree_add_uint(sub, hf_position, tvb, offset, length, (guint32)position));
     if (has_station) add(proto_tree_add_uint(sub, hf_station, tvb, offset, length, station));
     if (!s) return;
-    if (s->alias_known) add(proto_tree_add_uint(sub, hf_alias, tvb, offset, length, s->alias));
+    if (s->alias_bytes == 3) add(proto_tree_add_uint(sub, hf_alias, tvb, offset, length, s->alias));
     const int *hfs[] = {&hf_vendor, &hf_product, &hf_revision, &hf_serial};
     const guint words[] = {W_VENDOR, W_PRODUCT, W_REVISION, W_SERIAL};
     for (guint i = 0; i < G_N_ELEMENTS(words); i++)

@@ -58,7 +58,10 @@ BASELINE_TIMEOUT = 3600   # the unmutated run is the yardstick: it gets all the 
 def integration_script(src, script):
     """tests/integration/AREA/SCRIPT: the scripts live by what they test (language/, ethercat/, ...)."""
     found = glob.glob(os.path.join(src, "tests", "integration", "*", script))
-    return found[0] if len(found) == 1 else os.path.join(src, "tests", "integration", script)
+    if len(found) > 1:
+        raise SystemExit("two integration scripts named %s: %s" % (script, " ".join(sorted(found))))
+    # none: a placeholder source folder ("SRC", to read the command's shape)
+    return found[0] if found else os.path.join(src, "tests", "integration", script)
 
 
 def integration(script, *extra):

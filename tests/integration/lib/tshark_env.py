@@ -347,7 +347,7 @@ class TsharkTestCase:
 
 
 def run_unittests(add_arguments=None):
-    """The entry point of every tests/integration/test_*.py: parses --dissgen and
+    """The entry point of every tests/integration/*/test_*.py: parses --dissgen and
     --source-dir (plus what `add_arguments(parser)` adds), runs the module's unittest
     cases (or those named: `TestX.test_y`, `-k pattern`), and returns (args, exit status
     for ctest): 0 when every test run passed or skipped, 77 when every one skipped
