@@ -527,6 +527,23 @@ def bits_of(data, bit, n):
     return (v >> bit) & ((1 << n) - 1)
 
 
+def exchanges(steps):
+    """A master's frames and their returns: each step a frame, a list of (datagram as sent, data
+    it comes back with or None for the data sent, working counter it comes back with); the
+    datagrams of step i carry index i."""
+    master, back = b"\x00\x00\x00\x00\x00\x01", b"\x02\x00\x00\x00\x00\x01"
+    frames = []
+    for i, frame in enumerate(steps):
+        sent, returned = [], []
+        for d, data, wkc in frame:
+            d.idx = i & 0xFF
+            sent.append(d)
+            returned.append(pg.Datagram(d.cmd, idx=d.idx, adp=d.adp, ado=d.ado, lad=d.lad,
+                                        data=data if data else d.data, wkc=wkc))
+        frames += [pg.Frame(sent, src_mac=master), pg.Frame(returned, src_mac=back)]
+    return frames
+
+
 def coe_frames(config_steps, inputs_before, inputs_after, inputs_middle=None, station=0x1002, same_frame=False,
                identity=EL1252):
     """The EL1252 (or `identity`) at position 1 (station `station`): station, identity (SII), mailboxes, an FMMU
@@ -534,7 +551,6 @@ def coe_frames(config_steps, inputs_before, inputs_after, inputs_middle=None, st
     ((mailbox, returned working counter): a write to SyncManager 0, or for a response a read of
     SyncManager 1; "lrd": an LRD returning `inputs_middle`); the LRD again (with `same_frame`, in
     the frame of the last step). Returns (frames, frame numbers of the returned LRDs)."""
-    master, back = b"\x00\x00\x00\x00\x00\x01", b"\x02\x00\x00\x00\x00\x01"
 
     def lrd(data):
         return [(pg.Datagram(10, lad=0x10000, data=bytes(24)), data, 1)]
@@ -557,18 +573,8 @@ def coe_frames(config_steps, inputs_before, inputs_after, inputs_middle=None, st
         steps[-1] += lrd(inputs_after)
     else:
         steps.append(lrd(inputs_after))
-    frames, lrds = [], []
-    for i, frame in enumerate(steps):
-        sent, returned = [], []
-        for d, data, wkc in frame:
-            d.idx = i & 0xFF
-            sent.append(d)
-            returned.append(pg.Datagram(d.cmd, idx=d.idx, adp=d.adp, ado=d.ado, lad=d.lad,
-                                        data=data if data else d.data, wkc=wkc))
-        frames += [pg.Frame(sent, src_mac=master), pg.Frame(returned, src_mac=back)]
-        if any(d.cmd == 10 for d in sent):
-            lrds.append(len(frames))
-    return frames, lrds
+    lrds = [2 * (i + 1) for i, frame in enumerate(steps) if any(d.cmd == 10 for d, _data, _wkc in frame)]
+    return exchanges(steps), lrds
 
 
 def coe_checks(check, dissgen, source_dir, shared):
@@ -905,12 +911,7 @@ def station_byte_checks(check, dissgen, source_dir):
              (pg.Datagram(1, adp=0xFFFD, ado=0x0130, data=bytes(2)), None),
              (pg.Datagram(1, adp=0xFFFD, ado=0x0012, data=bytes(1)), b"\x9a"),
              (pg.Datagram(1, adp=0xFFFD, ado=0x0130, data=bytes(2)), None)]
-    frames = []
-    for i, (d, data) in enumerate(steps):
-        d.idx = i
-        back = pg.Datagram(d.cmd, idx=i, adp=d.adp, ado=d.ado, data=data or d.data, wkc=1)
-        frames += [pg.Frame([d], src_mac=b"\x00\x00\x00\x00\x00\x01"),
-                   pg.Frame([back], src_mac=b"\x02\x00\x00\x00\x00\x01")]
+    frames = exchanges([[(d, data, 1)] for d, data in steps])
     with TsharkEnv() as env:
         env.install_plugin(dissgen, os.path.join(source_dir, "rules", "ethercat.xml"))
         cap = env.add_file("station_bytes.pcap", pg.pcap_bytes(frames))
