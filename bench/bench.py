@@ -63,7 +63,6 @@ sys.dont_write_bytecode = True  # no __pycache__ in bench/ or tests/integration/
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, "tests", "integration", "lib"))
-import testpaths  # noqa: E402,F401  (the integration tests' folders: their captures)
 
 import pcapgen  # noqa: E402
 from tshark_env import TsharkEnv, TsharkError  # noqa: E402

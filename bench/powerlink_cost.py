@@ -19,7 +19,6 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(HERE, "..", "tests", "integration", "lib"))
-import testpaths  # noqa: E402,F401  (the integration tests' folders: their captures)
 import eplgen  # noqa: E402
 from profinet_cost import main_for  # noqa: E402
 

@@ -25,7 +25,6 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "tests", "integration", "lib"))
-import testpaths  # noqa: E402,F401  (the integration tests' folders: their captures)
 from pcapgen import udp_ethernet_frame  # noqa: E402
 from tshark_env import TsharkEnv  # noqa: E402
 

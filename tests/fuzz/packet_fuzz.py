@@ -22,7 +22,6 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "integration", "lib"))
-import testpaths  # noqa: E402,F401  (the integration tests' folders: their captures)
 from tshark_env import TsharkEnv  # noqa: E402
 
 TIMEOUT = 120
