@@ -586,8 +586,10 @@ void dissect_overlay(dg_state *st, const dg_node *n, proto_tree *tree, gboolean 
     const dg_slot *t = &st->slots[target];
     gint at = t->offset;
     dissect_container(st, n, tree, &at, t->offset + t->length, in_summary, NULL);
+    /* as for any container: one cut short says and teaches nothing */
+    if (st->stopped) return;
     if (n->extra->finding_count) raise_findings(st, n, tree, t->offset, at);
-    if (n->extra->learn_count && !st->stopped) learn_values(st, n);
+    if (n->extra->learn_count) learn_values(st, n);
 }
 
 /* --- lists of siblings --------------------------------------------------- */

@@ -10,7 +10,9 @@ bytes; a trailer. Every value is compared with the bytes, in one pass and
 with -2; the trailer and the fields after each overlay sit where they would
 without it; malformed messages (a head longer than the body, an odd byte
 left for an item, a frame cut inside the body) give their expert info and
-the tree decoded before it. Needs no corpus.
+the tree decoded before it; the record's own finding (a type from 128) is
+raised on every record decoded whole and never on one cut short. Needs no
+corpus.
 
     test_overlays.py --dissgen build/bin/dissgen --source-dir .
 """
@@ -153,10 +155,27 @@ class TestOverlays(TsharkTestCase, unittest.TestCase):
                 want = [str(n) for n, (m, _) in enumerate(self.messages, 1) if m["kind"] in kinds]
                 check(got == want, "%s: exactly the %d %s messages (got %d)" % (expert, len(want), "/".join(kinds),
                                                                                 len(got)))
-            clean = self.env.tshark(["-r", self.path, "-Y", "_ws.expert", "-T", "fields", "-e", "frame.number"]
+            malformed = "_ws.expert.group == 0x07000000"  # PI_MALFORMED: not the record's own finding
+            clean = self.env.tshark(["-r", self.path, "-Y", malformed, "-T", "fields", "-e", "frame.number"]
                                     ).stdout.split()
             bad = [str(n) for n, (m, _) in enumerate(self.messages, 1) if m["kind"] != "ok"]
-            check(clean == bad, "no expert info on the %d well-formed messages" % (len(self.messages) - len(bad)))
+            check(clean == bad, "no malformed expert info on the %d well-formed messages" % (
+                len(self.messages) - len(bad)))
+
+    def test_record_finding_only_on_records_decoded_whole(self):
+        """The record overlay stops at an odd byte left for an item ("odd"): its
+        finding is not raised there, though its type was read; a head past the
+        body stops the message after the record, which was decoded whole."""
+        vendor = lambda m: m["kind"] != "cut" and m["body"][0] >= 128
+        want = [str(n) for n, (m, _) in enumerate(self.messages, 1) if vendor(m) and m["kind"] != "odd"]
+        odd = sum(1 for m, _ in self.messages if vendor(m) and m["kind"] == "odd")
+        with self.checks() as check:
+            check(odd > 0 and want, "%d odd records of a vendor type, %d whole ones" % (odd, len(want)))
+            for two_pass in ([], ["-2"]):
+                got = self.env.tshark(["-r", self.path, "-Y", "ovl.finding.vendor_record", "-T", "fields",
+                                       "-e", "frame.number"] + two_pass).stdout.split()
+                check(got == want, "%s: the finding on exactly the %d whole records of a vendor type (got %d)" % (
+                    "-2" if two_pass else "one pass", len(want), len(got)))
 
     def test_record_summary_in_the_info_column(self):
         rows = self.env.field_rows(self.path, ["frame.number", "_ws.col.Info"], aggregator="\x01")
