@@ -31,7 +31,10 @@ bool is_numeric_display(Display d) {
 
 bool Node::is_numeric() const {
     if (is_computed()) return display != Display::Float;
-    if (!is_leaf() || !has_fixed_length()) return false;
+    if (!is_leaf()) return false;
+    // a number of 1-8 bytes, its length from a field (validator: check_leaf_display)
+    if (length_kind == LengthKind::Field) return is_numeric_display(display) && display != Display::Time;
+    if (!has_fixed_length()) return false;
     if (fixed_bits < 1 || fixed_bits > 64) return false;
     return is_numeric_display(display) || display == Display::NonDisplay;
 }

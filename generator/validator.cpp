@@ -71,6 +71,10 @@ private:
         int reach;
         int line;
         std::string in;
+        // a key's lookup: computed where learned{...} reads it, so the
+        // instance its fields and `index` belong to is the reader's
+        // (check_lookups_at_readers)
+        bool at_reader = false;
     };
     bool check_expr(Node& n, Expr& e);
     bool check_expr(Node& n, Expr& e, const ExprSite& at);
@@ -83,6 +87,14 @@ private:
     void collect_learns();
     void check_learns(Node& n);
     bool check_learned(Node& n, Expr& e, const ExprSite& at);
+    void check_lookups_at_readers();
+    struct LearnedRead {
+        const Node* reader;
+        const Learn* learn;
+        int line;
+        std::string in;
+    };
+    std::vector<LearnedRead> learned_reads_;
     bool check_integer_expr(Node& n, Expr& e, const ExprSite& at, const std::string& what);
     bool check_request_field(Node& n, Expr& e);
     const Node* request_field_target(const Node& n, const std::string& text, const std::string& what);
@@ -155,6 +167,7 @@ void Validator::run() {
         if (!n.findings.empty()) check_findings(n);
         if (!n.learns.empty()) check_learns(n);
     });
+    check_lookups_at_readers();
     check_pdulength();
     check_validity();
     check_pairing();
@@ -252,9 +265,15 @@ void Validator::check_leaf_display(Node& n) {
         diags_.warning(n.line, "leaf " + quote(n) + " has no length and no children: it takes no bytes");
     if (!n.display_given) n.display = Display::Origin;
     bool numeric = is_numeric_display(n.display);
-    if (numeric) {
+    // A number whose length comes from a field (a PDO entry laid out by a
+    // learned mapping) is read from its 1-8 bytes at run time, as 64 bits.
+    const bool sized_by_field = n.length_kind == LengthKind::Field && n.display != Display::Time;
+    if (numeric && sized_by_field) {
+        n.bits = 64;
+    } else if (numeric) {
         if (!n.has_fixed_length())
-            diags_.error(n.line, std::string(display_name(n.display)) + " display needs a fixed length of 1-64 bits; " +
+            diags_.error(n.line, std::string(display_name(n.display)) + " display needs a fixed length of 1-64 bits" +
+                                     (n.display == Display::Time ? "" : " or a length from a field") + "; " +
                                      quote(n) + " has a variable length");
         else if (n.fixed_bits > 64)
             diags_.error(n.line, std::string(display_name(n.display)) + " display on more than 64 bits: " + quote(n) +
@@ -926,6 +945,7 @@ bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
     case ExprOp::Int: return true;
     case ExprOp::Float: e.is_float = true; return true;
     case ExprOp::Index:
+        if (at.at_reader) return true;
         for (const Node* r = &n; r; r = r->parent)
             if (r->is_repeated()) return true;
         diags_.error(at.line, "'index'" + in + ": it is not inside a repeated node, so there is no instance to count");
@@ -956,7 +976,7 @@ bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
                                      "or a computed value");
             return false;
         }
-        for (const Node* r = t; r; r = r->parent)
+        for (const Node* r = t; r && !at.at_reader; r = r->parent)
             if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
                 diags_.error(at.line, "{" + e.name + "}" + in + " is inside repeated node " + quote(*r) + at_line(*r) +
                                          ", which does not contain " + quote(n) +
@@ -1902,7 +1922,7 @@ void Validator::check_learns(Node& n) {
         check_integer_expr(n, l.value, ExprSite{reach, l.line, " in the value of " + what}, "the value of " + what);
         if (l.condition)
             check_integer_expr(n, *l.condition, ExprSite{reach, l.line, " in the if of " + what}, "the if of " + what);
-        auto check_key = [&](Expr& e, int line, const std::string& word, int key_reach) {
+        auto check_key = [&](Expr& e, int line, const std::string& word, int key_reach, bool at_reader) {
             const std::string where = " in the " + word + " of " + what;
             if (reads_learned(e)) {
                 diags_.error(line, "learned{...}" + where +
@@ -1910,11 +1930,11 @@ void Validator::check_learns(Node& n) {
                                        "fields only");
                 return;
             }
-            check_integer_expr(n, e, ExprSite{key_reach, line, where}, "the " + word + " of " + what);
+            check_integer_expr(n, e, ExprSite{key_reach, line, where, at_reader}, "the " + word + " of " + what);
         };
         for (LearnKey& k : l.keys) {
-            check_key(k.value, k.line, "key", reach);
-            if (k.lookup) check_key(*k.lookup, k.line, "lookup", everywhere);
+            check_key(k.value, k.line, "key", reach, false);
+            if (k.lookup) check_key(*k.lookup, k.line, "lookup", everywhere, true);
         }
     }
 }
@@ -1938,8 +1958,46 @@ bool Validator::check_learned(Node& n, Expr& e, const ExprSite& at) {
     }
     e.learn_index = found->index;
     e.is_float = false;
+    learned_reads_.push_back({&n, found, at.line, at.in});
     if (n.is_computed()) mark_slot(&n);
     return true;
+}
+
+// A lookup is computed where learned{...} reads it: a field of a repeated
+// node it reads must be of the reader's own instance, decoded before it, and
+// `index` counts the reader's instances, so the reader is inside a repeat.
+void Validator::check_lookups_at_readers() {
+    for (const LearnedRead& read : learned_reads_) {
+        const Node& reader = *read.reader;
+        const std::string head = "learned{" + read.learn->name + "}" + read.in + ": the lookup of its key on line ";
+        std::function<void(const Expr&, int)> visit = [&](const Expr& e, int key_line) {
+            for (const Expr& a : e.args) visit(a, key_line);
+            if (e.op == ExprOp::Index) {
+                const Node* r = &reader;
+                while (r && !r->is_repeated()) r = r->parent;
+                if (!r)
+                    diags_.error(read.line, head + std::to_string(key_line) + " reads 'index', and " + quote(reader) +
+                                                " is not inside a repeated node, so there is no instance to count");
+            }
+            if (e.op != ExprOp::Field || !e.target) return;
+            const Node* t = e.target;
+            for (const Node* r = t; r; r = r->parent) {
+                if (!r->is_repeated()) continue;
+                if (!is_ancestor_or_self(r, &reader))
+                    diags_.error(read.line, head + std::to_string(key_line) + " reads {" + e.name + "}, inside " +
+                                                "repeated node " + quote(*r) + at_line(*r) + ", which does not contain " +
+                                                quote(reader) + "; use a field of the reader's instance or one "
+                                                "outside every repeat");
+                else if (t->doc_index >= reader.doc_index)
+                    diags_.error(read.line, head + std::to_string(key_line) + " reads {" + e.name + "}" + at_line(*t) +
+                                                " of the reader's instance, decoded after " + quote(reader) +
+                                                "; it must come earlier in the file");
+                break;
+            }
+        };
+        for (const LearnKey& k : read.learn->keys)
+            if (k.lookup) visit(*k.lookup, k.line);
+    }
 }
 
 }  // namespace dissgen

@@ -135,6 +135,32 @@ void append_unit(const dg_node *n, proto_item *item)
     if (n->extra && n->extra->unit) proto_item_append_text(item, "%s", n->extra->unit);
 }
 
+/* A number whose length comes from a field: 1 to 8 bytes (its Wireshark
+ * field has 64 bits); an `int` keeps its sign in its slot, as 64 bits. */
+void decode_sized_number(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len)
+{
+    if (len < 1 || len > 8) {
+        report(st, tree, &st->p->ei->bad_length, offset, len,
+               "'%s' is a number of %d bytes: one whose length comes from a field has 1 to 8", n->name, len);
+        return;
+    }
+    guint64 value = read_uint(st->tvb, offset, (guint)len, encoding_of(n));
+    if (n->show == DG_SHOW_INT && len < 8) {
+        const guint64 sign = G_GUINT64_CONSTANT(1) << (len * 8 - 1);
+        value = (value ^ sign) - sign;
+    }
+    if (tree) {
+        proto_item *item;
+        switch (n->show) {
+        case DG_SHOW_INT: item = proto_tree_add_int64(tree, *n->hf, st->tvb, offset, len, (gint64)value); break;
+        case DG_SHOW_BOOL: item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, encoding_of(n)); break;
+        default: item = proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, len, value); break;
+        }
+        if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+    }
+    store(st, n, value, offset, len);
+}
+
 void decode_leaf_value(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len)
 {
     guint64 value = 0;
@@ -150,6 +176,10 @@ void decode_leaf_value(dg_state *st, const dg_node *n, proto_tree *tree, gint of
         if (value_wanted(st, n)) value = read_uint(st->tvb, offset, 4, encoding_of(n));
         if (tree) item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, encoding_of(n));
     } else if (n->flags & DG_NUMERIC) {
+        if (n->length_kind == DG_LEN_FIELD) {
+            decode_sized_number(st, n, tree, offset, len);
+            return;
+        }
         decode_number(st, n, tree, offset, len);
         return;
     } else if (len > 0 && tree) {

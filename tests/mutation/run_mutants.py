@@ -167,6 +167,7 @@ TESTS = {
     "transactions": integration("test_transactions.py"),
     "computed": integration("test_computed.py"),
     "learned": integration("test_learned.py"),
+    "learned_layout": integration("test_learned_layout.py"),
     "rule_findings": integration("test_rule_findings.py"),
     "rule_cycles": integration("test_rule_cycles.py"),
     "overlays": integration("test_overlays.py"),

@@ -360,7 +360,7 @@ TEST(Displays, NumericDisplayErrors) {
                                   "  <node name=\"v\" length=\"rest\" displaytype=\"" + std::string(display) + "\"/>\n"));
         const std::string m = f.messages();
         EXPECT_TRUE(contains(m, "rules.xml:2: error: " + std::string(display) + " display on more than 64 bits: 'n' is 72 bits")) << m;
-        EXPECT_TRUE(contains(m, "rules.xml:3: error: " + std::string(display) + " display needs a fixed length of 1-64 bits; 'v' has a variable length")) << m;
+        EXPECT_TRUE(contains(m, "rules.xml:3: error: " + std::string(display) + " display needs a fixed length of 1-64 bits or a length from a field; 'v' has a variable length")) << m;
     }
 }
 
