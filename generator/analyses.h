@@ -18,6 +18,8 @@ namespace dissgen {
 struct AnalysisInputSpec {
     std::string name;
     bool per_instance = false;
+    bool bytes = false;     // where a field's bytes are (its offset and length), not a number
+    bool optional = false;  // a rule file may leave it unbound (the analysis does without)
 };
 
 struct Analysis {

@@ -26,7 +26,14 @@ bool check_input(const AnalysisInput& input, const AnalysisInputSpec& spec, cons
     if (!t) return false;  // the parser reported the XPath
     const std::string what = "input '" + input.name + "' ";
     const std::string field = "field '" + t->name + "'" + line_text(t->line);
-    if (!t->is_numeric()) {
+    if (spec.bytes) {
+        if (!t->is_leaf() || t->is_computed()) {
+            diags.error(input.line, what + "reads where bytes are, and " + field + " is " +
+                                        (t->is_computed() ? "a computed value, which has none" : "a container") +
+                                        ": name a leaf with bytes");
+            return false;
+        }
+    } else if (!t->is_numeric()) {
         diags.error(input.line, what + "reads a number, and " + field +
                                     " is not numeric: name a leaf of 1-64 bits shown as a number, bool, enum or "
                                     "nondisplay");
@@ -111,11 +118,13 @@ void check_analysis_inputs(Protocol& proto, Diagnostics& diags) {
         t->analysis_input = static_cast<int>(index);
         t->analysis_input_per_instance = spec.per_instance;
     }
-    for (const std::string& name : names)
-        if (!bound.count(name))
+    for (const AnalysisInputSpec& spec : analysis->inputs) {
+        const std::string& name = spec.name;
+        if (!spec.optional && !bound.count(name))
             diags.error(pairing.line, "the " + analysis->name + " analysis reads input '" + name +
                                           "' from each message: add <input name=\"" + name +
                                           "\" field=\"XPATH\"/> to <pairing>");
+    }
 }
 
 }  // namespace dissgen

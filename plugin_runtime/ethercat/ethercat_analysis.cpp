@@ -384,7 +384,8 @@ guint32 esc_compare(void *capture, tvbuff_t *request, const dg_view *request_vie
     for (guint i = 0; i < count; i++) d[i] = kept_compared(&d[i]);
     capture_hints *h = (capture_hints *)capture;
     bus_frame f = {};
-    bus_returned(h->bus, request, response, sent, back, count, pinfo, &f);
+    const frame_pair pair = {request, response, request_view, response_view};
+    bus_returned(h->bus, &pair, sent, back, count, pinfo, &f);
     if (!probe.length_changed) cycles_returned(h->cycles, sent, back, count, txn, pinfo);
     bus_set_dc_drift(&f, dc_returned(h->cycles, sent, back, count, response, pinfo));
     return new_record(h, intern(h, &probe, f.shape), &f);

@@ -506,13 +506,13 @@ gboolean is_mailbox(const slave_state *st, const datagram *d)
 
 /* --- PDO assignment and mapping over CoE ---------------------------------- */
 
-/* The data of an SDO transfer in a CoE mailbox (`length` bytes at `at`): a
- * download request (service 2, command specifier 1) as the master writes it
- * to SyncManager 0, or an upload response (service 3, specifier 2) the
- * master reads from SyncManager 1. Expedited transfers carry up to 4 bytes
- * in the header, normal ones a size and the data after it; one whose size
- * is more than the mailbox holds continues in segments, which are not
- * followed (nothing is learnt from it). */
+/* The SDO transfer of a frame's datagram `instance` as the walk decoded its
+ * CoE mailbox (the view's sdo inputs): a download request (command
+ * specifier 1) as the master writes it to SyncManager 0, or an upload
+ * response (specifier 2) the master reads from SyncManager 1. Expedited
+ * transfers carry up to 4 bytes in the header, normal ones a size and the
+ * data after it; one whose size is more than the mailbox holds continues in
+ * segments, which are not followed (nothing is learnt from it). */
 struct sdo_data {
     guint16 index;
     guint8 subindex;
@@ -521,27 +521,36 @@ struct sdo_data {
     guint32 length;
 };
 
-gboolean sdo_transfer(tvbuff_t *tvb, gint at, guint length, guint service, guint specifier, sdo_data *out)
+/* The seven sdo inputs of a download and of an upload, in this order (ethercat_inputs.h). */
+enum sdo_input { SDO_COMMAND, SDO_FLAGS, SDO_INDEX, SDO_SUBINDEX, SDO_EXPEDITED, SDO_SIZE, SDO_DATA, SDO_INPUTS };
+G_STATIC_ASSERT(ESC_IN_DOWNLOAD_DATA - ESC_IN_DOWNLOAD_COMMAND == SDO_DATA);
+G_STATIC_ASSERT(ESC_IN_UPLOAD_DATA - ESC_IN_UPLOAD_COMMAND == SDO_DATA);
+
+gboolean sdo_transfer(const dg_view *view, guint instance, gboolean upload, sdo_data *out)
 {
-    if (length < 16) return FALSE;  /* mailbox header 6, CoE header 2, SDO header 8 */
-    guint32 mailbox = dg_tvb_get_uint16(tvb, at, ENC_LITTLE_ENDIAN);
-    if (mailbox < 10 || (dg_tvb_get_uint8(tvb, at + 5) & 0x0f) != 3) return FALSE;  /* 3: CoE */
-    if ((guint)(dg_tvb_get_uint16(tvb, at + 6, ENC_LITTLE_ENDIAN) >> 12) != service) return FALSE;
-    guint8 cmd = dg_tvb_get_uint8(tvb, at + 8);
-    if ((guint)(cmd >> 5) != specifier) return FALSE;
-    out->index = dg_tvb_get_uint16(tvb, at + 9, ENC_LITTLE_ENDIAN);
-    out->subindex = dg_tvb_get_uint8(tvb, at + 11);
-    out->complete_access = (cmd & 0x10) != 0;
-    if (cmd & 0x02) {  /* expedited: 4 - n bytes when the size is indicated */
-        out->offset = at + 12;
-        out->length = (cmd & 0x01) ? 4u - (cmd >> 2 & 3u) : 4u;
+    const guint first = upload ? ESC_IN_UPLOAD_COMMAND : ESC_IN_DOWNLOAD_COMMAND;
+    const dg_view_value *in[SDO_INPUTS] = {};
+    for (guint i = 0; view && i < view->count; i++) {
+        const dg_view_value *x = &view->values[i];
+        if (x->instance == instance && x->input >= first && x->input < first + SDO_INPUTS) in[x->input - first] = x;
+    }
+    if (!in[SDO_COMMAND] || in[SDO_COMMAND]->value != (upload ? 2u : 1u) || !in[SDO_FLAGS] || !in[SDO_INDEX] ||
+        !in[SDO_SUBINDEX])
+        return FALSE;
+    const guint flags = (guint)in[SDO_FLAGS]->value; /* size indicated, expedited, unused bytes (2), complete access */
+    out->index = (guint16)in[SDO_INDEX]->value;
+    out->subindex = (guint8)in[SDO_SUBINDEX]->value;
+    out->complete_access = (flags & 0x10) != 0;
+    if (flags & 0x02) { /* expedited: 4 - n bytes when the size is indicated */
+        if (!in[SDO_EXPEDITED]) return FALSE;
+        out->offset = in[SDO_EXPEDITED]->offset;
+        out->length = (flags & 0x01) ? 4u - (flags >> 2 & 3u) : 4u;
         return TRUE;
     }
-    if (!(cmd & 0x01)) return FALSE;
-    guint32 present = MIN(mailbox + 6, length) - 16, size = dg_tvb_get_uint32(tvb, at + 12, ENC_LITTLE_ENDIAN);
-    if (size > present) return FALSE;  /* segmented */
-    out->offset = at + 16;
-    out->length = size;
+    if (!(flags & 0x01) || !in[SDO_SIZE] || !in[SDO_DATA]) return FALSE;
+    if (in[SDO_SIZE]->value > in[SDO_DATA]->length) return FALSE; /* segmented */
+    out->offset = in[SDO_DATA]->offset;
+    out->length = (guint32)in[SDO_SIZE]->value;
     return TRUE;
 }
 
@@ -622,15 +631,15 @@ void learn_object(slave_state *st, tvbuff_t *tvb, const sdo_data *sd, guint32 fr
 
 /* A mailbox datagram to a slave: a download to its SyncManager 0 (the frame
  * as sent), or an upload response read from SyncManager 1 (returned). */
-void learn_coe(slave_state *st, const datagram *s, const datagram *b, tvbuff_t *sent, tvbuff_t *back, guint32 frame)
+void learn_coe(slave_state *st, const datagram *s, const frame_pair *fp, guint instance, guint32 frame)
 {
     sdo_data sd;
     if (writes_registers(s->cmd) && !reads_registers(s->cmd) && st->mailbox_length[0] && s->ado == st->mailbox_start[0] &&
-        sdo_transfer(sent, data_offset(s), s->length, 2, 1, &sd))
-        learn_object(st, sent, &sd, frame);
+        sdo_transfer(fp->sent_view, instance, FALSE, &sd))
+        learn_object(st, fp->sent, &sd, frame);
     if (reads_registers(s->cmd) && !writes_registers(s->cmd) && st->mailbox_length[1] && s->ado == st->mailbox_start[1] &&
-        sdo_transfer(back, data_offset(b), b->length, 3, 2, &sd))
-        learn_object(st, back, &sd, frame);
+        sdo_transfer(fp->back_view, instance, TRUE, &sd))
+        learn_object(st, fp->back, &sd, frame);
 }
 
 /* An AL status read (0x0130) showing another state than the last one. */
@@ -646,9 +655,10 @@ gboolean al_changed(slave_state *st, const datagram *b, tvbuff_t *back)
 }
 
 /* What one datagram pair teaches about the slave it addressed; its stat_flags. */
-guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagram *b, tvbuff_t *sent, tvbuff_t *back,
-                   guint32 frame, events *ev)
+guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagram *b, const frame_pair *fp,
+                   guint instance, guint32 frame, events *ev)
 {
+    tvbuff_t *sent = fp->sent, *back = fp->back;
     slave_state *st = slave_at(m, position);
     if (!st) return 0;
     guint8 flags = is_mailbox(st, s) ? ST_MAILBOX : 0;
@@ -670,7 +680,7 @@ guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagr
         learn_fmmus(m, st, s, sent);
         learn_mailboxes(st, s, sent);
     }
-    learn_coe(st, s, b, sent, back, frame);
+    learn_coe(st, s, fp, instance, frame);
     if (reads_registers(s->cmd) && !writes_registers(s->cmd)) {
         learn_sii_data(m, position, st, b, back, ev);
         if (al_changed(st, b, back)) flags |= ST_AL_CHANGE;
@@ -1244,9 +1254,10 @@ void bus_set_dc_drift(bus_frame *f, double drift) { f->timing.dc_drift = drift; 
 
 double bus_dc_drift(const bus_frame *f) { return f->shape->returned ? f->timing.dc_drift : NAN; }
 
-void bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
+void bus_returned(bus_model *m, const frame_pair *fp, const datagram *s, const datagram *b, guint n,
                   packet_info *pinfo, bus_frame *f)
 {
+    tvbuff_t *sent = fp->sent;
     /* Only what is used is set: zeroing every possible event and datagram
      * would cost more than the rest of a cyclic frame's work. */
     events ev;
@@ -1260,7 +1271,7 @@ void bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *
         if (s[i].cmd != b[i].cmd || s[i].ado != b[i].ado || s[i].length != b[i].length) continue;
         gint32 position = is_auto_increment(s[i].cmd) ? position_of(s[i].adp)
                           : is_configured(s[i].cmd) ? station_position(m, s[i].adp) : -1;
-        if (position >= 0) flags[i] = learn_slave(m, (guint)position, &s[i], &b[i], sent, back, pinfo->num, &ev);
+        if (position >= 0) flags[i] = learn_slave(m, (guint)position, &s[i], &b[i], fp, i, pinfo->num, &ev);
         if (b[i].wkc <= s[i].wkc) continue;
         guint added = (guint)(b[i].wkc - s[i].wkc);
         if (s[i].cmd == BRD) learn_count(m, added, &b[i], &ev);

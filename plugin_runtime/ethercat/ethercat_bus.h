@@ -14,7 +14,7 @@ namespace dg_ecat {
 
 /* The inputs of a frame's dg_view, by number (ethercat_inputs.h). */
 enum esc_input {
-#define DG_ESC_INPUT_ID(id, name, per_instance) id,
+#define DG_ESC_INPUT_ID(id, name, kind) id,
     DG_ESC_INPUTS(DG_ESC_INPUT_ID)
 #undef DG_ESC_INPUT_ID
 };
@@ -28,6 +28,13 @@ struct datagram {
     guint16 adp, ado;    /* the 32-bit address: ADP low half, ADO high half */
     guint16 length;      /* of the data */
     guint16 wkc;
+};
+
+/* A returned frame with the frame as sent: their bytes and what the walk
+ * decoded of each (their dg_views). */
+struct frame_pair {
+    tvbuff_t *sent, *back;
+    const dg_view *sent_view, *back_view;
 };
 
 /* A datagram ends with its data and a 2-byte working counter. */
@@ -77,7 +84,7 @@ void bus_sent(bus_model *m, const datagram *d, guint n, bus_frame *f);
 /* First pass. A returned frame with the frame as sent: what it teaches about
  * the bus, and which slave each datagram addresses, in *f. s and b are their
  * first n datagrams as frame_datagrams() gives them. */
-void bus_returned(bus_model *m, tvbuff_t *sent, tvbuff_t *back, const datagram *s, const datagram *b, guint n,
+void bus_returned(bus_model *m, const frame_pair *fp, const datagram *s, const datagram *b, guint n,
                   packet_info *pinfo, bus_frame *f);
 /* A sent frame's cycle (ethercat_cycles.h), kept with its slaves. */
 struct cycle_mark;

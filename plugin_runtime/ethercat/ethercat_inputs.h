@@ -5,16 +5,44 @@
  * dg_view with them in this order. The one list both sides read: the
  * generator includes it (generator/analyses.cpp) as the runtime does.
  *
- * X(id, name, per_instance): per_instance 1 is one value per datagram (the
- * instances of one repeated node), 0 one per frame. Plain C: no includes. */
+ * X(id, name, kind): DG_INPUT_PER_MESSAGE is one number per frame,
+ * DG_INPUT_PER_INSTANCE one per datagram (the instances of one repeated
+ * node), DG_INPUT_BYTES_PER_INSTANCE where a datagram's bytes of a field are
+ * (any leaf with bytes: the view gives their offset and length);
+ * DG_INPUT_OPTIONAL added: a rule file may leave it unbound. The SDO inputs
+ * are the CoE mailbox's download request (as the master writes it) and
+ * upload response (as it reads it back), from which the bus model learns
+ * the PDO assignment and mapping; without them it learns none (the ESI
+ * file's default PDOs stay). Plain C: no includes. */
 #pragma once
 
-#define DG_ESC_INPUTS(X)                       \
-    X(ESC_IN_FRAME_LENGTH, "frame length", 0)  \
-    X(ESC_IN_COMMAND, "command", 1)            \
-    X(ESC_IN_INDEX, "index", 1)                \
-    X(ESC_IN_ADP, "slave address", 1)          \
-    X(ESC_IN_ADO, "offset address", 1)         \
-    X(ESC_IN_LOGICAL, "logical address", 1)    \
-    X(ESC_IN_LENGTH, "length", 1)              \
-    X(ESC_IN_WKC, "working counter", 1)
+#define DG_INPUT_PER_MESSAGE 0
+#define DG_INPUT_PER_INSTANCE 1
+#define DG_INPUT_BYTES_PER_INSTANCE 3 /* per instance (bit 0), bytes (bit 1) */
+#define DG_INPUT_OPTIONAL 4
+#define DG_SDO_INPUT (DG_INPUT_PER_INSTANCE | DG_INPUT_OPTIONAL)
+#define DG_SDO_BYTES_INPUT (DG_INPUT_BYTES_PER_INSTANCE | DG_INPUT_OPTIONAL)
+
+#define DG_ESC_INPUTS(X)                                                               \
+    X(ESC_IN_FRAME_LENGTH, "frame length", DG_INPUT_PER_MESSAGE)                       \
+    X(ESC_IN_COMMAND, "command", DG_INPUT_PER_INSTANCE)                                \
+    X(ESC_IN_INDEX, "index", DG_INPUT_PER_INSTANCE)                                    \
+    X(ESC_IN_ADP, "slave address", DG_INPUT_PER_INSTANCE)                              \
+    X(ESC_IN_ADO, "offset address", DG_INPUT_PER_INSTANCE)                             \
+    X(ESC_IN_LOGICAL, "logical address", DG_INPUT_PER_INSTANCE)                        \
+    X(ESC_IN_LENGTH, "length", DG_INPUT_PER_INSTANCE)                                  \
+    X(ESC_IN_WKC, "working counter", DG_INPUT_PER_INSTANCE)                            \
+    X(ESC_IN_DOWNLOAD_COMMAND, "sdo download command", DG_SDO_INPUT)                   \
+    X(ESC_IN_DOWNLOAD_FLAGS, "sdo download flags", DG_SDO_INPUT)                       \
+    X(ESC_IN_DOWNLOAD_INDEX, "sdo download index", DG_SDO_INPUT)                       \
+    X(ESC_IN_DOWNLOAD_SUBINDEX, "sdo download subindex", DG_SDO_INPUT)                 \
+    X(ESC_IN_DOWNLOAD_EXPEDITED, "sdo download expedited data", DG_SDO_BYTES_INPUT)    \
+    X(ESC_IN_DOWNLOAD_SIZE, "sdo download size", DG_SDO_INPUT)                         \
+    X(ESC_IN_DOWNLOAD_DATA, "sdo download data", DG_SDO_BYTES_INPUT)                   \
+    X(ESC_IN_UPLOAD_COMMAND, "sdo upload command", DG_SDO_INPUT)                       \
+    X(ESC_IN_UPLOAD_FLAGS, "sdo upload flags", DG_SDO_INPUT)                           \
+    X(ESC_IN_UPLOAD_INDEX, "sdo upload index", DG_SDO_INPUT)                           \
+    X(ESC_IN_UPLOAD_SUBINDEX, "sdo upload subindex", DG_SDO_INPUT)                     \
+    X(ESC_IN_UPLOAD_EXPEDITED, "sdo upload expedited data", DG_SDO_BYTES_INPUT)        \
+    X(ESC_IN_UPLOAD_SIZE, "sdo upload size", DG_SDO_INPUT)                             \
+    X(ESC_IN_UPLOAD_DATA, "sdo upload data", DG_SDO_BYTES_INPUT)
