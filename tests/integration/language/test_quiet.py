@@ -319,6 +319,12 @@ def dates_guids_frames():
     return [m.frame(p) for p in payloads * 4]
 
 
+def learned_layout_frames():
+    """tests/rules/learned_layout.xml: test_learned_layout.py's mappings and process data."""
+    import test_learned_layout as m
+    return [m.frame(payload) for payload, _ in m.messages(random.Random(11), 120)]
+
+
 def learned_frames():
     """tests/rules/learned.xml: test_learned.py's configurations and data of two senders."""
     import test_learned as m
@@ -406,6 +412,7 @@ CAPTURES = {
     "tests/rules/dates_guids_shared.xml": dates_guids_frames,
     "tests/rules/bit_fields.xml": bit_fields_frames,
     "tests/rules/learned.xml": learned_frames,
+    "tests/rules/learned_layout.xml": learned_layout_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,
