@@ -972,7 +972,8 @@ bool needs_extra(const Node& n) {
            (n.is_leaf() && n.display == Display::DateTime && n.datetime_unit() != "s+ns") ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
            n.keeps_values || n.keeps_instances || n.is_computed() || n.has_unit_label() || n.is_overlay() ||
-           !n.findings.empty() || !n.learns.empty() || n.analysis_input >= 0 || n.cycle_role != 0;
+           !n.findings.empty() || !n.learns.empty() || n.analysis_input >= 0 || n.cycle_role != 0 ||
+           n.is_counted_list_of_no_bytes();
 }
 
 void Emitter::extra_table() {
@@ -996,6 +997,7 @@ std::string Emitter::extra_row(const Node& n) const {
         add("units_per_second", n.unit == "s" ? "1" : n.unit == "ms" ? "1000" : "1000000");
     if (n.display == Display::DateTime && n.datetime_unit() != "s+ns") add("time_encoding", datetime_encoding(n));
     if (n.repeat_rest) add("repeat_rest", "");
+    if (n.is_counted_list_of_no_bytes()) add("no_bytes", "");
     if (n.direction != Direction::Any)
         add("direction", n.direction == Direction::Request ? "DG_DIR_REQUEST" : "DG_DIR_RESPONSE");
     if (n.dissector) add("dissector", c_string(*n.dissector));

@@ -29,6 +29,14 @@ bool is_numeric_display(Display d) {
            d == Display::Enum || d == Display::Int || d == Display::Time;
 }
 
+bool Node::takes_no_bytes() const {
+    if (is_computed()) return true;
+    if (is_overlay() || is_leaf() || length_kind != LengthKind::Children) return false;
+    for (const auto& c : children)
+        if (!c->is_overlay() && !(c->takes_no_bytes() && !c->is_repeated())) return false;
+    return true;
+}
+
 bool Node::is_numeric() const {
     if (is_computed()) return display != Display::Float;
     if (!is_leaf()) return false;

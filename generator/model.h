@@ -247,6 +247,12 @@ struct Node {
     bool is_container() const { return !children.empty(); }
     bool is_leaf() const { return children.empty(); }
     bool is_repeated() const { return repeat.has_value() || count.has_value() || repeat_rest || offsets.has_value(); }
+    // An instance takes no bytes: computed values, overlays and containers of them
+    // only (a list of entries laid out by learned values over bytes decoded before).
+    bool takes_no_bytes() const;
+    // A counted list of such instances: the walk repeats it `count` times without
+    // moving (dg_extra.no_bytes).
+    bool is_counted_list_of_no_bytes() const { return count.has_value() && !repeat && !repeat_rest && takes_no_bytes(); }
     // Decoded only under a condition (if/in or ifhook): may take no bytes.
     bool is_conditional() const {
         return if_field.has_value() || has_hook || direction != Direction::Any || !whens.empty() || otherwise;

@@ -73,6 +73,7 @@ struct dg_extra_row {
     constexpr dg_extra_row &encoding(guint32 v) { e.encoding = v; return *this; }
     constexpr dg_extra_row &units_per_second(guint32 v) { e.units_per_second = v; return *this; }
     constexpr dg_extra_row &repeat_rest() { e.repeat_rest = 1; return *this; }
+    constexpr dg_extra_row &no_bytes() { e.no_bytes = 1; return *this; }
     constexpr dg_extra_row &direction(guint8 v) { e.direction = v; return *this; }
     constexpr dg_extra_row &dissector(const char *v) { e.dissector = v; return *this; }
     constexpr dg_extra_row &reassemble_id(gint16 slot) { e.reassemble_id = slot; return *this; }

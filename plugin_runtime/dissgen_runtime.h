@@ -72,6 +72,7 @@ typedef struct dg_extra {
     guint32 encoding;         /* string, stringz: ENC_ASCII or ENC_UTF_8 */
     guint32 units_per_second; /* time: 1000000000 (ns), 1000000 (us), 1000 (ms) or 1 (s) */
     guint8 repeat_rest;       /* repeat="rest": instances until the enclosing container ends */
+    guint8 no_bytes;          /* count: instances that take no bytes (computed values, overlays) */
     guint8 direction;         /* dg_direction */
     const char *dissector;    /* dissector="NAME": hand the bytes to it; NULL: none */
     gint16 reassemble_id;     /* slot of reassemble-id; -1: no reassembly */

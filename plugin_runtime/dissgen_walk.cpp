@@ -411,12 +411,25 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
 
 /* --- repetition ---------------------------------------------------------- */
 
+/* The most instances of a counted list whose instances take no bytes: the
+ * packet's size does not bound it, this does. */
+#define DG_MAX_INSTANCES_WITHOUT_BYTES 65535
+
 /* repeat: another instance while the flag is set; count: exactly N. Every
- * instance must consume bytes, which bounds the loop by the packet size. */
+ * instance must consume bytes, which bounds the loop by the packet size;
+ * a counted list whose instances take none (computed values and overlays,
+ * e.g. entries laid out by a learned mapping) is bounded by a limit. */
 void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary)
 {
     gint64 wanted = -1;
     if (n->count.slot >= 0 && !ref_value(st, &n->count, n, "count", tree, *offset, &wanted)) return;
+    const gboolean no_bytes = n->extra && n->extra->no_bytes;
+    if (no_bytes && wanted > DG_MAX_INSTANCES_WITHOUT_BYTES) {
+        report(st, tree, &st->p->ei->bad_length, *offset, 0,
+               "'%s' should occur %" G_GINT64_MODIFIER "d times; a list whose entries take no bytes has at most %d",
+               n->name, wanted, DG_MAX_INSTANCES_WITHOUT_BYTES);
+        return;
+    }
     if (n->extra && n->extra->keep_values) table_reset(st, n, *offset); /* a new table for this repetition */
     dg_summaries summaries;
     gboolean collect = summaries_begin(st, n, in_summary, &summaries);
@@ -424,7 +437,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     guint instances = 0;
     const guint32 outer_instance = st->instance;
     for (gint64 done = 0; wanted < 0 || done < wanted; done++) {
-        if (wanted >= 0 && *offset >= end) {
+        if (wanted >= 0 && *offset >= end && !no_bytes) {
             report(st, tree, &st->p->ei->count_short, *offset, 0,
                    "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after %" G_GINT64_MODIFIER "d",
                    n->name, wanted, done);
@@ -437,7 +450,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
         st->instance = instances;
         dissect_instance(st, n, tree, offset, end, in_summary, collect ? &summaries : NULL);
         instances++;
-        if (st->stopped || *offset == before) break;
+        if (st->stopped || (*offset == before && !no_bytes)) break;
         if (n->repeat_slot >= 0) {
             const dg_slot *flag = &st->slots[n->repeat_slot];
             if (!st->present[n->repeat_slot] || flag->value == 0) break;

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Process data laid out by a mapping learned from earlier frames, with real tshark:
-tests/rules/learned_layout.xml on ethertype 0x88c2.
+tests/rules/learned_layout.xml on ethertype 0x88c2 (and tests/rules/entry_list.xml: a counted
+list whose entries take no bytes, as a layout over bytes decoded before it is).
 
 Map messages write one subindex of a node's mapping (subindex 0: the number of
 entries; k: the k-th entry's object, size in bytes and sign), as POWERLINK's and
@@ -182,6 +183,39 @@ class TestLearnedLayout(TsharkTestCase, unittest.TestCase):
         laid_out = sum(1 for w in want.values() if w["count"] not in ("", "0"))
         self.assertGreater(laid_out, 100, "enough Data frames laid out by a learned mapping")
         self.assertGreater(sum(1 for w in want.values() if w["not_mapped"]), 5)
+
+
+class TestEntryList(TsharkTestCase, unittest.TestCase):
+    """tests/rules/entry_list.xml: a counted list whose entries take no bytes (computed values
+    and an overlay) repeats exactly `Count` times where the message's bytes end, without a
+    count_short; a count above 65535 is bad_length there, and the frames after it decode."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "entry_list.xml"), "elist")
+
+    def test_counts(self):
+        rng = random.Random(3)
+        counts = [3, 0, 20, 70000, 1, 65535]
+        tables = [bytes(rng.randrange(256) for _ in range(8)) for _ in counts]
+        frames = [b"\x02\0\0\0\0\xff\x02\0\0\0\0\x01" + struct.pack("!H", 0x88C3) + struct.pack("<I", c) + t
+                  for c, t in zip(counts, tables)]  # 26 bytes: the message ends with its table
+        path = self.env.add_file("entry_list.pcap", raw_pcap_bytes(frames))
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = self.env.field_rows(path, ["frame.number", "elist.entry.number", "elist.entry.byte",
+                                                  "elist.expert.bad_length", "elist.expert.count_short"], two_pass)
+                for n, (count, table) in enumerate(zip(counts, tables), 1):
+                    row = rows[n]
+                    shown = min(count, 65535) if count <= 65535 else 0
+                    want_bytes = ["0x%02x" % table[i % 8] for i in range(shown)]
+                    check(row["elist.entry.number"] == [str(i + 1) for i in range(shown)] and
+                          row["elist.entry.byte"] == want_bytes,
+                          "frame %d (%s): %d entries, each its byte of the table" % (
+                              n, "-2" if two_pass else "one pass", shown))
+                    check(bool(row["elist.expert.bad_length"]) == (count > 65535) and
+                          not row["elist.expert.count_short"],
+                          "frame %d: bad_length only for a count above 65535, never count_short" % n)
 
 
 if __name__ == "__main__":

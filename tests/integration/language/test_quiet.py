@@ -325,6 +325,12 @@ def learned_layout_frames():
     return [m.frame(payload) for payload, _ in m.messages(random.Random(11), 120)]
 
 
+def entry_list_frames():
+    """tests/rules/entry_list.xml: counted lists of entries that take no bytes, one too long."""
+    header = b"\x02\0\0\0\0\xff\x02\0\0\0\0\x01" + struct.pack("!H", 0x88C3)
+    return [header + struct.pack("<I", c) + bytes(range(8)) for c in (0, 1, 5, 20, 70000, 3)]
+
+
 def learned_frames():
     """tests/rules/learned.xml: test_learned.py's configurations and data of two senders."""
     import test_learned as m
@@ -413,6 +419,7 @@ CAPTURES = {
     "tests/rules/bit_fields.xml": bit_fields_frames,
     "tests/rules/learned.xml": learned_frames,
     "tests/rules/learned_layout.xml": learned_layout_frames,
+    "tests/rules/entry_list.xml": entry_list_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,
