@@ -183,3 +183,81 @@ def cycle(rng, cycles=40, period_ns=400_000, nodes=(1, 2, 3), jitter_ns=2_000, d
             packets.append((t_res, ethernet(PRES, node, pres(rng, node))))
         packets.append((t + 10_000 + len(nodes) * 40_000, ethernet(SOA, MN, soa(rng))))
     return packets, truth
+
+
+def sdo_write(dest, index, subindex, data, transaction):
+    """An MN's expedited SDO Write by Index request (over ASnd) to node `dest`."""
+    sequence = bytes([(transaction & 63) << 2 | 2, (transaction & 63) << 2 | 2, 0, 0])  # connection valid
+    payload = struct.pack("<HBB", index, subindex, 0) + data
+    command = bytes([0, transaction & 0xFF, 0, 0x01]) + struct.pack("<HH", len(payload), 0)
+    return ethernet(ASND, MN, header(ASND, dest, MN) + bytes([SDO]) + sequence + command + payload)
+
+
+def mapping_entry(index, subindex, offset_bits, length_bits):
+    """An object mapping entry (DS 301: index, subindex, reserved, offset and length in bits)."""
+    return struct.pack("<HBBHH", index, subindex, 0, offset_bits, length_bits)
+
+
+def pdo_frame(kind, node, payload):
+    """A PReq to `node` or a PRes from it carrying `payload`."""
+    if kind == PREQ:
+        return ethernet(PREQ, MN, header(PREQ, node, MN) + bytes(5) + struct.pack("<H", len(payload)) + payload)
+    return ethernet(PRES, node, header(PRES, BROADCAST, node) + bytes([0xFD, 0, 0, 0, 0]) +
+                    struct.pack("<H", len(payload)) + payload)
+
+
+def random_layout(rng, bit_granular):
+    """[(index, subindex, offset bits, length bits)], the entries packed one after another:
+    8, 16 or 32 bits each (byte-aligned), or 1 to 32 bits anywhere (bit_granular)."""
+    entries, at = [], 0
+    for _ in range(rng.randrange(1, 6)):
+        length = rng.randrange(1, 33) if bit_granular else rng.choice([8, 16, 32])
+        entries.append((rng.randrange(0x2000, 0x7000), rng.randrange(256), at, length))
+        at += length
+    return entries
+
+
+def mapped_traffic(rng, bit_granular=False, nodes=(1, 2, 3, 4), unmapped=(7, 9), rounds=25):
+    """SDO writes that map each node's receive (0x1600) and transmit (0x1A00) PDO as DS 301
+    says (subindex 0 to 0, the entries, subindex 0 to their count), then PReq/PRes rounds whose
+    payloads follow those layouts; node 2's transmit PDO is mapped anew halfway. Nodes in
+    `unmapped` send and get payloads whose mapping is never written.
+    Returns (frames, truth): truth[frame number] for each PReq and PRes is
+    {"entries": [(index, subindex, value)] or None (not mapped), "note": whether it is the
+    node's first of its kind without a mapping (and carries data)}."""
+    frames, truth, layouts, noted = [], {}, {}, set()
+    transaction = [0]
+
+    def write_mapping(node, obj, layout):
+        for sub, data in [(0, bytes([0]))] + [(k + 1, mapping_entry(*e)) for k, e in enumerate(layout)] + \
+                [(0, bytes([len(layout)]))]:
+            transaction[0] += 1
+            frames.append(sdo_write(node, obj, sub, data, transaction[0]))
+        layouts[(node, obj)] = layout
+
+    def send(kind, node):
+        layout = layouts.get((node, 0x1600 if kind == PREQ else 0x1A00))
+        if layout is None:
+            payload = rand_bytes(rng, rng.randrange(9, 17))  # (epl guesses a number in up to 8 bytes)
+            note = (kind, node) not in noted
+            noted.add((kind, node))
+            frames.append(pdo_frame(kind, node, payload))
+            truth[len(frames)] = {"entries": None, "note": note}
+            return
+        bits = max(offset + length for _, _, offset, length in layout)
+        payload = rand_bytes(rng, (bits + 7) // 8)
+        number = int.from_bytes(payload, "little")
+        entries = [(index, sub, number >> offset & ((1 << length) - 1)) for index, sub, offset, length in layout]
+        frames.append(pdo_frame(kind, node, payload))
+        truth[len(frames)] = {"entries": entries, "note": False}
+
+    for node in nodes:
+        for obj in (0x1600, 0x1A00):
+            write_mapping(node, obj, random_layout(rng, bit_granular))
+    for r in range(rounds):
+        if r == rounds // 2:
+            write_mapping(2, 0x1A00, random_layout(rng, bit_granular))
+        for node in nodes + unmapped:
+            send(PREQ, node)
+            send(PRES, node)
+    return frames, truth
