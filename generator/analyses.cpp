@@ -9,7 +9,8 @@ namespace {
 
 // What the analysis called `name` reads from each message, in its dg_view's order.
 std::vector<AnalysisInputSpec> inputs_of(const std::string& name) {
-#define DG_INPUT_SPEC(id, input, kind) {input, ((kind) & 1) != 0, ((kind) & 2) != 0, ((kind) & 4) != 0},
+#define DG_INPUT_SPEC(id, input, kind) \
+    {input, ((kind) & DG_INPUT_PER_INSTANCE) != 0, ((kind) & DG_INPUT_BYTES) != 0, ((kind) & DG_INPUT_OPTIONAL) != 0},
     if (name == "ethercat-esc") return {DG_ESC_INPUTS(DG_INPUT_SPEC)};
 #undef DG_INPUT_SPEC
     return {};

@@ -29,6 +29,11 @@ bool is_numeric_display(Display d) {
            d == Display::Enum || d == Display::Int || d == Display::Time;
 }
 
+bool Node::is_number_sized_by_field() const {
+    return is_leaf() && !is_computed() && length_kind == LengthKind::Field && display != Display::Time &&
+           is_numeric_display(display);
+}
+
 bool Node::takes_no_bytes() const {
     if (is_computed()) return true;
     if (is_overlay() || is_leaf() || length_kind != LengthKind::Children) return false;
@@ -39,10 +44,8 @@ bool Node::takes_no_bytes() const {
 
 bool Node::is_numeric() const {
     if (is_computed()) return display != Display::Float;
-    if (!is_leaf()) return false;
-    // a number of 1-8 bytes, its length from a field (validator: check_leaf_display)
-    if (length_kind == LengthKind::Field) return is_numeric_display(display) && display != Display::Time;
-    if (!has_fixed_length()) return false;
+    if (is_number_sized_by_field()) return true;
+    if (!is_leaf() || !has_fixed_length()) return false;
     if (fixed_bits < 1 || fixed_bits > 64) return false;
     return is_numeric_display(display) || display == Display::NonDisplay;
 }

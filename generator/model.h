@@ -247,6 +247,9 @@ struct Node {
     bool is_container() const { return !children.empty(); }
     bool is_leaf() const { return children.empty(); }
     bool is_repeated() const { return repeat.has_value() || count.has_value() || repeat_rest || offsets.has_value(); }
+    // A number whose length comes from a field: 1-8 bytes read at run time as 64 bits
+    // (a PDO entry laid out by a learned mapping). A time needs a fixed length.
+    bool is_number_sized_by_field() const;
     // An instance takes no bytes: computed values, overlays and containers of them
     // only (a list of entries laid out by learned values over bytes decoded before).
     bool takes_no_bytes() const;

@@ -36,6 +36,13 @@ bool is_ancestor_or_self(const Node* ancestor, const Node* n) {
     return false;
 }
 
+// Whether n or a node around it is repeated: `index` has an instance to count.
+bool inside_repeat(const Node& n) {
+    for (const Node* r = &n; r; r = r->parent)
+        if (r->is_repeated()) return true;
+    return false;
+}
+
 // A Wireshark dissector table or heuristic list name: [a-z0-9._]+
 bool is_table_name(const std::string& table) {
     bool ok = !table.empty();
@@ -265,10 +272,7 @@ void Validator::check_leaf_display(Node& n) {
         diags_.warning(n.line, "leaf " + quote(n) + " has no length and no children: it takes no bytes");
     if (!n.display_given) n.display = Display::Origin;
     bool numeric = is_numeric_display(n.display);
-    // A number whose length comes from a field (a PDO entry laid out by a
-    // learned mapping) is read from its 1-8 bytes at run time, as 64 bits.
-    const bool sized_by_field = n.length_kind == LengthKind::Field && n.display != Display::Time;
-    if (numeric && sized_by_field) {
+    if (n.is_number_sized_by_field()) {
         n.bits = 64;
     } else if (numeric) {
         if (!n.has_fixed_length())
@@ -945,9 +949,7 @@ bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
     case ExprOp::Int: return true;
     case ExprOp::Float: e.is_float = true; return true;
     case ExprOp::Index:
-        if (at.at_reader) return true;
-        for (const Node* r = &n; r; r = r->parent)
-            if (r->is_repeated()) return true;
+        if (at.at_reader || inside_repeat(n)) return true;
         diags_.error(at.line, "'index'" + in + ": it is not inside a repeated node, so there is no instance to count");
         return false;
     case ExprOp::RequestField: return check_request_field(n, e);
@@ -1972,13 +1974,9 @@ void Validator::check_lookups_at_readers() {
         const std::string head = "learned{" + read.learn->name + "}" + read.in + ": the lookup of its key on line ";
         std::function<void(const Expr&, int)> visit = [&](const Expr& e, int key_line) {
             for (const Expr& a : e.args) visit(a, key_line);
-            if (e.op == ExprOp::Index) {
-                const Node* r = &reader;
-                while (r && !r->is_repeated()) r = r->parent;
-                if (!r)
-                    diags_.error(read.line, head + std::to_string(key_line) + " reads 'index', and " + quote(reader) +
-                                                " is not inside a repeated node, so there is no instance to count");
-            }
+            if (e.op == ExprOp::Index && !inside_repeat(reader))
+                diags_.error(read.line, head + std::to_string(key_line) + " reads 'index', and " + quote(reader) +
+                                            " is not inside a repeated node, so there is no instance to count");
             if (e.op != ExprOp::Field || !e.target) return;
             const Node* t = e.target;
             for (const Node* r = t; r; r = r->parent) {

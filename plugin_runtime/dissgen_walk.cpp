@@ -14,6 +14,7 @@
 
 #include <epan/proto_data.h>
 #include <epan/tap.h>
+#include <wsutil/sign_ext.h>
 
 #include <string.h>
 
@@ -145,10 +146,7 @@ void decode_sized_number(dg_state *st, const dg_node *n, proto_tree *tree, gint 
         return;
     }
     guint64 value = read_uint(st->tvb, offset, (guint)len, encoding_of(n));
-    if (n->show == DG_SHOW_INT && len < 8) {
-        const guint64 sign = G_GUINT64_CONSTANT(1) << (len * 8 - 1);
-        value = (value ^ sign) - sign;
-    }
+    if (n->show == DG_SHOW_INT) value = ws_sign_ext64(value, len * 8);
     if (tree) {
         proto_item *item;
         switch (n->show) {

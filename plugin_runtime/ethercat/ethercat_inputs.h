@@ -8,18 +8,20 @@
  * X(id, name, kind): DG_INPUT_PER_MESSAGE is one number per frame,
  * DG_INPUT_PER_INSTANCE one per datagram (the instances of one repeated
  * node), DG_INPUT_BYTES_PER_INSTANCE where a datagram's bytes of a field are
- * (any leaf with bytes: the view gives their offset and length);
- * DG_INPUT_OPTIONAL added: a rule file may leave it unbound. The SDO inputs
+ * (any leaf with bytes: the view gives their offset and length); with
+ * DG_INPUT_OPTIONAL a rule file may leave the input unbound. The SDO inputs
  * are the CoE mailbox's download request (as the master writes it) and
  * upload response (as it reads it back), from which the bus model learns
  * the PDO assignment and mapping; without them it learns none (the ESI
  * file's default PDOs stay). Plain C: no includes. */
 #pragma once
 
+/* the kinds are bits: one per instance, bytes, optional */
 #define DG_INPUT_PER_MESSAGE 0
 #define DG_INPUT_PER_INSTANCE 1
-#define DG_INPUT_BYTES_PER_INSTANCE 3 /* per instance (bit 0), bytes (bit 1) */
+#define DG_INPUT_BYTES 2
 #define DG_INPUT_OPTIONAL 4
+#define DG_INPUT_BYTES_PER_INSTANCE (DG_INPUT_PER_INSTANCE | DG_INPUT_BYTES)
 #define DG_SDO_INPUT (DG_INPUT_PER_INSTANCE | DG_INPUT_OPTIONAL)
 #define DG_SDO_BYTES_INPUT (DG_INPUT_BYTES_PER_INSTANCE | DG_INPUT_OPTIONAL)
 

@@ -108,8 +108,7 @@ def messages(rng, count, nodes=(1, 2, 3)):
                 size = rng.choice([1, 2, 3, 4, 5, 6, 7, 8, 2, 4])
                 message = (1, node, rng.randrange(1, 5), rng.randrange(0x1000, 0x10000), rng.randrange(256), size,
                            rng.randrange(2))
-            out.append((map_count(*message[1:3 + 1][0:1], message[3]) if message[2] == 0 else
-                        map_entry(*message[1:]), None))
+            out.append((map_count(node, message[3]) if message[2] == 0 else map_entry(*message[1:]), None))
             model.teach(message)
             continue
         layout = model.layout(node)
