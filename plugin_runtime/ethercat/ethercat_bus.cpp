@@ -507,12 +507,14 @@ gboolean is_mailbox(const slave_state *st, const datagram *d)
 /* --- PDO assignment and mapping over CoE ---------------------------------- */
 
 /* The SDO transfer of a frame's datagram `instance` as the walk decoded its
- * CoE mailbox (the view's sdo inputs): a download request (command
- * specifier 1) as the master writes it to SyncManager 0, or an upload
- * response (specifier 2) the master reads from SyncManager 1. Expedited
- * transfers carry up to 4 bytes in the header, normal ones a size and the
- * data after it; one whose size is more than the mailbox holds continues in
- * segments, which are not followed (nothing is learnt from it). */
+ * CoE mailbox (the view's sdo inputs): an initiate download request as the
+ * master writes it to SyncManager 0, or an initiate upload response the
+ * master reads from SyncManager 1. The rules decode the command byte's bits
+ * of those two commands alone, so their presence says which command it is;
+ * its expedited data is there when the command says so. Expedited transfers
+ * carry up to 4 bytes in the header, normal ones a size and the data after
+ * it; one whose size is more than the mailbox holds continues in segments,
+ * which are not followed (nothing is learnt from it). */
 struct sdo_data {
     guint16 index;
     guint8 subindex;
@@ -521,33 +523,41 @@ struct sdo_data {
     guint32 length;
 };
 
-/* The seven sdo inputs of a download and of an upload, in this order (ethercat_inputs.h). */
-enum sdo_input { SDO_COMMAND, SDO_FLAGS, SDO_INDEX, SDO_SUBINDEX, SDO_EXPEDITED, SDO_SIZE, SDO_DATA, SDO_INPUTS };
-G_STATIC_ASSERT(ESC_IN_DOWNLOAD_DATA - ESC_IN_DOWNLOAD_COMMAND == SDO_DATA);
-G_STATIC_ASSERT(ESC_IN_UPLOAD_DATA - ESC_IN_UPLOAD_COMMAND == SDO_DATA);
+/* The eight sdo inputs of a download and of an upload, in this order (ethercat_inputs.h). */
+enum sdo_input {
+    SDO_SIZE_INDICATED,
+    SDO_UNUSED_BYTES,
+    SDO_COMPLETE_ACCESS,
+    SDO_INDEX,
+    SDO_SUBINDEX,
+    SDO_EXPEDITED,
+    SDO_SIZE,
+    SDO_DATA,
+    SDO_INPUTS
+};
+G_STATIC_ASSERT(ESC_IN_DOWNLOAD_DATA - ESC_IN_DOWNLOAD_SIZE_INDICATED == SDO_DATA);
+G_STATIC_ASSERT(ESC_IN_UPLOAD_DATA - ESC_IN_UPLOAD_SIZE_INDICATED == SDO_DATA);
 
 gboolean sdo_transfer(const dg_view *view, guint instance, gboolean upload, sdo_data *out)
 {
-    const guint first = upload ? ESC_IN_UPLOAD_COMMAND : ESC_IN_DOWNLOAD_COMMAND;
+    const guint first = upload ? ESC_IN_UPLOAD_SIZE_INDICATED : ESC_IN_DOWNLOAD_SIZE_INDICATED;
     const dg_view_value *in[SDO_INPUTS] = {};
     for (guint i = 0; view && i < view->count; i++) {
         const dg_view_value *x = &view->values[i];
         if (x->instance == instance && x->input >= first && x->input < first + SDO_INPUTS) in[x->input - first] = x;
     }
-    if (!in[SDO_COMMAND] || in[SDO_COMMAND]->value != (upload ? 2u : 1u) || !in[SDO_FLAGS] || !in[SDO_INDEX] ||
-        !in[SDO_SUBINDEX])
-        return FALSE;
-    const guint flags = (guint)in[SDO_FLAGS]->value; /* size indicated, expedited, unused bytes (2), complete access */
+    if (!in[SDO_SIZE_INDICATED] || !in[SDO_COMPLETE_ACCESS] || !in[SDO_INDEX] || !in[SDO_SUBINDEX]) return FALSE;
+    const gboolean size_indicated = in[SDO_SIZE_INDICATED]->value != 0;
     out->index = (guint16)in[SDO_INDEX]->value;
     out->subindex = (guint8)in[SDO_SUBINDEX]->value;
-    out->complete_access = (flags & 0x10) != 0;
-    if (flags & 0x02) { /* expedited: 4 - n bytes when the size is indicated */
-        if (!in[SDO_EXPEDITED]) return FALSE;
+    out->complete_access = in[SDO_COMPLETE_ACCESS]->value != 0;
+    if (in[SDO_EXPEDITED]) { /* 4 - unused bytes when the size is indicated */
+        if (size_indicated && !in[SDO_UNUSED_BYTES]) return FALSE;
         out->offset = in[SDO_EXPEDITED]->offset;
-        out->length = (flags & 0x01) ? 4u - (flags >> 2 & 3u) : 4u;
+        out->length = size_indicated ? 4u - (guint32)MIN(in[SDO_UNUSED_BYTES]->value, 4u) : 4u;
         return TRUE;
     }
-    if (!(flags & 0x01) || !in[SDO_SIZE] || !in[SDO_DATA]) return FALSE;
+    if (!size_indicated || !in[SDO_SIZE] || !in[SDO_DATA]) return FALSE;
     if (in[SDO_SIZE]->value > in[SDO_DATA]->length) return FALSE; /* segmented */
     out->offset = in[SDO_DATA]->offset;
     out->length = (guint32)in[SDO_SIZE]->value;

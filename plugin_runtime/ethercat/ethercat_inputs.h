@@ -10,9 +10,9 @@
  * node), DG_INPUT_BYTES_PER_INSTANCE where a datagram's bytes of a field are
  * (any leaf with bytes: the view gives their offset and length); with
  * DG_INPUT_OPTIONAL a rule file may leave the input unbound. The SDO inputs
- * are the CoE mailbox's download request (as the master writes it) and
- * upload response (as it reads it back), from which the bus model learns
- * the PDO assignment and mapping; without them it learns none (the ESI
+ * are the CoE mailbox's initiate download request (as the master writes it)
+ * and initiate upload response (as it reads it back), from which the bus model
+ * learns the PDO assignment and mapping; without them it learns none (the ESI
  * file's default PDOs stay). Plain C: no includes. */
 #pragma once
 
@@ -25,26 +25,28 @@
 #define DG_SDO_INPUT (DG_INPUT_PER_INSTANCE | DG_INPUT_OPTIONAL)
 #define DG_SDO_BYTES_INPUT (DG_INPUT_BYTES_PER_INSTANCE | DG_INPUT_OPTIONAL)
 
-#define DG_ESC_INPUTS(X)                                                               \
-    X(ESC_IN_FRAME_LENGTH, "frame length", DG_INPUT_PER_MESSAGE)                       \
-    X(ESC_IN_COMMAND, "command", DG_INPUT_PER_INSTANCE)                                \
-    X(ESC_IN_INDEX, "index", DG_INPUT_PER_INSTANCE)                                    \
-    X(ESC_IN_ADP, "slave address", DG_INPUT_PER_INSTANCE)                              \
-    X(ESC_IN_ADO, "offset address", DG_INPUT_PER_INSTANCE)                             \
-    X(ESC_IN_LOGICAL, "logical address", DG_INPUT_PER_INSTANCE)                        \
-    X(ESC_IN_LENGTH, "length", DG_INPUT_PER_INSTANCE)                                  \
-    X(ESC_IN_WKC, "working counter", DG_INPUT_PER_INSTANCE)                            \
-    X(ESC_IN_DOWNLOAD_COMMAND, "sdo download command", DG_SDO_INPUT)                   \
-    X(ESC_IN_DOWNLOAD_FLAGS, "sdo download flags", DG_SDO_INPUT)                       \
-    X(ESC_IN_DOWNLOAD_INDEX, "sdo download index", DG_SDO_INPUT)                       \
-    X(ESC_IN_DOWNLOAD_SUBINDEX, "sdo download subindex", DG_SDO_INPUT)                 \
-    X(ESC_IN_DOWNLOAD_EXPEDITED, "sdo download expedited data", DG_SDO_BYTES_INPUT)    \
-    X(ESC_IN_DOWNLOAD_SIZE, "sdo download size", DG_SDO_INPUT)                         \
-    X(ESC_IN_DOWNLOAD_DATA, "sdo download data", DG_SDO_BYTES_INPUT)                   \
-    X(ESC_IN_UPLOAD_COMMAND, "sdo upload command", DG_SDO_INPUT)                       \
-    X(ESC_IN_UPLOAD_FLAGS, "sdo upload flags", DG_SDO_INPUT)                           \
-    X(ESC_IN_UPLOAD_INDEX, "sdo upload index", DG_SDO_INPUT)                           \
-    X(ESC_IN_UPLOAD_SUBINDEX, "sdo upload subindex", DG_SDO_INPUT)                     \
-    X(ESC_IN_UPLOAD_EXPEDITED, "sdo upload expedited data", DG_SDO_BYTES_INPUT)        \
-    X(ESC_IN_UPLOAD_SIZE, "sdo upload size", DG_SDO_INPUT)                             \
+#define DG_ESC_INPUTS(X)                                                             \
+    X(ESC_IN_FRAME_LENGTH, "frame length", DG_INPUT_PER_MESSAGE)                     \
+    X(ESC_IN_COMMAND, "command", DG_INPUT_PER_INSTANCE)                              \
+    X(ESC_IN_INDEX, "index", DG_INPUT_PER_INSTANCE)                                  \
+    X(ESC_IN_ADP, "slave address", DG_INPUT_PER_INSTANCE)                            \
+    X(ESC_IN_ADO, "offset address", DG_INPUT_PER_INSTANCE)                           \
+    X(ESC_IN_LOGICAL, "logical address", DG_INPUT_PER_INSTANCE)                      \
+    X(ESC_IN_LENGTH, "length", DG_INPUT_PER_INSTANCE)                                \
+    X(ESC_IN_WKC, "working counter", DG_INPUT_PER_INSTANCE)                          \
+    X(ESC_IN_DOWNLOAD_SIZE_INDICATED, "sdo download size indicated", DG_SDO_INPUT)   \
+    X(ESC_IN_DOWNLOAD_UNUSED_BYTES, "sdo download unused bytes", DG_SDO_INPUT)       \
+    X(ESC_IN_DOWNLOAD_COMPLETE_ACCESS, "sdo download complete access", DG_SDO_INPUT) \
+    X(ESC_IN_DOWNLOAD_INDEX, "sdo download index", DG_SDO_INPUT)                     \
+    X(ESC_IN_DOWNLOAD_SUBINDEX, "sdo download subindex", DG_SDO_INPUT)               \
+    X(ESC_IN_DOWNLOAD_EXPEDITED, "sdo download expedited data", DG_SDO_BYTES_INPUT)  \
+    X(ESC_IN_DOWNLOAD_SIZE, "sdo download size", DG_SDO_INPUT)                       \
+    X(ESC_IN_DOWNLOAD_DATA, "sdo download data", DG_SDO_BYTES_INPUT)                 \
+    X(ESC_IN_UPLOAD_SIZE_INDICATED, "sdo upload size indicated", DG_SDO_INPUT)       \
+    X(ESC_IN_UPLOAD_UNUSED_BYTES, "sdo upload unused bytes", DG_SDO_INPUT)           \
+    X(ESC_IN_UPLOAD_COMPLETE_ACCESS, "sdo upload complete access", DG_SDO_INPUT)     \
+    X(ESC_IN_UPLOAD_INDEX, "sdo upload index", DG_SDO_INPUT)                         \
+    X(ESC_IN_UPLOAD_SUBINDEX, "sdo upload subindex", DG_SDO_INPUT)                   \
+    X(ESC_IN_UPLOAD_EXPEDITED, "sdo upload expedited data", DG_SDO_BYTES_INPUT)      \
+    X(ESC_IN_UPLOAD_SIZE, "sdo upload size", DG_SDO_INPUT)                           \
     X(ESC_IN_UPLOAD_DATA, "sdo upload data", DG_SDO_BYTES_INPUT)
