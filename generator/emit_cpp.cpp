@@ -1051,12 +1051,13 @@ std::optional<FieldType> typed_field_type(const Node& n) {
     }
 }
 
-// A computed value: 64 bits, signed unless shown in hex or as a name.
+// A computed value: 64 bits (a hex one as wide as its mask), signed unless
+// shown in hex or as a name.
 FieldType computed_field_type(const Node& n) {
     switch (n.display) {
         case Display::Float: return {"FT_DOUBLE", "BASE_NONE", 0};
         case Display::Bool: return {"FT_BOOLEAN", "BASE_NONE", 0};
-        case Display::NumberHex: return {"FT_UINT64", "BASE_HEX", 0};
+        case Display::NumberHex: return {"FT_UINT" + std::to_string(n.bits), "BASE_HEX", 0};
         case Display::Enum: return {"FT_UINT64", "BASE_HEX|BASE_VAL64_STRING", 0};
         default: return {"FT_INT64", "BASE_DEC", 0};
     }

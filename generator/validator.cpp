@@ -930,7 +930,8 @@ void Validator::check_computed(Node& n) {
                                  "; a computed value is shown as numberdec, numberhex, int, bool, enum, float or "
                                  "nondisplay");
     }
-    n.bits = 64;
+    // A hex value masked to 16 bits is a 16-bit field: 0x6000, not 0x0000000000006000.
+    n.bits = n.display == Display::NumberHex ? expr_value_bits(*n.value) : 64;
 }
 
 // Resolves the fields of an expression, checks that index has a repeat to

@@ -134,6 +134,24 @@ TEST(FieldType, EveryDisplayTypeOnWholeBytes) {
     expect_type(p, "box", "FT_NONE", "BASE_NONE");
 }
 
+TEST(FieldType, ComputedHexIsAsWideAsItsMask) {
+    Front f = front_end(rules("  <node name=\"raw\" length=\"8byte\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"lo8\" value=\"{raw} &amp; 0xFF\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"mid16\" value=\"0x1FF &amp; {raw} &gt;&gt; 16\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"lo32\" value=\"{raw} &amp; 0xFFFFFFFF\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"wide\" value=\"{raw} &amp; 0x1FFFFFFFF\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"sum\" value=\"({raw} &amp; 0xFF) + 1\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"dec\" value=\"{raw} &amp; 0xFF\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Protocol& p = *f.proto;
+    expect_type(p, "lo8", "FT_UINT8", "BASE_HEX");
+    expect_type(p, "mid16", "FT_UINT16", "BASE_HEX");
+    expect_type(p, "lo32", "FT_UINT32", "BASE_HEX");
+    expect_type(p, "wide", "FT_UINT64", "BASE_HEX");
+    expect_type(p, "sum", "FT_UINT64", "BASE_HEX");
+    expect_type(p, "dec", "FT_INT64", "BASE_DEC");
+}
+
 TEST(FieldType, EnumsOfFiveToEightBytesUseVal64) {
     Front f = front_end(rules("  <node name=\"e40\" length=\"5byte\" displaytype=\"enum\"><enum value=\"0xffffffffff\" name=\"max\"/></node>\n"
                               "  <node name=\"e48\" length=\"6byte\" displaytype=\"enum\"/>\n"

@@ -8,7 +8,7 @@ count is odd). Every computed field is
 computed again here from the bytes, with C's rules (integer division
 truncates, 64-bit wrapping), and compared with what tshark shows, in one pass
 and with -2: reals, booleans, hex, enums, signed values, the instance index,
-an undefined value (division by zero: no item), a computed length, a summary.
+a hex value as wide as its mask, an undefined value (division by zero: no item), a computed length, a summary.
 Needs no corpus.
 
     test_computed.py --dissgen build/bin/dissgen --source-dir .
@@ -27,7 +27,7 @@ from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 
 ARGS = None
 ETHERTYPE = 0x88B6
-FIELDS = ["frame.number", "calc.temperature", "calc.alarm", "calc.mixed", "calc.kind", "calc.ratio",
+FIELDS = ["frame.number", "calc.temperature", "calc.alarm", "calc.mixed", "calc.high_byte", "calc.kind", "calc.ratio",
           "calc.negated", "calc.secret", "calc.registers.register", "calc.registers.flags.flag_index", "calc.tail_bytes", "calc.tail",
           "_ws.col.Info"]
 
@@ -61,6 +61,7 @@ def expected(start, count, raw, values):
         "calc.temperature": raw * 0.1 - 40,
         "calc.alarm": "1" if raw > 900 or count == 0 else "0",
         "calc.mixed": "0x%016x" % ((((start << 4) | count) & 0xFFFF) ^ 0x5A),
+        "calc.high_byte": "0x%02x" % (start >> 8),  # masked to 8 bits: an 8-bit field
         "calc.kind": str(count % 3),
         "calc.ratio": None if count == 2 else str(c_div(start, count - 2)),
         "calc.negated": str(-start + -1 + (0 if count else 1)),
