@@ -27,6 +27,7 @@
 #include "dissgen_label.h"
 
 #include <epan/expert.h>
+#include <wsutil/sign_ext.h>
 
 #include <math.h>
 #include <string.h>
@@ -866,8 +867,7 @@ void show_entry(proto_tree *tree, const dg_pdo_entry *e, tvbuff_t *tvb, gint dat
     header_field_info *hfi = proto_registrar_get_nth(*e->hf);
     if (!hfi) return;
     /* A switch on the type, not the IS_FT_* macros: Wireshark 4.4 renamed those. */
-    guint64 sign = G_GUINT64_CONSTANT(1) << (e->bit_length - 1);
-    gint64 value = (gint64)((v ^ sign) - sign);
+    gint64 value = (gint64)ws_sign_ext64(v, (int)e->bit_length);
     switch (hfi->type) {
     case FT_BOOLEAN: proto_tree_add_boolean(tree, *e->hf, tvb, offset, bytes, v ? 1 : 0); break;
     case FT_UINT8: case FT_UINT16: case FT_UINT24: case FT_UINT32:
