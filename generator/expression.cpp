@@ -40,7 +40,7 @@ public:
 
     bool parse(Expr& out, std::string& error) {
         int height = 0;
-        bool ok = binary(out, 1, 0, height);
+        bool ok = conditional(out, 0, height);
         skip_space();
         if (ok && pos_ < s_.size()) ok = fail("unexpected '" + s_.substr(pos_, 1) + "'");
         if (ok && s_.find_first_not_of(" \t\r\n") == std::string::npos) ok = fail("empty expression");
@@ -67,6 +67,34 @@ private:
         for (const BinaryOp& b : kBinary)
             if (s_.compare(pos_, std::char_traits<char>::length(b.text), b.text) == 0) return &b;
         return nullptr;
+    }
+
+    // c ? a : b, below every binary operator, right to left (a ? b : c ? d : e
+    // is a ? b : (c ? d : e)). While the runtime evaluates `b`, `c` and `a`
+    // wait on its stack: `b` is read two levels deeper, so that the nesting
+    // limit still bounds the stack (DG_EXPR_STACK).
+    bool conditional(Expr& out, int depth, int& height) {
+        if (!binary(out, 1, depth, height)) return false;
+        skip_space();
+        if (pos_ >= s_.size() || s_[pos_] != '?') return true;
+        ++pos_;
+        Expr then_value, else_value;
+        int then_height = 0, else_height = 0;
+        if (!conditional(then_value, depth + 1, then_height)) return false;
+        skip_space();
+        if (pos_ >= s_.size() || s_[pos_] != ':') return fail("missing ':' of '?'");
+        ++pos_;
+        if (!conditional(else_value, depth + 2, else_height)) return false;
+        height = std::max({height, then_height, else_height}) + 1;
+        if (height > kMaxChain)
+            return fail("expression too long (more than " + std::to_string(kMaxChain) + " operators deep)");
+        Expr joined;
+        joined.op = ExprOp::Conditional;
+        joined.args.push_back(std::move(out));
+        joined.args.push_back(std::move(then_value));
+        joined.args.push_back(std::move(else_value));
+        out = std::move(joined);
+        return true;
     }
 
     // Operands joined by operators of at least `min_precedence`, left to right.
@@ -106,7 +134,7 @@ private:
         if (s_.compare(pos_, 7, "defined") == 0) return defined(out, depth, height);
         if (c == '(') {
             ++pos_;
-            if (!binary(out, 1, depth + 1, height)) return false;
+            if (!conditional(out, depth + 1, height)) return false;
             skip_space();
             if (pos_ >= s_.size() || s_[pos_] != ')') return fail("missing ')'");
             ++pos_;
@@ -123,7 +151,7 @@ private:
         if (pos_ >= s_.size() || s_[pos_] != '(') return fail("expected '(' after 'defined'");
         ++pos_;
         Expr inner;
-        if (!binary(inner, 1, depth + 1, height)) return false;
+        if (!conditional(inner, depth + 1, height)) return false;
         skip_space();
         if (pos_ >= s_.size() || s_[pos_] != ')') return fail("missing ')'");
         ++pos_;
@@ -216,6 +244,7 @@ const char* expr_op_text(ExprOp op) {
     case ExprOp::Not: return "!";
     case ExprOp::BitNot: return "~";
     case ExprOp::Defined: return "defined";
+    case ExprOp::Conditional: return "?:";
     default: return "";
     }
 }
@@ -325,6 +354,12 @@ void compile_into(const Expr& e, bool as_float, std::vector<ExprRow>& out) {
         if (as_float && !e.is_float) out.push_back({"DG_OP_TO_FLOAT"});
         return;
     }
+    case ExprOp::Conditional:  // the condition in its own type; the chosen value as wanted
+        compile_into(e.args[0], e.args[0].is_float, out);
+        compile_into(e.args[1], as_float || e.is_float, out);
+        compile_into(e.args[2], as_float || e.is_float, out);
+        out.push_back({"DG_OP_SELECT"});
+        return;
     default:
         break;
     }

@@ -15,7 +15,7 @@
 // decoded, the request was captured, a value was learned; else 0).
 // Operators as in C, with C's
 // precedence: unary - ! ~; * / %; + -; << >>; < <= > >=; == !=; &; ^; |;
-// &&; ||; and parentheses.
+// &&; ||; c ? a : b (right to left); and parentheses.
 #pragma once
 
 #include <cstdint>
@@ -34,6 +34,7 @@ enum class ExprOp {
     Mul, Div, Mod, Add, Sub, Shl, Shr,         // binary, arithmetic
     Lt, Le, Gt, Ge, Eq, Ne,                    // binary, comparisons (0 or 1)
     BitAnd, BitXor, BitOr, And, Or,            // binary, logic
+    Conditional,                               // c ? a : b: args c, a, b
 };
 
 struct Expr {
@@ -44,7 +45,7 @@ struct Expr {
     Node* target = nullptr;         // Field, RequestField: resolved by the validator
     int request_index = -1;         // RequestField: its place among the values a request keeps
     int learn_index = -1;           // Learned: the <learn>'s row (Learn::index)
-    std::vector<Expr> args;         // one (unary) or two (binary) operands
+    std::vector<Expr> args;         // one (unary), two (binary) or three (conditional) operands
     bool is_float = false;          // derived by the validator: evaluated in double
 };
 

@@ -991,6 +991,9 @@ bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
         mark_slot(e.target);
         return true;
     }
+    case ExprOp::Conditional:  // a double when either value is; the condition may be either
+        e.is_float = e.args[1].is_float || e.args[2].is_float;
+        return true;
     default:
         break;
     }

@@ -112,6 +112,12 @@ dg_expr_value real_binary(guint8 code, dg_expr_value a, dg_expr_value b) {
     }
 }
 
+/* c ? a : b: the value c chooses, whether or not the other is defined. */
+dg_expr_value select(dg_expr_value c, dg_expr_value a, dg_expr_value b) {
+    if (!c.defined) return undefined_value();
+    return (c.is_float ? c.real != 0 : c.integer != 0) ? a : b;
+}
+
 }  // namespace
 
 dg_expr_value dg_expr_eval(const dg_expr_op *ops, guint count, const dg_expr_readers *readers, const void *context,
@@ -126,6 +132,10 @@ dg_expr_value dg_expr_eval(const dg_expr_op *ops, guint count, const dg_expr_rea
         } else if (code <= DG_OP_DEFINED) {
             if (depth < 1) return undefined_value();
             stack[depth - 1] = unary(code, stack[depth - 1]);
+        } else if (code == DG_OP_SELECT) {
+            if (depth < 3) return undefined_value();
+            depth -= 2;
+            stack[depth - 1] = select(stack[depth - 1], stack[depth], stack[depth + 1]);
         } else {
             if (depth < 2) return undefined_value();
             --depth;

@@ -11,7 +11,8 @@
  * 0 (>> shifts the bit pattern, as for unsigned values). A value is
  * undefined when a field it reads was not decoded in this message, or it
  * divides an integer by zero; && and || give a defined answer when their
- * left side decides, as in C, so "{n} != 0 && {x} / {n} > 2" is safe.
+ * left side decides, as in C, so "{n} != 0 && {x} / {n} > 2" is safe; so
+ * does c ? a : b, defined when c and the value it chooses are.
  * defined(X) asks: 1 when X is defined, 0 when not, never undefined.
  */
 #pragma once
@@ -40,7 +41,9 @@ enum dg_expr_code {
     DG_OP_BITAND, DG_OP_BITXOR, DG_OP_BITOR, DG_OP_AND, DG_OP_OR,
     /* binary, on doubles (comparisons and logic give integers 0 or 1) */
     DG_OP_FMUL, DG_OP_FDIV, DG_OP_FADD, DG_OP_FSUB,
-    DG_OP_FLT, DG_OP_FLE, DG_OP_FGT, DG_OP_FGE, DG_OP_FEQ, DG_OP_FNE, DG_OP_FAND, DG_OP_FOR
+    DG_OP_FLT, DG_OP_FLE, DG_OP_FGT, DG_OP_FGE, DG_OP_FEQ, DG_OP_FNE, DG_OP_FAND, DG_OP_FOR,
+    /* c ? a : b on the top three (c, a, b); a and b of one type, c of either */
+    DG_OP_SELECT
 };
 
 typedef struct dg_expr_op {
@@ -54,8 +57,9 @@ typedef struct dg_expr_op {
 
 /* The deepest stack an expression may need. The parser's nesting limit
  * (64 levels: each pending operand is one) keeps every accepted expression
- * within it (tests/unit/test_expr_eval.cpp); a deeper one would be undefined. */
-#define DG_EXPR_STACK 64
+ * within it, the operand read at the deepest level included
+ * (tests/unit/test_expr_eval.cpp); a deeper one would be undefined. */
+#define DG_EXPR_STACK 65
 
 /* A slot's value, or FALSE when the field was not decoded in this message. */
 typedef gboolean (*dg_slot_reader)(const void *context, gint16 slot, guint64 *value);

@@ -30,7 +30,8 @@ guint8 code_of(const std::string& name) {
         {"DG_OP_OR", DG_OP_OR}, {"DG_OP_FMUL", DG_OP_FMUL}, {"DG_OP_FDIV", DG_OP_FDIV},
         {"DG_OP_FADD", DG_OP_FADD}, {"DG_OP_FSUB", DG_OP_FSUB}, {"DG_OP_FLT", DG_OP_FLT},
         {"DG_OP_FLE", DG_OP_FLE}, {"DG_OP_FGT", DG_OP_FGT}, {"DG_OP_FGE", DG_OP_FGE}, {"DG_OP_FEQ", DG_OP_FEQ},
-        {"DG_OP_FNE", DG_OP_FNE}, {"DG_OP_FAND", DG_OP_FAND}, {"DG_OP_FOR", DG_OP_FOR}};
+        {"DG_OP_FNE", DG_OP_FNE}, {"DG_OP_FAND", DG_OP_FAND}, {"DG_OP_FOR", DG_OP_FOR},
+        {"DG_OP_SELECT", DG_OP_SELECT}};
     auto it = codes.find(name);
     if (it == codes.end()) ADD_FAILURE() << "no runtime code for " << name;
     return it == codes.end() ? 0 : it->second;
@@ -137,6 +138,19 @@ TEST(ComputedEval, TheDeepestExpressionTheParserTakesFitsTheStack) {
     EXPECT_NE(evaluate(deepest + inner + " * 1)))))", kFields).error, "");
 }
 
+TEST(ComputedEval, TheLongestConditionalChainTheParserTakesFitsTheStack) {
+    // 0 ? 0 : 0 ? 0 : ... 7: each level leaves its condition and first value waiting.
+    std::string accepted;
+    for (std::string chain = "7";; chain = "0 ? 0 : " + chain) {
+        Evaluated e = evaluate(chain, kFields);
+        if (!e.error.empty()) break;
+        accepted = chain;
+        ASSERT_TRUE(e.v.defined) << chain;
+        EXPECT_EQ(e.v.integer, 7);
+    }
+    EXPECT_GT(accepted.size(), 8 * 20u);  // some 30 levels, not a handful
+}
+
 TEST(ComputedEval, IntegerArithmeticAsInC) {
     EXPECT_EQ(integer("{A} + index + 1", {{A, 40000}, {C, 5}}, 3), 40004);
     EXPECT_EQ(integer("{S}"), -2);                 // an int field is signed
@@ -175,6 +189,23 @@ TEST(ComputedEval, UndefinedWhenAFieldIsMissingOrIntegerDivisionByZero) {
     EXPECT_EQ(integer("{C} == 3 || {A} > 1", {{C, 3}}), 1);
     EXPECT_TRUE(undefined("{C} == 4 || {A} > 1", {{C, 3}}));
     EXPECT_TRUE(undefined("{A} > 1 || {C} == 3", {{C, 3}}));  // an undefined left decides nothing
+}
+
+TEST(ComputedEval, ConditionalChoosesAndOnlyTheChosenValueMustBeDefined) {
+    EXPECT_EQ(integer("{C} == 3 ? {A} : 7"), 1000);
+    EXPECT_EQ(integer("{C} == 4 ? {A} : 7"), 7);
+    EXPECT_EQ(integer("{S} < 0 ? -{S} : {S}"), 2);
+    EXPECT_EQ(integer("{C} ? 1 : 2 + 3"), 1);             // ?: below every binary operator
+    EXPECT_EQ(integer("0 ? 1 : {C} == 3 ? 2 : 3"), 2);    // right to left
+    // a BER-style length: short form, else the long form's bytes
+    EXPECT_EQ(integer("{C} < 0x80 ? {C} : {A}", {{C, 3}}), 3);   // A not decoded, not chosen
+    EXPECT_EQ(integer("{C} == 3 ? 1 : {A} / 0"), 1);
+    EXPECT_TRUE(undefined("{C} == 3 ? {A} : 1", {{C, 3}}));      // the chosen one undefined
+    EXPECT_TRUE(undefined("{A} ? 1 : 2", {{C, 3}}));             // an undefined condition
+    EXPECT_EQ(integer("{F} > 1.5 ? 1 : 0"), 1);                   // a real condition, integer values
+    EXPECT_DOUBLE_EQ(real("{C} == 3 ? 1 : 0.5"), 1.0);           // one real value: both real
+    EXPECT_DOUBLE_EQ(real("{C} == 3 ? 0.5 : {A}"), 0.5);
+    EXPECT_DOUBLE_EQ(real("({C} == 4 ? 0.5 : {A}) / 3"), 1000.0 / 3);
 }
 
 TEST(ComputedEval, DefinedAsksWhetherAFieldWasDecoded) {

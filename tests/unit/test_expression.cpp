@@ -43,6 +43,12 @@ TEST(Expression, PrecedenceAsInC) {
     EXPECT_EQ(parsed("!~{A}"), "(! (~ {A}))");
     EXPECT_EQ(parsed("1 <= 2 >= 3 != 4"), "(!= (>= (<= 1 2) 3) 4)");
     EXPECT_EQ(parsed("8 >> 1 / 2"), "(>> 8 (/ 1 2))");
+    // ?: below ||, right to left, any expression in each part
+    EXPECT_EQ(parsed("{A} < 0x80 ? {A} : {B}"), "(?: (< {A} 128) {A} {B})");
+    EXPECT_EQ(parsed("1 || 0 ? 2 : 3"), "(?: (|| 1 0) 2 3)");
+    EXPECT_EQ(parsed("1 ? 2 : 3 ? 4 : 5"), "(?: 1 2 (?: 3 4 5))");
+    EXPECT_EQ(parsed("1 ? 2 ? 3 : 4 : 5"), "(?: 1 (?: 2 3 4) 5)");
+    EXPECT_EQ(parsed("(1 ? 2 : 3) + 4"), "(+ (?: 1 2 3) 4)");
 }
 
 TEST(Expression, Operands) {
@@ -66,6 +72,9 @@ TEST(Expression, MistakesSayWhere) {
     EXPECT_EQ(parsed("indexes"), "error: expected a number, {field}, index or '(' but found 'i' at character 1");
     EXPECT_EQ(parsed("9223372036854775808"), "error: number '9223372036854775808' is above 9223372036854775807 at character 1");
     EXPECT_EQ(parsed("A + 1"), "error: expected a number, {field}, index or '(' but found 'A' at character 1");
+    EXPECT_EQ(parsed("1 ? 2"), "error: missing ':' of '?' at character 6");
+    EXPECT_EQ(parsed("1 ? 2 : "), "error: expected a number, {field}, index or '(' but the expression ends at character 9");
+    EXPECT_EQ(parsed("1 : 2"), "error: unexpected ':' at character 3");
     // A number after the first character: the message quotes that number, not what follows it.
     EXPECT_EQ(parsed("{A} + 12ab - 3"), "error: bad number '12a' at character 7");
     EXPECT_EQ(parsed("2 * 9223372036854775808 + 1"),

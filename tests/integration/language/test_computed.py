@@ -8,7 +8,8 @@ count is odd). Every computed field is
 computed again here from the bytes, with C's rules (integer division
 truncates, 64-bit wrapping), and compared with what tshark shows, in one pass
 and with -2: reals, booleans, hex, enums, signed values, the instance index,
-a hex value as wide as its mask, an undefined value (division by zero: no item), a computed length, a summary.
+a hex value as wide as its mask, c ? a : b (its unchosen value undefined), an undefined value
+(division by zero: no item), a computed length, a summary.
 Needs no corpus.
 
     test_computed.py --dissgen build/bin/dissgen --source-dir .
@@ -28,7 +29,7 @@ from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 ARGS = None
 ETHERTYPE = 0x88B6
 FIELDS = ["frame.number", "calc.temperature", "calc.alarm", "calc.mixed", "calc.high_byte", "calc.kind", "calc.ratio",
-          "calc.negated", "calc.secret", "calc.registers.register", "calc.registers.flags.flag_index", "calc.tail_bytes", "calc.tail",
+          "calc.negated", "calc.magnitude", "calc.safe_ratio", "calc.secret", "calc.registers.register", "calc.registers.flags.flag_index", "calc.tail_bytes", "calc.tail",
           "_ws.col.Info"]
 
 
@@ -65,6 +66,8 @@ def expected(start, count, raw, values):
         "calc.kind": str(count % 3),
         "calc.ratio": None if count == 2 else str(c_div(start, count - 2)),
         "calc.negated": str(-start + -1 + (0 if count else 1)),
+        "calc.magnitude": str(abs(raw)),
+        "calc.safe_ratio": "-1" if count == 2 else str(c_div(start, count - 2)),
         "calc.secret": str(start >> 2),
         "calc.registers.register": ",".join(str(start + i + 1) for i in range(count)),
         "calc.registers.flags.flag_index": ",".join("0" for v in values if v & 1),
