@@ -126,6 +126,7 @@ TESTS = {
     "enip_pipelined": integration("test_enip.py", "PipelinedReplies"),
     "profinet": integration("test_profinet.py"),
     "powerlink": integration("test_powerlink.py"),
+    "goose": integration("test_goose.py"),
     "validity": integration("test_validity.py"),
     "validity_unit": unit("Validity.*"),
     "loading": integration("test_plugin_loading.py"),

@@ -325,6 +325,12 @@ def learned_layout_frames():
     return [m.frame(payload) for payload, _ in m.messages(random.Random(11), 120)]
 
 
+def goose_frames():
+    """tests/rules/goose.xml: test_goose.py's GOOSE messages (every BER length form)."""
+    import test_goose as m
+    return m.goose_frames(seed=13, count=60)
+
+
 def entry_list_frames():
     """tests/rules/entry_list.xml: counted lists of entries that take no bytes, one too long."""
     header = b"\x02\0\0\0\0\xff\x02\0\0\0\0\x01" + struct.pack("!H", 0x88C3)
@@ -420,6 +426,7 @@ CAPTURES = {
     "tests/rules/learned.xml": learned_frames,
     "tests/rules/learned_layout.xml": learned_layout_frames,
     "tests/rules/entry_list.xml": entry_list_frames,
+    "tests/rules/goose.xml": goose_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,
