@@ -97,7 +97,9 @@ std::string shared_field_mismatch(const Node& a, const Node& b) {
     FieldType ta = field_type(a), tb = field_type(b);
     if (ta.type != tb.type || ta.display != tb.display || ta.mask != tb.mask)
         return type_text(ta) + " and " + type_text(tb);
-    if (a.display == Display::Enum && !same_enums(a, b)) return "different <enum> items";
+    // (either side: a hex field owning the name would show an enum's values bare)
+    if ((a.display == Display::Enum || b.display == Display::Enum) && !same_enums(a, b))
+        return "different <enum> items";
     if (a.has_unit_label() != b.has_unit_label() || (a.has_unit_label() && a.unit != b.unit))
         return "different unit labels";
     return "";

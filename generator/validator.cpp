@@ -72,6 +72,7 @@ private:
     void check_reference(Node& n, const FieldRef& ref, const std::string& what);
     void check_pdulength();
     void check_computed(Node& n);
+    bool widen_masked_values(Node& n, const Node& owner, const std::vector<const Node*>& holders);
     // Where an expression is read: the node it belongs to, the fields it may
     // read (doc_index below reach), the line and words of its messages.
     struct ExprSite {
@@ -787,6 +788,23 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
     }
 }
 
+// Computed hex values as wide as their mask (check_computed) that share one
+// field with others of another width: all 64 bits again, as any computed value
+// (two masks, or a mask beside an 8-byte field, agree as they did before masks
+// narrowed them). Whether one was widened.
+bool Validator::widen_masked_values(Node& n, const Node& owner, const std::vector<const Node*>& holders) {
+    bool widened = false;
+    auto widen = [&](const Node& c) {
+        if (!c.is_computed() || c.display != Display::NumberHex || c.bits == 64) return;
+        const_cast<Node&>(c).bits = 64;  // the validator owns the model it checks
+        widened = true;
+    };
+    widen(n);
+    widen(owner);
+    for (const Node* h : holders) widen(*h);
+    return widened;
+}
+
 // A filter name already taken by `owner`: one field for both when they are
 // alternatives (at most one is decoded) of the same Wireshark type, as
 // Wireshark's pn_dcp.option is filled by every option's layout; otherwise an error.
@@ -801,6 +819,7 @@ void Validator::share_filter_name(Node& n, const Node& owner) {
             return;
         }
     std::string mismatch = shared_field_mismatch(owner, n);
+    if (!mismatch.empty() && widen_masked_values(n, owner, holders)) mismatch = shared_field_mismatch(owner, n);
     if (!mismatch.empty()) {
         diags_.error(n.line, "alternatives " + quote(owner) + at_line(owner) + " and " + quote(n) + at_line(n) +
                                  " share the filter name '" + name + "' but not its field type (" + mismatch +
@@ -1166,8 +1185,8 @@ bool Validator::check_defined(const Node& n, Expr& e) {
                                  " asks about one field, {Name}, request{Name} or learned{Name}: " +
                                  (x.op == ExprOp::Int || x.op == ExprOp::Float || x.op == ExprOp::Index
                                       ? "a number or index is always defined"
-                                      : "an expression is undefined exactly when a field it reads is; ask about that "
-                                        "field"));
+                                      : "an expression is undefined when a field it reads is (but for a value ?: "
+                                        "does not choose); ask about that field"));
         return false;
     }
     e.is_float = false;

@@ -64,6 +64,22 @@ TEST(SharedFilterNames, WhichNodesAreAlternatives) {
     EXPECT_TRUE(are_alternatives(p, *find(p, "b"), *find(p, "a")));  // either order
 }
 
+TEST(SharedFilterNames, MaskedHexValuesOfOneNameKeepSixtyFourBits) {
+    // Each mask alone would narrow its value (0xFF: FT_UINT8); sharing a field they agree
+    // as every computed value did before masks narrowed them: FT_UINT64.
+    Front f = front_end(rules("  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"Raw\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"Code\" value=\"{Raw} &amp; 0xFF\" displaytype=\"numberhex\"\n"
+                              "        if=\"../node[@name='Kind']\" in=\"1\"/>\n"
+                              "  <node name=\"Code\" value=\"{Raw} &gt;&gt; 8\" displaytype=\"numberhex\" otherwise=\"true\"/>\n"
+                              "  <node name=\"Low\" value=\"{Raw} &amp; 0xFF\" displaytype=\"numberhex\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_EQ(count_of(code, "\"tst.code\""), 1u) << code;
+    EXPECT_NE(code.find("\"tst.code\", FT_UINT64, BASE_HEX"), std::string::npos) << code;
+    EXPECT_NE(code.find("\"tst.low\", FT_UINT8, BASE_HEX"), std::string::npos) << code;  // alone: narrowed
+}
+
 TEST(SharedFilterNames, NamesThatDifferWarn) {
     Front f = front_end(rules(
         "  <node name=\"K\" length=\"1byte\" displaytype=\"numberdec\"/>\n"

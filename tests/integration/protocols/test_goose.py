@@ -133,14 +133,39 @@ class TestGoose(TsharkTestCase, unittest.TestCase):
                       "%s: the three length forms occur (%s)" % (mode, sorted(hex(f) for f in forms if f >= 0x80)))
 
     def test_a_frame_cut_inside_an_element_keeps_the_elements_before_it(self):
-        (integers, texts, _), frame = self.messages[0]
-        cut = frame[:14 + 8 + 3 + 3 + len(texts[0]) + 3 + 2]  # inside timeAllowedtoLive's value
-        path = self.env.add_file("goose_cut.pcap", pcap([cut]))
-        rows = field_rows(self.env, path, ["gooser.pdu.elem.text", "gooser.pdu.elem.tag", "_ws.expert"])
+        # a message whose timeAllowedtoLive takes 2 bytes or more, cut after its first byte
+        for (integers, texts, _), frame in self.messages:
+            elements = ber_elements(frame)
+            tag, start, end = elements[1]
+            if end - start >= 2:
+                break
+        self.assertEqual(tag, 0x81)
+        path = self.env.add_file("goose_cut.pcap", pcap([frame[:start + 1]]))
+        rows = field_rows(self.env, path, ["gooser.pdu.elem.text", "gooser.pdu.elem.tag", "gooser.pdu.elem.int",
+                                           "_ws.expert"])
         with self.checks() as check:
             check(rows[1]["gooser.pdu.elem.text"] == [texts[0]], "gocbRef decoded before the cut")
-            check(rows[1]["gooser.pdu.elem.tag"][:2] == ["0x80", "0x81"], "the cut element's tag is shown")
+            check(rows[1]["gooser.pdu.elem.tag"] == ["0x80", "0x81"], "the cut element's tag is shown, nothing after it")
+            check(rows[1]["gooser.pdu.elem.int"] == [], "the cut integer is not shown as a value")
             check(rows[1]["_ws.expert"] != [], "the cut raises an expert info")
+
+
+def ber_elements(frame):
+    """[(tag, value start, value end)] of the goosePdu's elements, as offsets in the frame."""
+    def length_at(at):
+        first = frame[at]
+        if first < 0x80:
+            return first, at + 1
+        size = first & 0x7F
+        return int.from_bytes(frame[at + 1:at + 1 + size], "big"), at + 1 + size
+
+    pdu_length, at = length_at(14 + 8 + 1)
+    end, out = at + pdu_length, []
+    while at < end:
+        length, start = length_at(at + 1)
+        out.append((frame[at], start, start + length))
+        at = start + length
+    return out
 
 
 if __name__ == "__main__":
