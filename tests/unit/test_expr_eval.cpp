@@ -202,7 +202,10 @@ TEST(ComputedEval, ConditionalChoosesAndOnlyTheChosenValueMustBeDefined) {
     EXPECT_EQ(integer("{C} == 3 ? 1 : {A} / 0"), 1);
     EXPECT_TRUE(undefined("{C} == 3 ? {A} : 1", {{C, 3}}));      // the chosen one undefined
     EXPECT_TRUE(undefined("{A} ? 1 : 2", {{C, 3}}));             // an undefined condition
-    EXPECT_EQ(integer("{F} > 1.5 ? 1 : 0"), 1);                   // a real condition, integer values
+    EXPECT_EQ(integer("{F} > 1.5 ? 1 : 0"), 1);                   // a comparison of reals, integer values
+    EXPECT_EQ(integer("{F} ? 1 : 2"), 1);                         // a real condition: not 0.0
+    EXPECT_EQ(integer("{F} - 500 ? 1 : 2"), 2);                   // 0.0: the other value
+    EXPECT_EQ(integer("{F} * 0.0 ? 1 : 2", {{F, bits_of(-0.0)}}), 2);
     EXPECT_DOUBLE_EQ(real("{C} == 3 ? 1 : 0.5"), 1.0);           // one real value: both real
     EXPECT_DOUBLE_EQ(real("{C} == 3 ? 0.5 : {A}"), 0.5);
     EXPECT_DOUBLE_EQ(real("({C} == 4 ? 0.5 : {A}) / 3"), 1000.0 / 3);
