@@ -11,6 +11,7 @@
 #include "dissgen_state.h"
 
 #include <epan/to_str.h>
+#include <wsutil/sign_ext.h>
 
 #include <float.h>
 #include <string.h>
@@ -81,8 +82,7 @@ void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
         break;
     }
     case DG_SHOW_INT: {
-        guint64 v = s->value;
-        if (n->bits > 0 && n->bits < 64 && (v >> (n->bits - 1)) & 1) v |= ~bit_mask(n->bits);
+        const guint64 v = ws_sign_ext64(s->value, (int)MIN(n->bits, 64u));
         g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "d", (gint64)v);
         break;
     }
