@@ -74,8 +74,9 @@ const char* expr_op_text(ExprOp op);
 // Integer-only operators: % << >> & ^ | ~ (a float operand is an error).
 bool expr_op_needs_integers(ExprOp op);
 
-// The width of a value `e` computes: 8, 16 or 32 when it ends in `& MASK`
-// with a constant mask that fits them (0xFFFF: 16), else 64.
+// The width of a value `e` computes: when its last operator is `&` with a
+// constant on either side, 8, 16 or 32 bits, the least that holds the constant
+// (0xFFFF: 16, 0xFFFFFF: 32); else 64.
 unsigned expr_value_bits(const Expr& e);
 
 }  // namespace dissgen

@@ -789,9 +789,9 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
 }
 
 // Computed hex values as wide as their mask (check_computed) that share one
-// field with others of another width: all 64 bits again, as any computed value
-// (two masks, or a mask beside an 8-byte field, agree as they did before masks
-// narrowed them). Whether one was widened.
+// field with values of another width are 64 bits, as every other computed
+// value: two masks, or a mask beside an 8-byte field, then agree. Whether one
+// was widened.
 bool Validator::widen_masked_values(Node& n, const Node& owner, const std::vector<const Node*>& holders) {
     bool widened = false;
     auto widen = [&](const Node& c) {

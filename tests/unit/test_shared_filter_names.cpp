@@ -65,8 +65,8 @@ TEST(SharedFilterNames, WhichNodesAreAlternatives) {
 }
 
 TEST(SharedFilterNames, MaskedHexValuesOfOneNameKeepSixtyFourBits) {
-    // Each mask alone would narrow its value (0xFF: FT_UINT8); sharing a field they agree
-    // as every computed value did before masks narrowed them: FT_UINT64.
+    // Each mask alone would narrow its value (0xFF: FT_UINT8); sharing a field they are
+    // 64 bits, as every other computed value: FT_UINT64.
     Front f = front_end(rules("  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
                               "  <node name=\"Raw\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
                               "  <node name=\"Code\" value=\"{Raw} &amp; 0xFF\" displaytype=\"numberhex\"\n"

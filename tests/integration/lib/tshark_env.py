@@ -211,13 +211,16 @@ class TsharkEnv:
             cmd = ["setpriv", "--reuid=%d" % NOBODY, "--regid=%d" % NOBODY, "--clear-groups"] + cmd
         return cmd
 
-    def field_rows(self, path, fields, two_pass=False, display_filter=None, aggregator=",", with_stderr=False):
+    def field_rows(self, path, fields, two_pass=False, display_filter=None, aggregator=",", with_stderr=False,
+                   extra_args=()):
         """{frame number: {field: [values]}} of `tshark -T fields` for fields[1:] (fields[0]
         is frame.number), every occurrence of each field; with display_filter, of the frames
         it keeps.  aggregator: what tshark puts between occurrences (one no value holds).
-        with_stderr: (rows, what tshark wrote to stderr)."""
+        with_stderr: (rows, what tshark wrote to stderr). extra_args: more tshark options
+        (--disable-protocol P, ...)."""
         args = ["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=" + aggregator]
         args += ["-2"] if two_pass else []
+        args += list(extra_args)
         if display_filter:
             args += ["-Y", display_filter]
         for f in fields:

@@ -21,6 +21,7 @@ import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
 import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
+import pcapgen  # noqa: E402
 from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 
 ARGS = None
@@ -74,22 +75,9 @@ def goose_frames(seed=5, count=200):
     return [goose_message(rng, i)[1] for i in range(count)]
 
 
-def pcap(frames):
-    out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
-    for i, f in enumerate(frames):
-        out.append(struct.pack("<IIII", 1_700_000_000 + i, 0, len(f), len(f)) + f)
-    return b"".join(out)
-
-
 def field_rows(env, path, fields, args=()):
-    """{frame number: {field: [values]}}; values of one field joined by '|' (no string has one)."""
-    out = env.tshark(["-r", path, "-T", "fields", "-E", "occurrence=a", "-E", "aggregator=|", "-e", "frame.number"]
-                     + [a for f in fields for a in ("-e", f)] + list(args)).stdout
-    rows = {}
-    for line in out.splitlines():
-        cols = (line.split("\t") + [""] * (len(fields) + 1))[:len(fields) + 1]
-        rows[int(cols[0])] = {f: (v.split("|") if v else []) for f, v in zip(fields, cols[1:])}
-    return rows
+    """{frame number: {field: [values]}}; occurrences joined by '|' (no string here has one)."""
+    return env.field_rows(path, ["frame.number"] + fields, aggregator="|", extra_args=args)
 
 
 class TestGoose(TsharkTestCase, unittest.TestCase):
@@ -98,7 +86,7 @@ class TestGoose(TsharkTestCase, unittest.TestCase):
         cls.install(os.path.join("tests", "rules", "goose.xml"), "gooser")
         rng = random.Random(5)
         cls.messages = [goose_message(rng, i) for i in range(200)]
-        cls.path = cls.env.add_file("goose.pcap", pcap([f for _, f in cls.messages]))
+        cls.path = cls.env.add_file("goose.pcap", pcapgen.raw_pcap_bytes([f for _, f in cls.messages]))
 
     def test_values_equal_wiresharks_goose(self):
         theirs = field_rows(self.env, self.path, INTEGER_FIELDS + TEXT_FIELDS, ["--disable-protocol", "gooser"])
@@ -140,7 +128,7 @@ class TestGoose(TsharkTestCase, unittest.TestCase):
             if end - start >= 2:
                 break
         self.assertEqual(tag, 0x81)
-        path = self.env.add_file("goose_cut.pcap", pcap([frame[:start + 1]]))
+        path = self.env.add_file("goose_cut.pcap", pcapgen.raw_pcap_bytes([frame[:start + 1]]))
         rows = field_rows(self.env, path, ["gooser.pdu.elem.text", "gooser.pdu.elem.tag", "gooser.pdu.elem.int",
                                            "_ws.expert"])
         with self.checks() as check:
