@@ -5,6 +5,12 @@
 
 namespace dissgen {
 
+void Diagnostics::add(Severity severity, int line, std::string message) {
+    for (const Diagnostic& d : items_)
+        if (d.severity == severity && d.line == line && d.message == message) return;
+    items_.push_back({severity, line, std::move(message)});
+}
+
 bool Diagnostics::has_errors() const {
     return std::any_of(items_.begin(), items_.end(),
                        [](const Diagnostic& d) { return d.severity == Severity::Error; });

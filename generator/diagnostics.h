@@ -18,12 +18,10 @@ struct Diagnostic {
 
 class Diagnostics {
 public:
-    void error(int line, std::string message) {
-        items_.push_back({Severity::Error, line, std::move(message)});
-    }
-    void warning(int line, std::string message) {
-        items_.push_back({Severity::Warning, line, std::move(message)});
-    }
+    // A message already given for the line is not repeated: the nodes of a
+    // group are checked once per use, and their mistake is one mistake.
+    void error(int line, std::string message) { add(Severity::Error, line, std::move(message)); }
+    void warning(int line, std::string message) { add(Severity::Warning, line, std::move(message)); }
     bool has_errors() const;
     const std::vector<Diagnostic>& items() const { return items_; }
 
@@ -31,6 +29,8 @@ public:
     std::string format(const std::string& file) const;
 
 private:
+    void add(Severity severity, int line, std::string message);
+
     std::vector<Diagnostic> items_;
 };
 

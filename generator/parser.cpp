@@ -15,6 +15,7 @@
 #include <map>
 #include <sstream>
 
+#include "node_groups.h"
 #include "text_util.h"
 #include "xml_input.h"
 
@@ -1275,7 +1276,7 @@ std::unique_ptr<Protocol> parse_rules(const std::string& text, Diagnostics& diag
     if (!root || element_name(root) != "root") {
         diags.error(root ? line_of(root) : 0,
                     "the document element must be <root>, not <" + (root ? element_name(root) : "") + ">");
-    } else {
+    } else if (expand_node_groups(root, diags)) {
         proto = Parser(doc, diags).parse_root(root);
     }
     xmlFreeDoc(doc);

@@ -1862,6 +1862,18 @@ void Validator::parse_finding_text(Node& n, Finding& f, const ExprSite& at) {
 }
 
 // Filter names P.finding.NAME: a lowercase segment, each once, and no field's.
+// Where the first of two same names is: another line, or this one again
+// when a <group> holding it is used more than once.
+namespace {
+
+std::string also_at(int first, int line) {
+    if (first != line) return " (also line " + std::to_string(first) + ")";
+    return " on this line again: when a <group> holding it is used more than once, each use copies the name "
+           "(give it its name outside the group)";
+}
+
+}  // namespace
+
 void Validator::name_findings() {
     std::map<std::string, int> seen;
     for_each_node(proto_.nodes, [&](Node& n) {
@@ -1874,8 +1886,7 @@ void Validator::name_findings() {
             f.filter_name = proto_.filter + ".finding." + f.name;
             auto [it, inserted] = seen.emplace(f.name, f.line);
             if (!inserted)
-                diags_.error(f.line, "duplicate finding name '" + f.name + "' (also line " + std::to_string(it->second) +
-                                         ")");
+                diags_.error(f.line, "duplicate finding name '" + f.name + "'" + also_at(it->second, f.line));
             else if (auto owner = filter_owner_.find(f.filter_name); owner != filter_owner_.end())
                 diags_.error(f.line, "finding '" + f.name + "' is filtered as '" + f.filter_name + "', the name of " +
                                          quote(*owner->second) + at_line(*owner->second) + "; rename one of them");
@@ -1902,8 +1913,7 @@ void Validator::collect_learns() {
             }
             auto [it, inserted] = seen.emplace(l.name, l.line);
             if (!inserted) {
-                diags_.error(l.line, "duplicate learn name '" + l.name + "' (also line " + std::to_string(it->second) +
-                                         ")");
+                diags_.error(l.line, "duplicate learn name '" + l.name + "'" + also_at(it->second, l.line));
                 continue;
             }
             l.index = static_cast<int>(proto_.learns.size());

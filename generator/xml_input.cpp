@@ -144,7 +144,12 @@ int xml_error_line(int reported, const std::string& message, const std::string& 
     return std::clamp(reported, 1, std::max(lines, 1));
 }
 
-int xml_line(const xmlNode* el) { return static_cast<int>(xmlGetLineNo(el)); }
+int xml_line(const xmlNode* el) {
+    // a rule file's line above 65534 is kept in psvi (parser.cpp, use_start_lines)
+    if (el->type == XML_ELEMENT_NODE && el->line == 65535 && el->psvi)
+        return static_cast<int>(reinterpret_cast<ptrdiff_t>(el->psvi));
+    return static_cast<int>(xmlGetLineNo(el));
+}
 
 std::string xml_name(const xmlNode* el) { return reinterpret_cast<const char*>(el->name); }
 
