@@ -117,7 +117,7 @@ struct Layout {
 
 void layout_conditions_and_windows(Layout& l, const std::map<const Node*, uint64_t>& quiet);
 void layout_findings(Layout& l, const std::string& filter);
-void layout_learns(Layout& l);
+void layout_learns(Layout& l, const Protocol& proto);
 
 std::string ident_for(const Protocol& proto, const Node& n) {
     std::string base = n.filter_name.empty() ? proto.filter + "_" + (n.segment.empty() ? n.name : n.segment)
@@ -176,13 +176,13 @@ Layout make_layout(const Protocol& proto, const std::map<const Node*, uint64_t>&
         l.exprs.insert(l.exprs.end(), rows.begin(), rows.end());
     }
     layout_findings(l, proto.filter);
-    layout_learns(l);
+    layout_learns(l, proto);
     return l;
 }
 
 // Each <learn>: its value, condition and keys' operations (after the
 // findings'), the sender flag; each key its value and lookup.
-void layout_learns(Layout& l) {
+void layout_learns(Layout& l, const Protocol& proto) {
     auto add = [&](const Expr* e) -> std::string {
         if (!e) return "0, 0";
         std::vector<ExprRow> rows = compile_expression(*e, false);
@@ -203,6 +203,18 @@ void layout_learns(Layout& l) {
                                condition + ", " + std::to_string(key_first) + ", " +
                                std::to_string(learn.keys.size()) + ", " + (learn.sender ? "TRUE" : "FALSE") + " }");
         }
+    }
+    // readers with keys of their own: what they read is their learn's
+    for (const auto& read : proto.learned_read_keys) {
+        const Learn& learn = *read->learn;
+        const size_t key_first = l.learn_keys.size();
+        for (size_t i = 0; i < learn.keys.size(); ++i) {
+            const Expr* lookup = read->lookups[i] ? &*read->lookups[i] : nullptr;
+            l.learn_keys.push_back("{ " + add(&learn.keys[i].value) + ", " + add(lookup) + " }");
+        }
+        l.learns.push_back("/* learned{" + learn.name + "} at line " + std::to_string(read->line) + " */ { 0, 0, 0, 0, " +
+                           std::to_string(key_first) + ", " + std::to_string(learn.keys.size()) + ", " +
+                           (learn.sender ? "TRUE" : "FALSE") + ", " + std::to_string(learn.index + 1) + " }");
     }
 }
 

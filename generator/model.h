@@ -126,6 +126,16 @@ struct Learn {
     int index = -1;                 // its row in the plugin's table of learns
 };
 
+// The keys of learned{Name} as one reader computes them, when its lookups
+// name other fields than the <learn>'s do: `{X}` in a lookup is the closest
+// X before the reader, so each copy of a <group> reads its own fields. Rows
+// of the plugin's learns table after the learns themselves.
+struct LearnedReadKeys {
+    const Learn* learn = nullptr;
+    std::vector<std::optional<Expr>> lookups;  // per key, as resolved at the reader (none: as the learner)
+    int line = 0;                              // the reader's
+};
+
 struct Node {
     // --- as written ---
     std::string name;
@@ -369,6 +379,8 @@ struct Protocol {
     const Node* first_request_reader = nullptr;
     // every <learn>, in document order (Learn::index)
     std::vector<Learn*> learns;
+    // readers whose lookups resolve to other fields (rows learns.size() + k)
+    std::vector<std::unique_ptr<LearnedReadKeys>> learned_read_keys;
 };
 
 // Calls fn(node) for every node in document order.

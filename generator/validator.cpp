@@ -101,7 +101,10 @@ private:
         const Learn* learn;
         int line;
         std::string in;
+        Expr* expr;  // the learned{...} operand
+        int reach;   // what the reader's own fields may read
     };
+    void resolve_lookups_at_reader(LearnedRead& read);
     std::vector<LearnedRead> learned_reads_;
     bool check_integer_expr(Node& n, Expr& e, const ExprSite& at, const std::string& what);
     bool check_request_field(Node& n, Expr& e);
@@ -1993,7 +1996,7 @@ bool Validator::check_learned(Node& n, Expr& e, const ExprSite& at) {
     }
     e.learn_index = found->index;
     e.is_float = false;
-    learned_reads_.push_back({&n, found, at.line, at.in});
+    learned_reads_.push_back({&n, found, at.line, at.in, &e, at.reach});
     if (n.is_computed()) mark_slot(&n);
     return true;
 }
@@ -2002,7 +2005,8 @@ bool Validator::check_learned(Node& n, Expr& e, const ExprSite& at) {
 // node it reads must be of the reader's own instance, decoded before it, and
 // `index` counts the reader's instances, so the reader is inside a repeat.
 void Validator::check_lookups_at_readers() {
-    for (const LearnedRead& read : learned_reads_) {
+    for (LearnedRead& read : learned_reads_) {
+        resolve_lookups_at_reader(read);
         const Node& reader = *read.reader;
         const std::string head = "learned{" + read.learn->name + "}" + read.in + ": the lookup of its key on line ";
         std::function<void(const Expr&, int)> visit = [&](const Expr& e, int key_line) {
@@ -2026,9 +2030,46 @@ void Validator::check_lookups_at_readers() {
                 break;
             }
         };
-        for (const LearnKey& k : read.learn->keys)
-            if (k.lookup) visit(*k.lookup, k.line);
+        const LearnedReadKeys* own = read.expr->learn_index >= static_cast<int>(proto_.learns.size())
+                                         ? proto_.learned_read_keys[read.expr->learn_index - proto_.learns.size()].get()
+                                         : nullptr;
+        for (size_t i = 0; i < read.learn->keys.size(); ++i) {
+            const LearnKey& k = read.learn->keys[i];
+            if (own && own->lookups[i]) visit(*own->lookups[i], k.line);
+            else if (k.lookup) visit(*k.lookup, k.line);
+        }
     }
+}
+
+// `{X}` in a key's lookup is the closest X before the reader (the <learn>
+// resolved it where the learn is, the last X in the file): where that is
+// another node, as in each copy of a <group>, the reader gets keys of its
+// own. A name with no node before the reader keeps the learn's, for the
+// checks above to explain.
+void Validator::resolve_lookups_at_reader(LearnedRead& read) {
+    auto row = std::make_unique<LearnedReadKeys>();
+    row->learn = read.learn;
+    row->line = read.line;
+    bool differs = false;
+    std::function<void(Expr&)> retarget = [&](Expr& e) {
+        for (Expr& a : e.args) retarget(a);
+        if (e.op != ExprOp::Field || !e.target) return;
+        const Node* near = find_before(read.reach, e.name);
+        if (!near || near == e.target || !near->is_numeric()) return;
+        e.target = const_cast<Node*>(near);
+        mark_slot(e.target);
+        differs = true;
+    };
+    for (const LearnKey& k : read.learn->keys) {
+        row->lookups.emplace_back();
+        if (!k.lookup) continue;
+        Expr copy = *k.lookup;
+        retarget(copy);
+        row->lookups.back() = std::move(copy);
+    }
+    if (!differs) return;
+    read.expr->learn_index = static_cast<int>(proto_.learns.size() + proto_.learned_read_keys.size());
+    proto_.learned_read_keys.push_back(std::move(row));
 }
 
 }  // namespace dissgen

@@ -67,6 +67,7 @@ gboolean probe_of(const dg_state *st, guint16 index, gboolean lookup, guint64 *k
 {
     const dg_learn *l = &st->p->learns[index];
     memset(probe, 0, sizeof *probe);
+    if (l->keys_of) index = (guint16)(l->keys_of - 1); /* a reader's keys: the entries are its learn's */
     probe->learn = index;
     probe->key_count = l->key_count;
     probe->keys = keys;

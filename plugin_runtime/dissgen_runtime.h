@@ -139,6 +139,9 @@ typedef struct dg_learn {
     guint16 if_first, if_count;
     guint16 key_first, key_count;
     gboolean by_sender;
+    /* 0: a <learn>; n: the keys one reader of learned{...} computes for the
+     * <learn> in row n - 1 (its lookups read the fields closest to it) */
+    guint16 keys_of = 0;
 } dg_learn;
 
 /* The most keys a <learn> has (the generator refuses more). */

@@ -5,6 +5,7 @@
 // nested Data values.)
 #include <gtest/gtest.h>
 
+#include "emit_cpp.h"
 #include "test_support.h"
 
 namespace dissgen::testing {
@@ -73,6 +74,39 @@ TEST(NodeGroups, UsesInsideGroupsExpandAndAFileWithoutGroupsIsUnchanged) {
     for (const auto& [name, line] : names_and_lines(*plain.proto)) b.push_back(name);
     EXPECT_EQ(a, b);
     EXPECT_NE(find(*grouped.proto, "Body")->length_ref.target, nullptr);
+}
+
+// Two copies of a group read learned{...} with a lookup: each computes the
+// key from its own copy's field, the closest before it (the <learn> alone
+// would resolve {Entry} to the last one in the file).
+TEST(NodeGroups, ALookupInEachCopyReadsTheFieldOfItsOwnCopy) {
+    Front f = front_end(rules(R"(  <group name="Entries">
+    <node name="Entry" length="1byte" displaytype="numberdec"/>
+    <node name="Size" value="learned{Size}"/>
+  </group>
+  <node name="Kind" length="1byte" displaytype="numberdec"/>
+  <node name="Inputs" if="../node[@name='Kind']" in="1"><use group="Entries"/></node>
+  <node name="Outputs" otherwise="true" if="../node[@name='Kind']" in="2"><use group="Entries"/></node>
+  <node name="Map" otherwise="true" if="../node[@name='Kind']" in="3">
+    <node name="Number" length="1byte" displaytype="numberdec"/>
+    <node name="Bytes" length="1byte" displaytype="numberdec"/>
+    <learn name="Size" value="{Bytes}"><key value="{Number}" lookup="{Entry}"/></learn>
+  </node>
+)"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    ASSERT_EQ(f.proto->learns.size(), 1u);
+    // the learn resolved {Entry} to Outputs' (the last): Inputs' reader has keys of its own
+    ASSERT_EQ(f.proto->learned_read_keys.size(), 1u);
+    const LearnedReadKeys& own = *f.proto->learned_read_keys[0];
+    EXPECT_EQ(own.learn, f.proto->learns[0]);
+    ASSERT_EQ(own.lookups.size(), 1u);
+    ASSERT_TRUE(own.lookups[0]);
+    ASSERT_NE(own.lookups[0]->target, nullptr);
+    EXPECT_EQ(own.lookups[0]->target->parent->name, "Inputs");
+    EXPECT_EQ(f.proto->learns[0]->keys[0].lookup->target->parent->name, "Outputs");
+    // the plugin's learns table: the learn, then the reader's keys for it (keys_of = row 0 + 1)
+    const std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_NE(code.find("/* learned{Size} at line 4 */ { 0, 0, 0, 0, 1, 1, FALSE, 1 }"), std::string::npos) << code;
 }
 
 }  // namespace
