@@ -197,6 +197,25 @@ def computed_frames():
     return out
 
 
+# ------------------------------------------------- mailboxes in datagrams and the gateway
+
+def coe_sdo_download(index, subindex, value):
+    """A CoE mailbox: an expedited initiate download request of 4 bytes."""
+    coe = struct.pack("<HBHBI", 0x2000, 0x23, index, subindex, value)  # service 2: SDO request
+    return struct.pack("<HHBB", len(coe), 0x1001, 0, 0x03 | 0x10) + coe
+
+
+def eoe_fragments(inner, frame_number, size=32):
+    """EoE mailboxes carrying the Ethernet frame `inner` in fragments of `size` bytes."""
+    out = []
+    for k in range(0, len(inner), size):
+        piece, last = inner[k:k + size], k + size >= len(inner)
+        offset = (len(inner) + 31) // 32 if k == 0 else k // 32
+        eoe = struct.pack("<HH", 0x0 | (int(last) << 8), (k // size) | (offset << 6) | (frame_number << 12)) + piece
+        out.append(struct.pack("<HHBB", len(eoe), 0x1001, 0, 0x02 | 0x10) + eoe)
+    return out
+
+
 class TestEscCommands(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
@@ -321,6 +340,42 @@ class TestEscCommands(TsharkTestCase, unittest.TestCase):
             rows = env.field_rows(path, ["frame.number"], display_filter="ecatr.esc.wkc_added")
             check(set(rows) == {2 * k + 2 for k in range(len(cs))},
                   "-Y ecatr.esc.wkc_added keeps every return (%d of %d)" % (len(rows), len(cs)))
+
+    def test_gateway_mailboxes_decode_as_datagram_mailboxes(self):
+        """One description of a mailbox (the rules' group "Mailbox") serves datagrams and the
+        mailbox gateway: the same CoE request shows the same object and Info text either way,
+        and an EoE frame in two fragments is reassembled and handed to eth either way."""
+        env = self.env
+        inner = bytes.fromhex("0102030405060a0b0c0d0e0f88b5") + bytes(range(46))
+        via_datagram = [pg.Datagram(cmd=5, idx=1, adp=0x1001, ado=0x1000, data=m, wkc=1)
+                        for m in [coe_sdo_download(0x1C12, 1, 0x1600)] + eoe_fragments(inner, 3)]
+        frames = [pg.Frame([d]) for d in via_datagram]
+        frames += [pg.Frame([], header_type=5, padding=m)
+                   for m in [coe_sdo_download(0x1C12, 1, 0x1600)] + eoe_fragments(inner, 4)]
+        t = 1704067200.0
+        for f in frames:
+            f.src_mac, f.ts = MASTER, t
+            t += 0.001
+        path = env.add_file("gateway-mailboxes.pcap", pg.pcap_bytes(frames))
+        with self.checks() as check:
+            for args in ([], ["-2"]):
+                mode = " ".join(args) or "one pass"
+                rows = env.field_rows(path, ["frame.number", "ecatr.datagram.mbx.coe.sdoreq.index",
+                                             "ecatr.gateway.coe.sdoreq.index", "ecatr.reassembled_in", "eth.type",
+                                             "_ws.col.Info"], two_pass=bool(args))
+                check(rows[1]["ecatr.datagram.mbx.coe.sdoreq.index"] == ["0x1c12"] and
+                      rows[4]["ecatr.gateway.coe.sdoreq.index"] == ["0x1c12"],
+                      "%s: the CoE request's object in a datagram and through the gateway" % mode)
+                info = [rows[n]["_ws.col.Info"][0] for n in (1, 4)]
+                check("Initiate download" in info[0] and info[0].split("Initiate download", 1)[1] ==
+                      info[1].split("Initiate download", 1)[1],
+                      "%s: the same CoE summary in the Info column (%s)" % (mode, info))
+                check(rows[3]["eth.type"] == ["0x88a4", "0x88b5"] and rows[6]["eth.type"] == ["0x88a4", "0x88b5"],
+                      "%s: each EoE frame reassembled and handed to eth in its last fragment (%s, %s)" % (
+                          mode, rows[3]["eth.type"], rows[6]["eth.type"]))
+                if args:
+                    check(rows[2]["ecatr.reassembled_in"] == ["3"] and rows[5]["ecatr.reassembled_in"] == ["6"],
+                          "-2: each first fragment links to the frame it was reassembled in")
 
     def test_computed_values_match_the_bytes(self):
         """Mailbox total lengths (ecatr.datagram.mbx.totallength, ecatr.gateway.totallength),
