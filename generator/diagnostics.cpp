@@ -6,8 +6,7 @@
 namespace dissgen {
 
 void Diagnostics::add(Severity severity, int line, std::string message) {
-    for (const Diagnostic& d : items_)
-        if (d.severity == severity && d.line == line && d.message == message) return;
+    if (!given_.emplace(severity, line, message).second) return;
     items_.push_back({severity, line, std::move(message)});
 }
 

@@ -3,7 +3,9 @@
 // about, from parsing to the final "FILE:LINE: error: MESSAGE" text.
 #pragma once
 
+#include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace dissgen {
@@ -32,6 +34,7 @@ private:
     void add(Severity severity, int line, std::string message);
 
     std::vector<Diagnostic> items_;
+    std::set<std::tuple<Severity, int, std::string>> given_;  // items_, to refuse repeats
 };
 
 }  // namespace dissgen

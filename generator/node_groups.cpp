@@ -3,9 +3,11 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
+#include "parser.h"
 #include "text_util.h"
 #include "xml_input.h"
 
@@ -25,12 +27,12 @@ struct Group {
     bool used = false;
 };
 
-// libxml2 copies an element's line but not what use_start_lines keeps in
-// psvi for lines above 65534: carried over here, element by element.
+// The copy's lines are the group's: libxml2 copies an element's line but
+// not a text's, nor what use_start_lines keeps in psvi for lines above 65534.
 void copy_lines(const xmlNode* from, xmlNode* to) {
     for (; from && to; from = from->next, to = to->next) {
+        to->line = from->line;
         if (from->type == XML_ELEMENT_NODE) {
-            to->line = from->line;
             to->psvi = from->psvi;
             copy_lines(from->children, to->children);
         }
@@ -92,7 +94,7 @@ private:
                 error(c, "<group> needs a 'name' attribute: what <use group=\"...\"/> calls it");
                 continue;
             }
-            if (const Group* before = find(g.name)) {
+            if (const Group* before = find_in(g.name)) {
                 error(c, "group '" + g.name + "' is already defined at line " +
                              std::to_string(xml_line(before->element)));
                 continue;
@@ -114,8 +116,15 @@ private:
                 error(c, "group '" + g.name + "' holds no <node>: a group is the nodes its uses stand for");
                 continue;
             }
+            index_[g.name] = groups_.size();
             groups_.push_back(g);
         }
+    }
+
+    // While groups are collected (groups_ may still move).
+    const Group* find_in(const std::string& name) const {
+        auto it = index_.find(name);
+        return it == index_.end() ? nullptr : &groups_[it->second];
     }
 
     // A <group> anywhere but directly in <root> is a mistake the parser
@@ -131,9 +140,8 @@ private:
     }
 
     Group* find(const std::string& name) {
-        for (Group& g : groups_)
-            if (g.name == name) return &g;
-        return nullptr;
+        auto it = index_.find(name);
+        return it == index_.end() ? nullptr : &groups_[it->second];
     }
 
     // Where a use may stand: where a <node> may.
@@ -165,18 +173,24 @@ private:
     }
 
     // Nested deeper than its group's depth: the rest of the container is
-    // shown as bytes, one leaf named after the group, filter name "deeper".
-    static void stand_in_for_deeper(xmlNode* use, const Group& g) {
+    // shown as bytes, one leaf named after the group, filter name "deeper"
+    // ("deeper_2", ... for the stand-ins after it in the same container).
+    void stand_in_for_deeper(xmlNode* use, const Group& g) {
+        int before = 0;
+        for (const xmlNode* s = use->prev; s; s = s->prev) before += stand_ins_.count(s) != 0;
+        const std::string suffix = before ? "_" + std::to_string(before + 1) : "";
         xmlNode* leaf = xmlNewDocNode(use->doc, nullptr, BAD_CAST "node", nullptr);
-        const std::string name = g.name + " (nested deeper than " + std::to_string(g.depth) + " levels)";
+        const std::string name = g.name + " (nested deeper than " + std::to_string(g.depth) + " levels)" +
+                                 (before ? " " + std::to_string(before + 1) : "");
         xmlNewProp(leaf, BAD_CAST "name", BAD_CAST name.c_str());
-        xmlNewProp(leaf, BAD_CAST "filter", BAD_CAST "deeper");
+        xmlNewProp(leaf, BAD_CAST "filter", BAD_CAST("deeper" + suffix).c_str());
         xmlNewProp(leaf, BAD_CAST "length", BAD_CAST "rest");
         xmlNewProp(leaf, BAD_CAST "displaytype", BAD_CAST "origin");
         leaf->line = use->line;
         leaf->psvi = use->psvi;
         xmlReplaceNode(use, leaf);
         xmlFreeNode(use);
+        stand_ins_.insert(leaf);
     }
 
     void replace_use(xmlNode* use) {
@@ -196,6 +210,10 @@ private:
                                                 : " (did you mean '" + near + "'?)"));
         }
         g->used = true;
+        if (stack_.size() >= static_cast<size_t>(kMaxNesting))
+            return error(use, "uses of groups nested deeper than " + std::to_string(kMaxNesting) +
+                                  " levels (a use inside group '" + stack_.back()->name + "', itself used inside "
+                                  "group '" + stack_.front()->name + "' ...): nodes cannot nest that deep");
         const int nested = static_cast<int>(std::count(stack_.begin(), stack_.end(), g));
         if (nested >= g->depth) {
             if (!g->depth_given)
@@ -228,6 +246,8 @@ private:
 
     Diagnostics& diags_;
     std::vector<Group> groups_;
+    std::map<std::string, size_t> index_;  // name -> groups_
+    std::set<const xmlNode*> stand_ins_;
     std::vector<const Group*> stack_;
     size_t added_ = 0;
     bool failed_ = false;

@@ -431,7 +431,7 @@ std::unique_ptr<Protocol> Parser::parse_root(xmlNode* root) {
         else if (c->type == XML_ELEMENT_NODE && element_name(c) == "cycles")
             parse_cycles(c, *proto);
         else
-            unexpected_child(c, "root", {"node", "hook", "pairing", "heuristic", "cycles"});
+            unexpected_child(c, "root", {"node", "hook", "pairing", "heuristic", "cycles", "group", "use"});
     }
     if (proto->pdulength) defer(*proto->pdulength, root, proto->line, "pdulength");
     resolve_all();
@@ -722,7 +722,7 @@ std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
         else if (c->type == XML_ELEMENT_NODE && element_name(c) == "learn")
             parse_learn(c, *node);
         else
-            unexpected_child(c, "node", {"node", "enum", "when", "finding", "learn"});
+            unexpected_child(c, "node", {"node", "enum", "when", "finding", "learn", "use"});
     }
     for (When& w : node->whens) defer(w.ref, el, w.line, w.peek ? "peek" : "field");
     if (node->base) defer(*node->base, el, node->line, "base");

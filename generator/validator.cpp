@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cctype>
 #include <functional>
+#include <tuple>
 #include <map>
 #include <optional>
 
@@ -106,6 +107,7 @@ private:
     };
     void resolve_lookups_at_reader(LearnedRead& read);
     std::vector<LearnedRead> learned_reads_;
+    std::map<std::string, size_t> read_rows_;  // a reader row's targets -> its row (resolve_lookups_at_reader)
     bool check_integer_expr(Node& n, Expr& e, const ExprSite& at, const std::string& what);
     bool check_request_field(Node& n, Expr& e);
     const Node* request_field_target(const Node& n, const std::string& text, const std::string& what);
@@ -221,6 +223,26 @@ void Validator::check_table_sizes() {
         over(n, operations, max_rows, "operations in computed values");
         if (n.slot >= 0) over(n, static_cast<size_t>(n.slot) + 1, 32767, "fields whose values are read");
     });
+    // readers with keys of their own: rows of learns (read by a 16-bit signed
+    // slot), of keys, and operations
+    size_t key_rows = 0;
+    for (const Learn* l : proto_.learns) key_rows += l->keys.size();
+    for (size_t k = 0; k < proto_.learned_read_keys.size() && !reported; ++k) {
+        const LearnedReadKeys& row = *proto_.learned_read_keys[k];
+        key_rows += row.lookups.size();
+        for (size_t i = 0; i < row.lookups.size(); ++i)
+            operations += compile_expression(row.learn->keys[i].value, false).size() +
+                          (row.lookups[i] ? compile_expression(*row.lookups[i], false).size() : 0);
+        const size_t rows = proto_.learns.size() + k + 1;
+        for (auto [count, limit, what] : {std::make_tuple(rows, size_t{32767}, "learned{...} readers and <learn>s"),
+                                          std::make_tuple(key_rows, max_rows, "keys of learned{...} readers"),
+                                          std::make_tuple(operations, max_rows, "operations in computed values")}) {
+            if (reported || count <= limit) continue;
+            reported = true;
+            diags_.error(row.line, "the rule file is too large for the plugin's tables: more than " +
+                                       std::to_string(limit) + " " + what + " in all");
+        }
+    }
 }
 
 void Validator::check_root() {
@@ -2016,6 +2038,15 @@ void Validator::check_lookups_at_readers() {
                                             " is not inside a repeated node, so there is no instance to count");
             if (e.op != ExprOp::Field || !e.target) return;
             const Node* t = e.target;
+            const bool in_repeat = [&] {
+                for (const Node* r = t; r; r = r->parent)
+                    if (r->is_repeated()) return true;
+                return false;
+            }();
+            if (!in_repeat && t->doc_index >= read.reach)
+                diags_.error(read.line, head + std::to_string(key_line) + " reads {" + e.name + "}" + at_line(*t) +
+                                            ", and no node of that name is decoded before " + quote(reader) +
+                                            ": a lookup reads what the reader's message decoded before it");
             for (const Node* r = t; r; r = r->parent) {
                 if (!r->is_repeated()) continue;
                 if (!is_ancestor_or_self(r, &reader))
@@ -2051,25 +2082,39 @@ void Validator::resolve_lookups_at_reader(LearnedRead& read) {
     row->learn = read.learn;
     row->line = read.line;
     bool differs = false;
-    std::function<void(Expr&)> retarget = [&](Expr& e) {
-        for (Expr& a : e.args) retarget(a);
+    std::string signature = std::to_string(read.learn->index);  // the row's targets, to share equal rows
+    std::function<void(Expr&, int)> retarget = [&](Expr& e, int key_line) {
+        for (Expr& a : e.args) retarget(a, key_line);
         if (e.op != ExprOp::Field || !e.target) return;
         const Node* near = find_before(read.reach, e.name);
-        if (!near || near == e.target || !near->is_numeric()) return;
-        e.target = const_cast<Node*>(near);
-        mark_slot(e.target);
-        differs = true;
+        if (near && near != e.target && !near->is_numeric()) {
+            diags_.error(read.line, "learned{" + read.learn->name + "}" + read.in + ": the lookup of its key on line " +
+                                        std::to_string(key_line) + " reads {" + e.name + "}, which before it is " +
+                                        quote(*near) + at_line(*near) + ", not numeric: it must be a leaf shown as "
+                                        "a number, or a computed value");
+            e.target = nullptr;  // told once: the checks at readers skip it
+            differs = true;
+            return;
+        }
+        if (near && near != e.target) {
+            e.target = const_cast<Node*>(near);
+            mark_slot(e.target);
+            differs = true;
+        }
+        signature += " " + std::to_string(e.target->doc_index);
     };
     for (const LearnKey& k : read.learn->keys) {
         row->lookups.emplace_back();
+        signature += ";";
         if (!k.lookup) continue;
         Expr copy = *k.lookup;
-        retarget(copy);
+        retarget(copy, k.line);
         row->lookups.back() = std::move(copy);
     }
     if (!differs) return;
-    read.expr->learn_index = static_cast<int>(proto_.learns.size() + proto_.learned_read_keys.size());
-    proto_.learned_read_keys.push_back(std::move(row));
+    auto [shared, added] = read_rows_.emplace(signature, proto_.learns.size() + proto_.learned_read_keys.size());
+    read.expr->learn_index = static_cast<int>(shared->second);
+    if (added) proto_.learned_read_keys.push_back(std::move(row));
 }
 
 }  // namespace dissgen
