@@ -48,7 +48,7 @@ size_t count_elements(const xmlNode* n) {
 
 class Expander {
 public:
-    explicit Expander(Diagnostics& diags) : diags_(diags) {}
+    Expander(Diagnostics& diags, GroupUses& uses) : diags_(diags), uses_(uses) {}
 
     bool run(xmlNode* root) {
         collect_groups(root);
@@ -235,8 +235,10 @@ private:
         stack_.push_back(g);
         expand_children(holder);
         stack_.pop_back();
+        const GroupUse here{g->name, xml_line(use)};
         while (xmlNode* n = holder->children) {
             xmlUnlinkNode(n);
+            if (n->type == XML_ELEMENT_NODE) uses_[n] = here;
             xmlAddPrevSibling(use, n);
         }
         xmlFreeNode(holder);
@@ -245,6 +247,7 @@ private:
     }
 
     Diagnostics& diags_;
+    GroupUses& uses_;
     std::vector<Group> groups_;
     std::map<std::string, size_t> index_;  // name -> groups_
     std::set<const xmlNode*> stand_ins_;
@@ -255,6 +258,19 @@ private:
 
 }  // namespace
 
-bool expand_node_groups(xmlNode* root, Diagnostics& diags) { return Expander(diags).run(root); }
+bool expand_node_groups(xmlNode* root, Diagnostics& diags, GroupUses& uses) {
+    return Expander(diags, uses).run(root);
+}
+
+std::string group_use_context(const GroupUses& uses, const xmlNode* el) {
+    std::string out;
+    for (; el; el = el->parent) {
+        auto it = uses.find(el);
+        if (it == uses.end()) continue;
+        out += (out.empty() ? " (in group '" : ", in group '") + it->second.group + "' used on line " +
+               std::to_string(it->second.line);
+    }
+    return out.empty() ? out : out + ")";
+}
 
 }  // namespace dissgen

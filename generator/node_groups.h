@@ -8,6 +8,9 @@
 
 #include <libxml/tree.h>
 
+#include <map>
+#include <string>
+
 #include "diagnostics.h"
 
 namespace dissgen {
@@ -18,8 +21,21 @@ constexpr int kMaxGroupDepth = 16;
 // Elements all uses together may add: copies of copies grow fast.
 constexpr size_t kMaxGroupElements = 100000;
 
+// Where a copy came from: each element a use put in place, with the group's
+// name and the use's line (for diagnostics that depend on where it stands).
+struct GroupUse {
+    std::string group;
+    int line = 0;
+};
+using GroupUses = std::map<const xmlNode*, GroupUse>;
+
 // Replaces the uses under `root` by copies of their groups and removes the
-// groups. False (after errors in `diags`) when a use or group is wrong.
-bool expand_node_groups(xmlNode* root, Diagnostics& diags);
+// groups; records the copies in `uses`. False (after errors in `diags`) when
+// a use or group is wrong.
+bool expand_node_groups(xmlNode* root, Diagnostics& diags, GroupUses& uses);
+
+// " (in group 'X' used on line N, ...)" for an element inside copies, from the
+// innermost use out; "" elsewhere.
+std::string group_use_context(const GroupUses& uses, const xmlNode* el);
 
 }  // namespace dissgen

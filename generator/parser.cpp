@@ -262,7 +262,7 @@ constexpr unsigned long kXPathFileStepLimit = 100000000;
 
 class Parser {
 public:
-    Parser(xmlDoc* doc, Diagnostics& diags) : doc_(doc), diags_(diags) {}
+    Parser(xmlDoc* doc, Diagnostics& diags, const GroupUses& uses) : doc_(doc), diags_(diags), uses_(uses) {}
 
     std::unique_ptr<Protocol> parse_root(xmlNode* root);
 
@@ -308,6 +308,7 @@ private:
 
     xmlDoc* doc_;
     Diagnostics& diags_;
+    const GroupUses& uses_;  // where copies of groups stand, for messages about them
     std::map<const xmlNode*, Node*> by_xml_;
     std::vector<PendingRef> pending_;
     int next_doc_index_ = 1;
@@ -1157,7 +1158,8 @@ std::string Parser::nothing_selected_hint(const PendingRef& p) const {
 }
 
 Node* Parser::resolve(const PendingRef& p) {
-    const std::string where = "XPath '" + excerpt(p.ref->xpath, 120) + "' in '" + p.attribute + "'";
+    const std::string where = "XPath '" + excerpt(p.ref->xpath, 120) + "' in '" + p.attribute + "'" +
+                              group_use_context(uses_, p.context);
     xmlXPathContextPtr ctx = xmlXPathNewContext(doc_);
     ctx->node = p.context;
     ctx->error = ignore_xml_error;
@@ -1276,8 +1278,8 @@ std::unique_ptr<Protocol> parse_rules(const std::string& text, Diagnostics& diag
     if (!root || element_name(root) != "root") {
         diags.error(root ? line_of(root) : 0,
                     "the document element must be <root>, not <" + (root ? element_name(root) : "") + ">");
-    } else if (expand_node_groups(root, diags)) {
-        proto = Parser(doc, diags).parse_root(root);
+    } else if (GroupUses uses; expand_node_groups(root, diags, uses)) {
+        proto = Parser(doc, diags, uses).parse_root(root);
     }
     xmlFreeDoc(doc);
     return proto;
