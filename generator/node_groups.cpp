@@ -94,7 +94,7 @@ private:
                 error(c, "<group> needs a 'name' attribute: what <use group=\"...\"/> calls it");
                 continue;
             }
-            if (const Group* before = find_in(g.name)) {
+            if (const Group* before = find(g.name)) {
                 error(c, "group '" + g.name + "' is already defined at line " +
                              std::to_string(xml_line(before->element)));
                 continue;
@@ -119,12 +119,6 @@ private:
             index_[g.name] = groups_.size();
             groups_.push_back(g);
         }
-    }
-
-    // While groups are collected (groups_ may still move).
-    const Group* find_in(const std::string& name) const {
-        auto it = index_.find(name);
-        return it == index_.end() ? nullptr : &groups_[it->second];
     }
 
     // A <group> anywhere but directly in <root> is a mistake the parser

@@ -71,11 +71,7 @@ const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberd
                                                 // absolute dates and times, GUIDs
                                                 "datetime", "guid"};
 
-int line_of(const xmlNode* el) {
-    if (el->type == XML_ELEMENT_NODE && el->line == 65535 && el->psvi)  // set by use_start_lines
-        return static_cast<int>(reinterpret_cast<ptrdiff_t>(el->psvi));
-    return static_cast<int>(xmlGetLineNo(el));
-}
+int line_of(const xmlNode* el) { return xml_line(el); }  // lines above 65534: use_start_lines
 
 std::string element_name(const xmlNode* el) { return reinterpret_cast<const char*>(el->name); }
 

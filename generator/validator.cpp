@@ -1886,7 +1886,6 @@ void Validator::parse_finding_text(Node& n, Finding& f, const ExprSite& at) {
     }
 }
 
-// Filter names P.finding.NAME: a lowercase segment, each once, and no field's.
 // Where the first of two same names is: another line, or this one again
 // when a <group> holding it is used more than once.
 namespace {
@@ -1899,6 +1898,7 @@ std::string also_at(int first, int line) {
 
 }  // namespace
 
+// Filter names P.finding.NAME: a lowercase segment, each once, and no field's.
 void Validator::name_findings() {
     std::map<std::string, int> seen;
     for_each_node(proto_.nodes, [&](Node& n) {
@@ -2038,27 +2038,22 @@ void Validator::check_lookups_at_readers() {
                                             " is not inside a repeated node, so there is no instance to count");
             if (e.op != ExprOp::Field || !e.target) return;
             const Node* t = e.target;
-            const bool in_repeat = [&] {
-                for (const Node* r = t; r; r = r->parent)
-                    if (r->is_repeated()) return true;
-                return false;
-            }();
-            if (!in_repeat && t->doc_index >= read.reach)
-                diags_.error(read.line, head + std::to_string(key_line) + " reads {" + e.name + "}" + at_line(*t) +
-                                            ", and no node of that name is decoded before " + quote(reader) +
-                                            ": a lookup reads what the reader's message decoded before it");
-            for (const Node* r = t; r; r = r->parent) {
-                if (!r->is_repeated()) continue;
-                if (!is_ancestor_or_self(r, &reader))
-                    diags_.error(read.line, head + std::to_string(key_line) + " reads {" + e.name + "}, inside " +
-                                                "repeated node " + quote(*r) + at_line(*r) + ", which does not contain " +
-                                                quote(reader) + "; use a field of the reader's instance or one "
-                                                "outside every repeat");
-                else if (t->doc_index >= reader.doc_index)
+            const Node* r = t;
+            while (r && !r->is_repeated()) r = r->parent;
+            if (!r) {
+                if (t->doc_index >= read.reach)
                     diags_.error(read.line, head + std::to_string(key_line) + " reads {" + e.name + "}" + at_line(*t) +
-                                                " of the reader's instance, decoded after " + quote(reader) +
-                                                "; it must come earlier in the file");
-                break;
+                                                ", and no node of that name is decoded before " + quote(reader) +
+                                                ": a lookup reads what the reader's message decoded before it");
+            } else if (!is_ancestor_or_self(r, &reader)) {
+                diags_.error(read.line, head + std::to_string(key_line) + " reads {" + e.name + "}, inside " +
+                                            "repeated node " + quote(*r) + at_line(*r) + ", which does not contain " +
+                                            quote(reader) + "; use a field of the reader's instance or one "
+                                            "outside every repeat");
+            } else if (t->doc_index >= reader.doc_index) {
+                diags_.error(read.line, head + std::to_string(key_line) + " reads {" + e.name + "}" + at_line(*t) +
+                                            " of the reader's instance, decoded after " + quote(reader) +
+                                            "; it must come earlier in the file");
             }
         };
         const LearnedReadKeys* own = read.expr->learn_index >= static_cast<int>(proto_.learns.size())
