@@ -297,7 +297,8 @@ private:
     bool parse_byteorder(const std::string& text, int line, ByteOrder& out);
     FieldRef make_ref(const std::string& text, int line, const std::string& attribute, bool arithmetic);
     void defer(FieldRef& ref, xmlNode* context, int line, const std::string& attribute);
-    std::string nothing_selected_hint(const PendingRef& p) const;
+    std::string nothing_selected_hint(const PendingRef& p);
+    std::string name_hint(const std::string& wanted) const;
     void unexpected_child(xmlNode* child, const std::string& parent, const std::vector<std::string>& allowed);
     void resolve_all();
     Node* resolve(const PendingRef& p);
@@ -306,6 +307,9 @@ private:
     Diagnostics& diags_;
     const GroupUses& uses_;  // where copies of groups stand, for messages about them
     std::map<const xmlNode*, Node*> by_xml_;
+    // name_hint of each name an XPath that selected nothing looked for: every
+    // copy of a failing path in a <group> gets the same
+    std::map<std::string, std::string> name_hints_;
     std::vector<PendingRef> pending_;
     int next_doc_index_ = 1;
     bool xpath_limit_hit_ = false;
@@ -1133,24 +1137,30 @@ std::string named_in_xpath(const std::string& xpath) {
 // Where an XPath that selected nothing was evaluated from, and, when it
 // names a node (@name='X'), whether any node has that name: the two usual
 // mistakes are a wrong step ('..' one level too few) and a misspelt name.
-std::string Parser::nothing_selected_hint(const PendingRef& p) const {
+std::string Parser::nothing_selected_hint(const PendingRef& p) {
     std::string from = "<" + element_name(p.context) + ">";
     if (auto it = by_xml_.find(p.context); it != by_xml_.end()) from = "node '" + it->second->name + "'";
     std::string hint = " (evaluated from " + from + " on line " + std::to_string(line_of(p.context)) + ")";
     const std::string wanted = named_in_xpath(p.ref->xpath);
     if (wanted.empty()) return hint;
-    std::vector<std::string> names;
-    int first_line = 0;
+    auto [known, added] = name_hints_.try_emplace(wanted);
+    if (added) known->second = name_hint(wanted);
+    return hint + known->second;
+}
+
+// Whether a node is named `wanted`, and where first, or the name most like it.
+std::string Parser::name_hint(const std::string& wanted) const {
+    std::map<std::string, int> first_line;  // each name, in order, with its first line
     for (const auto& [xml, node] : by_xml_) {
-        if (node->name == wanted && (first_line == 0 || node->line < first_line)) first_line = node->line;
-        names.push_back(node->name);
+        auto [at, added] = first_line.emplace(node->name, node->line);
+        if (!added) at->second = std::min(at->second, node->line);
     }
-    if (first_line)
-        return hint + "; node '" + wanted + "' is on line " + std::to_string(first_line) +
-               ": check the path's steps from there";
-    std::sort(names.begin(), names.end());
+    if (auto named = first_line.find(wanted); named != first_line.end())
+        return "; node '" + wanted + "' is on line " + std::to_string(named->second) + ": check the path's steps from there";
+    std::vector<std::string> names;
+    for (const auto& [name, line] : first_line) names.push_back(name);
     std::string near = closest_match(wanted, names);
-    return hint + "; no node is named '" + wanted + "'" + (near.empty() ? "" : " (did you mean '" + near + "'?)");
+    return "; no node is named '" + wanted + "'" + (near.empty() ? "" : " (did you mean '" + near + "'?)");
 }
 
 Node* Parser::resolve(const PendingRef& p) {

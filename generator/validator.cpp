@@ -11,8 +11,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <climits>
 #include <functional>
 #include <tuple>
+#include <unordered_map>
 #include <map>
 #include <optional>
 
@@ -88,6 +90,12 @@ private:
     bool check_expr(Node& n, Expr& e);
     bool check_expr(Node& n, Expr& e, const ExprSite& at);
     const Node* find_before(int reach, const std::string& name);
+    std::vector<std::string> names_before(int reach) const;
+    // Every node of each name, in document order: names are looked up once
+    // per expression operand, and a <group> used many times makes the tree
+    // large, so a lookup must not walk it.
+    std::unordered_map<std::string, std::vector<const Node*>> nodes_by_name_;
+    std::map<std::pair<int, std::string>, std::string> name_suggestions_;  // (line, misspelt name) -> nearest
     // <finding>s: their words, names, condition and text (findings.h)
     void check_findings(Node& n);
     void parse_finding_text(Node& n, Finding& f, const ExprSite& at);
@@ -111,6 +119,12 @@ private:
     bool check_integer_expr(Node& n, Expr& e, const ExprSite& at, const std::string& what);
     bool check_request_field(Node& n, Expr& e);
     const Node* request_field_target(const Node& n, const std::string& text, const std::string& what);
+    struct RequestTarget {
+        const Node* target;
+        std::string problem;  // why there is none, after the words naming the read
+    };
+    RequestTarget resolve_request_field(const std::string& text) const;
+    std::map<std::string, RequestTarget> request_targets_;  // request_field_target, by text
     bool check_defined(const Node& n, Expr& e);
     void check_request_keys();
     const Node* fixed_offset_blocker(const Node& n, uint64_t& offset) const;
@@ -156,6 +170,7 @@ private:
 };
 
 void Validator::run() {
+    for_each_node(proto_.nodes, [&](Node& n) { nodes_by_name_[n.name].push_back(&n); });
     check_root();
     collect_learns();
     for (auto& n : proto_.nodes) inherit_and_check_node(*n, proto_.byteorder);
@@ -947,11 +962,24 @@ void Validator::assign_slots() {
 
 // The node named `name` last in document order among the first reach - 1, or nullptr.
 const Node* Validator::find_before(int reach, const std::string& name) {
-    const Node* found = nullptr;
-    for_each_node(proto_.nodes, [&](Node& c) {
-        if (c.name == name && c.doc_index < reach) found = &c;
-    });
-    return found;
+    auto it = nodes_by_name_.find(name);
+    if (it == nodes_by_name_.end()) return nullptr;
+    const std::vector<const Node*>& named = it->second;
+    auto past = std::lower_bound(named.begin(), named.end(), reach,
+                                 [](const Node* c, int r) { return c->doc_index < r; });
+    return past == named.begin() ? nullptr : *(past - 1);
+}
+
+// The names of the nodes among the first reach - 1, each once, in document
+// order (of two as close, a misspelt name is offered the first).
+std::vector<std::string> Validator::names_before(int reach) const {
+    std::vector<std::pair<int, std::string>> firsts;
+    for (const auto& [name, named] : nodes_by_name_)
+        if (named.front()->doc_index < reach) firsts.emplace_back(named.front()->doc_index, name);
+    std::sort(firsts.begin(), firsts.end());
+    std::vector<std::string> names;
+    for (auto& f : firsts) names.push_back(std::move(f.second));
+    return names;
 }
 
 void Validator::check_computed(Node& n) {
@@ -1003,16 +1031,17 @@ bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
     case ExprOp::Field: {
         const Node* t = find_before(at.reach, e.name);
         if (!t) {
-            const Node* later = nullptr;
-            for_each_node(proto_.nodes, [&](Node& c) { if (!later && c.name == e.name) later = &c; });
-            if (later) {
+            auto named = nodes_by_name_.find(e.name);
+            if (named != nodes_by_name_.end()) {
+                const Node* later = named->second.front();
                 diags_.error(at.line, "{" + e.name + "}" + in + " is " + quote(*later) + at_line(*later) +
                                          ", which comes after it; a value reads fields decoded before it");
                 return false;
             }
-            std::vector<std::string> names;
-            for_each_node(proto_.nodes, [&](Node& c) { if (c.doc_index < at.reach) names.push_back(c.name); });
-            const std::string near = closest_match(e.name, names);
+            // copies of a <group> share the line, and the message once told
+            auto [near_it, first] = name_suggestions_.try_emplace({at.line, e.name});
+            if (first) near_it->second = closest_match(e.name, names_before(at.reach));
+            const std::string& near = near_it->second;
             diags_.error(at.line, "{" + e.name + "}" + in + ": no node of that name comes before it" +
                                      (near.empty() ? "" : " (did you mean {" + near + "}?)"));
             return false;
@@ -1104,36 +1133,42 @@ std::string telling_path(const Node& c, const std::vector<const Node*>& candidat
 // reading the first of several would silently pick a layout. NULL after an
 // error; a node decoded only in responses when no other fits.
 const Node* Validator::request_field_target(const Node& n, const std::string& text, const std::string& what) {
-    bool whole_name = false;
-    for_each_node(proto_.nodes, [&](Node& c) { whole_name = whole_name || c.name == text; });
+    auto [known, added] = request_targets_.try_emplace(text);
+    if (added) known->second = resolve_request_field(text);
+    const RequestTarget& r = known->second;
+    if (!r.target) diags_.error(n.line, what + r.problem);
+    return r.target;
+}
+
+// request_field_target's answer for TEXT, the same wherever it is read.
+Validator::RequestTarget Validator::resolve_request_field(const std::string& text) const {
+    auto nodes_named = [&](const std::string& name) {
+        auto it = nodes_by_name_.find(name);
+        return it == nodes_by_name_.end() ? std::vector<const Node*>{} : it->second;
+    };
+    const bool whole_name = nodes_by_name_.count(text) > 0;
     const std::vector<std::string> segments = whole_name ? std::vector<std::string>{text} : path_segments(text);
+    const std::vector<const Node*> named = nodes_named(segments.back());
     std::vector<const Node*> fits, requests, responses;
-    for_each_node(proto_.nodes, [&](Node& c) {
-        if (!matches_path(c, segments)) return;
-        (decoded_only_in(c, Direction::Response) ? responses : fits).push_back(&c);
-        if (decoded_only_in(c, Direction::Request)) requests.push_back(&c);
-    });
+    for (const Node* c : named) {
+        if (!matches_path(*c, segments)) continue;
+        (decoded_only_in(*c, Direction::Response) ? responses : fits).push_back(c);
+        if (decoded_only_in(*c, Direction::Request)) requests.push_back(c);
+    }
     if (!requests.empty()) fits = requests;
     if (fits.size() > 1) {
         std::string list;
         for (const Node* c : fits) list += std::string(list.empty() ? "" : ", ") + "'" + telling_path(*c, fits) + "'" + at_line(*c);
-        diags_.error(n.line, what + " is ambiguous: " + std::to_string(fits.size()) +
-                                 " fields a request decodes fit it: " + list + "; name one by its path, e.g. request{" +
-                                 telling_path(*fits.front(), fits) + "}");
-        return nullptr;
+        return {nullptr, " is ambiguous: " + std::to_string(fits.size()) + " fields a request decodes fit it: " + list +
+                             "; name one by its path, e.g. request{" + telling_path(*fits.front(), fits) + "}"};
     }
-    if (!fits.empty()) return fits.front();
-    if (!responses.empty()) return responses.front();
-    std::vector<std::string> names;
-    std::vector<const Node*> named;  // a path that is wrong above a right name: suggest the right path
-    for_each_node(proto_.nodes, [&](Node& c) {
-        names.push_back(c.name);
-        if (c.name == segments.back()) named.push_back(&c);
-    });
-    const std::string near = named.empty() ? closest_match(segments.back(), names) : telling_path(*named[0], named);
-    diags_.error(n.line, what + (segments.size() > 1 ? ": no node has that path" : ": no node has that name") +
-                             (near.empty() ? "" : " (did you mean request{" + near + "}?)"));
-    return nullptr;
+    if (!fits.empty()) return {fits.front(), ""};
+    if (!responses.empty()) return {responses.front(), ""};
+    // a path that is wrong above a right name: suggest the right path
+    const std::string near = named.empty() ? closest_match(segments.back(), names_before(INT_MAX))
+                                           : telling_path(*named[0], named);
+    return {nullptr, std::string(segments.size() > 1 ? ": no node has that path" : ": no node has that name") +
+                         (near.empty() ? "" : " (did you mean request{" + near + "}?)")};
 }
 
 // request{Name}: a field of the paired request (request_field_target).

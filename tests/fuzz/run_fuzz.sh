@@ -49,10 +49,21 @@ done
 echo "fuzz: $n seed files, $seconds seconds"
 
 # -max_len keeps inputs near rule-file size; -timeout flags a hang of 10 s on one input.
+# The input that failed is kept (artifacts/ beside the run) and its head
+# printed: a failure on a CI machine can then be replayed with
+#   fuzz_rules artifacts/crash-...
+artifacts="$PWD/fuzz-artifacts"
+mkdir -p "$artifacts"
 "$work/fuzz_rules" "$work/corpus" -max_total_time="$seconds" -max_len=16384 -timeout=10 \
-  -rss_limit_mb=2048 -print_final_stats=1 -dict="$here/rules.dict" 2>"$work/log" || {
+  -rss_limit_mb=2048 -print_final_stats=1 -dict="$here/rules.dict" -artifact_prefix="$artifacts/" 2>"$work/log" || {
   status=$?
   tail -60 "$work/log"
+  for a in "$artifacts"/*; do
+    [ -f "$a" ] || continue
+    echo "fuzz: failing input $a ($(wc -c <"$a") bytes), first 40 lines:"
+    head -c 4000 "$a" | head -40
+    echo
+  done
   echo "fuzz: FAILED (exit $status)"
   echo "0 passed, 1 failed"
   exit 1
