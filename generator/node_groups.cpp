@@ -39,11 +39,23 @@ void copy_lines(const xmlNode* from, xmlNode* to) {
     }
 }
 
-size_t count_elements(const xmlNode* n) {
-    size_t k = 0;
-    for (; n; n = n->next)
-        if (n->type == XML_ELEMENT_NODE) k += 1 + count_elements(n->children);
-    return k;
+// What a copy of a list of siblings adds: its elements, and the bytes of
+// their attribute values and text.
+struct Weight {
+    size_t elements = 0;
+    size_t text_bytes = 0;
+};
+
+void weigh(const xmlNode* n, Weight& w) {
+    for (; n; n = n->next) {
+        if (n->content) w.text_bytes += static_cast<size_t>(xmlStrlen(n->content));
+        if (n->type != XML_ELEMENT_NODE) continue;
+        w.elements += 1;
+        for (const xmlAttr* a = n->properties; a; a = a->next)
+            for (const xmlNode* v = a->children; v; v = v->next)
+                if (v->content) w.text_bytes += static_cast<size_t>(xmlStrlen(v->content));
+        weigh(n->children, w);
+    }
 }
 
 class Expander {
@@ -216,10 +228,14 @@ private:
                                       "on its <group> (line " + std::to_string(xml_line(g->element)) + ")");
             return stand_in_for_deeper(use, *g);
         }
-        added_ += count_elements(g->element->children);
-        if (added_ > kMaxGroupElements)
+        weigh(g->element->children, added_);
+        if (added_.elements > kMaxGroupElements)
             return error(use, "the uses of groups add more than " + std::to_string(kMaxGroupElements) +
                                   " elements to the file (" + chain_to(*g) + "): nest fewer levels");
+        if (added_.text_bytes > kMaxGroupTextBytes)
+            return error(use, "the uses of groups add more than " + std::to_string(kMaxGroupTextBytes >> 20) +
+                                  " MiB of attribute values, text and comments to the file (" + chain_to(*g) +
+                                  "): use a group with long values fewer times");
         xmlNode* copy = xmlDocCopyNodeList(use->doc, g->element->children);
         copy_lines(g->element->children, copy);
         // Expand the copy's own uses while it hangs under the group's name,
@@ -246,7 +262,7 @@ private:
     std::map<std::string, size_t> index_;  // name -> groups_
     std::set<const xmlNode*> stand_ins_;
     std::vector<const Group*> stack_;
-    size_t added_ = 0;
+    Weight added_;
     bool failed_ = false;
 };
 

@@ -20,6 +20,9 @@ namespace dissgen {
 constexpr int kMaxGroupDepth = 16;
 // Elements all uses together may add: copies of copies grow fast.
 constexpr size_t kMaxGroupElements = 100000;
+// Bytes of attribute values and text they may add: a few copies of a long
+// label weigh as much as many of a short one.
+constexpr size_t kMaxGroupTextBytes = 8 * 1024 * 1024;
 
 // Where a copy came from: each element a use put in place, with the group's
 // name and the use's line (for diagnostics that depend on where it stands).
