@@ -78,7 +78,7 @@ std::string element_name(const xmlNode* el) { return reinterpret_cast<const char
 // The valid name to suggest for an unknown one: one that begins with it or
 // contains it ("len" -> length, "type" -> displaytype), one it begins with
 // ("boolean" -> bool), else the closest by edit distance ("" if none is close).
-std::string suggest(const std::string& word, const std::vector<std::string>& valid) {
+std::string suggest_uncached(const std::string& word, const std::vector<std::string>& valid) {
     std::string w = word;
     std::transform(w.begin(), w.end(), w.begin(), [](unsigned char c) { return std::tolower(c); });
     if (w.size() >= 3) {
@@ -90,6 +90,17 @@ std::string suggest(const std::string& word, const std::vector<std::string>& val
             if (v.size() >= 3 && w.rfind(v, 0) == 0) return v;
     }
     return closest_match(word, valid);
+}
+
+// suggest_uncached, remembered: each copy of a <group> repeats its
+// mistakes, and the lists are short, so the key is cheap.
+std::string suggest(const std::string& word, const std::vector<std::string>& valid) {
+    static std::map<std::string, std::string> known;
+    std::string key = word;
+    for (const std::string& v : valid) key += '\0' + v;
+    if (auto it = known.find(key); it != known.end()) return it->second;
+    if (known.size() >= 4096) known.clear();  // a bound, not a policy: any entry can be made again
+    return known[key] = suggest_uncached(word, valid);
 }
 
 // Collects libxml2's messages instead of letting it print them.

@@ -96,6 +96,7 @@ private:
     // large, so a lookup must not walk it.
     std::unordered_map<std::string, std::vector<const Node*>> nodes_by_name_;
     std::map<std::pair<int, std::string>, std::string> name_suggestions_;  // (line, misspelt name) -> nearest
+    int past_last_node_ = 1;  // a reach past every node: all of them are before it
     // <finding>s: their words, names, condition and text (findings.h)
     void check_findings(Node& n);
     void parse_finding_text(Node& n, Finding& f, const ExprSite& at);
@@ -136,8 +137,13 @@ private:
     void check_hook_list(const Node& n);
     void check_list_fits(int line, const std::vector<ValueRange>& list, const FieldRef& ref,
                          const char* attribute = "in");
-    bool offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const Node* t, uint64_t& offset,
-                   const Node*& blocker) const;
+    void offset_of(const Node* t, uint64_t& offset, const Node*& blocker) const;
+    struct Place {
+        uint64_t offset;        // from the start of the message
+        const Node* blocker;    // what keeps it from being fixed, or nullptr
+    };
+    void place(const std::vector<std::unique_ptr<Node>>& nodes, uint64_t offset, const Node* blocker) const;
+    mutable std::unordered_map<const Node*, Place> places_;  // offset_of, made on first use
     void parse_summary(Node& n);
     void assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, const std::string& prefix);
     void share_filter_name(Node& n, const Node& owner);
@@ -170,7 +176,10 @@ private:
 };
 
 void Validator::run() {
-    for_each_node(proto_.nodes, [&](Node& n) { nodes_by_name_[n.name].push_back(&n); });
+    for_each_node(proto_.nodes, [&](Node& n) {
+        nodes_by_name_[n.name].push_back(&n);
+        past_last_node_ = std::max(past_last_node_, n.doc_index + 1);
+    });
     check_root();
     collect_learns();
     for (auto& n : proto_.nodes) inherit_and_check_node(*n, proto_.byteorder);
@@ -571,16 +580,24 @@ void Validator::check_reference(Node& n, const FieldRef& ref, const std::string&
 }
 
 // Finds the byte offset of `t` (of its bit group, for a bit field) from the
-// start of `nodes`. `blocker` is set to the first node that keeps the offset
-// from being fixed: a container of `t` (or `t`) that is repeated or has an
-// `if` or `otherwise`, or a field before it without a fixed size.
-bool Validator::offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const Node* t, uint64_t& offset,
-                          const Node*& blocker) const {
+// start of the message. `blocker` is set to the first node that keeps the
+// offset from being fixed: a container of `t` (or `t`) that is repeated or
+// has an `if` or `otherwise`, or a field before it without a fixed size.
+// Read after the layout checks, so every node is placed once, in one walk.
+void Validator::offset_of(const Node* t, uint64_t& offset, const Node*& blocker) const {
+    if (places_.empty()) place(proto_.nodes, 0, nullptr);
+    auto it = places_.find(t);
+    if (it == places_.end()) return;
+    offset += it->second.offset;
+    if (!blocker) blocker = it->second.blocker;
+}
+
+void Validator::place(const std::vector<std::unique_ptr<Node>>& nodes, uint64_t offset, const Node* blocker) const {
     for (const auto& c : nodes) {
-        if (is_ancestor_or_self(c.get(), t)) {
-            if (!blocker && (c->is_repeated() || c->if_field || c->otherwise || c->is_overlay())) blocker = c.get();
-            return c.get() == t || offset_of(c->children, t, offset, blocker);
-        }
+        const Node* inside = blocker;
+        if (!inside && (c->is_repeated() || c->if_field || c->otherwise || c->is_overlay())) inside = c.get();
+        places_[c.get()] = {offset, inside};
+        place(c->children, offset, inside);
         if (c->in_bit_group) {
             if (c->group_last) offset += c->group_bytes;
             continue;
@@ -589,7 +606,6 @@ bool Validator::offset_of(const std::vector<std::unique_ptr<Node>>& nodes, const
         if (b) offset += *b;
         else if (!blocker) blocker = c.get();
     }
-    return false;
 }
 
 // Why a node keeps the pdulength field from a fixed place in every message.
@@ -616,7 +632,7 @@ void Validator::check_pdulength() {
     }
     uint64_t offset = 0;
     const Node* blocker = nullptr;
-    offset_of(proto_.nodes, t, offset, blocker);
+    offset_of(t, offset, blocker);
     if (blocker) {
         diags_.error(proto_.line, "pdulength field " + quote(*t) + " must be at a fixed offset from the start of the "
                                                                      "message, in every message: " +
@@ -651,7 +667,7 @@ std::string valid_blocker(const Node& blocker, const Node& t) {
 // nullptr with `offset` set.
 const Node* Validator::fixed_offset_blocker(const Node& n, uint64_t& offset) const {
     const Node* blocker = nullptr;
-    offset_of(proto_.nodes, &n, offset, blocker);
+    offset_of(&n, offset, blocker);
     for (const Node* a = &n; a; a = a->parent) {
         const bool conditional = a->if_field || !a->whens.empty() || a->otherwise || a->direction != Direction::Any;
         // (a container of `rest - N` is not decoded at all with fewer than N bytes left)
@@ -1998,8 +2014,7 @@ bool Validator::check_integer_expr(Node& n, Expr& e, const ExprSite& at, const s
 // learned{...}: looking a value up would need another lookup first.
 void Validator::check_learns(Node& n) {
     const int reach = reach_after(n);
-    int everywhere = reach;
-    for_each_node(proto_.nodes, [&](Node& c) { everywhere = std::max(everywhere, c.doc_index + 1); });
+    const int everywhere = std::max(reach, past_last_node_);
     auto reads_learned = [](const Expr& e) {
         std::function<bool(const Expr&)> any = [&](const Expr& x) {
             if (x.op == ExprOp::Learned) return true;
