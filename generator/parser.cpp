@@ -78,7 +78,7 @@ std::string element_name(const xmlNode* el) { return reinterpret_cast<const char
 // The valid name to suggest for an unknown one: one that begins with it or
 // contains it ("len" -> length, "type" -> displaytype), one it begins with
 // ("boolean" -> bool), else the closest by edit distance ("" if none is close).
-std::string suggest_uncached(const std::string& word, const std::vector<std::string>& valid) {
+std::string suggest(const std::string& word, const std::vector<std::string>& valid) {
     std::string w = word;
     std::transform(w.begin(), w.end(), w.begin(), [](unsigned char c) { return std::tolower(c); });
     if (w.size() >= 3) {
@@ -90,17 +90,6 @@ std::string suggest_uncached(const std::string& word, const std::vector<std::str
             if (v.size() >= 3 && w.rfind(v, 0) == 0) return v;
     }
     return closest_match(word, valid);
-}
-
-// suggest_uncached, remembered: each copy of a <group> repeats its
-// mistakes, and the lists are short, so the key is cheap.
-std::string suggest(const std::string& word, const std::vector<std::string>& valid) {
-    static std::map<std::string, std::string> known;
-    std::string key = word;
-    for (const std::string& v : valid) key += '\0' + v;
-    if (auto it = known.find(key); it != known.end()) return it->second;
-    if (known.size() >= 4096) known.clear();  // a bound, not a policy: any entry can be made again
-    return known[key] = suggest_uncached(word, valid);
 }
 
 // Collects libxml2's messages instead of letting it print them.
@@ -311,6 +300,7 @@ private:
     void defer(FieldRef& ref, xmlNode* context, int line, const std::string& attribute);
     std::string nothing_selected_hint(const PendingRef& p);
     std::string name_hint(const std::string& wanted) const;
+    std::string remembered_suggestion(const std::string& word, const std::vector<std::string>& valid);
     void unexpected_child(xmlNode* child, const std::string& parent, const std::vector<std::string>& allowed);
     void resolve_all();
     Node* resolve(const PendingRef& p);
@@ -322,6 +312,9 @@ private:
     // name_hint of each name an XPath that selected nothing looked for: every
     // copy of a failing path in a <group> gets the same
     std::map<std::string, std::string> name_hints_;
+    // suggest's answer for each misspelt word with its list of valid words
+    // (the key joins them): each copy of a <group> repeats its mistakes
+    std::map<std::string, std::string> suggestions_;
     std::vector<PendingRef> pending_;
     int next_doc_index_ = 1;
     bool xpath_limit_hit_ = false;
@@ -335,7 +328,7 @@ std::map<std::string, std::string> Parser::attributes(xmlNode* el,
         std::string name = reinterpret_cast<const char*>(a->name);
         if (std::find(allowed.begin(), allowed.end(), name) == allowed.end()) {
             std::string msg = "unknown attribute '" + name + "' on <" + element_name(el) + ">";
-            std::string near = suggest(name, allowed);
+            std::string near = remembered_suggestion(name, allowed);
             msg += near.empty() ? "; valid: " + join(allowed, ", ") : "; did you mean '" + near + "'?";
             diags_.error(line_of(el), msg);
             continue;
@@ -345,6 +338,14 @@ std::map<std::string, std::string> Parser::attributes(xmlNode* el,
         xmlFree(value);
     }
     return out;
+}
+
+std::string Parser::remembered_suggestion(const std::string& word, const std::vector<std::string>& valid) {
+    std::string key = word;
+    for (const std::string& v : valid) key += '\0' + v;
+    auto [known, added] = suggestions_.try_emplace(std::move(key));
+    if (added) known->second = suggest(word, valid);
+    return known->second;
 }
 
 void Parser::unexpected_child(xmlNode* child, const std::string& parent,
@@ -364,7 +365,7 @@ void Parser::unexpected_child(xmlNode* child, const std::string& parent,
     if (child->type != XML_ELEMENT_NODE) return;  // comments, processing instructions
     std::string name = element_name(child);
     std::string msg = "unknown element <" + name + "> in <" + parent + ">";
-    std::string near = suggest(name, allowed);
+    std::string near = remembered_suggestion(name, allowed);
     if (allowed.empty())
         msg += "; <" + parent + "> has no child elements";
     else if (!near.empty())
@@ -936,7 +937,7 @@ void Parser::parse_display(const std::string& text, int line, Node& node) {
         }
     }
     std::string msg = "unknown displaytype '" + text + "'";
-    std::string near = text.empty() ? "" : suggest(text, kDisplayNames);
+    std::string near = text.empty() ? "" : remembered_suggestion(text, kDisplayNames);
     if (!near.empty()) msg += " (did you mean '" + near + "'?)";
     diags_.error(line, msg + "; valid: " + join(kDisplayNames, ", "));
 }

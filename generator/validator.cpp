@@ -11,7 +11,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <climits>
 #include <functional>
 #include <tuple>
 #include <unordered_map>
@@ -1158,13 +1157,14 @@ const Node* Validator::request_field_target(const Node& n, const std::string& te
 
 // request_field_target's answer for TEXT, the same wherever it is read.
 Validator::RequestTarget Validator::resolve_request_field(const std::string& text) const {
-    auto nodes_named = [&](const std::string& name) {
+    static const std::vector<const Node*> none;
+    auto nodes_named = [&](const std::string& name) -> const std::vector<const Node*>& {
         auto it = nodes_by_name_.find(name);
-        return it == nodes_by_name_.end() ? std::vector<const Node*>{} : it->second;
+        return it == nodes_by_name_.end() ? none : it->second;
     };
     const bool whole_name = nodes_by_name_.count(text) > 0;
     const std::vector<std::string> segments = whole_name ? std::vector<std::string>{text} : path_segments(text);
-    const std::vector<const Node*> named = nodes_named(segments.back());
+    const std::vector<const Node*>& named = nodes_named(segments.back());
     std::vector<const Node*> fits, requests, responses;
     for (const Node* c : named) {
         if (!matches_path(*c, segments)) continue;
@@ -1181,7 +1181,7 @@ Validator::RequestTarget Validator::resolve_request_field(const std::string& tex
     if (!fits.empty()) return {fits.front(), ""};
     if (!responses.empty()) return {responses.front(), ""};
     // a path that is wrong above a right name: suggest the right path
-    const std::string near = named.empty() ? closest_match(segments.back(), names_before(INT_MAX))
+    const std::string near = named.empty() ? closest_match(segments.back(), names_before(past_last_node_))
                                            : telling_path(*named[0], named);
     return {nullptr, std::string(segments.size() > 1 ? ": no node has that path" : ": no node has that name") +
                          (near.empty() ? "" : " (did you mean request{" + near + "}?)")};
