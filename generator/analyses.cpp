@@ -10,7 +10,8 @@ namespace {
 // What the analysis called `name` reads from each message, in its dg_view's order.
 std::vector<AnalysisInputSpec> inputs_of(const std::string& name) {
 #define DG_INPUT_SPEC(id, input, kind) \
-    {input, ((kind) & DG_INPUT_PER_INSTANCE) != 0, ((kind) & DG_INPUT_BYTES) != 0, ((kind) & DG_INPUT_OPTIONAL) != 0},
+    {input, ((kind) & DG_INPUT_PER_INSTANCE) != 0, ((kind) & DG_INPUT_BYTES) != 0, ((kind) & DG_INPUT_OPTIONAL) != 0, \
+     ((kind) & DG_INPUT_ADDRESS) != 0},
     if (name == "ethercat-esc") return {DG_ESC_INPUTS(DG_INPUT_SPEC)};
 #undef DG_INPUT_SPEC
     return {};

@@ -14,12 +14,14 @@
 namespace dissgen {
 
 // One input an analysis reads from each message (<pairing><input name="...">):
-// one value per message, or one per instance of a repeated node.
+// one value per message, or one per instance of a repeated node; or, read
+// once, where a child of a window (a register of a register map) is.
 struct AnalysisInputSpec {
     std::string name;
     bool per_instance = false;
     bool bytes = false;     // where a field's bytes are (its offset and length), not a number
     bool optional = false;  // a rule file may leave it unbound (the analysis does without)
+    bool address = false;   // where a window child is (its at=, stride=, instances=), not a value of each message
 };
 
 struct Analysis {

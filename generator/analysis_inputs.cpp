@@ -18,6 +18,30 @@ const Node* repeated_owner(const Node* n) {
 
 std::string line_text(int line) { return " (line " + std::to_string(line) + ")"; }
 
+// An input that says where a register is: a child of a window (at=), all
+// of them of one window, whose base is the address the analysis reads from.
+bool check_address_input(const AnalysisInput& input, const Node*& window, int& window_line, Diagnostics& diags) {
+    const Node* t = input.field.target;
+    const std::string what = "input '" + input.name + "' ";
+    const std::string field = "field '" + t->name + "'" + line_text(t->line);
+    if (!t->at) {
+        diags.error(input.line, what + "is where a register sits in a register map, and " + field +
+                                    " is not a child of a window: name a node with at=\"ADDRESS\" inside a "
+                                    "container with base=\"...\"");
+        return false;
+    }
+    if (!window) {
+        window = t->parent;
+        window_line = input.line;
+    } else if (t->parent != window) {
+        diags.error(input.line, what + "must be in the same window as the register inputs before it: " + field +
+                                    " is in '" + t->parent->name + "', the input on line " +
+                                    std::to_string(window_line) + " in '" + window->name + "'");
+        return false;
+    }
+    return true;
+}
+
 // One bound input: the leaf it names fits what the analysis reads there.
 // `unit` is the repeated node of the first per-instance input (and its line).
 bool check_input(const AnalysisInput& input, const AnalysisInputSpec& spec, const Node*& unit, int& unit_line,
@@ -77,7 +101,7 @@ bool check_input(const AnalysisInput& input, const AnalysisInputSpec& spec, cons
 
 void check_analysis_inputs(Protocol& proto, Diagnostics& diags) {
     if (!proto.pairing) return;
-    const Pairing& pairing = *proto.pairing;
+    Pairing& pairing = *proto.pairing;
     const Analysis* analysis = find_analysis(pairing.analysis);
     if (!analysis) {
         // Without an analysis nobody reads them (an unknown one is reported by the parser).
@@ -92,7 +116,10 @@ void check_analysis_inputs(Protocol& proto, Diagnostics& diags) {
     std::map<std::string, int> bound;  // input name -> its line
     const Node* unit = nullptr;
     int unit_line = 0;
-    for (const AnalysisInput& input : pairing.inputs) {
+    const Node* window = nullptr;  // of the register inputs
+    int window_line = 0;
+    std::map<const Node*, std::string> registers;  // register inputs' fields -> input name
+    for (AnalysisInput& input : pairing.inputs) {
         size_t index = 0;
         while (index < names.size() && names[index] != input.name) ++index;
         if (index == names.size()) {
@@ -108,6 +135,18 @@ void check_analysis_inputs(Protocol& proto, Diagnostics& diags) {
             continue;
         }
         const AnalysisInputSpec& spec = analysis->inputs[index];
+        if (spec.address) {
+            if (!input.field.target || !check_address_input(input, window, window_line, diags)) continue;
+            auto [named, first] = registers.emplace(input.field.target, input.name);
+            if (!first) {
+                diags.error(input.line, "field '" + input.field.target->name + "' is already input '" +
+                                            named->second + "': one field per input");
+                continue;
+            }
+            input.index = static_cast<int>(index);
+            input.address = true;
+            continue;
+        }
         if (!check_input(input, spec, unit, unit_line, diags)) continue;
         Node* t = input.field.target;
         if (t->analysis_input >= 0) {
@@ -115,6 +154,7 @@ void check_analysis_inputs(Protocol& proto, Diagnostics& diags) {
                                         "': one field per input");
             continue;
         }
+        input.index = static_cast<int>(index);
         t->analysis_input = static_cast<int>(index);
         t->analysis_input_per_instance = spec.per_instance;
     }

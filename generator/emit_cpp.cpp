@@ -416,6 +416,7 @@ private:
     void condition_and_window_tables();
     void learn_tables();
     void protocol_struct();
+    size_t input_places();
     void register_functions();
     void expert_entries();
     void finding_entries();
@@ -715,6 +716,26 @@ void Emitter::walk_definitions() {
         if (has_walk(*n)) define(n, l_.first_child.at(n), n->children.size());
 }
 
+// The registers the pairing's analysis reads (<input> of a window child):
+// where each sits, handed to it once. Returns how many.
+size_t Emitter::input_places() {
+    std::vector<const AnalysisInput*> bound;
+    for (const AnalysisInput& input : p_.pairing->inputs)
+        if (input.address && input.index >= 0) bound.push_back(&input);
+    if (bound.empty()) return 0;
+    o_ << "/* Where the registers the analysis reads sit in their register map: input, address, size,\n"
+       << "   stride and instances (from at=, stride=, instances=). */\n"
+       << "static const dg_input_place " << p_.filter << "_input_places[] = {\n";
+    for (const AnalysisInput* input : bound) {
+        const Node& t = *input->field.target;
+        o_ << "    { " << input->index << ", " << hex(*t.at, 4) << ", " << t.place_bytes << ", " << t.stride.value_or(0)
+           << ", " << t.instances.value_or(1) << " }, /* " << comment_text(input->name) << ": "
+           << comment_text(t.name) << ", line " << t.line << " */\n";
+    }
+    o_ << "};\n";
+    return bound.size();
+}
+
 void Emitter::protocol_struct() {
     const std::string& f = p_.filter;
     const Node* pdu = p_.pdulength ? p_.pdulength->target : nullptr;
@@ -729,9 +750,10 @@ void Emitter::protocol_struct() {
         if (analysis)
             o_ << "/* The " << c_string(analysis->name) << " analysis, compiled in from the runtime. */\n"
                << "extern \"C\" const struct dg_analysis " << analysis->symbol << ";\n";
+        const size_t places = input_places();
         o_ << "static const dg_pairing " << f << "_pairing = { " << timeout << ", "
            << (analysis ? "&" + analysis->symbol : std::string("NULL")) << ", " << (p_.pairing->ordered ? 1 : 0)
-           << " };\n";
+           << ", " << (places ? f + "_input_places" : std::string("NULL")) << ", " << places << " };\n";
         if (!p_.request_fields.empty()) request_context();
     }
     if (p_.cycles) cycles_tables();

@@ -309,6 +309,10 @@ struct AnalysisInput {
     std::string name;
     FieldRef field;
     int line = 0;
+    // set by check_analysis_inputs: the analysis' input number (-1: not
+    // bound) and whether it is a window child's address, read once
+    int index = -1;
+    bool address = false;
 };
 
 struct Pairing {

@@ -106,6 +106,16 @@ typedef struct dg_view {
     guint count;
 } dg_view;
 
+/* The register the pairing's analysis reads as its input `input`, where
+ * the rule file's register map puts it; NULL when the rule file binds none. */
+static inline const dg_input_place *dg_input_place_of(const dg_protocol *p, guint input)
+{
+    const dg_pairing *pairing = p ? p->pairing : NULL;
+    for (guint i = 0; pairing && i < pairing->place_count; i++)
+        if (pairing->places[i].input == input) return &pairing->places[i];
+    return NULL;
+}
+
 /* What one protocol knows about its requests and responses. Every callback
  * may be NULL. Those given a dg_view get the message's (and the request's);
  * its bytes come as a tvb for what the rules do not describe (e.g. whether

@@ -314,10 +314,21 @@ typedef struct dg_cycles {
     guint8 lost_by_period; /* lost="period": a cycle's period of n nominal ones means n - 1 lost */
 } dg_cycles;
 
+/* A register the pairing's analysis reads, where the rule file's register map
+ * puts it (<input> bound to a child of a window): its address in the window,
+ * its size, and with stride > 0 `instances` blocks `stride` bytes apart. */
+typedef struct dg_input_place {
+    guint8 input;            /* the analysis' input number */
+    guint64 at;
+    guint32 size, stride, instances;
+} dg_input_place;
+
 typedef struct dg_pairing {
     double timeout;          /* seconds a request waits for its response */
     const struct dg_analysis *analysis; /* NULL, or the protocol analysis the rule file names */
     guint8 ordered;          /* order="request": responses come in their requests' order (per connection) */
+    const dg_input_place *places; /* the registers the analysis reads (NULL: none bound) */
+    guint16 place_count;
 } dg_pairing;
 
 /* request{Name} in computed values: a response reads fields of its paired

@@ -99,6 +99,7 @@ static_assert(recent_slots == 64, "recent_slot gives 6 bits");
 struct capture_hints {
     gboolean marking_seen; /* a slave set the locally administered bit: the capture shows direction */
     guint8 master[6];      /* the (unmarked) source of the frames answered so far */
+    esc_registers registers; /* where the registers sit (the rule file's register map) */
     bus_model *bus;        /* the slaves the capture shows (ethercat_bus.cpp) */
     cycle_model *cycles;   /* the cycles it finds (ethercat_cycles.cpp) */
     wmem_map_t *shapes;    /* shape -> itself */
@@ -277,8 +278,9 @@ void *esc_capture_new(const dg_protocol *p)
     h->kinds = wmem_array_new(wmem_file_scope(), sizeof(kind));
     h->kind_ids = wmem_map_new(wmem_file_scope(), kind_hash, kind_equal);
     h->records = wmem_array_new(wmem_file_scope(), sizeof(record *));
-    h->bus = bus_new(static_cast<const dg_bus *>(p->analysis_data));
-    h->cycles = cycles_new();
+    h->registers = esc_registers_of(p);
+    h->bus = bus_new(static_cast<const dg_bus *>(p->analysis_data), &h->registers);
+    h->cycles = cycles_new(h->registers.system_time);
     return h;
 }
 
@@ -508,7 +510,7 @@ void esc_show(const void *capture, guint32 data, tvbuff_t *tvb, packet_info *pin
             if (!shown) proto_item_set_hidden(proto_tree_get_parent(dg));
         }
         show_datagram_experts(c, i, tvb, pinfo, dg);
-        if (!dc_shown && dc_datagram(&c->sent, &c->back)) {
+        if (!dc_shown && dc_datagram(h->registers.system_time, &c->sent, &c->back)) {
             dc_show(&c->back, bus_dc_drift(&frame), tvb, tree);
             dc_shown = TRUE;
         }

@@ -5,15 +5,19 @@
  * the frame as sent (a datagram counts only when its working counter grew):
  *  - the slave count: the working counter a broadcast read (BRD) adds, since
  *    every slave increments it;
- *  - station addresses: an auto-increment write (APWR/APRW) to register
- *    0x0010 at ADP = -position (16-bit wrap) gives that position its station;
- *  - aliases: register 0x0012, read or written;
- *  - identities from the SII EEPROM: a write of the EEPROM address (0x0504,
- *    with the control word at 0x0502 asking for a read when it is written as
- *    well), then a read of the data at 0x0508 (4 or 8 bytes) gives the words
- *    from that address on; TwinCAT reads 14 bytes from 0x0502 (status,
- *    address and data in one). Words 0x0008/9 hold the vendor id, 0x000A/B the
- *    product code, 0x000C/D the revision, 0x000E/F the serial number.
+ *  - station addresses: an auto-increment write (APWR/APRW) to the
+ *    configured station address register at ADP = -position (16-bit wrap)
+ *    gives that position its station;
+ *  - aliases: the station alias register, read or written;
+ *  - identities from the SII EEPROM: a write of the EEPROM address register
+ *    (with the control word asking for a read when it is written as well),
+ *    then a read of the data register (4 or 8 bytes) gives the words from
+ *    that address on; TwinCAT reads control, address and data in one.
+ *    Words 0x0008/9 hold the vendor id, 0x000A/B the product code, 0x000C/D
+ *    the revision, 0x000E/F the serial number.
+ * Where each register sits is the rule file's (its register map, bound by
+ * <input>s of registers: esc_registers); what the bytes there mean is the
+ * slave controller's, here.
  * Datagrams addressed to one slave (APxx: ADP = -position on the frame as
  * sent; FPxx: ADP = station address) carry that slave's items. On the first
  * pass they show what is known at that point of the capture; on later passes
@@ -102,15 +106,15 @@ enum ident_word { W_VENDOR = 0x08, W_PRODUCT = 0x0a, W_REVISION = 0x0c, W_SERIAL
 struct slave_state {
     gboolean station_known, sii_address_known;
     guint16 station, alias;
-    guint8 alias_bytes;            /* bit per byte of the alias (0x0012, 0x0013) read back */
+    guint8 alias_bytes;            /* bit per byte of the alias read back */
     guint32 sii_address;           /* in words, the last one the master asked for */
     guint16 sii[SII_WORDS];        /* SII words 0x0000..0x000F as read */
     guint32 sii_known;             /* bit per word of sii[] */
     gboolean checked;              /* compared with the design */
-    fmmu fmmus[max_fmmus];         /* as the master configured them (0x0600 + 16n) */
+    fmmu fmmus[max_fmmus];         /* as the master configured them */
     guint16 mailbox_start[2], mailbox_length[2];  /* SM0 (out), SM1 (in) in mailbox mode */
     gboolean al_known;
-    guint8 al_state;               /* AL status (0x0130) bits 0-3, last seen */
+    guint8 al_state;               /* AL status bits 0-3, last seen */
     pdo_object *writing[max_pdo_objects];  /* the objects as written so far */
     guint writing_count;
     const pdo_config **configs;    /* learned configurations, in frame order */
@@ -152,6 +156,7 @@ struct bus_model {
     gboolean mismatch, ok_noted;
     gboolean fmmus_known;  /* some slave's FMMU configuration was seen */
     wmem_map_t *shapes;    /* bus_shape -> itself: the frames' shapes without events */
+    esc_registers regs;    /* where the registers it reads sit */
 };
 
 /* What a frame's datagrams address and what the network check found there:
@@ -183,22 +188,15 @@ using namespace dg_ecat_commands;
 /* The position an auto-increment datagram as sent addresses. */
 guint16 position_of(guint16 adp) { return (guint16)(0x10000u - adp); }
 
-/* Where register `reg` (n bytes) sits in the datagram's data, or -1. */
-gint register_at(const datagram *d, guint32 reg, guint32 n)
-{
-    if (d->ado > reg || reg + n > (guint32)d->ado + d->length) return -1;
-    return data_offset(d) + (gint)(reg - d->ado);
-}
-
-/* The bytes of the 16-bit register at `reg` that a datagram covers, put into
+/* The bytes of the 16-bit register r that a datagram covers, put into
  * `value`: a slave controller takes each byte written, and a master may write
  * (or read) one of the two alone. `shift` moves from the sent datagram's data
  * to the bytes read (the returned frame's). Returns a bit per byte taken. */
-guint take_register16(const datagram *s, tvbuff_t *tvb, gint shift, guint32 reg, guint16 *value)
+guint take_register16(const datagram *s, tvbuff_t *tvb, gint shift, const dg_input_place *r, guint16 *value)
 {
     guint taken = 0;
     for (guint32 k = 0; k < 2; k++) {
-        gint at = register_at(s, reg + k, 1);
+        gint at = register_at(s, r, 0, k, 1);
         if (at < 0) continue;
         guint byte = dg_tvb_get_uint8(tvb, at + shift);
         *value = (guint16)((*value & ~(0xffu << (8 * k))) | byte << (8 * k));
@@ -329,20 +327,20 @@ void check_identity(bus_model *m, guint position, slave_state *s, const datagram
     check_complete(m, d, ev);
 }
 
-/* The SII words a read of 0x0508 returned, stored from the EEPROM address on. */
+/* The SII words a read of the EEPROM data register returned, stored from the EEPROM address on. */
 void learn_sii_data(bus_model *m, guint position, slave_state *s, const datagram *b, tvbuff_t *back, events *ev)
 {
-    gint data = register_at(b, 0x0508, 4);
+    gint data = register_at(b, m->regs.sii_data, 0, 0, 4);
     if (data < 0) return;
     guint32 address;
-    gint status = register_at(b, 0x0502, 2);
+    gint status = register_at(b, m->regs.sii_control, 0, 0, 2);
     guint bytes = MIN(8u, (guint)(wkc_offset(b) - data));
     if (status >= 0) {
         guint16 st = dg_tvb_get_uint16(back, status, ENC_LITTLE_ENDIAN);
         if (st & 0x8000) return;        /* busy: the data is not there yet */
         if (!(st & 0x0040)) bytes = 4;  /* the ESC reads 4 bytes at a time */
     }
-    gint at = register_at(b, 0x0504, 2);
+    gint at = register_at(b, m->regs.sii_address, 0, 0, 2);
     if (at >= 0) address = dg_tvb_get_uint16(back, at, ENC_LITTLE_ENDIAN);
     else if (s->sii_address_known) address = s->sii_address;
     else return;
@@ -356,26 +354,26 @@ void learn_sii_data(bus_model *m, guint position, slave_state *s, const datagram
 }
 
 /* A write of the EEPROM address (with a read command when the control word is written too). */
-void learn_sii_address(slave_state *s, const datagram *d, tvbuff_t *sent)
+void learn_sii_address(const esc_registers *r, slave_state *s, const datagram *d, tvbuff_t *sent)
 {
-    gint at = register_at(d, 0x0504, 2);
+    gint at = register_at(d, r->sii_address, 0, 0, 2);
     if (at < 0) return;
-    gint control = register_at(d, 0x0502, 2);
+    gint control = register_at(d, r->sii_control, 0, 0, 2);
     if (control >= 0 && !(dg_tvb_get_uint16(sent, control, ENC_LITTLE_ENDIAN) & 0x0100)) return;
     s->sii_address = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
     s->sii_address_known = TRUE;
 }
 
-/* FMMU configuration writes: 16 bytes per FMMU at 0x0600 + 16n (logical
- * start 4, length 2, start/stop bit, physical start 2 and bit, type at +11,
- * activate at +12), or the activate byte alone. */
+/* FMMU configuration writes: 16 bytes per FMMU, one FMMU per instance of
+ * the register (logical start 4, length 2, start/stop bit, physical start 2
+ * and bit, type at +11, activate at +12), or the activate byte alone. */
 void learn_fmmus(bus_model *m, slave_state *st, const datagram *d, tvbuff_t *sent)
 {
-    if (d->ado >= 0x0700 || (guint32)d->ado + d->length <= 0x0600) return;
-    for (guint n = 0; n < max_fmmus; n++) {
-        guint32 reg = 0x0600 + 16 * n;
+    const dg_input_place *r = m->regs.fmmus;
+    if (!r || d->ado >= r->at + (guint64)r->stride * r->instances || (guint32)d->ado + d->length <= r->at) return;
+    for (guint n = 0; n < max_fmmus && n < r->instances; n++) {
         fmmu *f = &st->fmmus[n];
-        gint at = register_at(d, reg, 16);
+        gint at = register_at(d, r, n, 0, 16);
         if (at >= 0) {
             f->known = TRUE;
             f->logical = dg_tvb_get_uint32(sent, at, ENC_LITTLE_ENDIAN);
@@ -385,7 +383,7 @@ void learn_fmmus(bus_model *m, slave_state *st, const datagram *d, tvbuff_t *sen
             f->type = dg_tvb_get_uint8(sent, at + 11) & 3;
             f->active = dg_tvb_get_uint8(sent, at + 12) & 1;
             m->fmmus_known = TRUE;
-        } else if (f->known && (at = register_at(d, reg + 12, 1)) >= 0) {
+        } else if (f->known && (at = register_at(d, r, n, 12, 1)) >= 0) {
             f->active = dg_tvb_get_uint8(sent, at) & 1;
         }
     }
@@ -484,12 +482,13 @@ void check_wkc(const bus_model *m, const datagram *s, const datagram *b, events 
     ev->add(EV_WKC, b, wmem_strbuf_get_str(text));
 }
 
-/* SyncManager 0 and 1 configured as mailboxes (0x0800 + 8n: start 2,
- * length 2, control 1 with mode bits 0-1 = 2). */
-void learn_mailboxes(slave_state *st, const datagram *d, tvbuff_t *sent)
+/* SyncManager 0 and 1 configured as mailboxes (one SyncManager per
+ * instance of the register: start 2, length 2, control 1 with mode bits
+ * 0-1 = 2). */
+void learn_mailboxes(const esc_registers *r, slave_state *st, const datagram *d, tvbuff_t *sent)
 {
     for (guint n = 0; n < 2; n++) {
-        gint at = register_at(d, 0x0800 + 8 * n, 5);
+        gint at = register_at(d, r->syncmanagers, n, 0, 5);
         if (at < 0 || (dg_tvb_get_uint8(sent, at + 4) & 3) != 2) continue;
         st->mailbox_start[n] = dg_tvb_get_uint16(sent, at, ENC_LITTLE_ENDIAN);
         st->mailbox_length[n] = dg_tvb_get_uint16(sent, at + 2, ENC_LITTLE_ENDIAN);
@@ -653,10 +652,10 @@ void learn_coe(slave_state *st, const datagram *s, const frame_pair *fp, guint i
         learn_object(st, fp->back, &sd, frame);
 }
 
-/* An AL status read (0x0130) showing another state than the last one. */
-gboolean al_changed(slave_state *st, const datagram *b, tvbuff_t *back)
+/* An AL status read showing another state than the last one. */
+gboolean al_changed(const esc_registers *r, slave_state *st, const datagram *b, tvbuff_t *back)
 {
-    gint at = register_at(b, 0x0130, 1);
+    gint at = register_at(b, r->al_status, 0, 0, 1);
     if (at < 0) return FALSE;
     guint8 state = dg_tvb_get_uint8(back, at) & 0x0f;
     gboolean changed = st->al_known && state != st->al_state;
@@ -675,7 +674,7 @@ guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagr
     guint8 flags = is_mailbox(st, s) ? ST_MAILBOX : 0;
     if (b->wkc <= s->wkc) return flags | ST_WKC_ERROR;
     guint16 was = st->station;
-    if (writes_registers(s->cmd) && is_auto_increment(s->cmd) && take_register16(s, sent, 0, 0x0010, &st->station)) {
+    if (writes_registers(s->cmd) && is_auto_increment(s->cmd) && take_register16(s, sent, 0, m->regs.station, &st->station)) {
         /* a station given anew: the old address no longer reaches this slave */
         if (st->station_known && was != st->station && station_position(m, was) == (gint32)position)
             wmem_map_remove(m->stations, GUINT_TO_POINTER((guint)was));
@@ -685,16 +684,16 @@ guint8 learn_slave(bus_model *m, guint position, const datagram *s, const datagr
     /* The alias is loaded from the EEPROM: the segment only reads it (a write
      * leaves it), and it is known once both its bytes came back. */
     if (reads_registers(s->cmd))
-        st->alias_bytes |= (guint8)take_register16(s, back, b->offset - s->offset, 0x0012, &st->alias);
+        st->alias_bytes |= (guint8)take_register16(s, back, b->offset - s->offset, m->regs.alias, &st->alias);
     if (writes_registers(s->cmd) && s->cmd != APRW && s->cmd != FPRW) {
-        learn_sii_address(st, s, sent);
+        learn_sii_address(&m->regs, st, s, sent);
         learn_fmmus(m, st, s, sent);
-        learn_mailboxes(st, s, sent);
+        learn_mailboxes(&m->regs, st, s, sent);
     }
     learn_coe(st, s, fp, instance, frame);
     if (reads_registers(s->cmd) && !writes_registers(s->cmd)) {
         learn_sii_data(m, position, st, b, back, ev);
-        if (al_changed(st, b, back)) flags |= ST_AL_CHANGE;
+        if (al_changed(&m->regs, st, b, back)) flags |= ST_AL_CHANGE;
     }
     return flags;
 }
@@ -1223,10 +1222,34 @@ guint hash_bytes(guint h, const void *bytes, gsize n)
     return h;
 }
 
-bus_model *bus_new(const dg_bus *design)
+gint register_at(const datagram *d, const dg_input_place *r, guint instance, guint32 offset, guint32 n)
+{
+    if (!r || instance >= r->instances) return -1;
+    guint64 reg = r->at + (guint64)r->stride * instance + offset;
+    if (d->ado > reg || reg + n > (guint64)d->ado + d->length) return -1;
+    return data_offset(d) + (gint)(reg - d->ado);
+}
+
+esc_registers esc_registers_of(const dg_protocol *p)
+{
+    esc_registers r;
+    r.station = dg_input_place_of(p, ESC_REG_STATION);
+    r.alias = dg_input_place_of(p, ESC_REG_ALIAS);
+    r.al_status = dg_input_place_of(p, ESC_REG_AL_STATUS);
+    r.sii_control = dg_input_place_of(p, ESC_REG_SII_CONTROL);
+    r.sii_address = dg_input_place_of(p, ESC_REG_SII_ADDRESS);
+    r.sii_data = dg_input_place_of(p, ESC_REG_SII_DATA);
+    r.fmmus = dg_input_place_of(p, ESC_REG_FMMU);
+    r.syncmanagers = dg_input_place_of(p, ESC_REG_SYNCMANAGER);
+    r.system_time = dg_input_place_of(p, ESC_REG_SYSTEM_TIME);
+    return r;
+}
+
+bus_model *bus_new(const dg_bus *design, const esc_registers *registers)
 {
     bus_model *m = wmem_new0(wmem_file_scope(), bus_model);
     m->design = design;
+    m->regs = *registers;
     m->stations = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
     m->shapes = wmem_map_new(wmem_file_scope(), shape_hash, shape_equal);
     m->count_reported = -1;
@@ -1287,7 +1310,7 @@ void bus_returned(bus_model *m, const frame_pair *fp, const datagram *s, const d
         if (s[i].cmd == BRD) learn_count(m, added, &b[i], &ev);
         else if (s[i].cmd == BWR)
             for (guint p = 0; m->count_known && p < m->count && p < max_positions; p++)
-                learn_sii_address(slave_at(m, p), &s[i], sent);
+                learn_sii_address(&m->regs, slave_at(m, p), &s[i], sent);
     }
     addressed a[max_datagrams];
     for (guint i = 0; i < n; i++) {

@@ -77,7 +77,22 @@ struct bus_frame {
     guint16 cycle;
 };
 
-bus_model *bus_new(const dg_bus *design);
+/* Where the registers the model reads sit: the rule file's register map
+ * says it (its <input>s of registers, dg_pairing.places); NULL: not bound,
+ * the model learns nothing from that register. */
+struct esc_registers {
+    const dg_input_place *station, *alias, *al_status;
+    const dg_input_place *sii_control, *sii_address, *sii_data;
+    const dg_input_place *fmmus, *syncmanagers;
+    const dg_input_place *system_time;
+};
+esc_registers esc_registers_of(const dg_protocol *p);
+
+/* Where `n` bytes from `offset` into register r (its instance `instance`)
+ * sit in the datagram's data, or -1: not covered, or r not bound. */
+gint register_at(const datagram *d, const dg_input_place *r, guint instance, guint32 offset, guint32 n);
+
+bus_model *bus_new(const dg_bus *design, const esc_registers *registers);
 /* First pass. A frame as sent (a request, or one whose response is not paired),
  * its n datagrams as frame_datagrams() gives them: which slave each one addresses, in *f. */
 void bus_sent(bus_model *m, const datagram *d, guint n, bus_frame *f);

@@ -111,6 +111,7 @@ struct cycle_model {
     cycle *first, *last;
     guint16 cycles;
     wmem_map_t *long_periods;    /* frame -> gint64 *, periods of 2^32 ns or more */
+    const dg_input_place *system_time; /* the DC system time register, NULL: unbound */
     dc_reference dc32, dc64;
     guint32 last_frame;          /* the last frame the first pass brought here */
     /* the last frames sent and their signatures, so that most returns find
@@ -207,9 +208,10 @@ void capture_cleanup(void) { current = NULL; }
 
 } /* namespace */
 
-cycle_model *cycles_new(void)
+cycle_model *cycles_new(const dg_input_place *system_time)
 {
     cycle_model *m = wmem_new0(wmem_file_scope(), cycle_model);
+    m->system_time = system_time;
     m->signatures = wmem_map_new(wmem_file_scope(), sig_hash, sig_equal);
     current = m;
     return m;
@@ -301,9 +303,10 @@ void cycles_returned(cycle_model *m, const datagram *s, const datagram *b, guint
 
 /* --- distributed clocks ---------------------------------------------------- */
 
-gboolean dc_datagram(const datagram *s, const datagram *b)
+gboolean dc_datagram(const dg_input_place *system_time, const datagram *s, const datagram *b)
 {
-    return (s->cmd == 13 || s->cmd == 14) && s->ado == 0x0910 && (s->length == 4 || s->length == 8) &&
+    return system_time && (s->cmd == dg_ecat_commands::ARMW || s->cmd == dg_ecat_commands::FRMW) &&
+           s->ado == system_time->at && (s->length == 4 || s->length == 8) &&
            b->cmd == s->cmd && b->ado == s->ado && b->length == s->length && b->wkc > s->wkc;
 }
 
@@ -325,7 +328,7 @@ double dc_returned(cycle_model *m, const datagram *s, const datagram *b, guint n
                    const packet_info *pinfo)
 {
     guint i = 0;
-    while (i < n && !dc_datagram(&s[i], &b[i])) i++;
+    while (i < n && !dc_datagram(m->system_time, &s[i], &b[i])) i++;
     if (i == n || (guint)data_offset(&b[i]) + b[i].length > tvb_captured_length(back)) return NAN;
     guint64 raw = systime_of(back, &b[i]);
     gint64 at = ns_of(&pinfo->abs_ts);

@@ -20,7 +20,8 @@ struct cycle_mark {
 
 struct cycle_model;   /* capture-wide, wmem_file_scope */
 
-cycle_model *cycles_new(void);
+/* system_time: where the reference clock's system time sits (NULL: no DC figures). */
+cycle_model *cycles_new(const dg_input_place *system_time);
 /* First pass, a frame as sent: its n datagrams. */
 cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_info *pinfo);
 /* First pass, a returned frame answering `txn`: s and b its first n datagrams
@@ -35,8 +36,8 @@ void cycles_returned(cycle_model *m, const datagram *s, const datagram *b, guint
 double dc_returned(cycle_model *m, const datagram *s, const datagram *b, guint n, tvbuff_t *back,
                    const packet_info *pinfo);
 /* Whether a returned datagram carries the reference clock's system time: an
- * FRMW or ARMW of 4 or 8 bytes at 0x0910 that a slave processed. */
-gboolean dc_datagram(const datagram *s, const datagram *b);
+ * FRMW or ARMW of 4 or 8 bytes at its register that a slave processed. */
+gboolean dc_datagram(const dg_input_place *system_time, const datagram *s, const datagram *b);
 /* Every pass: ecatr.dc.systime over b (a dc_datagram) and the drift unless NAN. */
 void dc_show(const datagram *b, double drift, tvbuff_t *tvb, proto_tree *tree);
 /* Every pass: the cycle items of a sent frame of m's capture. */

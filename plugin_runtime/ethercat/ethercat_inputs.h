@@ -9,21 +9,30 @@
  * DG_INPUT_PER_INSTANCE one per datagram (the instances of one repeated
  * node), DG_INPUT_BYTES_PER_INSTANCE where a datagram's bytes of a field are
  * (any leaf with bytes: the view gives their offset and length); with
- * DG_INPUT_OPTIONAL a rule file may leave the input unbound. The SDO inputs
+ * DG_INPUT_OPTIONAL a rule file may leave the input unbound. DG_INPUT_ADDRESS
+ * is not a value of each frame but where a register sits in the rule file's
+ * register map (a child of the window on the datagram's ADO: its at=,
+ * stride= and instances=), handed to the analysis once (dg_pairing.places):
+ * the bus model reads the registers there, so their addresses are stated
+ * once, in the rules; how many bytes it reads and what they mean (the SII
+ * interface, an FMMU's layout) is the slave controller's, and stays here in
+ * the runtime. Unbound, the model learns nothing from that register. The SDO inputs
  * are the CoE mailbox's initiate download request (as the master writes it)
  * and initiate upload response (as it reads it back), from which the bus model
  * learns the PDO assignment and mapping; without them it learns none (the ESI
  * file's default PDOs stay). Plain C: no includes. */
 #pragma once
 
-/* the kinds are bits: one per instance, bytes, optional */
+/* the kinds are bits: one per instance, bytes, optional, a register's address */
 #define DG_INPUT_PER_MESSAGE 0
 #define DG_INPUT_PER_INSTANCE 1
 #define DG_INPUT_BYTES 2
 #define DG_INPUT_OPTIONAL 4
+#define DG_INPUT_ADDRESS 8
 #define DG_INPUT_BYTES_PER_INSTANCE (DG_INPUT_PER_INSTANCE | DG_INPUT_BYTES)
 #define DG_SDO_INPUT (DG_INPUT_PER_INSTANCE | DG_INPUT_OPTIONAL)
 #define DG_SDO_BYTES_INPUT (DG_INPUT_BYTES_PER_INSTANCE | DG_INPUT_OPTIONAL)
+#define DG_REGISTER_INPUT (DG_INPUT_ADDRESS | DG_INPUT_OPTIONAL)
 
 #define DG_ESC_INPUTS(X)                                                             \
     X(ESC_IN_FRAME_LENGTH, "frame length", DG_INPUT_PER_MESSAGE)                     \
@@ -49,4 +58,13 @@
     X(ESC_IN_UPLOAD_SUBINDEX, "sdo upload subindex", DG_SDO_INPUT)                   \
     X(ESC_IN_UPLOAD_EXPEDITED, "sdo upload expedited data", DG_SDO_BYTES_INPUT)      \
     X(ESC_IN_UPLOAD_SIZE, "sdo upload size", DG_SDO_INPUT)                           \
-    X(ESC_IN_UPLOAD_DATA, "sdo upload data", DG_SDO_BYTES_INPUT)
+    X(ESC_IN_UPLOAD_DATA, "sdo upload data", DG_SDO_BYTES_INPUT)                     \
+    X(ESC_REG_STATION, "station address register", DG_REGISTER_INPUT)               \
+    X(ESC_REG_ALIAS, "station alias register", DG_REGISTER_INPUT)                   \
+    X(ESC_REG_AL_STATUS, "al status register", DG_REGISTER_INPUT)                   \
+    X(ESC_REG_SII_CONTROL, "sii control register", DG_REGISTER_INPUT)               \
+    X(ESC_REG_SII_ADDRESS, "sii address register", DG_REGISTER_INPUT)               \
+    X(ESC_REG_SII_DATA, "sii data register", DG_REGISTER_INPUT)                     \
+    X(ESC_REG_FMMU, "fmmu registers", DG_REGISTER_INPUT)                            \
+    X(ESC_REG_SYNCMANAGER, "syncmanager registers", DG_REGISTER_INPUT)              \
+    X(ESC_REG_SYSTEM_TIME, "system time register", DG_REGISTER_INPUT)

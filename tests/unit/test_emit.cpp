@@ -10,6 +10,7 @@
 #include "emit_cpp.h"
 #include "../../plugin_runtime/ethercat/ethercat_commands.h"
 #include "runtime_names.h"
+#include "text_util.h"
 #include "test_support.h"
 
 namespace dissgen::testing {
@@ -514,7 +515,7 @@ TEST(Pairing, KeysAreFlaggedAndThePairingIsEmitted) {
     std::string code = emit_cpp(*f.proto, "t.xml");
     // The generated code names the analysis object: the runtime looks nothing up.
     EXPECT_TRUE(contains(code, "extern \"C\" const struct dg_analysis dg_ethercat_esc;")) << code;
-    EXPECT_TRUE(contains(code, "static const dg_pairing tst_pairing = { 0.25, &dg_ethercat_esc, 1 };")) << code;
+    EXPECT_TRUE(contains(code, "static const dg_pairing tst_pairing = { 0.25, &dg_ethercat_esc, 1, tst_input_places, ")) << code;
     EXPECT_TRUE(contains(code, ".pairing(&tst_pairing);")) << code;
     EXPECT_TRUE(contains(code, ".show(DG_SHOW_HEX).flags(DG_NUMERIC|DG_KEY)")) << code;
     EXPECT_EQ(code.find(".show(DG_SHOW_DEC).flags(DG_NUMERIC|DG_KEY)"), std::string::npos) << "only the key is flagged";
@@ -531,16 +532,38 @@ TEST(Pairing, InputsAreNumberedInTheirExtraAndNeverQuiet) {
     const Analysis* esc = find_analysis("ethercat-esc");
     ASSERT_TRUE(esc);
     std::string code = emit_cpp(*f.proto, "t.xml");
+    size_t registers = 0;
     for (size_t i = 0; i < esc->inputs.size(); ++i) {
         const Node* leaf = find(*f.proto, "Input " + std::to_string(i));
         ASSERT_TRUE(leaf);
+        if (esc->inputs[i].address) {
+            // a register: where it sits goes to the analysis once, the walk gives it no value
+            EXPECT_EQ(leaf->analysis_input, -1);
+            EXPECT_TRUE(contains(code, "    { " + std::to_string(i) + ", " + hex(0x100 + 2 * i, 4) + ", 1, 0, 1 }, /* " +
+                                           esc->inputs[i].name + ": Input " + std::to_string(i) + ", line "))
+                << code;
+            ++registers;
+            continue;
+        }
         EXPECT_EQ(leaf->analysis_input, static_cast<int>(i));
         EXPECT_EQ(leaf->analysis_input_per_instance, esc->inputs[i].per_instance);
         EXPECT_TRUE(contains(code, "/* " + std::to_string(leaf->doc_index - 1) + ": Input " + std::to_string(i) +
                                        " */\n    dg_node_extra().input(" + std::to_string(i) + ")"))
             << code;
     }
-    EXPECT_FALSE(contains(code, ".quiet_size(")) << "an input is never stepped over:\n" << code;
+    // a value input is never stepped over; a register is, as the walk reads nothing there for the analysis
+    for (size_t i = 0; i < esc->inputs.size(); ++i) {
+        const Node* leaf = find(*f.proto, "Input " + std::to_string(i));
+        const std::string row = "dg_leaf(\"Input " + std::to_string(i) + "\"";
+        const size_t at = code.find(row);
+        ASSERT_NE(at, std::string::npos) << row;
+        const std::string rest = code.substr(at, code.find("/*", at) - at);
+        EXPECT_EQ(contains(rest, ".quiet_size("), esc->inputs[i].address) << leaf->name << ":\n" << rest;
+    }
+    EXPECT_TRUE(registers > 0) << "the analysis reads registers";
+    EXPECT_TRUE(contains(code, "static const dg_pairing tst_pairing = { 1, &dg_ethercat_esc, 1, tst_input_places, " +
+                                   std::to_string(registers) + " };"))
+        << code;
 }
 
 TEST(Pairing, AbsentMeansNoPairingCode) {
@@ -555,14 +578,14 @@ TEST(Pairing, DefaultTimeoutIsOneSecondAndNoAnalysis) {
     Front f = front_end(rules("  <pairing><key field=\"node[@name='Id']\"/></pairing>\n"
                               "  <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
-    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 1 };"));
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 1, NULL, 0 };"));
 }
 
 TEST(Pairing, ResponsesInAnyOrder) {
     Front f = front_end(rules("  <pairing order=\"any\"><key field=\"node[@name='Id']\"/></pairing>\n"
                               "  <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
-    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 0 };"));
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 0, NULL, 0 };"));
 }
 
 // The analyses' table of EtherCAT commands (ethercat_commands.h) names each

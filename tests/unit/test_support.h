@@ -101,20 +101,28 @@ inline AnalysisScaffold analysis_scaffold(const std::string& name) {
     AnalysisScaffold s;
     const Analysis* a = find_analysis(name);
     if (!a) return s;
-    std::vector<std::string> own, repeated;
+    std::vector<std::string> own, repeated, registers;
     for (size_t i = 0; i < a->inputs.size(); ++i) {
         const std::string leaf = "Input " + std::to_string(i);
         const std::string path = a->inputs[i].per_instance ? "node[@name='Inputs']/node[@name='" + leaf + "']"
+                                 : a->inputs[i].address    ? "node[@name='Registers']/node[@name='" + leaf + "']"
                                                            : "node[@name='" + leaf + "']";
         s.inputs.push_back("    <input name=\"" + a->inputs[i].name + "\" field=\"" + path + "\"/>");
-        (a->inputs[i].per_instance ? repeated : own)
-            .push_back("<node name=\"" + leaf + "\" length=\"1byte\" displaytype=\"numberdec\"/>");
+        const std::string at = a->inputs[i].address ? " at=\"" + std::to_string(0x100 + 2 * i) + "\"" : "";
+        (a->inputs[i].per_instance ? repeated : a->inputs[i].address ? registers : own)
+            .push_back("<node name=\"" + leaf + "\" length=\"1byte\" displaytype=\"numberdec\"" + at + "/>");
     }
     s.nodes.push_back("  <node name=\"Input count\" length=\"1byte\" displaytype=\"numberdec\"/>");
     for (const std::string& n : own) s.nodes.push_back("  " + n);
     s.nodes.push_back("  <node name=\"Inputs\" count=\"../node[@name='Input count']\">");
     for (const std::string& n : repeated) s.nodes.push_back("    " + n);
     s.nodes.push_back("  </node>");
+    if (!registers.empty()) {
+        // a register map on the input count: each register input names one of its registers
+        s.nodes.push_back("  <node name=\"Registers\" base=\"../node[@name='Input count']\" length=\"rest\">");
+        for (const std::string& n : registers) s.nodes.push_back("    " + n);
+        s.nodes.push_back("  </node>");
+    }
     return s;
 }
 
