@@ -280,7 +280,7 @@ void *esc_capture_new(const dg_protocol *p)
     h->records = wmem_array_new(wmem_file_scope(), sizeof(record *));
     h->registers = esc_registers_of(p);
     h->bus = bus_new(static_cast<const dg_bus *>(p->analysis_data), &h->registers);
-    h->cycles = cycles_new(h->registers.system_time);
+    h->cycles = cycles_new(&h->registers);
     return h;
 }
 

@@ -82,11 +82,16 @@ struct bus_frame {
  * the model learns nothing from that register. */
 struct esc_registers {
     const dg_input_place *station, *alias, *al_status;
-    const dg_input_place *sii_control, *sii_address, *sii_data;
+    const dg_input_place *sii_configuration, *sii_control, *sii_address, *sii_data;
     const dg_input_place *fmmus, *syncmanagers;
-    const dg_input_place *system_time;
+    const dg_input_place *receive_times, *system_time;
 };
 esc_registers esc_registers_of(const dg_protocol *p);
+
+/* ESC addresses below this are registers (an FMMU there maps e.g. a
+ * SyncManager's status bit for mailbox polling); from it on, the process
+ * memory that holds the mailboxes and the process data. */
+const guint16 process_ram = 0x1000;
 
 /* Where `n` bytes from `offset` into register r (its instance `instance`)
  * sit in the datagram's data, or -1: not covered, or r not bound. */

@@ -7,9 +7,10 @@
  *  - A signature that transfers a mailbox or does what only a start-up
  *    does is never a cycle: a non-logical datagram addressing ESC memory at
  *    0x1000 or above (the mailboxes), the SyncManager 0/1 status bytes
- *    (0x0805, 0x080D, which masters poll for mail), the SII interface
- *    (0x0500-0x050F) or the DC port receive times (0x0900-0x090F, latched
- *    to measure the topology).
+ *    (which masters poll for mail), the SII interface or the DC port
+ *    receive times (latched to measure the topology); the registers where
+ *    the rule file's register map puts them (0x0805, 0x080D, 0x0500-0x050F
+ *    and 0x0900-0x090F in rules/ethercat.xml).
  *  - A period is the time from a frame sent to the next one sent with its
  *    signature. It is regular when it is above 0, the previous frame came
  *    back before this one was sent (not a retry after a timeout) and this
@@ -111,7 +112,7 @@ struct cycle_model {
     cycle *first, *last;
     guint16 cycles;
     wmem_map_t *long_periods;    /* frame -> gint64 *, periods of 2^32 ns or more */
-    const dg_input_place *system_time; /* the DC system time register, NULL: unbound */
+    esc_registers regs;          /* where the registers it reads sit */
     dc_reference dc32, dc64;
     guint32 last_frame;          /* the last frame the first pass brought here */
     /* the last frames sent and their signatures, so that most returns find
@@ -141,15 +142,28 @@ gboolean sig_equal(gconstpointer a, gconstpointer b)
     return TRUE;
 }
 
-gboolean overlaps(guint from, guint length, guint lo, guint hi) { return from <= hi && from + length > lo; }
+/* Whether a datagram's bytes overlap the `bytes` bytes from `offset` into
+ * instance `instance` of register r (never when r is unbound). */
+gboolean overlaps(const sig_datagram *d, const dg_input_place *r, guint instance, guint32 offset, guint32 bytes)
+{
+    if (!r || instance >= r->instances) return FALSE;
+    guint64 lo = r->at + (guint64)r->stride * instance + offset;
+    return d->ado < lo + bytes && (guint64)d->ado + d->length > lo;
+}
 
-/* Mailbox transfers and SII reads: never cyclic process data. */
-gboolean mailbox_or_sii(const sig_datagram *d)
+/* Mailbox transfers and start-up work: never cyclic process data. What the
+ * slave controller has there: the mailboxes in its process memory; a
+ * SyncManager's status byte 5 bytes into its block (SyncManagers 0 and 1,
+ * the mailboxes, are polled for mail); the SII interface's 16 bytes from
+ * its configuration register; the four ports' receive times, 4 bytes each,
+ * latched to measure the topology. */
+gboolean mailbox_or_startup(const cycle_model *m, const sig_datagram *d)
 {
     if (d->cmd == dg_ecat_commands::NOP || dg_ecat_commands::is_logical(d->cmd)) return FALSE;
-    guint ado = d->ado, len = d->length;
-    return ado + len > 0x1000 || overlaps(ado, len, 0x0805, 0x0805) || overlaps(ado, len, 0x080D, 0x080D) ||
-           overlaps(ado, len, 0x0500, 0x050F) || overlaps(ado, len, 0x0900, 0x090F);
+    const esc_registers *r = &m->regs;
+    return (guint)d->ado + d->length > process_ram || overlaps(d, r->syncmanagers, 0, 5, 1) ||
+           overlaps(d, r->syncmanagers, 1, 5, 1) || overlaps(d, r->sii_configuration, 0, 0, 16) ||
+           overlaps(d, r->receive_times, 0, 0, 16);
 }
 
 signature *signature_of(cycle_model *m, const datagram *d, guint n)
@@ -177,7 +191,7 @@ signature *signature_of(cycle_model *m, const datagram *d, guint n)
     s->d = (sig_datagram *)wmem_memdup(wmem_file_scope(), probe_d, n * sizeof(sig_datagram));
     s->eligible = n > 0;
     for (guint i = 0; i < n; i++)
-        if (mailbox_or_sii(&s->d[i])) s->eligible = FALSE;
+        if (mailbox_or_startup(m, &s->d[i])) s->eligible = FALSE;
     wmem_map_insert(m->signatures, s, s);
     return s;
 }
@@ -208,10 +222,10 @@ void capture_cleanup(void) { current = NULL; }
 
 } /* namespace */
 
-cycle_model *cycles_new(const dg_input_place *system_time)
+cycle_model *cycles_new(const esc_registers *r)
 {
     cycle_model *m = wmem_new0(wmem_file_scope(), cycle_model);
-    m->system_time = system_time;
+    m->regs = *r;
     m->signatures = wmem_map_new(wmem_file_scope(), sig_hash, sig_equal);
     current = m;
     return m;
@@ -328,7 +342,7 @@ double dc_returned(cycle_model *m, const datagram *s, const datagram *b, guint n
                    const packet_info *pinfo)
 {
     guint i = 0;
-    while (i < n && !dc_datagram(m->system_time, &s[i], &b[i])) i++;
+    while (i < n && !dc_datagram(m->regs.system_time, &s[i], &b[i])) i++;
     if (i == n || (guint)data_offset(&b[i]) + b[i].length > tvb_captured_length(back)) return NAN;
     guint64 raw = systime_of(back, &b[i]);
     gint64 at = ns_of(&pinfo->abs_ts);

@@ -20,8 +20,10 @@ struct cycle_mark {
 
 struct cycle_model;   /* capture-wide, wmem_file_scope */
 
-/* system_time: where the reference clock's system time sits (NULL: no DC figures). */
-cycle_model *cycles_new(const dg_input_place *system_time);
+/* r: where the registers sit that tell start-up and mailbox traffic (the
+ * SII interface, the port receive times, the mailbox SyncManagers' status)
+ * and the reference clock's system time; unbound ones tell nothing. */
+cycle_model *cycles_new(const esc_registers *r);
 /* First pass, a frame as sent: its n datagrams. */
 cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_info *pinfo);
 /* First pass, a returned frame answering `txn`: s and b its first n datagrams

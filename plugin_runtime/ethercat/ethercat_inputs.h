@@ -62,9 +62,11 @@
     X(ESC_REG_STATION, "station address register", DG_REGISTER_INPUT)               \
     X(ESC_REG_ALIAS, "station alias register", DG_REGISTER_INPUT)                   \
     X(ESC_REG_AL_STATUS, "al status register", DG_REGISTER_INPUT)                   \
+    X(ESC_REG_SII_CONFIGURATION, "sii configuration register", DG_REGISTER_INPUT)   \
     X(ESC_REG_SII_CONTROL, "sii control register", DG_REGISTER_INPUT)               \
     X(ESC_REG_SII_ADDRESS, "sii address register", DG_REGISTER_INPUT)               \
     X(ESC_REG_SII_DATA, "sii data register", DG_REGISTER_INPUT)                     \
     X(ESC_REG_FMMU, "fmmu registers", DG_REGISTER_INPUT)                            \
     X(ESC_REG_SYNCMANAGER, "syncmanager registers", DG_REGISTER_INPUT)              \
+    X(ESC_REG_RECEIVE_TIMES, "receive time register", DG_REGISTER_INPUT)            \
     X(ESC_REG_SYSTEM_TIME, "system time register", DG_REGISTER_INPUT)
