@@ -14,9 +14,10 @@ and one rule file may make several): its .gcno notes land there, and tshark writ
 Tests that build no plugin (the unit tests) map to no runtime line.  The generator is not mapped yet: for its files the runner keeps the
 mutant's own tests.
 
-The map (coverage.json): for each test its seconds and {runtime file: [executed lines]};
-the source files mapped with their sha256 (a file changed since: the runner takes every
-test that runs any line of it); "unmapped": the runner's tests not run for the map yet.
+The map (coverage.json): for each test its seconds, {runtime file: [executed lines]} and
+the sha256 of each source file when its lines were counted (a file changed since: the
+runner takes that test for any line of it); the map's own sources, with their sha256;
+"unmapped": the runner's tests not run for the map yet.
 --check fails when the runner has a test or the runtime a source file that the map does
 not know (added since the map was written: refresh it with the first command).
 """
@@ -87,10 +88,14 @@ def run_with_coverage(name, source_dir, dissgen, work):
     return kind, secs, gcov_lines(notes, by_basename), p.stdout
 
 
+def source_hashes(source_dir):
+    return {f: sha256(os.path.join(source_dir, f)) for f in runtime_sources(source_dir)}
+
+
 def save(source_dir, tests, path):
     data = {
         "about": "tests/mutation/coverage_map.py: executed runtime lines per mutation-runner test",
-        "sources": {f: sha256(os.path.join(source_dir, f)) for f in runtime_sources(source_dir)},
+        "sources": source_hashes(source_dir),
         "tests": dict(sorted(tests.items())),
         "unmapped": sorted(set(run_mutants.TESTS) - set(tests)),
     }
@@ -113,7 +118,9 @@ def write_map(source_dir, dissgen, names, path):
                 name, kind, secs, len(lines), sum(len(v) for v in lines.values())), flush=True)
             if kind in (run_mutants.FAIL, run_mutants.TIMEOUT):
                 raise SystemExit("%s fails unmutated: fix it before mapping\n%s" % (name, run_mutants.tail(out)))
-            tests[name] = {"seconds": round(secs, 1), "lines": lines}
+            # the sources these lines were counted in: a test mapped again alone must not make
+            # the others' lines look current (the runner takes a moved file's every test)
+            tests[name] = {"seconds": round(secs, 1), "lines": lines, "sources": source_hashes(source_dir)}
             save(source_dir, tests, path)
     finally:
         shutil.rmtree(work, ignore_errors=True)

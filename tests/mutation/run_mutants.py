@@ -536,16 +536,19 @@ CONSTANT = re.compile(r"^\s*(static\s+)?(const|constexpr)\s")
 
 def tests_running(coverage, file, lines, text):
     """Names of the tests that the coverage map says execute a line of lines in file
-    (any line of file when its text changed since the map was written: its line numbers
-    may have moved)."""
+    (every test running file whose lines were recorded for another text of it, since
+    then: its line numbers may have moved). Each test keeps the hashes of the sources it
+    was mapped with (its "sources"; maps before that have only the map's)."""
     if not coverage or file not in coverage.get("sources", {}):
         return []
-    moved = coverage["sources"][file] != hashlib.sha256(text.encode("utf-8")).hexdigest()
+    now = hashlib.sha256(text.encode("utf-8")).hexdigest()
     first, last = lines
     runs_file = [t for t, row in coverage.get("tests", {}).items() if t in TESTS and file in row["lines"]]
-    if moved:
-        return runs_file
-    running = [t for t in runs_file if any(first <= l <= last for l in coverage["tests"][t]["lines"][file])]
+
+    def moved(t):
+        return coverage["tests"][t].get("sources", coverage["sources"]).get(file) != now
+    running = [t for t in runs_file
+               if moved(t) or any(first <= l <= last for l in coverage["tests"][t]["lines"][file])]
     # A constant is run through its uses, and gcov counts no line for its definition:
     # every test of its file, then.
     if not running and any(CONSTANT.match(l) for l in text.splitlines()[first - 1:last]):

@@ -166,6 +166,19 @@ class ChosenByCoverage(unittest.TestCase):
         self.assertEqual(sorted(rm.tests_running(self.coverage(), "plugin_runtime/x.cpp", (1, 1), moved)),
                          ["edges_offsets", "overlays", "widths"])
 
+    def test_a_test_mapped_before_the_file_changed_is_taken_whole(self):
+        # widths was mapped alone afterwards: its lines are current, the others' are not
+        moved = "new first line\n" + self.TEXT
+        coverage = self.coverage(moved)
+        coverage["tests"]["widths"]["sources"] = dict(coverage["sources"])
+        coverage["tests"]["widths"]["lines"]["plugin_runtime/x.cpp"] = [3, 4]
+        for stale in ("overlays", "edges_offsets"):
+            coverage["tests"][stale]["sources"] = self.coverage()["sources"]
+        self.assertEqual(sorted(rm.tests_running(coverage, "plugin_runtime/x.cpp", (1, 1), moved)),
+                         ["edges_offsets", "overlays"])
+        self.assertEqual(sorted(rm.tests_running(coverage, "plugin_runtime/x.cpp", (3, 3), moved)),
+                         ["edges_offsets", "overlays", "widths"])
+
     def test_own_tests_and_covering_ones_cheapest_first(self):
         class M:
             problem, file, tests = None, "plugin_runtime/x.cpp", ["everything", "overlays"]
