@@ -366,7 +366,7 @@ void learn_sii_address(const esc_registers *r, slave_state *s, const datagram *d
 void learn_fmmus(bus_model *m, slave_state *st, const datagram *d, tvbuff_t *sent)
 {
     const dg_input_place *r = m->regs.fmmus;
-    if (!r || d->ado >= r->at + (guint64)r->stride * r->instances || (guint32)d->ado + d->length <= r->at) return;
+    if (!r || d->ado >= register_address(r, r->instances, 0) || (guint32)d->ado + d->length <= r->at) return;
     for (guint n = 0; n < max_fmmus && n < r->instances; n++) {
         fmmu *f = &st->fmmus[n];
         gint at = register_at(d, r, n, 0, 16);
@@ -1221,7 +1221,7 @@ guint hash_bytes(guint h, const void *bytes, gsize n)
 gint register_at(const datagram *d, const dg_input_place *r, guint instance, guint32 offset, guint32 n)
 {
     if (!r || instance >= r->instances) return -1;
-    guint64 reg = r->at + (guint64)r->stride * instance + offset;
+    guint64 reg = register_address(r, instance, offset);
     if (d->ado > reg || reg + n > (guint64)d->ado + d->length) return -1;
     return data_offset(d) + (gint)(reg - d->ado);
 }

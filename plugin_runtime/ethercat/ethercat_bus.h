@@ -93,6 +93,13 @@ esc_registers esc_registers_of(const dg_protocol *p);
  * memory that holds the mailboxes and the process data. */
 const guint16 process_ram = 0x1000;
 
+/* The ESC address `offset` bytes into instance `instance` of register r
+ * (instance r->instances: the address just past its last instance). */
+static inline guint64 register_address(const dg_input_place *r, guint instance, guint32 offset)
+{
+    return r->at + (guint64)r->stride * instance + offset;
+}
+
 /* Where `n` bytes from `offset` into register r (its instance `instance`)
  * sit in the datagram's data, or -1: not covered, or r not bound. */
 gint register_at(const datagram *d, const dg_input_place *r, guint instance, guint32 offset, guint32 n);

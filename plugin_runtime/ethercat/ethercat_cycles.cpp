@@ -147,7 +147,7 @@ gboolean sig_equal(gconstpointer a, gconstpointer b)
 gboolean overlaps(const sig_datagram *d, const dg_input_place *r, guint instance, guint32 offset, guint32 bytes)
 {
     if (!r || instance >= r->instances) return FALSE;
-    guint64 lo = r->at + (guint64)r->stride * instance + offset;
+    guint64 lo = register_address(r, instance, offset);
     return d->ado < lo + bytes && (guint64)d->ado + d->length > lo;
 }
 
