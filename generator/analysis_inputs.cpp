@@ -118,7 +118,7 @@ void check_analysis_inputs(Protocol& proto, Diagnostics& diags) {
     int unit_line = 0;
     const Node* window = nullptr;  // of the register inputs
     int window_line = 0;
-    std::map<const Node*, std::string> registers;  // register inputs' fields -> input name
+    std::map<const Node*, std::string> fields;  // bound fields -> their input's name
     for (AnalysisInput& input : pairing.inputs) {
         size_t index = 0;
         while (index < names.size() && names[index] != input.name) ++index;
@@ -137,24 +137,18 @@ void check_analysis_inputs(Protocol& proto, Diagnostics& diags) {
         const AnalysisInputSpec& spec = analysis->inputs[index];
         if (spec.address) {
             if (!input.field.target || !check_address_input(input, window, window_line, diags)) continue;
-            auto [named, first] = registers.emplace(input.field.target, input.name);
-            if (!first) {
-                diags.error(input.line, "field '" + input.field.target->name + "' is already input '" +
-                                            named->second + "': one field per input");
-                continue;
-            }
-            input.index = static_cast<int>(index);
-            input.address = true;
+        } else if (!check_input(input, spec, unit, unit_line, diags)) {
             continue;
         }
-        if (!check_input(input, spec, unit, unit_line, diags)) continue;
         Node* t = input.field.target;
-        if (t->analysis_input >= 0) {
-            diags.error(input.line, "field '" + t->name + "' is already input '" + names[t->analysis_input] +
-                                        "': one field per input");
+        auto [named, first] = fields.emplace(t, input.name);
+        if (!first) {
+            diags.error(input.line,
+                        "field '" + t->name + "' is already input '" + named->second + "': one field per input");
             continue;
         }
         input.index = static_cast<int>(index);
+        if (spec.address) continue;  // read where the register map puts it, not by the walk
         t->analysis_input = static_cast<int>(index);
         t->analysis_input_per_instance = spec.per_instance;
     }

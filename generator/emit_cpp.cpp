@@ -719,9 +719,10 @@ void Emitter::walk_definitions() {
 // The registers the pairing's analysis reads (<input> of a window child):
 // where each sits, handed to it once. Returns how many.
 size_t Emitter::input_places() {
+    const Analysis* analysis = find_analysis(p_.pairing->analysis);
     std::vector<const AnalysisInput*> bound;
     for (const AnalysisInput& input : p_.pairing->inputs)
-        if (input.address && input.index >= 0) bound.push_back(&input);
+        if (analysis && input.index >= 0 && analysis->inputs[input.index].address) bound.push_back(&input);
     if (bound.empty()) return 0;
     o_ << "/* Where the registers the analysis reads sit in their register map: input, address, size,\n"
        << "   stride and instances (from at=, stride=, instances=). */\n"

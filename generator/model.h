@@ -310,9 +310,8 @@ struct AnalysisInput {
     FieldRef field;
     int line = 0;
     // set by check_analysis_inputs: the analysis' input number (-1: not
-    // bound) and whether it is a window child's address, read once
+    // bound); whether it is read by address says the analysis' spec of it
     int index = -1;
-    bool address = false;
 };
 
 struct Pairing {
