@@ -87,9 +87,7 @@ private:
         for (const xmlAttr* a = el->properties; a; a = a->next) {
             const std::string name = reinterpret_cast<const char*>(a->name);
             if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
-            std::string near = closest_match(name, allowed);
-            error(el, "unknown attribute '" + name + "' on <" + xml_name(el) + ">" +
-                          (near.empty() ? "; valid: " + join(allowed, ", ") : "; did you mean '" + near + "'?"));
+            error(el, unknown_attribute(name, xml_name(el), closest_match(name, allowed), allowed));
             ok = false;
         }
         return ok;

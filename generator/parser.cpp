@@ -327,10 +327,8 @@ std::map<std::string, std::string> Parser::attributes(xmlNode* el,
     for (xmlAttr* a = el->properties; a; a = a->next) {
         std::string name = reinterpret_cast<const char*>(a->name);
         if (std::find(allowed.begin(), allowed.end(), name) == allowed.end()) {
-            std::string msg = "unknown attribute '" + name + "' on <" + element_name(el) + ">";
-            std::string near = remembered_suggestion(name, allowed);
-            msg += near.empty() ? "; valid: " + join(allowed, ", ") : "; did you mean '" + near + "'?";
-            diags_.error(line_of(el), msg);
+            diags_.error(line_of(el),
+                         unknown_attribute(name, element_name(el), remembered_suggestion(name, allowed), allowed));
             continue;
         }
         xmlChar* value = xmlNodeListGetString(doc_, a->children, 1);

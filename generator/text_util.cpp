@@ -63,4 +63,10 @@ std::string join(const std::vector<std::string>& items, const std::string& sep) 
     return out;
 }
 
+std::string unknown_attribute(const std::string& name, const std::string& element, const std::string& near,
+                              const std::vector<std::string>& valid) {
+    return "unknown attribute '" + name + "' on <" + element + ">" +
+           (near.empty() ? "; valid: " + join(valid, ", ") : "; did you mean '" + near + "'?");
+}
+
 }  // namespace dissgen

@@ -23,4 +23,9 @@ std::string excerpt(const std::string& s, size_t limit = 80);
 // "a, b, c"
 std::string join(const std::vector<std::string>& items, const std::string& sep);
 
+// "unknown attribute 'NAME' on <ELEMENT>", then "; did you mean 'NEAR'?" or,
+// when no valid name is near, "; valid: " and the valid names.
+std::string unknown_attribute(const std::string& name, const std::string& element, const std::string& near,
+                              const std::vector<std::string>& valid);
+
 }  // namespace dissgen

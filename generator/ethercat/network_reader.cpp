@@ -136,9 +136,7 @@ bool DesignReader::read(const xmlNode* root, Network& net) {
         for (const xmlAttr* a = c->properties; a; a = a->next) {
             std::string n = reinterpret_cast<const char*>(a->name);
             if (std::find(kSlaveAttributes.begin(), kSlaveAttributes.end(), n) != kSlaveAttributes.end()) continue;
-            std::string near = closest_match(n, kSlaveAttributes);
-            diags_.error(xml_line(c), "unknown attribute '" + n + "' on <slave>" +
-                                          (near.empty() ? "" : " (did you mean '" + near + "'?)"));
+            diags_.error(xml_line(c), unknown_attribute(n, "slave", closest_match(n, kSlaveAttributes), kSlaveAttributes));
             ok = false;
         }
         for (const xmlNode* inner = c->children; inner; inner = inner->next) {
