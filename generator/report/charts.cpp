@@ -38,6 +38,9 @@ std::string file_name(const std::string& path) {
 // The functions both reports' scripts draw with (before their own script).
 const char kChartScript[] = R"JS(
 function bars(series) { return series.map(p => [p[0], p[1]]); }
+// Capture-time axis labels to the µs: Dygraph's default two decimals repeat
+// (0.02 0.02 0.03) on a capture a few hundredths of a second long.
+const captureTimeAxis = {axisLabelFormatter: v => String(+v.toFixed(6))};
 function chart(id, rows, options) {
   const el = document.getElementById(id);
   if (!el) return;

@@ -128,7 +128,7 @@ const char kScript[] = R"JS(
 (function () {
   const data = JSON.parse(document.getElementById('report-data').textContent);
   const common = {legend: 'follow', labelsSeparateLines: true, xlabel: 'Capture time (s)', animatedZooms: false,
-                  axes: {y: {axisLabelWidth: 64}}};
+                  axes: {x: captureTimeAxis, y: {axisLabelWidth: 64}}};
   const marks = {strokeWidth: 0, drawPoints: true, pointSize: 4};
   cycleCharts(data.cycles, common, 'Messages');
   // Losses: how many messages each gap lost, and the repeats, over time.

@@ -119,7 +119,8 @@ const char kScript[] = R"JS(
   const stateNames = {1: 'INIT', 2: 'PREOP', 3: 'BOOT', 4: 'SAFEOP', 8: 'OP'};
   const stateLevel = {1: 1, 2: 2, 3: 2.5, 4: 3, 8: 4};
   const common = {customBars: true, legend: 'follow', labelsSeparateLines: true,
-                  xlabel: 'Capture time (s)', animatedZooms: false, axes: {y: {axisLabelWidth: 64}}};
+                  xlabel: 'Capture time (s)', animatedZooms: false,
+                  axes: {x: captureTimeAxis, y: {axisLabelWidth: 64}}};
   cycleCharts(data.cycles, common, 'Frames');
   // Round trips with the lost frames and working-counter errors as marks on top.
   const top = data.round_trip.reduce((m, p) => Math.max(m, p[1][2]), 0) * 1.05 || 1;
@@ -143,7 +144,8 @@ const char kScript[] = R"JS(
     chart('al-states', stateRows, {labels: ['t'].concat(data.slaves.map(s => s.label)), stepPlot: true,
         xlabel: 'Capture time (s)', ylabel: 'AL state', title: 'Slaves: AL state over time', legend: 'follow',
         labelsSeparateLines: true, valueRange: [0.5, 4.5], yLabelWidth: 20,
-        axes: {y: {axisLabelWidth: 70, valueFormatter: v => names[v] || '', axisLabelFormatter: v => names[v] || ''}}});
+        axes: {x: captureTimeAxis,
+               y: {axisLabelWidth: 70, valueFormatter: v => names[v] || '', axisLabelFormatter: v => names[v] || ''}}});
   }
 })();
 )JS";
