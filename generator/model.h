@@ -275,6 +275,9 @@ struct Node {
     }
     // A leaf of 1-64 bits whose value other fields may refer to.
     bool is_numeric() const;
+    // How wide a numeric leaf's value is: its bits, or 64 for a computed
+    // value and a number whose length comes from a field (read as 64-bit).
+    unsigned value_bits() const { return has_fixed_length() ? static_cast<unsigned>(fixed_bits) : 64; }
 };
 
 // <heuristic table="udp" enabled="true|false"/>: found by its valid fields on a heuristic list.
@@ -348,6 +351,7 @@ struct Cycles {
     std::optional<CycleField> sequence;    // the sequence count, if any
     unsigned sequence_bits = 0;            // its width (bits="..."; default: the field's)
     uint64_t sequence_step = 1;            // how much it advances per message (step="..."); 0: learned
+    uint64_t sequence_wrap = 0;            // wrap="N": it runs 0 .. N - 1 (0: to 2^bits - 1)
     std::vector<CycleField> only, never;   // conditions
     bool lost_by_period = false;           // lost="period": a cycle's gap of n periods is n - 1 lost
     int lost_line = 0;                     // the line of lost="sequence" (0: not given)

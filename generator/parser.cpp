@@ -61,7 +61,7 @@ const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kInputAttributes = {"name", "field"};
 const std::vector<std::string> kCyclesAttributes = {"window", "sender", "lost"};
 const std::vector<std::string> kCycleFieldAttributes = {"field"};
-const std::vector<std::string> kSequenceAttributes = {"field", "bits", "step"};
+const std::vector<std::string> kSequenceAttributes = {"field", "bits", "step", "wrap"};
 const std::vector<std::string> kCycleTestAttributes = {"field", "in"};
 const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberdec", "bool",
                                                 "origin",  "enum",      "nondisplay",
@@ -644,6 +644,18 @@ void Parser::parse_cycles(xmlNode* el, Protocol& proto) {
                                                  "from 1) or 'learned'");
                 else
                     cycles.sequence_step = n;
+            }
+            if (sattrs.count("wrap")) {
+                uint64_t n = 0;
+                if (sattrs.count("bits"))
+                    diags_.error(line_of(c), "bits= and wrap= both say where the count wraps: keep one (wrap=\"N\": "
+                                             "it runs 0 to N - 1; bits=\"B\": 0 to 2^B - 1)");
+                else if (!parse_number(sattrs["wrap"], n) || n < 2)
+                    diags_.error(line_of(c), "bad wrap '" + sattrs["wrap"] +
+                                                 "': expected how many values the count takes before it wraps to 0 "
+                                                 "(a number from 2)");
+                else
+                    cycles.sequence_wrap = n;
             }
         } else if (name == "only" || name == "never") {
             if (parse_cycle_field(c, kCycleTestAttributes, f, sattrs))

@@ -733,7 +733,7 @@ void Validator::check_list_fits(int line, const std::vector<ValueRange>& list, c
                                 const char* attribute) {
     const Node* t = ref.target;
     // a computed value is a 64-bit integer, whatever its (zero) width in the message
-    if (!t || !t->is_numeric() || t->is_computed() || t->fixed_bits >= 64) return;
+    if (!t || !t->is_numeric() || t->value_bits() >= 64) return;
     const uint64_t max = (uint64_t{1} << t->fixed_bits) - 1;
     for (const ValueRange& r : list) {
         if (r.high <= max) continue;
@@ -931,17 +931,24 @@ void Validator::check_cycles() {
     for (const CycleField& f : c.never) check_cycle_field(f, "never", 4, test++, seen);
     if (!c.sequence || !check_cycle_field(*c.sequence, "sequence", 2, 0, seen)) return;
     const Node& t = *c.sequence->field.target;  // decoded more than once in a message: the last value counts
-    const unsigned width = t.is_computed() ? 64 : static_cast<unsigned>(t.fixed_bits);
+    const unsigned width = t.value_bits();
     if (c.sequence_bits == 0)
         c.sequence_bits = width;
     else if (c.sequence_bits > width)
         diags_.error(c.sequence->line, "bits=\"" + std::to_string(c.sequence_bits) + "\" is wider than sequence field " +
                                            quote(t) + at_line(t) + " (" + std::to_string(width) + " bits)");
+    if (c.sequence_wrap && width < 64 && c.sequence_wrap - 1 > (uint64_t{1} << width) - 1)
+        diags_.error(c.sequence->line, "wrap=\"" + std::to_string(c.sequence_wrap) + "\" is more values than sequence field " +
+                                           quote(t) + at_line(t) + " holds (" + std::to_string(width) + " bits)");
     // a step of half the count's range or more would make every advance look like a count going back
-    if (c.sequence_step > 1 && c.sequence_bits < 64 && c.sequence_step > ((uint64_t{1} << c.sequence_bits) - 1) >> 1)
+    const uint64_t top = c.sequence_wrap        ? c.sequence_wrap - 1
+                         : c.sequence_bits < 64 ? (uint64_t{1} << c.sequence_bits) - 1
+                                                : ~uint64_t{0};
+    const std::string range = c.sequence_wrap ? "count wrapping at " + std::to_string(c.sequence_wrap)
+                                              : std::to_string(c.sequence_bits) + "-bit sequence count";
+    if (c.sequence_step > 1 && c.sequence_step > top >> 1)
         diags_.error(c.sequence->line, "step=\"" + std::to_string(c.sequence_step) +
-                                           "\" is not below half the range of a " +
-                                           std::to_string(c.sequence_bits) + "-bit sequence count");
+                                           "\" is not below half the range of a " + range);
 }
 
 bool Validator::check_cycle_field(const CycleField& f, const char* element, int role, int test,

@@ -6,12 +6,14 @@
  *    fields, every <only> test held and no <never> test did. Its stream is
  *    the signature's values in decoding order (and, with sender="yes", the
  *    sender's address and port).
- *  - With a sequence count `bits` wide, from the stream's second message on,
- *    the step d = (count - previous count) mod 2^bits says: d = 0, the
- *    previous message again (a duplicate: P.cycle.duplicate, not timed);
- *    1 <= d < 2^(bits-1), d - 1 messages lost right before this one
- *    (P.cycle.lost); a larger d, the count went back (a restart, or a
- *    message overtaken): nothing lost.
+ *  - With a sequence count of range R (2^bits, or wrap="R": 0 .. R - 1),
+ *    from the stream's second message on, the step d = (count - previous
+ *    count) mod R says: d = 0, the previous message again (a duplicate:
+ *    P.cycle.duplicate, not timed); 1 <= d <= (R - 1) / 2, d - 1 messages
+ *    lost right before this one (P.cycle.lost); a larger d, the count went
+ *    back (a restart, or a message overtaken): nothing lost. A count of R or
+ *    more (wrap= only) is no count: the message is timed as one without, and
+ *    the stream's next count is its first again.
  *  - With lost="period" (no count), a cycle's period rounded to n >= 2 whole
  *    nominal periods means n - 1 messages lost right before this one; more
  *    than max_gap_periods is a pause: nothing lost, not regular.
@@ -182,12 +184,12 @@ cycle *new_cycle(capture_state *c, stream *s, guint window, guint32 frame)
 }
 
 /* Messages lost before an advance of the count by `advance` (not 0) in a
- * stream whose count advances by `step` per message: G_MAXUINT32 when the
- * count went back (half the range or more: a restart, a message overtaken) or
- * jumped by no whole number of steps. */
-guint32 lost_before(guint64 advance, guint64 step, guint64 mask)
+ * stream whose count advances by `step` per message and runs up to `top`:
+ * G_MAXUINT32 when the count went back (more than half the range: a
+ * restart, a message overtaken) or jumped by no whole number of steps. */
+guint32 lost_before(guint64 advance, guint64 step, guint64 top)
 {
-    if (advance > mask >> 1 || advance % step) return G_MAXUINT32;
+    if (advance > top >> 1 || advance % step) return G_MAXUINT32;
     return (guint32)MIN(advance / step - 1, (guint64)G_MAXUINT32 - 1);
 }
 
@@ -210,19 +212,27 @@ guint32 lost_in_gap(gint64 period, guint32 nominal)
  * when it is a duplicate; else *lost messages lost (G_MAXUINT32: the count
  * went back). A learned step (`step` 0) is the stream's first advance, or a
  * smaller one that divides it (the first held a loss). */
-gboolean sequence_step(stream *s, const dg_cycle_input *in, guint bits, guint64 step, guint32 *lost)
+gboolean sequence_step(stream *s, const dg_cycle_input *in, const dg_cycles *cy, guint32 *lost)
 {
     *lost = 0;
+    const guint bits = cy->sequence_bits;
+    const guint64 step = cy->sequence_step, wrap = cy->sequence_wrap;
     if (!bits || !in->has_sequence) return TRUE;
     const guint64 mask = bits >= 64 ? G_MAXUINT64 : ((guint64)1 << bits) - 1;
     const guint64 count = in->sequence & mask;
+    if (wrap && count >= wrap) { /* outside the count's range: no count, and the next one starts afresh */
+        s->has_sequence = FALSE;
+        return TRUE;
+    }
+    const guint64 top = wrap ? wrap - 1 : mask; /* the highest count */
     if (s->has_sequence) {
-        const guint64 advance = (count - s->last_sequence) & mask;
+        const guint64 last = s->last_sequence;
+        const guint64 advance = wrap ? (count >= last ? count - last : count + (wrap - last)) : (count - last) & mask;
         if (advance == 0) return FALSE;
-        if (!step && advance <= mask >> 1 && (!s->learned_step || s->learned_step % advance == 0))
+        if (!step && advance <= top >> 1 && (!s->learned_step || s->learned_step % advance == 0))
             s->learned_step = advance;
         const guint64 by = step ? step : s->learned_step;
-        *lost = by ? lost_before(advance, by, mask) : G_MAXUINT32;
+        *lost = by ? lost_before(advance, by, top) : G_MAXUINT32;
     }
     s->last_sequence = count;
     s->has_sequence = TRUE;
@@ -239,7 +249,7 @@ mark *time_message(capture_state *c, const dg_cycle_input *in, const packet_info
     s->messages++;
     mark m = {};
     guint32 lost;
-    if (!sequence_step(s, in, cy->sequence_bits, cy->sequence_step, &lost)) {
+    if (!sequence_step(s, in, cy, &lost)) {
         s->duplicates++;
         m.duplicate_of = s->last_frame;
         m.cycle = s->cyc ? s->cyc->number : 0;

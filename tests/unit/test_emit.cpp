@@ -55,7 +55,7 @@ TEST(Emit, CyclesGiveEachFieldItsRoleAndTheTestsTheirRanges) {
     Front without = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n" + nodes);
     ASSERT_TRUE(with.ok() && without.ok()) << with.messages() << without.messages();
     const std::string code = emit_cpp(*with.proto, "rules.xml");
-    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 5, 16, 1, 1, t_cycle_tests, t_cycle_ranges, 1u, 0 };"))
+    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 5, 16, 1, 1, t_cycle_tests, t_cycle_ranges, 1u, 0, 0u };"))
         << code;
     EXPECT_TRUE(contains(code, "{ 0x1, 0x1 }") && contains(code, "{ 0x3, 0x4 }") &&
                 contains(code, "{ 0x1, 0xffffffffffffffff }"));
@@ -66,19 +66,44 @@ TEST(Emit, CyclesGiveEachFieldItsRoleAndTheTestsTheirRanges) {
     EXPECT_FALSE(contains(emit_cpp(*without.proto, "rules.xml"), "cycle"));  // costs nothing where absent
 }
 
+// The code of a file whose <cycles> counts by `sequence` (a <sequence>
+// element) over a 2-byte Stream and `count_nodes`.
+std::string code_with_sequence(const std::string& sequence, const std::string& count_nodes) {
+    Front f = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n"
+                        "  <cycles><signature field=\"node[@name='Stream']\"/>" + sequence + "</cycles>\n"
+                        "  <node name=\"Stream\" length=\"2byte\" displaytype=\"numberhex\"/>\n" + count_nodes +
+                        "</root>\n");
+    EXPECT_TRUE(f.ok()) << sequence << ": " << f.messages();
+    return f.ok() ? emit_cpp(*f.proto, "rules.xml") : "";
+}
+
 // bits="1" to bits="64": the range's ends are sequence counts too (a 1-bit toggle).
 TEST(Emit, CyclesSequenceWidthsAtTheEnds) {
     for (const std::string width : {"1", "64"}) {
-        Front f = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n"
-                            "  <cycles><signature field=\"node[@name='Stream']\"/>"
-                            "<sequence field=\"node[@name='Count']\" bits=\"" + width + "\"/></cycles>\n"
-                            "  <node name=\"Stream\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
-                            "  <node name=\"Count\" length=\"8byte\" displaytype=\"numberdec\"/>\n</root>\n");
-        ASSERT_TRUE(f.ok()) << width << ": " << f.messages();
-        EXPECT_TRUE(contains(emit_cpp(*f.proto, "rules.xml"),
-                             "static const dg_cycles t_cycles = { 8, " + width + ", 0, 0, NULL, NULL, 1u, 0 };"))
+        const std::string code =
+            code_with_sequence("<sequence field=\"node[@name='Count']\" bits=\"" + width + "\"/>",
+                               "  <node name=\"Count\" length=\"8byte\" displaytype=\"numberdec\"/>\n");
+        EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 8, " + width + ", 0, 0, NULL, NULL, 1u, 0, 0u };"))
             << width;
     }
+}
+
+// wrap="4000" (IEC 61850's smpCnt wraps at the sample rate): the table's last
+// member, the count's width the field's.
+TEST(Emit, CyclesSequenceWrap) {
+    const std::string code = code_with_sequence("<sequence field=\"node[@name='Count']\" wrap=\"4000\"/>",
+                                                "  <node name=\"Count\" length=\"2byte\" displaytype=\"numberdec\"/>\n");
+    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 8, 16, 0, 0, NULL, NULL, 1u, 0, 4000u };")) << code;
+}
+
+// A count whose length comes from a field (a BER integer) is read as a 64-bit
+// number: a 64-bit count, not none (it was taken for 0 bits and never counted).
+TEST(Emit, CyclesSequenceOfFieldLength) {
+    const std::string code =
+        code_with_sequence("<sequence field=\"node[@name='Count']\"/>",
+                           "  <node name=\"Size\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                           "  <node name=\"Count\" length=\"../node[@name='Size']\" displaytype=\"numberdec\"/>\n");
+    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 8, 64, 0, 0, NULL, NULL, 1u, 0, 0u };")) << code;
 }
 
 // lost="period": the table's last flag.
@@ -88,7 +113,7 @@ TEST(Emit, CyclesLostByPeriod) {
                         "  <cycles lost=\"period\"><signature field=\"node[@name='Stream']\"/></cycles>\n" + nodes);
     ASSERT_TRUE(f.ok()) << f.messages();
     EXPECT_TRUE(contains(emit_cpp(*f.proto, "rules.xml"),
-                         "static const dg_cycles t_cycles = { 8, 0, 0, 0, NULL, NULL, 1u, 1 };"))
+                         "static const dg_cycles t_cycles = { 8, 0, 0, 0, NULL, NULL, 1u, 1, 0u };"))
         << emit_cpp(*f.proto, "rules.xml");
 }
 

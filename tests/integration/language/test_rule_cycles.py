@@ -210,5 +210,76 @@ class TestRuleCycles(TsharkTestCase, unittest.TestCase):
             self.assert_report(staged, cycles, check)
 
 
+# --- a count wrapping at the sample rate ----------------------------------------------
+
+SAMPLE_RATE = 4000  # tests/rules/cycles_wrap.xml: wrap="4000"
+
+
+def sample_frame(stream, count, size=2):
+    """A frame of tests/rules/cycles_wrap.xml: stream, the count in `size` bytes, a sample."""
+    return (bytes([0x01, 0x0C, 0xCD, 0x04, 0, 1, 0x02, 0, 0, 0, 0, 1]) + struct.pack(">HHB", 0x88B5, stream, size) +
+            count.to_bytes(size, "big") + struct.pack(">i", -count))
+
+
+def sample_capture(seed=4000):
+    """Stream 0x4000 at 250 us from count 3980 through the wrap 3999 -> 0: the sample at the
+    wrap (3999) dropped, later three in a row, one sent twice, one count out of range (4095:
+    no count); stream 0x4001 at 208.333 us from mid-capture, its count in 4 bytes."""
+    rng = random.Random(seed)
+    packets = []
+    for k in range(80):
+        count = (3980 + k) % SAMPLE_RATE
+        t = 10**9 + k * 250_000 + rng.randint(-3000, 3000)
+        if count == 3999 or k in (50, 51, 52):
+            continue
+        packets.append((t, sample_frame(0x4000, 4095 if k == 60 else count)))
+        if k == 40:
+            packets.append((t + 10_123, sample_frame(0x4000, count)))
+    for k in range(60):
+        t = 10**9 + 7_000_000 + k * 208_333 + rng.randint(-2000, 2000)
+        packets.append((t, sample_frame(0x4001, (3990 + k) % SAMPLE_RATE, size=4)))
+    packets.sort(key=lambda p: p[0])
+    return packets
+
+
+class CountWrappingAtTheSampleRate(TsharkTestCase, unittest.TestCase):
+    """wrap="4000": the count's step from 3999 to 0 is the next sample, a sample dropped at
+    the wrap is one lost, a count of 4000 or more is no count (timed, nothing lost); a count
+    whose length comes from a field is counted (it once had no width and was never)."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "cycles_wrap.xml"), "samples")
+        cls.packets = sample_capture()
+        cls.capture = cls.env.add_file("samples.pcap", pcap_ns(cls.packets))
+
+    def test_marks_and_report_follow_the_model(self):
+        messages = []
+        for frame, (t, data) in enumerate(self.packets, 1):
+            size = data[16]
+            messages.append((frame, t, struct.unpack(">H", data[14:16])[0],
+                             int.from_bytes(data[17:17 + size], "big")))
+        marks, cycles = model(messages, window=8, bits=64, wrap=SAMPLE_RATE)
+        with self.checks() as check:
+            check(sorted(m["lost"] for m in marks.values() if "lost" in m) == [1, 3],
+                  "the model: one lost at the wrap, three in a row")
+            check(sum(1 for m in marks.values() if "duplicate" in m) == 1, "the model: one duplicate")
+            check(len(cycles) == 2, "the model: two cycles")
+            for two_pass in (False, True):
+                how = "-2" if two_pass else "one pass"
+                rows = self.env.field_rows(self.capture, ["frame.number"] + mark_fields("samples"), two_pass=two_pass)
+                for frame, row in sorted(rows.items()):
+                    got, want = mark_of(row, "samples"), marks.get(frame, {})
+                    check(got == want, "%s frame %d: %s, expected %s" % (how, frame, got, want))
+                    check(bool(row["samples.expert.cycle_lost"]) == ("lost" in want),
+                          "%s frame %d: cycle_lost expert %s" % (how, frame, row["samples.expert.cycle_lost"]))
+                out = self.env.tshark(["-r", self.capture, "-q", "-z", "samples,cycles"] +
+                                      (["-2"] if two_pass else [])).stdout
+                got = parse_report(out)
+                check([g["figures"] for g in got] == [figures(c) for c in cycles],
+                      "%s -z samples,cycles: %s, expected %s" % (how, [g["figures"] for g in got],
+                                                             [figures(c) for c in cycles]))
+
+
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])

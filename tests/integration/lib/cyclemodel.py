@@ -23,29 +23,35 @@ def clamp(ns):
 MAX_GAP_PERIODS = 16  # lost="period": a longer gap is a pause, nothing lost
 
 
-def model(messages, window, bits, step=1, lost_by_period=False):
+def model(messages, window, bits, step=1, lost_by_period=False, wrap=None):
     """messages: (frame, time ns, stream key, sequence count) in capture order; step: how
     much the count advances per message, 0 when learned from the stream (step="learned");
-    lost_by_period: lost="period", a cycle's period of n whole nominal periods is n - 1 lost.
+    lost_by_period: lost="period", a cycle's period of n whole nominal periods is n - 1 lost;
+    wrap: wrap="N", the count runs 0 .. N - 1 (a count of N or more is no count, and the
+    next count is the stream's first again).
     Returns ({frame: mark}, [cycle]) as the manual describes them."""
     mask = (1 << bits) - 1
+    modulus = wrap or (1 << bits)
+    top = modulus - 1  # the highest count: an advance above top // 2 is the count going back
     streams, cycles, marks = {}, [], {}
     for frame, ts, key, seq in messages:
         s = streams.setdefault(key, {"key": key, "last_frame": 0, "last_ts": 0, "last_seq": None, "recent": [],
                                      "cycle": None, "lost": 0, "duplicates": 0, "step": step})
         lost, back = 0, False
+        if seq is not None and wrap and (seq & mask) >= wrap:
+            seq, s["last_seq"] = None, None  # no count; the next one is the stream's first again
         if seq is not None:
             seq &= mask
             if s["last_seq"] is not None:
-                advance = (seq - s["last_seq"]) & mask
+                advance = (seq - s["last_seq"]) % modulus
                 if advance == 0:
                     s["duplicates"] += 1
                     marks[frame] = {"cycle": s["cycle"]["number"] if s["cycle"] else 0,
                                     "duplicate": s["last_frame"]}
                     continue
-                if not step and advance <= mask >> 1 and (not s["step"] or s["step"] % advance == 0):
+                if not step and advance <= top >> 1 and (not s["step"] or s["step"] % advance == 0):
                     s["step"] = advance  # learned: the first advance, or a smaller one dividing it
-                if s["step"] and advance <= mask >> 1 and advance % s["step"] == 0:
+                if s["step"] and advance <= top >> 1 and advance % s["step"] == 0:
                     lost = min(advance // s["step"] - 1, 2**32 - 2)
                 else:
                     back = True
