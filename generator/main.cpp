@@ -440,10 +440,16 @@ int cmd_report(const std::vector<std::string>& captures, const std::string& out_
 
 int main(int argc, char** argv) {
     std::vector<std::string> args(argv + 1, argv + argc);
-    if (args.empty() || args[0] == "-h" || args[0] == "--help" || args[0] == "help") {
+    if (args.empty() || args[0] == "help") {
         std::cout << kUsage;
         return args.empty() ? 2 : 0;
     }
+    // -h/--help anywhere (`dissgen install --help`): the help, not a usage error
+    for (const std::string& a : args)
+        if (a == "-h" || a == "--help") {
+            std::cout << kUsage;
+            return 0;
+        }
     if (args[0] == "--version") {
         std::cout << "dissgen " DISSGEN_VERSION "\n";
         return 0;

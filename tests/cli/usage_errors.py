@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Every misuse of dissgen's command line: exit status 2 (as for a usage error anywhere), one
-line on stderr that says what is wrong, nothing on stdout, and nothing written (Python 3
-stdlib only).
+line on stderr that says what is wrong, nothing on stdout, and nothing written; and -h/--help
+after a command: the help, exit 0 (Python 3 stdlib only).
 
     usage_errors.py --dissgen build/bin/dissgen
 
@@ -61,6 +61,16 @@ def main(argv=None):
                 failed += 1
                 print("FAILED: dissgen %s: exit %d (want 2), stderr %r (want %r), stdout %r, files %s" % (
                     " ".join(arguments), p.returncode, got, first_line, p.stdout[:80], os.listdir(tmp)))
+        # Help asked for after a command is no misuse: the help, exit 0, nothing written.
+        for arguments in (["install", RULES, "--help"], ["report", "-h"], ["check", "--help"]):
+            p = subprocess.run([dissgen] + arguments, capture_output=True, text=True, cwd=tmp)
+            if p.returncode == 0 and p.stdout.startswith("usage: dissgen") and not p.stderr and not os.listdir(tmp):
+                passed += 1
+                print("ok: dissgen %s: exit 0, the help" % " ".join(arguments))
+            else:
+                failed += 1
+                print("FAILED: dissgen %s: exit %d (want 0), stdout %r, stderr %r, files %s" % (
+                    " ".join(arguments), p.returncode, p.stdout[:40], p.stderr[:80], os.listdir(tmp)))
     print("%d passed, %d failed" % (passed, failed))
     return 0 if failed == 0 else 1
 
