@@ -140,6 +140,9 @@ struct Node {
     // --- as written ---
     std::string name;
     int line = 0;
+    // a node of a group's copy: "in group 'G' used on line N" (outermost use
+    // last), which tells the copies apart where `line` cannot; else empty
+    std::string group_use;
     int doc_index = 0;      // 1-based position among all <node> elements
     LengthKind length_kind = LengthKind::Children;
     uint64_t fixed_bits = 0;        // for Bits and Bytes

@@ -270,15 +270,20 @@ bool expand_node_groups(xmlNode* root, Diagnostics& diags, GroupUses& uses) {
     return Expander(diags, uses).run(root);
 }
 
-std::string group_use_context(const GroupUses& uses, const xmlNode* el) {
+std::string group_uses_of(const GroupUses& uses, const xmlNode* el) {
     std::string out;
     for (; el; el = el->parent) {
         auto it = uses.find(el);
         if (it == uses.end()) continue;
-        out += (out.empty() ? " (in group '" : ", in group '") + it->second.group + "' used on line " +
+        out += (out.empty() ? "in group '" : ", in group '") + it->second.group + "' used on line " +
                std::to_string(it->second.line);
     }
-    return out.empty() ? out : out + ")";
+    return out;
+}
+
+std::string group_use_context(const GroupUses& uses, const xmlNode* el) {
+    const std::string in = group_uses_of(uses, el);
+    return in.empty() ? in : " (" + in + ")";
 }
 
 }  // namespace dissgen

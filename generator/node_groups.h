@@ -39,8 +39,10 @@ using GroupUses = std::map<const xmlNode*, GroupUse>;
 // a use or group is wrong.
 bool expand_node_groups(xmlNode* root, Diagnostics& diags, GroupUses& uses);
 
-// " (in group 'X' used on line N, ...)" for an element inside copies, from the
+// "in group 'X' used on line N, ..." for an element inside copies, from the
 // innermost use out; "" elsewhere.
+std::string group_uses_of(const GroupUses& uses, const xmlNode* el);
+// The same in parentheses after a space, or "".
 std::string group_use_context(const GroupUses& uses, const xmlNode* el);
 
 }  // namespace dissgen

@@ -694,6 +694,7 @@ bool Parser::parse_cycle_field(xmlNode* el, const std::vector<std::string>& allo
 std::unique_ptr<Node> Parser::parse_node(xmlNode* el, Node* parent, int depth) {
     auto node = std::make_unique<Node>();
     node->line = line_of(el);
+    if (!uses_.empty()) node->group_use = group_uses_of(uses_, el);
     node->parent = parent;
     node->doc_index = next_doc_index_++;
     by_xml_[el] = node.get();

@@ -23,7 +23,9 @@ namespace {
 
 std::string quote(const Node& n) { return "'" + n.name + "'"; }
 
-std::string at_line(const Node& n) { return " (line " + std::to_string(n.line) + ")"; }
+std::string at_line(const Node& n) {
+    return " (line " + std::to_string(n.line) + (n.group_use.empty() ? "" : ", " + n.group_use) + ")";
+}
 
 // Displays that show whole bytes and never join a bit group.
 bool is_byte_display(Display d) {
@@ -869,8 +871,9 @@ void Validator::share_filter_name(Node& n, const Node& owner) {
     if (holders.empty()) holders.push_back(&owner);
     for (const Node* other : holders)
         if (!are_alternatives(proto_, *other, n)) {
-            diags_.error(n.line, "duplicate filter name '" + name + "' (also used by " + quote(*other) +
-                                     at_line(*other) + "); give one of them a 'filter' attribute");
+            diags_.error(n.line, "duplicate filter name '" + name + "'" +
+                                     (n.group_use.empty() ? "" : " of the copy " + n.group_use) + " (also used by " +
+                                     quote(*other) + at_line(*other) + "); give one of them a 'filter' attribute");
             return;
         }
     std::string mismatch = shared_field_mismatch(owner, n);
