@@ -93,13 +93,13 @@
     X(stream_jitter, "cycle.jitter", FT_RELATIVE_TIME, BASE_NONE, NULL, "Cycle jitter",                     \
       "The period minus the cycle's nominal period (the median of its periods so far)")                    \
     X(stream_lost, "cycle.lost", FT_UINT32, BASE_DEC, NULL, "Messages lost",                                \
-      "Messages of the stream missing right before this one, by its sequence count")                       \
+      "Messages of the stream missing right before this one (its sequence count, or its period)")          \
     X(stream_duplicate, "cycle.duplicate", FT_FRAMENUM, BASE_NONE, NULL, "Duplicate of",                    \
       "The stream's previous message, whose sequence count this one repeats")
 
 #define DG_CYCLES_EXPERTS(X)                                                                               \
     X(stream_lost_expert, "expert.cycle_lost", PI_SEQUENCE, PI_WARN,                                        \
-      "Messages of the stream lost (its sequence count skipped)")                                         \
+      "Messages of the stream lost (a gap in its sequence count or its period)")                                         \
     X(stream_duplicate_expert, "expert.cycle_duplicate", PI_SEQUENCE, PI_NOTE,                              \
       "Message of the stream repeated (its sequence count did not advance)")
 

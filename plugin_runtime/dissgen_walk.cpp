@@ -714,7 +714,8 @@ void show_message_tail(dg_state *st, proto_tree *tree, gint offset, gboolean on_
         return;
     }
     proto_tree_add_expert_format(tree, st->pinfo, &st->p->ei->unused, st->tvb, offset, rest,
-                                 "%d bytes after the message's last field are not decoded", rest);
+                                 "%d byte%s after the message's last field %s not decoded", rest,
+                                 rest == 1 ? "" : "s", rest == 1 ? "is" : "are");
 }
 
 /* Key of the per-packet count of messages decoded (p_add_proto_data). */
