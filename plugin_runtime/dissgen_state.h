@@ -75,6 +75,7 @@ struct dg_state {
     gint packet_end;      /* captured bytes */
     gboolean stopped;     /* a malformed spot was reported: decode nothing more */
     gboolean faulted;     /* a malformed spot was reported in this message, even if decoding went on */
+    gboolean cut_shown;   /* the capture kept less than the frame had: shown once (capture_cut) */
     gboolean want_text;   /* summaries are shown: a visible tree, or columns */
     gboolean want_info;   /* the Info column is shown (pinfo->cinfo) */
     gboolean quiet;       /* no tree, no tap listener: step over quiet nodes (dg_node.quiet_size) */
@@ -124,6 +125,21 @@ extern const dg_expr_readers message_readers;
 /* Reports a malformed spot at `offset` (clamped into the packet) and stops decoding. */
 void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format, ...)
     G_GNUC_PRINTF(6, 7);
+
+/* Whether bytes needed up to needed_end are missing only because the capture
+ * kept less of the frame than was on the wire (a snapshot length): the data
+ * ran out at the captured end (data_end), and the frame's length on the wire
+ * reaches needed_end. Such a frame is not malformed. */
+static inline gboolean cut_by_capture(const dg_state *st, gint64 data_end, gint64 needed_end)
+{
+    const gint64 on_wire = (gint64)tvb_reported_length(st->tvb);
+    return data_end >= st->packet_end && st->packet_end < on_wire && needed_end <= on_wire;
+}
+
+/* Stops decoding where the captured bytes end, as Wireshark shows a frame cut
+ * by the snapshot length ("[Packet size limited during capture]", once per
+ * message): no expert info, the frame is not malformed. */
+void capture_cut(dg_state *st, proto_tree *tree);
 
 /* One instance of n (a leaf or a container) at *offset, before end; sink
  * gathers the Info column text of a repeated node's instances, or NULL. */
@@ -415,6 +431,10 @@ static inline __attribute__((always_inline)) gboolean group_read(dg_state *st, c
 {
     if (!(n->flags & DG_GROUP_FIRST)) return TRUE;
     if ((gint)n->length > end - offset) {
+        if (cut_by_capture(st, end, (gint64)offset + n->length)) {
+            capture_cut(st, tree);
+            return FALSE;
+        }
         report(st, tree, &st->p->ei->truncated, offset, -1, "Truncated: '%s' needs %u bytes, only %d left", n->name,
                n->length, end - offset);
         return FALSE;

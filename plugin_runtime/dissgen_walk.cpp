@@ -13,6 +13,7 @@
 #include "dissgen_state.h"
 
 #include <epan/proto_data.h>
+#include <epan/show_exception.h>
 #include <epan/tap.h>
 #include <wsutil/sign_ext.h>
 
@@ -38,6 +39,15 @@ void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint 
     char *text = wmem_strdup_vprintf(st->pinfo->pool, format, ap);
     va_end(ap);
     proto_tree_add_expert_format(tree, st->pinfo, ei, st->tvb, offset, length, "%s", text);
+}
+
+void capture_cut(dg_state *st, proto_tree *tree)
+{
+    st->stopped = TRUE;
+    st->faulted = TRUE; /* no "bytes not decoded" after it either */
+    if (st->cut_shown) return;
+    st->cut_shown = TRUE;
+    show_exception(st->tvb, st->pinfo, tree, BoundsError, NULL);
 }
 
 int hf_padding = -1;
@@ -114,7 +124,9 @@ void report_short_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint of
         proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, left, item_encoding(n));
         if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
     }
-    if (n->show == DG_SHOW_STRINGZ && n->length_kind == DG_LEN_CHILDREN)
+    if (cut_by_capture(st, (gint64)offset + left, (gint64)offset + length))
+        capture_cut(st, tree);
+    else if (n->show == DG_SHOW_STRINGZ && n->length_kind == DG_LEN_CHILDREN)
         report(st, tree, &st->p->ei->truncated, offset, left,
                "Truncated: '%s' has no NUL before the end of its data (%d bytes left)", n->name, left);
     else if (n->length_kind == DG_LEN_FIELD)
@@ -379,7 +391,9 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
 
     proto_item *item = NULL;
     proto_tree *subtree = open_container(st, n, tree, start, &item);
-    if (past_end)
+    if (past_end && cut_by_capture(st, end, start + length))
+        capture_cut(st, subtree);
+    else if (past_end)
         report(st, subtree, n->length_kind == DG_LEN_FIELD ? &st->p->ei->past_end : &st->p->ei->truncated, start,
                end - start, "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)",
                n->name, length, end - start);
@@ -441,6 +455,11 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     const guint32 outer_instance = st->instance;
     for (gint64 done = 0; wanted < 0 || done < wanted; done++) {
         if (wanted >= 0 && *offset >= end && !no_bytes) {
+            if (cut_by_capture(st, end, (gint64)end + 1)) {
+                capture_cut(st, tree);
+                st->stopped = FALSE; /* as below: siblings may still be empty-length */
+                break;
+            }
             report(st, tree, &st->p->ei->count_short, *offset, 0,
                    "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after %" G_GINT64_MODIFIER "d",
                    n->name, wanted, done);
@@ -457,6 +476,11 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
         if (n->repeat_slot >= 0) {
             const dg_slot *flag = &st->slots[n->repeat_slot];
             if (!st->present[n->repeat_slot] || flag->value == 0) break;
+            if (*offset >= end && cut_by_capture(st, end, (gint64)end + 1)) {
+                capture_cut(st, tree);
+                st->stopped = FALSE;
+                break;
+            }
             if (*offset >= end) {
                 report(st, tree, &st->p->ei->more_no_data, *offset, 0,
                        "'%s': the repeat flag '%s' says another follows, but no data is left", n->name,
@@ -502,7 +526,10 @@ void dissect_packed_bits(dg_state *st, const dg_node *n, proto_tree *tree, gint 
     st->instance = outer_instance;
     *offset += (gint)have;
     if (st->tap) tap_record(st, n, (guint64)instances);
-    if (instances < wanted) {
+    if (instances < wanted && cut_by_capture(st, *offset, (gint64)*offset + 1)) {
+        capture_cut(st, tree);
+        st->stopped = FALSE;
+    } else if (instances < wanted) {
         report(st, tree, &st->p->ei->count_short, *offset, 0,
                "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after %" G_GINT64_MODIFIER "d",
                n->name, wanted, instances);

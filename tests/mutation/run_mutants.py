@@ -160,6 +160,7 @@ TESTS = {
     "edges_message_tail": integration("test_edges.py", "TestEdges.test_bytes_after_the_message"),
     "edges_no_padding": integration("test_edges.py", "TestEdges.test_protocol_without_padding"),
     "malformed_skip": integration("test_malformed_skip.py"),
+    "snapshot_length": integration("test_snapshot_length.py"),
     "quiet": integration("test_quiet.py"),
     "live_capture": integration("test_live_capture.py"),
     "differential": integration("ecat_differential.py", "--frames", "2000", "--max-datagrams", "20",

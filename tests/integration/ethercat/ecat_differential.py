@@ -625,24 +625,33 @@ OUR_EXPERTS = ("truncated", "past_end", "more_no_data", "count_short", "bad_leng
 DG_FIXED = [("Command", 1), ("Index", 1)]
 
 
-def ours_shows(payload):
+def ours_shows(payload, on_wire=None):
     """What the bytes imply ecatr shows besides the field values, by rules/ethercat.xml and
     the runtime's rules (docs/manual.md): the number of ecatr.datagram items, the Info column, and
     the expert infos as (filter name, offset in the EtherCAT payload, message) in tree order,
     and the regions (start, end, container, ours stops inside) of datagram data where ours reports what the rules
     inside find (registers, mailboxes: the Wireshark comparison checks those; container None:
     a faulty mailbox, where ours stops with an expert info of its own), and the ecatr.padding
-    value (hex; "" when none): zeros after the datagrams, up to the header's Length."""
+    value (hex; "" when none): zeros after the datagrams, up to the header's Length.
+    on_wire: the payload's length on the wire, when the capture kept less (a snapshot length):
+    what runs out at the kept end but was on the wire is no expert info (docs/manual.md,
+    "Malformed packets"); decoding stops there."""
     experts, summaries, regions = [], [], []
     size = len(payload)
+
+    def cut(data_end, needed_end):
+        """The data ran out only because the capture kept less than the wire had."""
+        return on_wire is not None and data_end >= size and size < on_wire and needed_end <= on_wire
+
     if size < 2:
-        experts.append(("truncated", 0, "Truncated: 'Length' needs 2 bytes, only %d left" % size))
+        if not cut(size, 2):
+            experts.append(("truncated", 0, "Truncated: 'Length' needs 2 bytes, only %d left" % size))
         return 0, "EtherCAT", experts, regions, ""
     h = struct.unpack("<H", payload[:2])[0]
     length, ftype = h & 0x7FF, h >> 12
     name = "Datagrams" if ftype == 1 else "Payload"
     past_end = length > size - 2
-    if past_end:
+    if past_end and not cut(size, 2 + length):
         experts.append(("past_end", 2, "'%s' has length %d, past the end of its data (%d bytes left)"
                         % (name, length, size - 2)))
     if ftype != 1:
@@ -653,7 +662,8 @@ def ours_shows(payload):
     def leaf(what, n):
         nonlocal off, stopped
         if n > end - off:
-            experts.append(("truncated", off, "Truncated: '%s' needs %d bytes, only %d left" % (what, n, end - off)))
+            if not cut(end, off + n):
+                experts.append(("truncated", off, "Truncated: '%s' needs %d bytes, only %d left" % (what, n, end - off)))
             stopped = True
             return None
         v = payload[off:off + n]
@@ -692,8 +702,9 @@ def ours_shows(payload):
                 wkc = struct.unpack_from("<H", payload, off + dlen)[0] if dlen + 2 <= end - off else None
                 view = ours_view({"cmd": cmd, "len": dlen, "ado": ado, "wkc": wkc})
                 if dlen > end - off:
-                    experts.append(("past_end", off, "'%s' has length %d, past the end of its data (%d bytes left)"
-                                    % (DATA_CONTAINERS[view], dlen, end - off)))
+                    if not cut(end, off + dlen):
+                        experts.append(("past_end", off, "'%s' has length %d, past the end of its data (%d bytes left)"
+                                        % (DATA_CONTAINERS[view], dlen, end - off)))
                     regions.append((off, end, DATA_CONTAINERS[view], True))
                     stopped = True
                 else:
@@ -707,8 +718,9 @@ def ours_shows(payload):
         if stopped or not more:
             break
         if off >= end:
-            experts.append(("more_no_data", off, "'Datagram': the repeat flag 'More' says another follows, "
-                            "but no data is left"))
+            if not cut(end, end + 1):
+                experts.append(("more_no_data", off, "'Datagram': the repeat flag 'More' says another follows, "
+                                "but no data is left"))
             break
     padding = ""
     if not stopped and not past_end and off < end:
@@ -808,9 +820,9 @@ def info_agrees(got, implied):
     return rest == ""
 
 
-def compare_extras(num, payload, got):
+def compare_extras(num, payload, got, on_wire=None):
     """Problems of one frame: ecatr.datagram items, Info, padding, expert infos against ours_shows()."""
-    items, info, experts, regions, padding = ours_shows(payload)
+    items, info, experts, regions, padding = ours_shows(payload, on_wire)
     got = got or {"items": 0, "info": None, "padding": "", "experts": []}
     got_experts, problems = inside_data(got["experts"], regions)
     got = dict(got, experts=got_experts)
@@ -1032,7 +1044,8 @@ def compare_capture(packets, ours_text, ws_json, stats, label, truths=None, extr
         context = {"explained": set(), "header_length_why": header_length_why(payloads[num][0], expected[num])}
         probs = compare_frame(num, expected[num], models[num], ours.get(num), ws[num - 1], stats, context)
         if extras is not None:
-            probs += compare_extras(num, payloads[num][0], extras.get(num))
+            payload, pkt, orig, _encap = payloads[num]
+            probs += compare_extras(num, payload, extras.get(num), len(payload) + orig - len(pkt))
             stats.extras_frames += 1
             stats.extras_experts += len((extras.get(num) or {"experts": []})["experts"])
         if deep_ws is not None:

@@ -86,14 +86,19 @@ class Malformed(unittest.TestCase):
                 for orig in (len(whole), cut):   # snap-length truncation and a short frame
                     packets.append((whole[:cut], orig))
                     expected_cmds.append(["0x%02x" % d.cmd for d, s in zip(f.datagrams, starts) if s < cut])
-        rows = self.decode(packets, ["ecatr.datagram.cmd", "_ws.expert.message", "_ws.col.Protocol"])
-        for (data, _), row, cmds in zip(packets, rows, expected_cmds):
+        rows = self.decode(packets, ["ecatr.datagram.cmd", "_ws.expert.message", "_ws.col.Protocol", "_ws.short"])
+        for (data, orig), row, cmds in zip(packets, rows, expected_cmds):
             self.assertEqual(row[2], "ECATR")
             got = row[0].split("|") if row[0] else []
             self.assertEqual(got, cmds, "datagrams inside the cut must still be decoded (%d bytes)" % len(data))
-            if len(data) > 14:
-                self.assertTrue(any(w in row[1] for w in ("Truncated", "past the end")),
-                                "no expert info for a frame cut at %d bytes: %r" % (len(data), row[1]))
+            if len(data) > 14 and orig == len(data):  # that short on the wire: malformed
+                self.assertTrue(any(w in row[1] for w in ("Truncated", "past the end")) and not row[3],
+                                "no expert info for a frame of %d bytes: %r" % (len(data), row[1]))
+            elif len(data) > 14:  # whole on the wire, the capture kept less: not malformed
+                malformed = ("Truncated", "past the end", "no data is left", "should occur")
+                self.assertTrue(row[3] and not any(w in row[1] for w in malformed),
+                                "a frame cut by the capture at %d of %d bytes: "
+                                "expert %r, _ws.short %r" % (len(data), orig, row[1], row[3]))
 
     def test_length_fields_past_the_end(self):
         f = Frame([Datagram(cmd=4, data=b"\x01\x02", wkc=1)], header_length=2000 & 0x7FF, pad=False)
@@ -199,20 +204,26 @@ class Malformed(unittest.TestCase):
         self.assertEqual(nonzero, 2 * (2 + 1 + 16 + 15 + 14))
 
     def test_padding_cut_short_by_the_capture(self):
-        """Zeros the capture did not keep are not known to be zeros: a header Length past the
-        captured bytes is reported as before, with no padding item."""
+        """Zeros the capture did not keep are not known to be zeros: no padding item. The frame
+        had them on the wire (the capture kept less: a snapshot length), so it is not malformed:
+        Wireshark's "[Packet size limited during capture]" (_ws.short), no expert info; the same
+        bytes that short on the wire: the header Length runs past the end."""
         packets, cuts = [], []
         for declared in (14, 28):
             size = 13
             for cut in range(0, declared - size):
                 f = Frame([Datagram(cmd=4, idx=len(packets), data=b"\x01", wkc=1)], padding=bytes(declared - size),
                           truncate_to=2 + size + cut, pad=False)
-                packets.append(pcapgen.encode_frame(f))
+                data, orig = pcapgen.encode_frame(f)
+                packets += [(data, orig), (data, len(data))]
                 cuts.append((declared, size + cut))
-        rows = self.decode(packets, ["ecatr.datagram.cmd", "ecatr.padding", "_ws.expert.message"])
-        for row, (declared, left) in zip(rows, cuts):
-            self.assertEqual(row, ["0x04", "", "'Datagrams' has length %d, past the end of its data (%d bytes left)"
-                                   % (declared, left)])
+        rows = self.decode(packets, ["ecatr.datagram.cmd", "ecatr.padding", "_ws.expert.message", "_ws.short"])
+        for k, (declared, left) in enumerate(cuts):
+            cut_by_capture, short = rows[2 * k], rows[2 * k + 1]
+            self.assertEqual(cut_by_capture[:3], ["0x04", "", ""])
+            self.assertTrue(cut_by_capture[3].startswith("[Packet size limited during capture"), cut_by_capture)
+            self.assertEqual(short, ["0x04", "", "'Datagrams' has length %d, past the end of its data (%d bytes left)"
+                                     % (declared, left), ""])
 
     def test_over_a_hundred_empty_datagrams(self):
         f = Frame([Datagram(cmd=0, idx=i & 0xFF) for i in range(124)])

@@ -13,7 +13,9 @@ the bytes actually captured. The messages travel on
 the ethertype and on the UDP hook. Malformed messages (truncated, lengths past
 the end, negative lengths, short counts, repeat flags with nothing after
 them, containers not filled) must give our expert infos and what was decoded
-so far, and never a Wireshark exception.
+so far, and never a Wireshark exception; a message whole on the wire that the
+capture kept only in part (pcap caplen below its length) is not malformed:
+Wireshark's "[Packet size limited during capture]" item where its data runs out.
 
     test_everything.py --dissgen build/bin/dissgen --source-dir .  [--keep-pcap DIR]
 """
@@ -300,8 +302,10 @@ class Expected:
     bytes actually captured (`cut`), and collects what tshark must show: the tree,
     the expert messages and the Info column."""
 
-    def __init__(self, msg, cut=None):
+    def __init__(self, msg, cut=None, on_wire=None):
         self.buf = bytes(msg.data if cut is None else msg.data[:cut])
+        self.on_wire = on_wire  # the message's length on the wire, when the capture kept less
+        self.cut_shown = False
         self.stopped = False
         self.experts = []       # (field, message) in order
         self.info = []
@@ -336,7 +340,19 @@ class Expected:
         return ", ".join(self.info) if self.info else PROTO_NAME
 
     # -- decoding --------------------------------------------------------------
-    def expert(self, parent, kind, text, stop=True):
+    def expert(self, parent, kind, text, stop=True, data_end=None, needed=None):
+        """An expert info of ours; data_end, needed: where the data ran out and how far the
+        node needed it, for a shortfall: in a frame the capture kept only in part (a snapshot
+        length), one that the frame on the wire covers is Wireshark's "[Packet size limited
+        during capture]" item (once), no expert info (docs/manual.md, "Malformed packets")."""
+        if (data_end is not None and self.on_wire is not None and data_end >= len(self.buf) and
+                len(self.buf) < self.on_wire and needed <= self.on_wire):
+            if not self.cut_shown:
+                parent.children.append(Item("[Packet size limited during capture: %s truncated]" % PROTO.upper(),
+                                            "_ws.short"))
+                self.cut_shown = True
+            self.stopped = True
+            return
         severity, group = EXPERTS[kind]
         item = Item(text, "%s.expert.%s" % (PROTO, kind))
         info = Item("[Expert Info (%s/%s): %s]" % (severity, group, text))
@@ -368,7 +384,7 @@ class Expected:
             nbytes, first, last = n.group
             if first and nbytes > end - offset:
                 self.expert(parent, "truncated", "Truncated: '%s' needs %d bytes, only %d left"
-                            % (n.name, nbytes, end - offset))
+                            % (n.name, nbytes, end - offset), data_end=end, needed=offset + nbytes)
                 return offset
             parent.children.append(Item(n.label, n.field, n.fval))
             self.svals[id(n)] = n.sval
@@ -377,7 +393,7 @@ class Expected:
             length = n.end - n.start
             if length > end - offset:
                 self.expert(parent, "truncated", "Truncated: '%s' needs %d bytes, only %d left"
-                            % (n.name, length, end - offset))
+                            % (n.name, length, end - offset), data_end=end, needed=offset + length)
                 return offset
             parent.children.append(Item(n.label, n.field, n.fval))
             self.svals[id(n)] = n.sval
@@ -393,10 +409,10 @@ class Expected:
                 parent.children.append(self.blob_item(n, self.buf[offset:end]))
             if n.lenkind == "field":
                 self.expert(parent, "past_end", "'%s' has length %d, past the end of its data (%d bytes left)"
-                            % (n.name, length, left))
+                            % (n.name, length, left), data_end=end, needed=offset + length)
             else:
                 self.expert(parent, "truncated", "Truncated: '%s' needs %d bytes, only %d left"
-                            % (n.name, length, left))
+                            % (n.name, length, left), data_end=end, needed=offset + length)
             return offset
         data = self.buf[offset:offset + length]
         if data:
@@ -424,7 +440,8 @@ class Expected:
         parent.children.append(item)
         if past_end:
             self.expert(item, "past_end" if n.lenkind == "field" else "truncated",
-                        "'%s' has length %d, past the end of its data (%d bytes left)" % (n.name, length, end - start))
+                        "'%s' has length %d, past the end of its data (%d bytes left)" % (n.name, length, end - start),
+                        data_end=end, needed=start + length)
         was_stopped, self.stopped = self.stopped, False
         offset = self.node_list(n.children, item, offset, inner_end, in_summary or bool(n.pieces))
         self.stopped = self.stopped or was_stopped
@@ -451,7 +468,7 @@ class Expected:
         while r.mode == "repeat" or done < r.wanted:
             if r.mode == "count" and offset >= end:
                 self.expert(parent, "count_short", "'%s' should occur %d times, but the data ends after %d"
-                            % (r.name, r.wanted, done))
+                            % (r.name, r.wanted, done), data_end=end, needed=end + 1)
                 self.stopped = False
                 break
             inst = r.children[done]
@@ -465,7 +482,7 @@ class Expected:
                     break
                 if offset >= end:
                     self.expert(parent, "more_no_data", "'%s': the repeat flag '%s' says another follows, "
-                                "but no data is left" % (r.name, r.flag_name))
+                                "but no data is left" % (r.name, r.flag_name), data_end=end, needed=end + 1)
                     self.stopped = False
                     break
         if sink and len(sink) > 1:
@@ -746,7 +763,8 @@ class Case:
 
     def __init__(self, msg, cut=None, udp=False, short=False, note="valid"):
         self.msg, self.cut, self.udp, self.short, self.note = msg, cut, udp, short, note
-        self.expected = Expected(msg, cut)
+        # cut by the capture (not short): the whole message was on the wire
+        self.expected = Expected(msg, cut, None if cut is None or short else len(msg.data))
 
     def packet(self):
         frame = eth_frame(bytes(self.msg.data), self.udp)
@@ -785,7 +803,8 @@ def malformed_cases(g):
     def bad(note, cut_after=None, **kw):
         m = build_message(g, nsec=kw.pop("nsec", None), nrec=kw.pop("nrec", None), bad=kw)
         cut = m.runs[cut_after].end if cut_after else None
-        cases.append(Case(m, cut, udp=len(cases) % 2 == 1, note=note))
+        # cut after a run: that short on the wire (a capture's cut would be no fault of the message)
+        cases.append(Case(m, cut, udp=cut is None and len(cases) % 2 == 1, short=cut is not None, note=note))
 
     for total in (0, 1, 23):
         bad("Total length %d: Options length negative" % total, total=total)
@@ -980,8 +999,10 @@ class Everything(TsharkTestCase, unittest.TestCase):
             if got != "|".join(want):
                 bad.append("%s:\n  expected %r\n  got      %r" % (self.where(i), want, got))
             c = self.cases[i]
-            if not want and c.cut is not None and c.cut < c.msg.top.children[-1].start:
+            if not want and c.cut is not None and c.short and c.cut < c.msg.top.children[-1].start:
                 bad.append("%s: a message cut before its trailer without an expert info?" % self.where(i))
+            if c.cut is not None and not c.short and not c.expected.cut_shown and c.cut < c.msg.top.children[-1].start:
+                bad.append("%s: cut by the capture before its trailer, and not shown so?" % self.where(i))
         self.assertEqual(bad[:10], [], "%d packets differ" % len(bad))
         self.assertEqual(kinds, set(EXPERTS), "every expert info is exercised")
 

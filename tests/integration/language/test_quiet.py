@@ -50,9 +50,10 @@ def corpus_captures(kind):
 
 def padded_frames():
     """A 13-byte datagram inside a header Length of 14 or 28 bytes: the rest zeros (padding,
-    no expert info), or with a non-zero byte (the unused expert info, a warning), or cut
-    short by the capture inside the zeros (not known to be zero: the datagrams are past the
-    end, an error). -> [(frame, severity in the Expert column in one pass)], a second apart
+    no expert info), or with a non-zero byte (the unused expert info, a warning), or that
+    short on the wire inside the zeros (not known to be zero: the datagrams are past the
+    end, an error), or cut there by the capture only (not malformed: no expert info).
+    -> [(frame, severity in the Expert column in one pass)], a second apart
     from the rest of the capture and from one another (nothing pairs with them)."""
     frames = []
 
@@ -67,7 +68,8 @@ def padded_frames():
             padding = bytearray(size)
             padding[k] = 0x80
             frame(padding, "Warning")
-        frame(bytes(size), "Error", truncate_to=2 + 13 + size // 2, pad=False)
+        frame(bytes(size), "Error", truncate_to=2 + 13 + size // 2, truncate_mode="short", pad=False)
+        frame(bytes(size), "", truncate_to=2 + 13 + size // 2, truncate_mode="snap", pad=False)
     return frames
 
 
@@ -176,6 +178,18 @@ def everything_frames():
     import test_everything as m
     g = m.Gen(2024)
     return [c.packet() for c in m.valid_cases(g, 60) + m.malformed_cases(g)]
+
+
+def capture_cut_frames():
+    import test_snapshot_length as m
+    whole = m.message()
+    return ([(whole[:c], len(whole)) for c in range(m.HEADER + 1, len(whole))] +
+            [(whole[:c], c) for c in range(m.HEADER + 1, len(whole), 7)])
+
+
+def cycles_wrap_frames():
+    import test_rule_cycles as m
+    return [(frame, len(frame)) for _t, frame in m.sample_capture()]
 
 
 def layout_frames():
@@ -427,6 +441,8 @@ CAPTURES = {
     "tests/rules/learned_layout.xml": learned_layout_frames,
     "tests/rules/entry_list.xml": entry_list_frames,
     "tests/rules/goose.xml": goose_frames,
+    "tests/rules/capture_cut.xml": capture_cut_frames,
+    "tests/rules/cycles_wrap.xml": cycles_wrap_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,

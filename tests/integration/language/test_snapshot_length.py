@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Frames cut by the capture's snapshot length, with real tshark: tests/rules/capture_cut.xml.
+
+A message of 10 records (a Length, then a Body of that many bytes of 2-byte Words) and a
+4-byte Trailer, captured whole on the wire but kept only up to each byte in turn (pcap caplen
+below its length): the frame is not malformed, so as Wireshark shows it, it gets one
+"[Packet size limited during capture]" item (_ws.short) and no expert info, and every Word the
+capture kept is decoded. The control: the same bytes really that short on the wire (caplen =
+length) are malformed (an expert info, no _ws.short); and a Length that runs past even the
+frame's length on the wire stays an error in a cut frame. One pass and -2.
+
+    test_snapshot_length.py --dissgen build/bin/dissgen --source-dir .
+"""
+import os
+import struct
+import sys
+import unittest
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
+
+RECORDS = 10
+HEADER = 14  # Ethernet
+
+
+def message(lie=None):
+    """Count, then RECORDS records of two words (record 1's Length `lie` when given), a trailer."""
+    p = bytes([RECORDS])
+    for i in range(RECORDS):
+        p += bytes([lie if lie is not None and i == 1 else 4]) + struct.pack(">HH", 0x1000 + i, 0x2000 + i)
+    return b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01\x88\xb5" + p + b"\xde\xad\xbe\xef"
+
+
+def words_kept(caplen):
+    """The Words wholly inside the first caplen bytes, as tshark shows them."""
+    out = []
+    for i in range(RECORDS):
+        for k, value in enumerate((0x1000 + i, 0x2000 + i)):
+            if HEADER + 1 + 5 * i + 1 + 2 * k + 2 <= caplen:
+                out.append("0x%04x" % value)
+    return out
+
+
+def pcap(records):
+    """A microsecond pcap of (caplen, frame): each frame kept up to caplen."""
+    out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
+    for n, (caplen, frame) in enumerate(records):
+        out.append(struct.pack("<IIII", 1, n, caplen, len(frame)) + frame[:caplen])
+    return b"".join(out)
+
+
+class SnapshotLength(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "capture_cut.xml"), "cutt")
+        whole = message()
+        cls.cuts = list(range(HEADER + 1, len(whole)))            # cut by the capture at every byte
+        cls.short = [HEADER + 6, HEADER + 19, len(whole) - 3]     # really that short on the wire
+        records = [(c, whole) for c in cls.cuts] + [(c, whole[:c]) for c in cls.short]
+        records.append((HEADER + 16, message(lie=200)))           # Length 200: past the frame itself
+        cls.capture = cls.env.add_file("cut.pcap", pcap(records))
+
+    def test_cut_frames_are_not_malformed(self):
+        fields = ["frame.number", "frame.cap_len", "_ws.short", "_ws.expert.message", "cutt.record.body.word"]
+        with self.checks() as check:
+            for two_pass in (False, True):
+                how = "-2" if two_pass else "one pass"
+                rows = self.env.field_rows(self.capture, fields, two_pass=two_pass, aggregator="|")
+                check(len(rows) == len(self.cuts) + len(self.short) + 1, "%s: %d frames" % (how, len(rows)))
+                for n, caplen in enumerate(self.cuts, 1):
+                    r = rows[n]
+                    check(len(r["_ws.short"]) == 1 and not r["_ws.expert.message"],
+                          "%s frame %d (kept %d bytes): one _ws.short %s, no expert %s" % (
+                              how, n, caplen, r["_ws.short"], r["_ws.expert.message"]))
+                    check(r["cutt.record.body.word"] == words_kept(caplen),
+                          "%s frame %d: words %s, kept %s" % (how, n, r["cutt.record.body.word"], words_kept(caplen)))
+                for k, caplen in enumerate(self.short):
+                    r = rows[len(self.cuts) + 1 + k]
+                    check(r["_ws.expert.message"] and not r["_ws.short"],
+                          "%s: %d bytes on the wire are malformed: %s, short %s" % (
+                              how, caplen, r["_ws.expert.message"], r["_ws.short"]))
+                lie = rows[len(rows)]["_ws.expert.message"]
+                check(any("'Body' has length 200, past the end" in m for m in lie),
+                      "%s: a Length past the frame on the wire is an error in a cut frame: %s" % (how, lie))
+
+
+if __name__ == "__main__":
+    sys.exit(run_unittests()[1])
