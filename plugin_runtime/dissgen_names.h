@@ -70,7 +70,7 @@
     X(no_response_to, "no_response_to", FT_FRAMENUM, BASE_NONE, FRAMENUM_TYPE(FT_FRAMENUM_REQUEST),          \
       "No response to", "A request this message proves lost (its key reused, or its timeout passed)")     \
     X(no_request, "no_request", FT_NONE, BASE_NONE, NULL, "Request not captured",                           \
-      "A response whose request is not in the capture (it answers nothing)")
+      "A response whose request is not known: not captured, or given up as lost before it came")
 
 #define DG_PAIRING_EXPERTS(X)                                                                              \
     X(no_response, "expert.no_response", PI_SEQUENCE, PI_WARN, "No response seen")                          \
@@ -81,7 +81,7 @@
 
 #define DG_REQUEST_CONTEXT_EXPERTS(X)                                                                      \
     X(no_request_context, "expert.no_request_context", PI_SEQUENCE, PI_NOTE,                                \
-      "The request of this response is not in the capture: the values read from it are unknown")
+      "The request of this response is not known (not captured or given up as lost before it came): the values read from it are unknown")
 
 /* --- A protocol with <cycles> (dissgen_cycles.cpp) ------------------------- */
 

@@ -266,14 +266,14 @@ class TestRequestContext(TsharkTestCase, unittest.TestCase):
     def test_expert_text(self):
         out = self.env.tshark(["-r", self.orphan_path, "-V", "-c", "1"]).stdout
         with self.checks() as check:
-            check("The request of this response is not in the capture" in out,
+            check("The request of this response is not known (not captured or given up as lost before it came)" in out,
                   "the expert info says why the values are missing")
             # Where it sits: at the start of the message, covering no byte (the whole
             # message, not one of its fields, lacks its request).
             pdml = self.env.tshark(["-r", self.orphan_path, "-T", "pdml", "-c", "3"]).stdout
             starts = re.findall(r'<proto name="rqc"[^>]*\bpos="(\d+)"', pdml)
             experts = re.findall(r'<field name="_ws\.expert" showname="[^"]*The request of this response is not '
-                                 r'in the capture[^>]*>', pdml)
+                                 r'known[^>]*>', pdml)
             places = [(re.search(r'\bpos="(\d+)"', e).group(1), re.search(r'\bsize="(\d+)"', e).group(1))
                       for e in experts]
             check(len(starts) == 3 and places == [(p, "0") for p in starts],

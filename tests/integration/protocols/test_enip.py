@@ -912,8 +912,8 @@ class Services(unittest.TestCase):
         self.assertEqual(s["fields"], s["agree"])
 
 
-NO_REQUEST_NOTE = ("Expert Info (Note/Sequence): The request of this response is not in the capture: the values "
-                   "read from it are unknown")
+NO_REQUEST_NOTE = ("Expert Info (Note/Sequence): The request of this response is not known (not captured or given "
+                   "up as lost before it came): the values read from it are unknown")
 # The pairing's expert infos (requests and replies across frames), apart from the malformed ones.
 PAIRING_EXPERTS = ("enipr.expert.no_request_context", "enipr.expert.no_response", "enipr.expert.duplicate",
                    "enipr.expert.out_of_order")
