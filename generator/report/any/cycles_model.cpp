@@ -2,6 +2,7 @@
 #include "cycles_model.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "../../runtime_names.h"
 
@@ -121,6 +122,8 @@ void CyclesModelBuilder::add(const FieldRow& row) {
         return;
     model_.frames++;
     model_.duration = t;
+    if (frame >= frame_times_.size()) frame_times_.resize(frame + 1, std::nan(""));
+    frame_times_[frame] = t;
     // A message of no cycle (yet) has no P.cycle but may still show losses.
     if (!parse_uint(value(row, runtime_field::stream_cycle), cycle)) cycle = 0;
     if (cycle > 0) add_cycle_message(row, t, static_cast<unsigned>(cycle));
@@ -148,7 +151,9 @@ void CyclesModelBuilder::add_pairing(const FieldRow& row, double t) {
     if (parse_seconds_ns(value(row, runtime_field::time), rtt)) model_.round_trip.push_back({t, rtt});
     for (std::string_view request : split_values(value(row, runtime_field::no_response_to))) {
         uint64_t f = 0;
-        if (parse_uint(request, f)) model_.no_response.push_back({t, static_cast<uint32_t>(f), 0, 1});
+        if (!parse_uint(request, f)) continue;
+        const double sent = f < frame_times_.size() && !std::isnan(frame_times_[f]) ? frame_times_[f] : t;
+        model_.no_response.push_back({sent, static_cast<uint32_t>(f), 0, 1});
     }
 }
 

@@ -60,7 +60,7 @@ struct CyclesModel {
     std::vector<StreamEvent> lost;        // P.cycle.lost
     std::vector<StreamEvent> duplicates;  // P.cycle.duplicate
     std::vector<TimedValue> round_trip;   // P.time
-    std::vector<StreamEvent> no_response; // P.no_response_to
+    std::vector<StreamEvent> no_response; // P.no_response_to: the requests, when each was sent
     uint64_t messages_lost() const;
 };
 
@@ -93,6 +93,9 @@ private:
     FieldColumns columns_;
     CaptureClock clock_;
     StreamCycle* statistics_cycle_ = nullptr;  // the -z P,cycles block being read
+    // each frame's time (NaN: not one of the protocol's), so that a request
+    // proved unanswered is marked when it was sent, not when it was proved
+    std::vector<double> frame_times_;
 };
 
 }  // namespace dissgen

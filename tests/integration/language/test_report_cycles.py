@@ -23,6 +23,7 @@ cycles report, and:
   requests as the fields show them, no cycle section); an unknown one is one clear message.
 """
 
+import json
 import os
 import re
 import shutil
@@ -179,7 +180,8 @@ class TestReportCycles(TsharkTestCase, unittest.TestCase):
         try:
             rqc, pairing_page, _took = self.report(pairs, "pairing", extra=["--protocol", "rqc"], home=home)
             rqc_fields = subprocess.run(self.env.command(["-r", pairs, "-T", "fields", "-e", "rqc.time", "-e",
-                                                          "rqc.no_response_to"]),
+                                                          "rqc.no_response_to", "-e", "frame.number",
+                                                          "-e", "frame.time_relative"]),
                                         env=dict(self.env.env(), HOME=home), capture_output=True, text=True).stdout
             both, _page, _took = self.report(self.generated, "both", home=home)
             chosen, page, _took = self.report(self.generated, "chosen", extra=["--protocol", "enipr"], home=home)
@@ -200,6 +202,13 @@ class TestReportCycles(TsharkTestCase, unittest.TestCase):
                   (int(headline.group(1)), int(headline.group(2))) == (trips, unanswered) and unanswered > 0,
                   "--protocol rqc (pairing, no cycles): headline %s, the fields %d round trips, %d unanswered"
                   % (headline and headline.groups(), trips, unanswered))
+            # each unanswered request is marked when it was sent, not when a later message proved it
+            sent = {int(c[2]): float(c[3]) for c in (line.split("\t") for line in rqc_fields.splitlines())}
+            want = sorted(round(sent[int(f)], 6) for line in rqc_fields.splitlines()
+                          for f in (line.split("\t")[1].split(",") if line.split("\t")[1] else []))
+            data = json.loads(re.search(r'id="report-data">(.*?)</script>', pairing_page, re.S).group(1))
+            got = sorted(round(e[0], 6) for e in data["no_response"])
+            check(got == want, "the unanswered requests marked at their own times %s, sent at %s" % (got[:5], want[:5]))
             check('id="round-trip"' in pairing_page and 'id="cycles"' not in pairing_page and
                   'id="loss-events"' not in pairing_page, "pairing only: a round-trip chart, no cycles, no losses")
             check(unknown.returncode == 1 and "nosuch" in unknown.stderr,
