@@ -103,30 +103,39 @@ using namespace dg_rt;
 
 /* --- conditions (selected() in dissgen_state.h) -------------------------- */
 
-/* The value of the leaf a peek reads ahead, when its bytes are there. */
-gboolean dg_rt::peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guint64 *out)
+/* A peek's bytes up to needed_end lie past `limit`: DG_PEEK_CUT when only
+ * the capture's cut hides them (its list reaches the captured end, and the
+ * frame on the wire has them), else DG_PEEK_ABSENT. */
+static gint peek_missing(const dg_state *st, gint64 list_end, gint64 needed_end)
 {
-    if (pk->up > st->lists || st->lists - pk->up >= DG_MAX_LISTS) return FALSE;
+    return list_end >= st->packet_end && cut_by_capture(st, st->packet_end, needed_end) ? DG_PEEK_CUT
+                                                                                        : DG_PEEK_ABSENT;
+}
+
+/* The value of the leaf a peek reads ahead, when its bytes are there. */
+gint dg_rt::peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guint64 *out)
+{
+    if (pk->up > st->lists || st->lists - pk->up >= DG_MAX_LISTS) return DG_PEEK_ABSENT;
     gint64 at = (gint64)(pk->up ? st->list_starts[st->lists - pk->up] : node_start) + pk->offset;
     /* The leaf must lie inside the list it belongs to: bytes after a container's
      * end (padding, the next message) are not its value. */
     guint list = st->lists - 1 - pk->target_up;
-    gint64 limit = (pk->target_up < st->lists && list < DG_MAX_LISTS) ? MIN(st->list_ends[list], st->packet_end)
-                                                                       : st->packet_end;
+    gint64 list_end = (pk->target_up < st->lists && list < DG_MAX_LISTS) ? st->list_ends[list] : st->packet_end;
+    gint64 limit = MIN(list_end, st->packet_end);
     for (guint i = 0; i < pk->length_count; i++) {
         const dg_ref *ref = &st->p->peek_lengths[pk->length_first + i];
         const dg_slot *s = &st->slots[ref->slot];
-        if (!st->present[ref->slot]) return FALSE;
+        if (!st->present[ref->slot]) return DG_PEEK_ABSENT;
         gint64 v = ref_arith(s->value, ref);
-        if (v < 0) return FALSE;
+        if (v < 0) return DG_PEEK_ABSENT;
         at += v;
-        if (at > limit) return FALSE;
+        if (at > limit) return peek_missing(st, list_end, at);
     }
     const dg_node *t = &st->p->nodes[pk->target];
-    if (at + t->length > limit) return FALSE;
+    if (at + t->length > limit) return peek_missing(st, list_end, at + t->length);
     guint64 v = read_uint(st->tvb, (gint)at, t->length, encoding_of(t));
     *out = (t->flags & DG_GROUP) ? bit_field(v, t->shift, t->bits) : v;
-    return TRUE;
+    return DG_PEEK_VALUE;
 }
 
 namespace {
@@ -178,7 +187,10 @@ void dissect_place(dg_state *st, const dg_place *pl, proto_tree *tree, gint star
 {
     const dg_node *c = &st->p->nodes[pl->node];
     gboolean no_chain = FALSE;
-    if (!selected(st, st->p->conditions, c, start, &no_chain)) return;
+    if (!selected(st, st->p->conditions, c, start, &no_chain)) {
+        if (st->peek_cut) capture_cut(st, tree);
+        return;
+    }
     guint32 i = 0;
     if (pl->stride && base > pl->at) i = (guint32)MIN((base - pl->at + pl->stride - 1) / pl->stride, (guint64)pl->instances);
     for (; i < pl->instances && !st->stopped; i++) {

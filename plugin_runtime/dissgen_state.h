@@ -76,6 +76,7 @@ struct dg_state {
     gboolean stopped;     /* a malformed spot was reported: decode nothing more */
     gboolean faulted;     /* a malformed spot was reported in this message, even if decoding went on */
     gboolean cut_shown;   /* the capture kept less than the frame had: shown once (capture_cut) */
+    gboolean peek_cut;    /* a <when peek> read past the kept bytes: which alternative holds is not known */
     gboolean want_text;   /* summaries are shown: a visible tree, or columns */
     gboolean want_info;   /* the Info column is shown (pinfo->cinfo) */
     gboolean quiet;       /* no tree, no tap listener: step over quiet nodes (dg_node.quiet_size) */
@@ -175,7 +176,8 @@ void table_reset(dg_state *st, const dg_node *n, gint offset);
 
 /* The value of the leaf a <when peek> reads ahead from node_start, when its
  * bytes are there. */
-gboolean peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guint64 *out);
+enum { DG_PEEK_ABSENT = 0, DG_PEEK_VALUE = 1, DG_PEEK_CUT = -1 /* past the bytes the capture kept */ };
+gint peek_value(const dg_state *st, const dg_peek *pk, gint node_start, guint64 *out);
 
 /* A window's children, at addresses: dg_node.window. */
 void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary);
@@ -360,7 +362,7 @@ static inline __attribute__((always_inline)) gboolean condition_holds(const dg_s
 }
 
 /* Whether every <when> of n holds; node_start is where n would begin. */
-static inline __attribute__((always_inline)) gboolean whens_hold(const dg_state *st, const dg_conditions *c,
+static inline __attribute__((always_inline)) gboolean whens_hold(dg_state *st, const dg_conditions *c,
                                                                  const dg_node *n, gint node_start)
 {
     /* unrolled: with a constant node, each <when> folds to its comparisons */
@@ -369,7 +371,9 @@ static inline __attribute__((always_inline)) gboolean whens_hold(const dg_state 
         const dg_when *w = &c->whens[n->when_first + i];
         guint64 value;
         if (w->peek >= 0) {
-            if (!peek_value(st, &st->p->peeks[w->peek], node_start, &value)) return FALSE;
+            gint peeked = peek_value(st, &st->p->peeks[w->peek], node_start, &value);
+            if (G_UNLIKELY(peeked == DG_PEEK_CUT)) st->peek_cut = TRUE; /* undecidable: nothing after is known */
+            if (peeked != DG_PEEK_VALUE) return FALSE;
         } else {
             const dg_slot *s = &st->slots[w->slot];
             if (!st->present[w->slot]) return FALSE;
@@ -385,7 +389,7 @@ static inline __attribute__((always_inline)) gboolean whens_hold(const dg_state 
  * after it) was decoded; an otherwise node is skipped when one was. With a
  * constant node and constant conditions, as in compiled walks, only the tests
  * the node has are left, each its comparisons with constants. */
-static inline __attribute__((always_inline)) gboolean selected(const dg_state *st, const dg_conditions *c,
+static inline __attribute__((always_inline)) gboolean selected(dg_state *st, const dg_conditions *c,
                                                                const dg_node *n, gint offset, gboolean *chain_taken)
 {
     const guint8 direction = n->extra ? n->extra->direction : (guint8)DG_DIR_ANY;
@@ -511,6 +515,10 @@ static inline __attribute__((always_inline)) void dissect_child(dg_state *st, co
                                                                 gboolean in_summary, gboolean *chain_taken)
 {
     if (!selected(st, c, n, *offset, chain_taken)) {
+        if (G_UNLIKELY(st->peek_cut)) { /* which alternative holds is in bytes the capture did not keep */
+            capture_cut(st, tree);
+            return;
+        }
         if (n->flags & DG_GROUP) pass_bit_field(st, n, tree, offset, end); /* its bits stay in the group */
         return;
     }

@@ -701,7 +701,11 @@ def ours_shows(payload, on_wire=None):
             if not stopped:
                 wkc = struct.unpack_from("<H", payload, off + dlen)[0] if dlen + 2 <= end - off else None
                 view = ours_view({"cmd": cmd, "len": dlen, "ado": ado, "wkc": wkc})
-                if dlen > end - off:
+                if cmd in (1, 4, 7) and 1 <= dlen <= 2047 and wkc is None and cut(end, off + dlen + 2):
+                    # the rules' look-ahead at the working counter (a read answered or not) reads
+                    # bytes the capture did not keep: no alternative is taken, decoding stops
+                    stopped = True
+                elif dlen > end - off:
                     if not cut(end, off + dlen):
                         experts.append(("past_end", off, "'%s' has length %d, past the end of its data (%d bytes left)"
                                         % (DATA_CONTAINERS[view], dlen, end - off)))

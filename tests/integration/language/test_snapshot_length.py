@@ -2,11 +2,12 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Frames cut by the capture's snapshot length, with real tshark: tests/rules/capture_cut.xml.
 
-A message of 10 records (a Length, then a Body of that many bytes of 2-byte Words) and a
-4-byte Trailer, captured whole on the wire but kept only up to each byte in turn (pcap caplen
-below its length): the frame is not malformed, so as Wireshark shows it, it gets one
-"[Packet size limited during capture]" item (_ws.short) and no expert info, and every Word the
-capture kept is decoded. The control: the same bytes really that short on the wire (caplen =
+A message of 10 records (a Length, then a Body of that many bytes of 2-byte Words), a Status
+chosen by a look-ahead at the Trailer (else Other) and a 4-byte Trailer, captured whole on the
+wire but kept only up to each byte in turn (pcap caplen below its length): the frame is not
+malformed, so as Wireshark shows it, it gets one "[Packet size limited during capture]" item
+(_ws.short) and no expert info, every Word the capture kept is decoded, and neither Status nor
+Other (which one holds lies in the bytes not kept). The control: the same bytes really that short on the wire (caplen =
 length) are malformed (an expert info, no _ws.short); and a Length that runs past even the
 frame's length on the wire stays an error in a cut frame. One pass and -2.
 
@@ -30,7 +31,7 @@ def message(lie=None):
     p = bytes([RECORDS])
     for i in range(RECORDS):
         p += bytes([lie if lie is not None and i == 1 else 4]) + struct.pack(">HH", 0x1000 + i, 0x2000 + i)
-    return b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01\x88\xb5" + p + b"\xde\xad\xbe\xef"
+    return b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01\x88\xb5" + p + b"\x00\x07\xde\xad\xbe\xef"
 
 
 def words_kept(caplen):
@@ -60,15 +61,17 @@ class SnapshotLength(TsharkTestCase, unittest.TestCase):
         cls.short = [HEADER + 6, HEADER + 19, len(whole) - 3]     # really that short on the wire
         records = [(c, whole) for c in cls.cuts] + [(c, whole[:c]) for c in cls.short]
         records.append((HEADER + 16, message(lie=200)))           # Length 200: past the frame itself
+        records.append((len(whole), whole))                        # whole: the look-ahead sees the trailer
         cls.capture = cls.env.add_file("cut.pcap", pcap(records))
 
     def test_cut_frames_are_not_malformed(self):
-        fields = ["frame.number", "frame.cap_len", "_ws.short", "_ws.expert.message", "cutt.record.body.word"]
+        fields = ["frame.number", "frame.cap_len", "_ws.short", "_ws.expert.message", "cutt.record.body.word",
+                  "cutt.status", "cutt.other"]
         with self.checks() as check:
             for two_pass in (False, True):
                 how = "-2" if two_pass else "one pass"
                 rows = self.env.field_rows(self.capture, fields, two_pass=two_pass, aggregator="|")
-                check(len(rows) == len(self.cuts) + len(self.short) + 1, "%s: %d frames" % (how, len(rows)))
+                check(len(rows) == len(self.cuts) + len(self.short) + 2, "%s: %d frames" % (how, len(rows)))
                 for n, caplen in enumerate(self.cuts, 1):
                     r = rows[n]
                     check(len(r["_ws.short"]) == 1 and not r["_ws.expert.message"],
@@ -76,12 +79,21 @@ class SnapshotLength(TsharkTestCase, unittest.TestCase):
                               how, n, caplen, r["_ws.short"], r["_ws.expert.message"]))
                     check(r["cutt.record.body.word"] == words_kept(caplen),
                           "%s frame %d: words %s, kept %s" % (how, n, r["cutt.record.body.word"], words_kept(caplen)))
+                    check(not r["cutt.status"] and not r["cutt.other"],
+                          "%s frame %d: no alternative taken without the trailer: %s %s" % (
+                              how, n, r["cutt.status"], r["cutt.other"]))
                 for k, caplen in enumerate(self.short):
                     r = rows[len(self.cuts) + 1 + k]
                     check(r["_ws.expert.message"] and not r["_ws.short"],
                           "%s: %d bytes on the wire are malformed: %s, short %s" % (
                               how, caplen, r["_ws.expert.message"], r["_ws.short"]))
-                lie = rows[len(rows)]["_ws.expert.message"]
+                whole = rows[len(rows)]
+                check(whole["cutt.status"] == ["0x0007"] and not whole["cutt.other"] and not whole["_ws.short"] and
+                      not whole["_ws.expert.message"], "%s: the whole frame takes Status: %s" % (how, whole))
+                short_other = rows[len(self.cuts) + len(self.short)]
+                check(short_other["cutt.other"] == ["0x0007"], "%s: that short on the wire, the look-ahead "
+                      "fails and Other is taken: %s" % (how, short_other["cutt.other"]))
+                lie = rows[len(rows) - 1]["_ws.expert.message"]
                 check(any("'Body' has length 200, past the end" in m for m in lie),
                       "%s: a Length past the frame on the wire is an error in a cut frame: %s" % (how, lie))
 
