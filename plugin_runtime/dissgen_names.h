@@ -99,7 +99,7 @@
 
 #define DG_CYCLES_EXPERTS(X)                                                                               \
     X(stream_lost_expert, "expert.cycle_lost", PI_SEQUENCE, PI_WARN,                                        \
-      "Messages of the stream lost (a gap in its sequence count or its period)")                                         \
+      "Messages of the stream lost (a gap in its sequence count or its period)")                            \
     X(stream_duplicate_expert, "expert.cycle_duplicate", PI_SEQUENCE, PI_NOTE,                              \
       "Message of the stream repeated (its sequence count did not advance)")
 

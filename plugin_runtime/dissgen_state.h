@@ -142,6 +142,11 @@ static inline gboolean cut_by_capture(const dg_state *st, gint64 data_end, gint6
  * message): no expert info, the frame is not malformed. */
 void capture_cut(dg_state *st, proto_tree *tree);
 
+/* Data that ran out at data_end where a node needed it up to needed_end: the
+ * capture's cut (cut_by_capture) or a malformed spot reported as report() does. */
+void report_missing(dg_state *st, proto_tree *tree, expert_field *ei, gint64 data_end, gint64 needed_end, gint offset,
+                    gint length, const char *format, ...) G_GNUC_PRINTF(8, 9);
+
 /* One instance of n (a leaf or a container) at *offset, before end; sink
  * gathers the Info column text of a repeated node's instances, or NULL. */
 void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end,
@@ -435,12 +440,8 @@ static inline __attribute__((always_inline)) gboolean group_read(dg_state *st, c
 {
     if (!(n->flags & DG_GROUP_FIRST)) return TRUE;
     if ((gint)n->length > end - offset) {
-        if (cut_by_capture(st, end, (gint64)offset + n->length)) {
-            capture_cut(st, tree);
-            return FALSE;
-        }
-        report(st, tree, &st->p->ei->truncated, offset, -1, "Truncated: '%s' needs %u bytes, only %d left", n->name,
-               n->length, end - offset);
+        report_missing(st, tree, &st->p->ei->truncated, end, (gint64)offset + n->length, offset, -1,
+                       "Truncated: '%s' needs %u bytes, only %d left", n->name, n->length, end - offset);
         return FALSE;
     }
     st->group_value = read_uint(st->tvb, offset, n->length, encoding_of(n));

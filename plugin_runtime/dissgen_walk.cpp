@@ -21,7 +21,8 @@
 
 namespace dg_rt {
 
-void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format, ...)
+static void report_v(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format,
+                     va_list ap)
 {
     if (offset > st->packet_end) offset = st->packet_end;
     if (length < 0 || offset + length > st->packet_end) length = st->packet_end - offset;
@@ -34,11 +35,29 @@ void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint 
         proto_tree_add_expert(tree, st->pinfo, ei, st->tvb, offset, length);
         return;
     }
+    char *text = wmem_strdup_vprintf(st->pinfo->pool, format, ap);
+    proto_tree_add_expert_format(tree, st->pinfo, ei, st->tvb, offset, length, "%s", text);
+}
+
+void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format, ...)
+{
     va_list ap;
     va_start(ap, format);
-    char *text = wmem_strdup_vprintf(st->pinfo->pool, format, ap);
+    report_v(st, tree, ei, offset, length, format, ap);
     va_end(ap);
-    proto_tree_add_expert_format(tree, st->pinfo, ei, st->tvb, offset, length, "%s", text);
+}
+
+void report_missing(dg_state *st, proto_tree *tree, expert_field *ei, gint64 data_end, gint64 needed_end, gint offset,
+                    gint length, const char *format, ...)
+{
+    if (cut_by_capture(st, data_end, needed_end)) {
+        capture_cut(st, tree);
+        return;
+    }
+    va_list ap;
+    va_start(ap, format);
+    report_v(st, tree, ei, offset, length, format, ap);
+    va_end(ap);
 }
 
 void capture_cut(dg_state *st, proto_tree *tree)
@@ -124,18 +143,17 @@ void report_short_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint of
         proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, left, item_encoding(n));
         if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
     }
-    if (cut_by_capture(st, (gint64)offset + left, (gint64)offset + length))
-        capture_cut(st, tree);
-    else if (n->show == DG_SHOW_STRINGZ && n->length_kind == DG_LEN_CHILDREN)
-        report(st, tree, &st->p->ei->truncated, offset, left,
-               "Truncated: '%s' has no NUL before the end of its data (%d bytes left)", n->name, left);
+    const gint64 data_end = (gint64)offset + left, needed_end = (gint64)offset + length;
+    if (n->show == DG_SHOW_STRINGZ && n->length_kind == DG_LEN_CHILDREN)
+        report_missing(st, tree, &st->p->ei->truncated, data_end, needed_end, offset, left,
+                       "Truncated: '%s' has no NUL before the end of its data (%d bytes left)", n->name, left);
     else if (n->length_kind == DG_LEN_FIELD)
-        report(st, tree, &st->p->ei->past_end, offset, left,
-               "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)", n->name,
-               length, left);
+        report_missing(st, tree, &st->p->ei->past_end, data_end, needed_end, offset, left,
+                       "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)", n->name,
+                       length, left);
     else
-        report(st, tree, &st->p->ei->truncated, offset, left,
-               "Truncated: '%s' needs %" G_GINT64_MODIFIER "d bytes, only %d left", n->name, length, left);
+        report_missing(st, tree, &st->p->ei->truncated, data_end, needed_end, offset, left,
+                       "Truncated: '%s' needs %" G_GINT64_MODIFIER "d bytes, only %d left", n->name, length, left);
 }
 
 /* The `len` bytes of a leaf at offset, all there: its item and its value.
@@ -391,12 +409,11 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
 
     proto_item *item = NULL;
     proto_tree *subtree = open_container(st, n, tree, start, &item);
-    if (past_end && cut_by_capture(st, end, start + length))
-        capture_cut(st, subtree);
-    else if (past_end)
-        report(st, subtree, n->length_kind == DG_LEN_FIELD ? &st->p->ei->past_end : &st->p->ei->truncated, start,
-               end - start, "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)",
-               n->name, length, end - start);
+    if (past_end)
+        report_missing(st, subtree, n->length_kind == DG_LEN_FIELD ? &st->p->ei->past_end : &st->p->ei->truncated,
+                       end, start + length, start, end - start,
+                       "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)", n->name,
+                       length, end - start);
     /* Decode what is there even when the length overruns. */
     gboolean was_stopped = st->stopped;
     st->stopped = FALSE;
@@ -455,14 +472,9 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
     const guint32 outer_instance = st->instance;
     for (gint64 done = 0; wanted < 0 || done < wanted; done++) {
         if (wanted >= 0 && *offset >= end && !no_bytes) {
-            if (cut_by_capture(st, end, (gint64)end + 1)) {
-                capture_cut(st, tree);
-                st->stopped = FALSE; /* as below: siblings may still be empty-length */
-                break;
-            }
-            report(st, tree, &st->p->ei->count_short, *offset, 0,
-                   "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after %" G_GINT64_MODIFIER "d",
-                   n->name, wanted, done);
+            report_missing(st, tree, &st->p->ei->count_short, end, (gint64)end + 1, *offset, 0,
+                           "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after "
+                           "%" G_GINT64_MODIFIER "d", n->name, wanted, done);
             st->stopped = FALSE; /* the data simply ended: siblings may still be empty-length */
             break;
         }
@@ -476,15 +488,10 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
         if (n->repeat_slot >= 0) {
             const dg_slot *flag = &st->slots[n->repeat_slot];
             if (!st->present[n->repeat_slot] || flag->value == 0) break;
-            if (*offset >= end && cut_by_capture(st, end, (gint64)end + 1)) {
-                capture_cut(st, tree);
-                st->stopped = FALSE;
-                break;
-            }
             if (*offset >= end) {
-                report(st, tree, &st->p->ei->more_no_data, *offset, 0,
-                       "'%s': the repeat flag '%s' says another follows, but no data is left", n->name,
-                       flag->node->name);
+                report_missing(st, tree, &st->p->ei->more_no_data, end, (gint64)end + 1, *offset, 0,
+                               "'%s': the repeat flag '%s' says another follows, but no data is left", n->name,
+                               flag->node->name);
                 st->stopped = FALSE;
                 break;
             }
@@ -526,13 +533,10 @@ void dissect_packed_bits(dg_state *st, const dg_node *n, proto_tree *tree, gint 
     st->instance = outer_instance;
     *offset += (gint)have;
     if (st->tap) tap_record(st, n, (guint64)instances);
-    if (instances < wanted && cut_by_capture(st, *offset, (gint64)*offset + 1)) {
-        capture_cut(st, tree);
-        st->stopped = FALSE;
-    } else if (instances < wanted) {
-        report(st, tree, &st->p->ei->count_short, *offset, 0,
-               "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after %" G_GINT64_MODIFIER "d",
-               n->name, wanted, instances);
+    if (instances < wanted) {
+        report_missing(st, tree, &st->p->ei->count_short, *offset, (gint64)*offset + 1, *offset, 0,
+                       "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after %" G_GINT64_MODIFIER
+                       "d", n->name, wanted, instances);
         st->stopped = FALSE; /* the data simply ended, as for any repetition */
     }
 }

@@ -136,7 +136,8 @@ bool DesignReader::read(const xmlNode* root, Network& net) {
         for (const xmlAttr* a = c->properties; a; a = a->next) {
             std::string n = reinterpret_cast<const char*>(a->name);
             if (std::find(kSlaveAttributes.begin(), kSlaveAttributes.end(), n) != kSlaveAttributes.end()) continue;
-            diags_.error(xml_line(c), unknown_attribute(n, "slave", closest_match(n, kSlaveAttributes), kSlaveAttributes));
+            diags_.error(xml_line(c),
+                         unknown_attribute(n, "slave", closest_match(n, kSlaveAttributes), kSlaveAttributes));
             ok = false;
         }
         for (const xmlNode* inner = c->children; inner; inner = inner->next) {
