@@ -111,6 +111,12 @@ struct key_entry {
     nstime_t request_period;     /* between its last two requests; 0 until there are two */
 };
 
+/* An order scope's requests: how many were sent, and the highest of their
+ * numbers in it (dg_transaction.order_seq) answered so far. */
+struct order_count {
+    guint64 sent, answered;
+};
+
 struct capture_state {
     wmem_map_t *keys;            /* pair_key -> key_entry */
     key_entry *oldest, *newest;  /* key entries by their last message, least recent first */
@@ -119,11 +125,12 @@ struct capture_state {
     guint guessed;               /* of them, taken for requests for want of a better idea */
     guint64 requests;            /* the last request's seq */
     guint64 answered_max;        /* the highest seq answered so far, in any order scope */
-    /* Per order scope, the highest seq answered so far. A server answers a
-     * connection's requests in order, not those of other connections: the
-     * out-of-order note and overtaken requests go by the request's TCP or
-     * UDP conversation, or (scope 0) by the whole capture for a protocol
-     * right over a link layer, such as EtherCAT over Ethernet. */
+    /* Per order scope, its requests counted and the highest of their
+     * numbers answered so far (order_count). A server answers a connection's
+     * requests in order, not those of other connections: the out-of-order
+     * note and overtaken requests go by the request's TCP or UDP
+     * conversation, or (scope 0) by the whole capture for a protocol right
+     * over a link layer, such as EtherCAT over Ethernet. */
     wmem_array_t *scope_answered;
     guint32 last_frame;          /* the last message paired (its frame) */
     void *analysis;              /* the analysis's capture-wide state */
@@ -232,12 +239,12 @@ capture_state *current_capture(void)
     if (!capture) {
         capture = wmem_new0(wmem_file_scope(), capture_state);
         capture->keys = wmem_map_new(wmem_file_scope(), key_hash, key_equal);
-        capture->scope_answered = wmem_array_sized_new(wmem_file_scope(), sizeof(guint64), 4);
+        capture->scope_answered = wmem_array_sized_new(wmem_file_scope(), sizeof(order_count), 4);
         capture->table = wmem_array_new(wmem_file_scope(), sizeof(kept *));
         capture->lost_lists = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
         capture->long_trips = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
         capture->unanswered = wmem_array_new(wmem_file_scope(), sizeof(dg_transaction *));
-        guint64 none = 0;
+        order_count none = {0, 0};
         wmem_array_append_one(capture->scope_answered, none);
         if (analysis && analysis->capture_new) capture->analysis = analysis->capture_new(protocol);
     }
@@ -317,22 +324,32 @@ guint32 order_scope_of(capture_state *c, packet_info *pinfo)
     guint32 scope = GPOINTER_TO_UINT(conversation_get_proto_data(conv, *protocol->proto));
     if (scope) return scope;
     scope = wmem_array_get_count(c->scope_answered);
-    guint64 none = 0;
+    order_count none = {0, 0};
     wmem_array_append_one(c->scope_answered, none);
     conversation_add_proto_data(conv, *protocol->proto, GUINT_TO_POINTER(scope));
     return scope;
 }
 
-guint64 *answered_in(const capture_state *c, const dg_transaction *t)
+order_count *order_of(const capture_state *c, guint32 scope)
 {
-    return (guint64 *)wmem_array_index(c->scope_answered, t->order_scope);
+    return (order_count *)wmem_array_index(c->scope_answered, scope);
 }
 
+/* Puts a new request t in the order scope of its packet, numbered in it. */
+void place_in_order(capture_state *c, dg_transaction *t, packet_info *pinfo)
+{
+    t->order_scope = order_scope_of(c, pinfo);
+    t->order_seq = ++order_of(c, t->order_scope)->sent;
+}
+
+guint64 *answered_in(const capture_state *c, const dg_transaction *t) { return &order_of(c, t->order_scope)->answered; }
+
 /* More than `by` later requests of t's order scope were answered: t is overtaken
- * (never where responses come in any order). */
+ * (never where responses come in any order). Requests on other connections
+ * do not count: a busy session beside a slow one overtakes nothing. */
 gboolean overtaken(const capture_state *c, const dg_transaction *t, guint64 by)
 {
-    return protocol->pairing->ordered && *answered_in(c, t) > t->seq + by;
+    return protocol->pairing->ordered && *answered_in(c, t) > t->order_seq + by;
 }
 
 key_entry *entry_for(capture_state *c, const guint64 *keys, guint key_count)
@@ -762,8 +779,8 @@ void response_to(capture_state *c, dg_transaction *t, kept *request, const guint
         wmem_map_insert(c->long_trips, k, wmem_memdup(wmem_file_scope(), &ns, sizeof ns));
     }
     guint64 *answered = answered_in(c, t);
-    k->out_of_order = protocol->pairing->ordered && t->seq < *answered;
-    if (t->seq > *answered) *answered = t->seq;
+    k->out_of_order = protocol->pairing->ordered && t->order_seq < *answered;
+    if (t->order_seq > *answered) *answered = t->order_seq;
     if (t->seq > c->answered_max) c->answered_max = t->seq;
     if (analysis && analysis->compare && request_bytes) {
         tvbuff_t *bytes = tvb_new_real_data(request_bytes, request_length, (gint)request_length);
@@ -802,7 +819,7 @@ gboolean adopt_orphan(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, pa
     t->request_frame = e->last_frame;
     t->request_time = e->last_time;
     t->seq = ++c->requests;
-    t->order_scope = order_scope_of(c, pinfo);
+    place_in_order(c, t, pinfo);
     kept *request = e->last_record;
     request->role = DG_ROLE_REQUEST;
     response_to(c, t, request, e->last_bytes, e->last_length, e->last_view_count, k, tvb, pinfo);
@@ -820,7 +837,7 @@ dg_transaction *new_request(capture_state *c, key_entry *e, kept *k, tvbuff_t *t
     t->request_frame = pinfo->num;
     t->request_time = pinfo->abs_ts;
     t->seq = ++c->requests;
-    t->order_scope = order_scope_of(c, pinfo);
+    place_in_order(c, t, pinfo);
     k->role = DG_ROLE_REQUEST;
     set_unanswered(c, k, t);
     if (!nstime_is_zero(&e->last_request_time) && nstime_cmp(&pinfo->abs_ts, &e->last_request_time) > 0)

@@ -36,6 +36,7 @@ typedef struct dg_transaction {
     guint32 given_up_in;     /* no response: the frame that proved it (the key
                               * reused, the timeout passed); 0 while not known */
     guint32 order_scope;     /* the connection it was sent on (its order scope), 0 the capture's */
+    guint64 order_seq;       /* its number among that scope's requests, from 1 */
     const struct dg_request_values *values; /* request{...}: what the request kept, or NULL */
 } dg_transaction;
 

@@ -12,6 +12,8 @@ reported lost (with -2 on itself, in one pass on the request that proved it), an
 capture goes on for longer than the timeout after; one the capture ends exactly the timeout after
 is still in flight. A protocol whose only key is a computed value (its walk reads no byte)
 still tells a message sent again with other bytes from a duplicate by the message's bytes.
+A request overtaken by the answers to 16 later requests still waits, by 17 it is lost; only
+requests on its own connection count.
 Needs no corpus.
 """
 
@@ -53,9 +55,9 @@ PAIRS = {3: 2, 6: 5, 9: 8, 10: 7, 14: 13}
 LOST = {4: 5, 15: 17}  # lost request: the frame that proves it
 
 
-def frame(direction, transaction, unit, n):
+def frame(direction, transaction, unit, n, client_port=40000):
     payload = struct.pack(">HBBI", transaction, unit, 3, n)
-    sport, dport = (40000, PORT) if direction == "request" else (PORT, 40000)
+    sport, dport = (client_port, PORT) if direction == "request" else (PORT, client_port)
     src, dst = (CLIENT, SERVER) if direction == "request" else (SERVER, CLIENT)
     u = struct.pack("!HHHH", sport, dport, 8 + len(payload), 0) + payload
     ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src, dst)
@@ -75,8 +77,8 @@ def write_frames(path, frames):
 
 
 def write(path, messages=MESSAGES):
-    write_frames(path, [(ms, frame(direction, transaction, unit, n + 1))
-                        for n, (ms, direction, transaction, unit) in enumerate(messages)])
+    """messages: (ms, direction, transaction, unit[, the client's port: its connection])."""
+    write_frames(path, [(m[0], frame(m[1], m[2], m[3], n + 1, *m[4:])) for n, m in enumerate(messages)])
 
 
 def decode(env, path, two_pass):
@@ -184,6 +186,26 @@ class TestOvertaken(TsharkTestCase, unittest.TestCase):
                         check(answered == "" and lost == {proof}, "%s: overtaken by 17, frame 1 lost (noted on "
                               "frame %d), frame %d an orphan (request_in %r, lost %s)" % (
                                   mode, proof, last, answered, sorted(lost)))
+
+    def test_other_connections_overtake_nothing(self):
+        """Order is per connection: 20 exchanges on another client port, then one answered
+        on the request's own, overtake it once, not 21 times: its late response answers it
+        (out of order), and nothing is lost."""
+        messages = [(0, "request", 0x100, 1, 40001)]
+        for k in range(20):
+            messages += [(1 + 2 * k, "request", k + 1, 1, 40002), (2 + 2 * k, "response", k + 1, 1, 40002)]
+        messages += [(50, "request", 0x200, 1, 40001), (51, "response", 0x200, 1, 40001),
+                     (60, "response", 0x100, 1, 40001)]
+        path = self.env.path("other_connections.pcap")
+        write(path, messages)
+        last = len(messages)
+        with self.checks() as check:
+            for two_pass in (True, False):
+                rows = decode(self.env, path, two_pass)
+                lost = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
+                check(rows[last]["txnp.request_in"] == "1" and not lost,
+                      "%s: frame %d answers frame 1, nothing lost (request_in %r, lost %s)" % (
+                          "-2" if two_pass else "one pass", last, rows[last]["txnp.request_in"], sorted(lost)))
 
 
 class TestComputedKey(TsharkTestCase, unittest.TestCase):
