@@ -358,6 +358,7 @@ struct Cycles {
     std::vector<CycleField> only, never;   // conditions
     bool lost_by_period = false;           // lost="period": a cycle's gap of n periods is n - 1 lost
     int lost_line = 0;                     // the line of lost="sequence" (0: not given)
+    bool requests_only = false;            // requests="yes": only the pairing's requests, with round trips
 };
 
 struct Protocol {

@@ -59,7 +59,7 @@ const std::vector<std::string> kLearnKeyAttributes = {"value", "lookup"};
 const std::vector<std::string> kPairingAttributes = {"timeout", "analysis", "order"};
 const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kInputAttributes = {"name", "field"};
-const std::vector<std::string> kCyclesAttributes = {"window", "sender", "lost"};
+const std::vector<std::string> kCyclesAttributes = {"window", "sender", "lost", "requests"};
 const std::vector<std::string> kCycleFieldAttributes = {"field"};
 const std::vector<std::string> kSequenceAttributes = {"field", "bits", "step", "wrap"};
 const std::vector<std::string> kCycleTestAttributes = {"field", "in"};
@@ -296,6 +296,8 @@ private:
     bool parse_value_list(const std::string& text, int line, const std::string& attribute,
                           std::vector<ValueRange>& out);
     bool parse_byteorder(const std::string& text, int line, ByteOrder& out);
+    void parse_yes_no(std::map<std::string, std::string>& attrs, const char* name, int line, const std::string& of,
+                      const std::string& yes_means, bool& out);
     FieldRef make_ref(const std::string& text, int line, const std::string& attribute, bool arithmetic);
     void defer(FieldRef& ref, xmlNode* context, int line, const std::string& attribute);
     std::string nothing_selected_hint(const PendingRef& p);
@@ -371,6 +373,19 @@ void Parser::unexpected_child(xmlNode* child, const std::string& parent,
     else
         msg += "; expected <" + join(allowed, "> or <") + ">";
     diags_.error(line_of(child), msg);
+}
+
+// A yes/no attribute `name`, when given, into `out`; else `FILE:LINE: error:
+// bad NAME 'VALUE'OF: expected yes (YES_MEANS) or no`.
+void Parser::parse_yes_no(std::map<std::string, std::string>& attrs, const char* name, int line, const std::string& of,
+                          const std::string& yes_means, bool& out) {
+    if (!attrs.count(name)) return;
+    const std::string v = trim(attrs[name]);
+    if (v == "yes" || v == "no")
+        out = v == "yes";
+    else
+        diags_.error(line, std::string("bad ") + name + " '" + attrs[name] + "'" + of + ": expected yes (" + yes_means +
+                               ") or no");
 }
 
 bool Parser::parse_byteorder(const std::string& text, int line, ByteOrder& out) {
@@ -568,7 +583,7 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
         defer(input.field, el->parent, input.line, "field");
 }
 
-// Periodic traffic: <cycles window="8" sender="yes" lost="sequence|period"><signature field="XPATH"/>...
+// Periodic traffic: <cycles window="8" sender="yes" lost="sequence|period" requests="yes"><signature field="XPATH"/>...
 // [<sequence field="XPATH" bits="N"/>] [<only field="XPATH" in="LIST"/>]... [<never .../>]...</cycles>
 void Parser::parse_cycles(xmlNode* el, Protocol& proto) {
     int line = line_of(el);
@@ -590,14 +605,10 @@ void Parser::parse_cycles(xmlNode* el, Protocol& proto) {
         else
             cycles.window = static_cast<unsigned>(w);
     }
-    if (attrs.count("sender")) {
-        const std::string v = trim(attrs["sender"]);
-        if (v == "yes" || v == "no")
-            cycles.by_sender = v == "yes";
-        else
-            diags_.error(line, "bad sender '" + attrs["sender"] +
-                                   "': expected yes (the sender's address and port are part of the signature) or no");
-    }
+    parse_yes_no(attrs, "sender", line, "", "the sender's address and port are part of the signature",
+                 cycles.by_sender);
+    parse_yes_no(attrs, "requests", line, "", "only the <pairing>'s requests are timed, with their round trips",
+                 cycles.requests_only);
     if (attrs.count("lost")) {
         const std::string v = trim(attrs["lost"]);
         if (v == "period")
@@ -858,14 +869,7 @@ void Parser::parse_learn(xmlNode* el, Node& node) {
         l.condition.emplace();
         ok = parse_expression_attribute(l.condition_text, l.line, "if of " + what, *l.condition) && ok;
     }
-    if (attrs.count("sender")) {
-        const std::string v = trim(attrs["sender"]);
-        if (v == "yes" || v == "no")
-            l.sender = v == "yes";
-        else
-            diags_.error(l.line, "bad sender '" + attrs["sender"] + "' of " + what +
-                                     ": expected yes (the sender's address and port are a key too) or no");
-    }
+    parse_yes_no(attrs, "sender", l.line, " of " + what, "the sender's address and port are a key too", l.sender);
     for (xmlNode* c = el->children; c; c = c->next) {
         if (c->type != XML_ELEMENT_NODE || element_name(c) != "key") {
             unexpected_child(c, "learn", {"key"});

@@ -920,6 +920,9 @@ void Validator::check_cycles() {
         diags_.error(c.line, "<cycles> cannot be used with <pairing analysis=\"" DG_ANALYSIS_ETHERCAT_ESC
                              "\">, which finds EtherCAT's cycles itself (" +
                                  proto_.filter + ".cycle)");
+    if (c.requests_only && !proto_.pairing)
+        diags_.error(c.line, "requests=\"yes\" times the requests of a <pairing>, and this protocol has none: "
+                             "add <pairing> with the key fields that tie a response to its request");
     if (c.lost_by_period && c.sequence)
         diags_.error(c.line, "lost=\"period\" and the <sequence> count (line " + std::to_string(c.sequence->line) +
                                  ") would both tell the messages lost: a stream with a count is judged by its count; "

@@ -28,15 +28,27 @@
  *    periods and has a jitter: the period minus the cycle's nominal period,
  *    the median (the lower of the two middle values for an even count) of
  *    its regular periods so far, the window's and this one included.
+ *  - With requests="yes" only the pairing's requests are in streams, and a
+ *    period is regular only when the stream's previous request was answered
+ *    before this one was sent (not a retry after a timeout) and this one is
+ *    not a poll: sent less than that round trip after the answer (a master
+ *    asking again as soon as it has its answer, as while it waits for a
+ *    state). A response adds its round trip to its request's cycle; a
+ *    request of a cycle is unanswered when a later one of the cycle was
+ *    answered and it was not (those after the latest answered may still be
+ *    in flight at the capture's end).
  *
  * Memory: a record per message of a stream that shows something (its
  * cycle, a loss, a duplicate), in wmem_file_scope, and a pointer per frame
  * (the table of first messages' records); per cycle 8 bytes per regular
- * period (the running median and the figures of -z P,cycles).
+ * period (the running median and the figures of -z P,cycles) and, with
+ * requests="yes", 4 bytes per round trip and per stream its last
+ * pending_ring requests.
  */
 #include "dissgen_cycles.h"
 
 #include "dissgen_compat.h"
+#include "dissgen_pairing.h"
 #include "dissgen_periods.h"
 #include "dissgen_values.h"
 
@@ -60,6 +72,18 @@ using namespace dg_periods;
 const guint32 mark_key = 0x63790000u;
 
 struct cycle;
+struct stream;
+
+/* requests="yes": a stream's request not answered yet. Only a stream's last
+ * pending_ring requests are kept: an answer to an older one (a response
+ * after many timeouts) is not counted, and its request stays unanswered. */
+const guint pending_ring = 16;
+
+struct pending_request {
+    guint64 seq;        /* the pairing's number of the request (dg_transaction.seq); 0: a free slot */
+    guint32 ordinal;    /* its number among its cycle's messages, from 1; 0: sent before the cycle */
+    stream *s;
+};
 
 struct stream {
     guint32 hash;
@@ -77,6 +101,12 @@ struct stream {
     guint regular, next_slot;
     guint messages, lost, duplicates;
     cycle *cyc;
+    /* requests="yes": its latest request (the pairing's number), the latest
+     * answered, when that answer came and its round trip */
+    guint64 last_request, last_answered;
+    nstime_t last_return, last_rtt;
+    pending_request *pending;   /* a ring of pending_ring, from its first request */
+    guint next_pending;
 };
 
 struct cycle {
@@ -87,6 +117,9 @@ struct cycle {
     guint frames;            /* marked messages */
     guint32 first_frame;
     double jitter_sum, jitter_squares;
+    u32_vec rtts;            /* requests="yes": the round trips of its messages answered, ns */
+    guint answered;
+    guint32 latest_answered; /* the ordinal of the latest of its messages answered */
     cycle *next;
 };
 
@@ -109,6 +142,7 @@ struct capture_state {
     guint32 cycles;
     guint32 last_frame;     /* the last frame the first pass brought here */
     guint messages_timed;   /* and how many of its messages were timed */
+    wmem_map_t *pending;    /* requests="yes": a request's number -> its pending_request */
 };
 
 const dg_protocol *protocol;
@@ -239,10 +273,62 @@ gboolean sequence_step(stream *s, const dg_cycle_input *in, const dg_cycles *cy,
     return TRUE;
 }
 
+gpointer request_key(guint64 seq) { return GSIZE_TO_POINTER((gsize)seq); /* unique below 2^32 requests */ }
+
+/* requests="yes", first pass: a request of stream s, the cycle's message
+ * number `ordinal` (0: before the cycle), waits for its answer. */
+void request_sent(capture_state *c, stream *s, const dg_transaction *txn, guint32 ordinal)
+{
+    if (!c->pending) c->pending = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+    if (!s->pending) s->pending = wmem_alloc0_array(wmem_file_scope(), pending_request, pending_ring);
+    pending_request *r = &s->pending[s->next_pending];
+    s->next_pending = (s->next_pending + 1) % pending_ring;
+    if (r->seq) wmem_map_remove(c->pending, request_key(r->seq)); /* the oldest kept: given up */
+    r->seq = txn->seq;
+    r->ordinal = ordinal;
+    r->s = s;
+    wmem_map_insert(c->pending, request_key(txn->seq), r);
+    s->last_request = txn->seq;
+}
+
+/* requests="yes", first pass: a response answering `txn`. */
+void request_answered(capture_state *c, const dg_transaction *txn, const packet_info *pinfo)
+{
+    pending_request *r = c->pending ? (pending_request *)wmem_map_remove(c->pending, request_key(txn->seq)) : NULL;
+    if (!r) return; /* a request in no stream, or given up */
+    stream *s = r->s;
+    const guint32 ordinal = r->ordinal;
+    r->seq = 0;
+    if (txn->seq >= s->last_answered) {
+        s->last_answered = txn->seq;
+        s->last_return = pinfo->abs_ts;
+        s->last_rtt = txn->round_trip;
+    }
+    cycle *cy = s->cyc;
+    if (!cy || !ordinal) return;
+    cy->rtts.push(clamp_period(ns_of(&txn->round_trip)));
+    cy->answered++;
+    cy->latest_answered = MAX(cy->latest_answered, ordinal);
+}
+
+/* requests="yes": whether a request's period since the stream's previous
+ * request can be regular: that one was answered before this one was sent,
+ * and this one is no poll (sent less than that round trip after the answer). */
+gboolean answered_before(const stream *s, const packet_info *pinfo)
+{
+    if (!s->last_request || s->last_answered != s->last_request) return FALSE;
+    return ns_of(&pinfo->abs_ts) - ns_of(&s->last_return) >= ns_of(&s->last_rtt);
+}
+
 /* First pass: times the message in its stream; what it shows, or NULL. */
-mark *time_message(capture_state *c, const dg_cycle_input *in, const packet_info *pinfo)
+mark *time_message(capture_state *c, const dg_cycle_input *in, const dg_frame_pairing *fp, const packet_info *pinfo)
 {
     const dg_cycles *cy = protocol->cycles;
+    if (cy->requests_only) { /* only requests are timed; a response tells its request's stream */
+        if (!fp || !fp->txn) return NULL;
+        if (fp->role == DG_ROLE_RESPONSE) request_answered(c, fp->txn, pinfo);
+        if (fp->role != DG_ROLE_REQUEST) return NULL;
+    }
     const guint32 all_only = cy->only_count >= 32 ? G_MAXUINT32 : ((guint32)1 << cy->only_count) - 1;
     if (!in->count || in->never || (in->only_held & all_only) != all_only) return NULL;
     stream *s = stream_of(c, in, pinfo);
@@ -263,9 +349,10 @@ mark *time_message(capture_state *c, const dg_cycle_input *in, const packet_info
         m.lost = lost;
         s->lost += lost;
     }
+    const gboolean paired_regular = !cy->requests_only || answered_before(s, pinfo);
     s->last_frame = pinfo->num;
     s->last_time = pinfo->abs_ts;
-    const gboolean regular = !first && period > 0 && lost == 0;
+    const gboolean regular = !first && period > 0 && lost == 0 && paired_regular;
     if (!first && !s->cyc) {
         if (!regular) {
             s->regular = 0;
@@ -292,6 +379,7 @@ mark *time_message(capture_state *c, const dg_cycle_input *in, const packet_info
             cyc->jitter_squares += (double)m.jitter_ns * (double)m.jitter_ns;
         }
     }
+    if (cy->requests_only) request_sent(c, s, fp->txn, cyc ? cyc->frames : 0);
     if (!m.cycle && !m.lost) return NULL;
     return (mark *)wmem_memdup(wmem_file_scope(), &m, sizeof m);
 }
@@ -338,8 +426,9 @@ void show(const mark *m, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 /* A cycle's whole-capture figures, from the capture's state. */
 struct figures {
     guint32 nominal;
-    quantiles period;
+    quantiles period, rtt;
     double jitter_sd;
+    guint unanswered;       /* requests="yes" */
 };
 
 figures figures_of(const cycle *c)
@@ -354,6 +443,11 @@ figures figures_of(const cycle *c)
     double mean = n ? c->jitter_sum / n : 0;
     double var = n ? c->jitter_squares / n - mean * mean : 0;
     f.jitter_sd = var > 0 ? sqrt(var) : 0.0;
+    guint32 *rtts = g_new(guint32, c->rtts.n + 1);
+    if (c->rtts.n) memcpy(rtts, c->rtts.v, c->rtts.n * sizeof(guint32));
+    f.rtt = quantiles_of(rtts, c->rtts.n);
+    g_free(rtts);
+    f.unanswered = c->latest_answered - MIN(c->answered, c->latest_answered);
     return f;
 }
 
@@ -401,6 +495,11 @@ void cycles_draw(void *)
         printf("  jitter std dev (ns): %.1f\n", f.jitter_sd);
         if (losses_counted()) printf("  messages lost: %u\n", c->s->lost);
         if (duplicates_counted()) printf("  duplicates: %u\n", c->s->duplicates);
+        if (protocol->cycles->requests_only) {
+            print_quantiles("round trip", &f.rtt);
+            printf("  requests answered: %u\n", c->answered);
+            printf("  requests unanswered: %u\n", f.unanswered);
+        }
     }
     printf("===================================================================\n");
 }
@@ -433,6 +532,11 @@ tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *
         st_cycle_row(st, c->number, "jitter std dev (ns)", id, (guint64)(f.jitter_sd + 0.5));
         if (losses_counted()) st_cycle_row(st, c->number, "messages lost", id, c->s->lost);
         if (duplicates_counted()) st_cycle_row(st, c->number, "duplicates", id, c->s->duplicates);
+        if (protocol->cycles->requests_only) {
+            st_quantile_rows(st, c->number, "round trip", &f.rtt, id);
+            st_cycle_row(st, c->number, "requests answered", id, c->answered);
+            st_cycle_row(st, c->number, "requests unanswered", id, f.unanswered);
+        }
     }
     return TAP_PACKET_REDRAW;
 }
@@ -464,7 +568,7 @@ void dg_cycles_register(const dg_protocol *p)
 }
 
 void dg_cycles_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
-                       const dg_cycle_input *in, guint message)
+                       const dg_cycle_input *in, const dg_frame_pairing *fp, guint message)
 {
     const mark *m = NULL;
     capture_state *c = current_capture();
@@ -477,7 +581,7 @@ void dg_cycles_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, 
             c->messages_timed = 0;
         }
         c->messages_timed = MAX(c->messages_timed, message + 1);
-        m = in ? time_message(c, in, pinfo) : NULL;
+        m = in ? time_message(c, in, fp, pinfo) : NULL;
         if (m && message == 0)
             keep_first_mark(c, pinfo->num, m);
         else if (m)

@@ -32,7 +32,9 @@ void dg_cycles_register(const dg_protocol *p);
 
 /* After a message was decoded: on the first pass (`in` given) times it in
  * its stream; on every pass shows what was found in `tree` (the expert infos
- * also without a tree). `message`: its number within the frame (0 first). */
+ * also without a tree). `fp`: what the pairing found for the message (NULL
+ * without one), which requests="yes" reads. `message`: its number within the
+ * frame (0 first). */
 void dg_cycles_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
-                       const dg_cycle_input *in, guint message);
+                       const dg_cycle_input *in, const struct dg_frame_pairing *fp, guint message);
 }

@@ -125,6 +125,8 @@ struct capture_state {
     guint guessed;               /* of them, taken for requests for want of a better idea */
     guint64 requests;            /* the last request's seq */
     guint64 answered_max;        /* the highest seq answered so far, in any order scope */
+    const struct kept *just_answered; /* the latest response, and the seq it answered: */
+    guint64 just_answered_seq;        /* its view on the first pass says which request */
     /* Per order scope, its requests counted and the highest of their
      * numbers answered so far (order_count). A server answers a connection's
      * requests in order, not those of other connections: the out-of-order
@@ -782,6 +784,8 @@ void response_to(capture_state *c, dg_transaction *t, kept *request, const guint
     k->out_of_order = protocol->pairing->ordered && t->order_seq < *answered;
     if (t->order_seq > *answered) *answered = t->order_seq;
     if (t->seq > c->answered_max) c->answered_max = t->seq;
+    c->just_answered = k;
+    c->just_answered_seq = t->seq;
     if (analysis && analysis->compare && request_bytes) {
         tvbuff_t *bytes = tvb_new_real_data(request_bytes, request_length, (gint)request_length);
         const dg_view request_view = kept_view(request_bytes, request_length, request_view_count);
@@ -1138,6 +1142,7 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *, tvbuff_t *tvb, p
         fresh = first_pass(c, k, tvb, pinfo, keys, key_count, view, len, direction);
     }
     const dg_frame_pairing *fp = view_of(capture, k, pinfo, fresh);
+    if (!PINFO_FD_VISITED(pinfo) && fp->txn && k == capture->just_answered) fp->txn->seq = capture->just_answered_seq;
     show(fp, tvb, pinfo, tree);
     return fp;
 }

@@ -32,7 +32,8 @@ typedef struct dg_transaction {
     guint32 response_frame;  /* 0: no response seen */
     nstime_t request_time;   /* pinfo->abs_ts of the request */
     nstime_t round_trip;     /* response time - request time */
-    guint64 seq;             /* requests in capture order, from 1 */
+    guint64 seq;             /* requests in capture order, from 1; a response's view
+                              * has its request's on the first pass, 0 later */
     guint32 given_up_in;     /* no response: the frame that proved it (the key
                               * reused, the timeout passed); 0 while not known */
     guint32 order_scope;     /* the connection it was sent on (its order scope), 0 the capture's */

@@ -882,10 +882,11 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     walk_list(&st, p->top_walk, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
     show_message_tail(&st, subtree, offset, on_ethertype);
     proto_item_set_len(root, offset);
+    const dg_frame_pairing *fp = NULL;
     if (p->pairing) {
         if (st.request_pending) request_walked(&st);
         const dg_view view = {st.views, st.view_count};
-        const dg_frame_pairing *fp = dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count,
+        fp = dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count,
                                                         st.wants_view ? &view : NULL, offset, messages - 1,
                                                         st.direction);
         if (st.tap) st.tap->pairing = fp;
@@ -893,7 +894,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     }
 
     if (p->cycles) {
-        dg_cycles_dissect(p, tvb, pinfo, subtree, st.wants_cycles ? &st.cycle : NULL, messages - 1);
+        dg_cycles_dissect(p, tvb, pinfo, subtree, st.wants_cycles ? &st.cycle : NULL, fp, messages - 1);
     }
 
     if (st.tap) tap_queue_packet(stats_tap, pinfo, st.tap);

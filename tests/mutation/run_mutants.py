@@ -172,6 +172,7 @@ TESTS = {
     "learned_layout": integration("test_learned_layout.py"),
     "rule_findings": integration("test_rule_findings.py"),
     "rule_cycles": integration("test_rule_cycles.py"),
+    "polled_cycles": integration("test_polled_cycles.py"),
     "overlays": integration("test_overlays.py"),
     "request_context": integration("test_request_context.py"),
     "request_by_position": integration("test_request_context.py", "TestRequestByPosition"),

@@ -48,6 +48,11 @@ bool set_figure(StreamCycleFigures& f, std::string_view label, std::string_view 
     if (label == "jitter std dev (ns)") return (f.jitter_sd = std::string(text), true);
     if (label == "messages lost") return (f.counted = true) && parse_uint(text, f.lost, 10);
     if (label == "duplicates") return (f.duplicates_counted = true) && parse_uint(text, f.duplicates, 10);
+    if (label == "round trip") return (f.requests = true) && text == "none";
+    if (label == "round trip min/median/p99/max (ns)")
+        return (f.requests = true) && (f.has_round_trip = parse_quantiles(text, f.round_trip));
+    if (label == "requests answered") return (f.requests = true) && parse_uint(text, f.answered, 10);
+    if (label == "requests unanswered") return (f.requests = true) && parse_uint(text, f.unanswered, 10);
     return false;
 }
 

@@ -31,6 +31,10 @@ struct StreamCycleFigures {
     bool counted = false;          // losses are told (a sequence count, or lost="period"): lost is printed
     bool duplicates_counted = false;  // the stream has a sequence count: duplicates are printed
     uint64_t lost = 0, duplicates = 0;
+    bool requests = false;         // requests="yes": the round trips and answers are printed
+    bool has_round_trip = false;   // false: "round trip: none"
+    Quantiles round_trip;
+    uint64_t answered = 0, unanswered = 0;
 };
 
 struct StreamCycle {

@@ -67,35 +67,45 @@ def table(page, table_id):
     return [r for r in reader.rows if r]
 
 
+def stage_report(env, dissgen):
+    """(dissgen, reports folder) where the tshark user can run and write: dissgen runs
+    tshark itself, so it must run as that user, from a place that user can read."""
+    staged = env.path("dissgen")
+    shutil.copyfile(dissgen, staged)
+    os.chmod(staged, 0o755)
+    out = env.path("reports")
+    os.makedirs(out)
+    if env.as_nobody:
+        os.chown(out, NOBODY, NOBODY)
+    return staged, out
+
+
+def run_report(env, dissgen, out_dir, capture, name, extra=(), home=None):
+    """(completed process, page or "", seconds) of `dissgen report` as the tshark user."""
+    out = os.path.join(out_dir, name + ".html")
+    cmd = [dissgen, "report", capture, "-o", out] + list(extra)
+    if env.as_nobody:
+        cmd = ["setpriv", "--reuid=%d" % NOBODY, "--regid=%d" % NOBODY, "--clear-groups"] + cmd
+    environment = dict(env.env(), **({"HOME": home} if home else {}))
+    started = time.monotonic()
+    p = subprocess.run(cmd, env=environment, cwd=env.home, capture_output=True, text=True, timeout=1800)
+    took = time.monotonic() - started
+    page = ""
+    if p.returncode == 0:
+        with open(out, encoding="utf-8") as fh:
+            page = fh.read()
+    return p, page, took
+
+
 class TestReportCycles(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
         cls.install(os.path.join("rules", "enip.xml"), "enipr")
-        # dissgen runs tshark itself: it must run as the tshark user, from a place that user can read.
-        cls.dissgen = cls.env.path("dissgen")
-        shutil.copyfile(ARGS.dissgen, cls.dissgen)
-        os.chmod(cls.dissgen, 0o755)
-        cls.out = cls.env.path("reports")
-        os.makedirs(cls.out)
-        if cls.env.as_nobody:
-            os.chown(cls.out, NOBODY, NOBODY)
+        cls.dissgen, cls.out = stage_report(cls.env, ARGS.dissgen)
         cls.generated = cls.env.add_file("io_cycles.pcap", pcap_ns(generated_capture()))
 
     def report(self, capture, name, extra=(), home=None):
-        """(completed process, page or "", seconds) of `dissgen report` as the tshark user."""
-        out = os.path.join(self.out, name + ".html")
-        cmd = [self.dissgen, "report", capture, "-o", out] + list(extra)
-        if self.env.as_nobody:
-            cmd = ["setpriv", "--reuid=%d" % NOBODY, "--regid=%d" % NOBODY, "--clear-groups"] + cmd
-        environment = dict(self.env.env(), **({"HOME": home} if home else {}))
-        started = time.monotonic()
-        p = subprocess.run(cmd, env=environment, cwd=self.env.home, capture_output=True, text=True, timeout=1800)
-        took = time.monotonic() - started
-        page = ""
-        if p.returncode == 0:
-            with open(out, encoding="utf-8") as fh:
-                page = fh.read()
-        return p, page, took
+        return run_report(self.env, self.dissgen, self.out, capture, name, extra, home)
 
     def corpus_capture(self):
         path = os.path.abspath(os.path.join(ARGS.source_dir, CORPUS_CAPTURE))

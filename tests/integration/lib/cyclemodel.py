@@ -23,12 +23,14 @@ def clamp(ns):
 MAX_GAP_PERIODS = 16  # lost="period": a longer gap is a pause, nothing lost
 
 
-def model(messages, window, bits, step=1, lost_by_period=False, wrap=None):
+def model(messages, window, bits, step=1, lost_by_period=False, wrap=None, irregular=()):
     """messages: (frame, time ns, stream key, sequence count) in capture order; step: how
     much the count advances per message, 0 when learned from the stream (step="learned");
     lost_by_period: lost="period", a cycle's period of n whole nominal periods is n - 1 lost;
     wrap: wrap="N", the count runs 0 .. N - 1 (a count of N or more is no count, and the
-    next count is the stream's first again).
+    next count is the stream's first again); irregular: frames whose period cannot be regular
+    for a reason outside the stream's times and counts (requests="yes": the previous request
+    was not answered before, or this one is a poll).
     Returns ({frame: mark}, [cycle]) as the manual describes them."""
     mask = (1 << bits) - 1
     modulus = wrap or (1 << bits)
@@ -68,7 +70,7 @@ def model(messages, window, bits, step=1, lost_by_period=False, wrap=None):
                 lost = gap - 1
         s["lost"] += lost
         s["last_frame"], s["last_ts"] = frame, ts
-        regular = not first and period > 0 and lost == 0 and not back
+        regular = not first and period > 0 and lost == 0 and not back and frame not in irregular
         if not first and s["cycle"] is None:
             if not regular:
                 s["recent"] = []
@@ -95,11 +97,17 @@ def model(messages, window, bits, step=1, lost_by_period=False, wrap=None):
     return marks, cycles
 
 
+def quantiles(values):
+    """Minimum, lower median, nearest-rank 99th percentile and maximum; None for none."""
+    v = sorted(values)
+    n = len(v)
+    return (v[0], v[(n - 1) // 2], v[(99 * n + 99) // 100 - 1], v[-1]) if n else None
+
+
 def figures(c):
     """What -z enipr,cycles prints for cycle c."""
-    v = sorted(c["marked"])
-    n = len(v)
-    quant = (v[0], v[(n - 1) // 2], v[(99 * n + 99) // 100 - 1], v[-1]) if n else None
+    n = len(c["marked"])
+    quant = quantiles(c["marked"])
     total = squares = 0.0
     for j in c["jitters"]:
         total += float(j)
@@ -163,6 +171,12 @@ def parse_report(text):
             f["lost"] = int(value)
         elif what == "duplicates":
             f["duplicates"] = int(value)
+        elif what.startswith("round trip"):
+            f["round trip"] = None if value == "none" else tuple(int(x) for x in value.split())
+        elif what == "requests answered":
+            f["answered"] = int(value)
+        elif what == "requests unanswered":
+            f["unanswered"] = int(value)
     return cycles
 
 
