@@ -376,12 +376,13 @@ key_entry *entry_for(capture_state *c, const guint64 *keys, guint key_count)
  * response in between was lost). */
 gboolean within_copy_window(const key_entry *e, const nstime_t *then, const packet_info *pinfo)
 {
+    /* in whole nanoseconds: a copy exactly at the window's end is a copy */
     nstime_t gap;
     nstime_delta(&gap, &pinfo->abs_ts, then);
-    double window = protocol->pairing->timeout / 100;
-    double period = nstime_to_sec(&e->request_period);
+    gint64 window = (gint64)(protocol->pairing->timeout * 1e7 + 0.5); /* timeout / 100, in ns */
+    const gint64 period = (gint64)e->request_period.secs * 1000000000 + e->request_period.nsecs;
     if (period > 0 && period / 2 < window) window = period / 2;
-    return nstime_to_sec(&gap) <= window;
+    return (gint64)gap.secs * 1000000000 + gap.nsecs <= window;
 }
 
 /* The same bytes from the same source as the last message of this key, soon

@@ -211,11 +211,13 @@ class TestOvertaken(TsharkTestCase, unittest.TestCase):
 class TestComputedKey(TsharkTestCase, unittest.TestCase):
     """Keyed by a computed value alone, the walk decodes no byte of the message: whether a
     message from the same sender soon after is the same again (a duplicate) or a new request
-    is still told by all of its bytes, not by the none the walk read."""
+    is still told by all of its bytes, not by the none the walk read. A copy exactly a
+    hundredth of the timeout later is a duplicate, to the nanosecond (0.7 s / 100 is not 7 ms
+    in floating point)."""
 
     RULES = """<root name="Transactions Protocol" abbreviation="TXNP" byteorder="big">
   <hook table="udp.port" value="%d"/>
-  <pairing timeout="1"><key field="node[@name='Channel']"/></pairing>
+  <pairing timeout="0.7"><key field="node[@name='Channel']"/></pairing>
   <node name="Channel" value="7" displaytype="numberdec"/>
 </root>
 """ % PORT
@@ -225,7 +227,13 @@ class TestComputedKey(TsharkTestCase, unittest.TestCase):
                (2, "response", 3),  # 3: answers 2
                (100, "request", 4), # 4
                (101, "request", 4), # 5: the same bytes again at once: a duplicate of 4
-               (102, "response", 5)]  # 6: answers 4
+               (102, "response", 5),  # 6: answers 4
+               (200, "request", 6),   # 7
+               (207, "request", 6),   # 8: a hundredth of the timeout (7 ms) later, exactly: a duplicate of 7
+               (212, "response", 7),  # 9: answers 7
+               (300, "request", 8),   # 10: given up: 11 is the sender's next request
+               (308, "request", 8),   # 11: 8 ms later: the same bytes, a new request
+               (312, "response", 9)]  # 12: answers 11
 
     @classmethod
     def prepare(cls):
@@ -244,8 +252,8 @@ class TestComputedKey(TsharkTestCase, unittest.TestCase):
                 pairs = {n: int(r["txnp.request_in"][0]) for n, r in rows.items() if r["txnp.request_in"]}
                 duplicates = {n for n, r in rows.items() if r["txnp.expert.duplicate"]}
                 mode = "-2" if two_pass else "one pass"
-                check(pairs == {3: 2, 6: 4}, "%s: responses answer 2 and 4 (%s)" % (mode, pairs))
-                check(duplicates == {5}, "%s: only frame 5 is a duplicate (%s)" % (mode, sorted(duplicates)))
+                check(pairs == {3: 2, 6: 4, 9: 7, 12: 11}, "%s: responses answer 2, 4, 7 and 11 (%s)" % (mode, pairs))
+                check(duplicates == {5, 8}, "%s: only frames 5 and 8 are duplicates (%s)" % (mode, sorted(duplicates)))
 
 
 if __name__ == "__main__":
