@@ -192,6 +192,11 @@ def cycles_wrap_frames():
     return [(frame, len(frame)) for _t, frame in m.sample_capture()]
 
 
+def polled_cycles_frames():
+    import test_polled_cycles as m
+    return [(frame, len(frame)) for _t, frame in m.polled_capture()]
+
+
 def layout_frames():
     import test_layout as m
     out = []
@@ -443,6 +448,7 @@ CAPTURES = {
     "tests/rules/goose.xml": goose_frames,
     "tests/rules/capture_cut.xml": capture_cut_frames,
     "tests/rules/cycles_wrap.xml": cycles_wrap_frames,
+    "tests/rules/polled_cycles.xml": polled_cycles_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,
