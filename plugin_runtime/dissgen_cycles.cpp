@@ -435,18 +435,12 @@ figures figures_of(const cycle *c)
 {
     figures f = {};
     f.nominal = c->periods.median();
-    guint32 *v = g_new(guint32, c->marked.n + 1);
-    if (c->marked.n) memcpy(v, c->marked.v, c->marked.n * sizeof(guint32));
-    f.period = quantiles_of(v, c->marked.n);
-    g_free(v);
+    f.period = quantiles_of(c->marked);
     guint n = c->marked.n;
     double mean = n ? c->jitter_sum / n : 0;
     double var = n ? c->jitter_squares / n - mean * mean : 0;
     f.jitter_sd = var > 0 ? sqrt(var) : 0.0;
-    guint32 *rtts = g_new(guint32, c->rtts.n + 1);
-    if (c->rtts.n) memcpy(rtts, c->rtts.v, c->rtts.n * sizeof(guint32));
-    f.rtt = quantiles_of(rtts, c->rtts.n);
-    g_free(rtts);
+    f.rtt = quantiles_of(c->rtts);
     f.unanswered = c->latest_answered - MIN(c->answered, c->latest_answered);
     return f;
 }

@@ -24,6 +24,7 @@
  * Nothing here is touched on later passes.
  */
 #include "dissgen_pairing.h"
+#include "dissgen_periods.h"
 
 
 #include <epan/conversation.h>
@@ -380,9 +381,9 @@ gboolean within_copy_window(const key_entry *e, const nstime_t *then, const pack
     nstime_t gap;
     nstime_delta(&gap, &pinfo->abs_ts, then);
     gint64 window = (gint64)(protocol->pairing->timeout * 1e7 + 0.5); /* timeout / 100, in ns */
-    const gint64 period = (gint64)e->request_period.secs * 1000000000 + e->request_period.nsecs;
+    const gint64 period = dg_periods::ns_of(&e->request_period);
     if (period > 0 && period / 2 < window) window = period / 2;
-    return (gint64)gap.secs * 1000000000 + gap.nsecs <= window;
+    return dg_periods::ns_of(&gap) <= window;
 }
 
 /* The same bytes from the same source as the last message of this key, soon
@@ -774,7 +775,7 @@ void response_to(capture_state *c, dg_transaction *t, kept *request, const guint
     nstime_delta(&t->round_trip, &pinfo->abs_ts, &t->request_time);
     k->partner = t->request_frame;
     /* nstime_delta gives seconds and nanoseconds of one sign: exact both ways. */
-    gint64 ns = (gint64)t->round_trip.secs * 1000000000 + t->round_trip.nsecs;
+    gint64 ns = dg_periods::ns_of(&t->round_trip);
     if (ns > long_trip && ns <= G_MAXINT32) {
         k->round_trip = (gint32)ns;
     } else {

@@ -124,6 +124,16 @@ inline quantiles quantiles_of(guint32 *v, guint n)
     return q;
 }
 
+/* The quantiles of the values of v, left as they are (a sorted copy). */
+inline quantiles quantiles_of(const u32_vec &v)
+{
+    guint32 *copy = g_new(guint32, v.n + 1);
+    if (v.n) memcpy(copy, v.v, v.n * sizeof(guint32));
+    const quantiles q = quantiles_of(copy, v.n);
+    g_free(copy);
+    return q;
+}
+
 /* A period in ns as the 32 bits kept: 0 when time went backwards,
  * G_MAXUINT32 from 4.29 s up. */
 inline guint32 clamp_period(gint64 ns)

@@ -457,10 +457,7 @@ figures figures_of(const cycle *c)
     double mean = c->frames ? c->jitter_sum / c->frames : 0;
     double var = c->frames ? c->jitter_squares / c->frames - mean * mean : 0;
     f.jitter_sd = var > 0 ? sqrt(var) : 0.0;
-    guint32 *rtts = g_new(guint32, c->rtts.n + 1);
-    if (c->rtts.n) memcpy(rtts, c->rtts.v, c->rtts.n * sizeof(guint32));
-    f.rtt = quantiles_of(rtts, c->rtts.n);
-    g_free(rtts);
+    f.rtt = quantiles_of(c->rtts);
     guint unanswered = c->frames - c->answered;
     f.lost = unanswered - MIN(c->unanswered_tail, unanswered);
     return f;
