@@ -50,4 +50,13 @@ bool Node::is_numeric() const {
     return is_numeric_display(display) || display == Display::NonDisplay;
 }
 
+bool Node::is_compared_by_bytes() const {
+    if (!is_leaf() || is_computed() || is_numeric()) return false;
+    switch (display) {
+        case Display::String: case Display::StringZ: case Display::Origin: case Display::Address:
+        case Display::IPv4: case Display::Guid: case Display::NonDisplay: return true;
+        default: return false;
+    }
+}
+
 }  // namespace dissgen

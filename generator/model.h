@@ -278,6 +278,9 @@ struct Node {
     }
     // A leaf of 1-64 bits whose value other fields may refer to.
     bool is_numeric() const;
+    // A leaf read from bytes that are not a number (text, an address, a GUID,
+    // raw bytes): what <cycles> compares byte for byte in a signature.
+    bool is_compared_by_bytes() const;
     // How wide a numeric leaf's value is: its bits, or 64 for a computed
     // value and a number whose length comes from a field (read as 64-bit).
     unsigned value_bits() const { return has_fixed_length() ? static_cast<unsigned>(fixed_bits) : 64; }

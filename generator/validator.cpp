@@ -961,7 +961,14 @@ bool Validator::check_cycle_field(const CycleField& f, const char* element, int 
                                   std::map<const Node*, int>& seen) {
     Node* t = f.field.target;
     if (!t) return false;  // the parser reported the XPath
-    if (!t->is_numeric()) {
+    const bool signature = role == 1;
+    if (signature && !t->is_numeric() && !t->is_compared_by_bytes()) {
+        diags_.error(f.line, "signature field " + quote(*t) + at_line(*t) +
+                                 " cannot tell streams apart: a signature field is a number, an integer computed "
+                                 "value, or a leaf of text, an address, a GUID or bytes (compared byte for byte)");
+        return false;
+    }
+    if (!signature && !t->is_numeric()) {
         diags_.error(f.line, std::string(element) + " field " + quote(*t) + at_line(*t) +
                                  " is not numeric: <cycles> reads leaves of 1-64 bits shown as a number, bool, "
                                  "enum or nondisplay, or integer computed values");

@@ -5,7 +5,8 @@
  *  - A message belongs to a stream when it holds a value of the signature
  *    fields, every <only> test held and no <never> test did. Its stream is
  *    the signature's values in decoding order (and, with sender="yes", the
- *    sender's address and port).
+ *    sender's address and port); a field of text, an address or bytes is
+ *    compared by its bytes, which the stream keeps (its value is their hash).
  *  - With a sequence count of range R (2^bits, or wrap="R": 0 .. R - 1),
  *    from the stream's second message on, the step d = (count - previous
  *    count) mod R says: d = 0, the previous message again (a duplicate:
@@ -53,6 +54,7 @@
 #include "dissgen_values.h"
 
 #include <epan/addr_resolv.h>
+#include <epan/strutil.h>
 #include <epan/expert.h>
 #include <epan/to_str.h>
 #include <epan/proto_data.h>
@@ -90,6 +92,8 @@ struct stream {
     guint count;
     guint64 *values;
     guint16 *nodes;
+    const guint8 **bytes;   /* a text, address or bytes field's own bytes (NULL for a number) */
+    guint32 *lengths;
     address src;            /* sender="yes": the sender's address and port; AT_NONE otherwise */
     guint32 port;
     guint32 last_frame;     /* the stream's latest message that was not a duplicate; 0: none yet */
@@ -155,18 +159,27 @@ expert_field ei_stream_lost_expert = EI_INIT, ei_stream_duplicate_expert = EI_IN
 void capture_init(void) { capture = NULL; }
 void capture_cleanup(void) { capture = NULL; /* its memory goes with wmem_file_scope */ }
 
+/* Equal hashes, values and senders, and the same bytes in each field
+ * compared by its bytes (a value is only their hash). */
+gboolean same_stream(gconstpointer a, gconstpointer b)
+{
+    const stream *x = (const stream *)a, *y = (const stream *)b;
+    if (x->hash != y->hash || x->count != y->count || x->port != y->port || !addresses_equal(&x->src, &y->src) ||
+        memcmp(x->values, y->values, x->count * sizeof(guint64)) ||
+        memcmp(x->nodes, y->nodes, x->count * sizeof(guint16)))
+        return FALSE;
+    for (guint i = 0; i < x->count; i++)
+        if (x->bytes[i] && (x->lengths[i] != y->lengths[i] || memcmp(x->bytes[i], y->bytes[i], x->lengths[i])))
+            return FALSE;
+    return TRUE;
+}
+
 capture_state *current_capture(void)
 {
     if (!capture) {
         capture = wmem_new0(wmem_file_scope(), capture_state);
         capture->streams = wmem_map_new(wmem_file_scope(), [](gconstpointer p) { return ((const stream *)p)->hash; },
-                                        [](gconstpointer a, gconstpointer b) -> gboolean {
-                                            const stream *x = (const stream *)a, *y = (const stream *)b;
-                                            return x->hash == y->hash && x->count == y->count && x->port == y->port &&
-                                                   addresses_equal(&x->src, &y->src) &&
-                                                   !memcmp(x->values, y->values, x->count * sizeof(guint64)) &&
-                                                   !memcmp(x->nodes, y->nodes, x->count * sizeof(guint16));
-                                        });
+                                        same_stream);
     }
     return capture;
 }
@@ -177,6 +190,8 @@ stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info 
     probe.count = in->count;
     probe.values = (guint64 *)in->values;
     probe.nodes = (guint16 *)in->nodes;
+    probe.bytes = in->bytes;
+    probe.lengths = in->lengths;
     clear_address(&probe.src);
     probe.port = 0;
     if (protocol->cycles->by_sender) {
@@ -195,6 +210,15 @@ stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info 
     s->count = in->count;
     s->values = (guint64 *)wmem_memdup(wmem_file_scope(), in->values, in->count * sizeof(guint64));
     s->nodes = (guint16 *)wmem_memdup(wmem_file_scope(), in->nodes, in->count * sizeof(guint16));
+    s->lengths = (guint32 *)wmem_memdup(wmem_file_scope(), in->lengths, in->count * sizeof(guint32));
+    s->bytes = wmem_alloc0_array(wmem_file_scope(), const guint8 *, in->count);
+    for (guint i = 0; i < in->count; i++) {
+        if (!in->bytes[i]) continue;
+        guint8 *copy = (guint8 *)wmem_alloc(wmem_file_scope(), in->lengths[i] + 1); /* NUL-ended: text */
+        memcpy(copy, in->bytes[i], in->lengths[i]);
+        copy[in->lengths[i]] = 0;
+        s->bytes[i] = copy;
+    }
     copy_address_wmem(wmem_file_scope(), &s->src, &probe.src);
     s->port = probe.port;
     wmem_map_insert(c->streams, s, s);
@@ -445,6 +469,24 @@ figures figures_of(const cycle *c)
     return f;
 }
 
+/* A field compared by its bytes, as its item shows them: text in quotes
+ * up to its first NUL (non-printable characters escaped), an IPv4 address dotted, other bytes
+ * in hex separated by colons (a MAC address, a GUID, raw bytes). */
+void append_bytes(GString *t, const dg_node *n, const guint8 *b, guint32 length)
+{
+    if (n->show == DG_SHOW_STRING || n->show == DG_SHOW_STRINGZ) {
+        const guint8 *nul = (const guint8 *)memchr(b, 0, length); /* the text ends there, as its item shows it */
+        const guint32 text = nul ? (guint32)(nul - b) : length;
+        char *shown = format_text(NULL, b, text);
+        g_string_append_printf(t, "%s \"%s\"", n->name, shown);
+        wmem_free(NULL, shown);
+        return;
+    }
+    g_string_append_printf(t, "%s ", n->name);
+    for (guint32 i = 0; i < length; i++)
+        g_string_append_printf(t, n->show == DG_SHOW_IPV4 ? (i ? ".%u" : "%u") : (i ? ":%02x" : "%02x"), b[i]);
+}
+
 /* "Connection ID 0x00ff0001, sender 192.168.1.10:2222": each signature field
  * by its node's name and value as the stream first had them. */
 char *stream_text(const stream *s)
@@ -453,7 +495,9 @@ char *stream_text(const stream *s)
     for (guint i = 0; i < s->count; i++) {
         const dg_node *n = &protocol->nodes[s->nodes[i]];
         if (i) g_string_append(t, ", ");
-        if (n->show == DG_SHOW_DEC || n->show == DG_SHOW_INT)
+        if (s->bytes[i])
+            append_bytes(t, n, s->bytes[i], s->lengths[i]);
+        else if (n->show == DG_SHOW_DEC || n->show == DG_SHOW_INT)
             g_string_append_printf(t, "%s %" G_GUINT64_FORMAT, n->name, s->values[i]);
         else
             g_string_append_printf(t, "%s 0x%" G_GINT64_MODIFIER "x", n->name, s->values[i]);

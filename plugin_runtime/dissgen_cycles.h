@@ -17,6 +17,10 @@
 typedef struct dg_cycle_input {
     guint64 *values;           /* the signature fields' values, in decoding order */
     guint16 *nodes;            /* the node of each (dg_protocol.nodes), for the stream's name */
+    /* a text, address or bytes field's bytes, compared byte for byte (its
+     * value is their hash); NULL for a number */
+    const guint8 **bytes;
+    guint32 *lengths;
     guint count;
     guint64 sequence;
     gboolean has_sequence;

@@ -272,18 +272,39 @@ static inline void view_append(dg_state *st, const dg_node *n, guint64 value, gi
     v->instance = st->instance;
 }
 
+/* A signature field shown as text, an address or bytes: its bytes, in the
+ * packet's pool, and their hash for its value. NULL when the capture cut
+ * them short (the message then has no value for it). */
+static inline const guint8 *signature_bytes(dg_state *st, gint offset, gint length, guint64 *hash)
+{
+    if (length < 0 || !tvb_bytes_exist(st->tvb, offset, length)) return NULL;
+    const guint8 *b = length ? (const guint8 *)tvb_memdup(st->pinfo->pool, st->tvb, offset, length)
+                             : (const guint8 *)"";
+    guint64 h = 14695981039346656037ull ^ (guint64)length;
+    for (gint i = 0; i < length; i++) h = (h ^ b[i]) * 1099511628211ull;
+    *hash = h;
+    return b;
+}
+
 /* A leaf the cycle analysis reads (dg_extra.cycle_role), first pass. */
-static inline void cycle_record(dg_state *st, const dg_node *n, guint64 value)
+static inline void cycle_record(dg_state *st, const dg_node *n, guint64 value, gint offset, gint length)
 {
     const dg_extra *x = n->extra;
     dg_cycle_input *in = &st->cycle;
     if (x->cycle_role == DG_CYCLE_SIGNATURE) {
+        const guint8 *bytes = NULL;
+        if (!(n->flags & DG_NUMERIC) && !(bytes = signature_bytes(st, offset, length, &value))) return;
         if (in->count == st->cycle_capacity) {
             st->cycle_capacity = st->cycle_capacity ? 2 * st->cycle_capacity : 8;
-            in->values = (guint64 *)wmem_realloc(st->pinfo->pool, in->values, st->cycle_capacity * sizeof(guint64));
-            in->nodes = (guint16 *)wmem_realloc(st->pinfo->pool, in->nodes, st->cycle_capacity * sizeof(guint16));
+            const gsize c = st->cycle_capacity;
+            in->values = (guint64 *)wmem_realloc(st->pinfo->pool, in->values, c * sizeof(guint64));
+            in->nodes = (guint16 *)wmem_realloc(st->pinfo->pool, in->nodes, c * sizeof(guint16));
+            in->bytes = (const guint8 **)wmem_realloc(st->pinfo->pool, in->bytes, c * sizeof(const guint8 *));
+            in->lengths = (guint32 *)wmem_realloc(st->pinfo->pool, in->lengths, c * sizeof(guint32));
         }
         in->values[in->count] = value;
+        in->bytes[in->count] = bytes;
+        in->lengths[in->count] = bytes ? (guint32)length : 0;
         in->nodes[in->count++] = (guint16)(n - st->p->nodes);
         return;
     }
@@ -333,7 +354,7 @@ static inline __attribute__((always_inline)) void store(dg_state *st, const dg_n
     if (st->tap && n->show == DG_SHOW_ENUM) tap_record(st, n, value);
     if (n->flags & DG_KEY) key_append(st, value);
     if (is_view_input(st, n)) view_append(st, n, value, offset, length);
-    if (is_cycle_input(st, n)) cycle_record(st, n, value);
+    if (is_cycle_input(st, n)) cycle_record(st, n, value, offset, length);
     if (n->slot < 0) return;
     if (n->extra && n->extra->keep_values) table_append(st, n, value);
     if (n->extra && n->extra->keep_instances) table_put(st, n, value);

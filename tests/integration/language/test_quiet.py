@@ -192,6 +192,13 @@ def cycles_wrap_frames():
     return [(frame, len(frame)) for _t, frame in m.sample_capture()]
 
 
+def named_streams_frames():
+    """Its streams, then one message cut in its name, in its address and after it."""
+    import test_rule_cycles as m
+    whole = m.named_frame(b"PUMP-1", b"\x02\x00\x00\x00\x00\x01", 7)
+    return [(frame, len(frame)) for _t, frame in m.named_capture()] + [(whole[:c], len(whole)) for c in (18, 24, 27)]
+
+
 def polled_cycles_frames():
     import test_polled_cycles as m
     return [(frame, len(frame)) for _t, frame in m.polled_capture()]
@@ -449,6 +456,7 @@ CAPTURES = {
     "tests/rules/capture_cut.xml": capture_cut_frames,
     "tests/rules/cycles_wrap.xml": cycles_wrap_frames,
     "tests/rules/polled_cycles.xml": polled_cycles_frames,
+    "tests/rules/named_streams.xml": named_streams_frames,
     # QuietWalk: with Wireshark's own plugins, the samples and the corpus
     "rules/ethercat.xml": None,
     "rules/enip.xml": None,

@@ -210,6 +210,28 @@ class TestRuleCycles(TsharkTestCase, unittest.TestCase):
             self.assert_report(staged, cycles, check)
 
 
+def follows_the_model(env, check, capture, protocol, marks, cycles, names=None):
+    """In one pass and -2: each frame's marks and cycle expert infos are the model's, and
+    -z P,cycles lists the model's cycles with its figures (and `names`, when given)."""
+    for two_pass in (False, True):
+        how = "-2" if two_pass else "one pass"
+        rows = env.field_rows(capture, ["frame.number"] + mark_fields(protocol), two_pass=two_pass)
+        for frame, row in sorted(rows.items()):
+            got, want = mark_of(row, protocol), marks.get(frame, {})
+            check(got == want, "%s frame %d: %s, expected %s" % (how, frame, got, want))
+            for expert, key in (("cycle_lost", "lost"), ("cycle_duplicate", "duplicate")):
+                shown = row["%s.expert.%s" % (protocol, expert)]
+                check(bool(shown) == (key in want), "%s frame %d: %s expert %s" % (how, frame, expert, shown))
+        got = parse_report(env.tshark(["-r", capture, "-q", "-z", protocol + ",cycles"] +
+                                      (["-2"] if two_pass else [])).stdout)
+        if names is not None:
+            check([g["name"] for g in got] == names,
+                  "%s -z %s,cycles names %s, expected %s" % (how, protocol, [g["name"] for g in got], names))
+        check([g["figures"] for g in got] == [figures(c) for c in cycles],
+              "%s -z %s,cycles: %s, expected %s" % (how, protocol, [g["figures"] for g in got],
+                                                   [figures(c) for c in cycles]))
+
+
 # --- a count wrapping at the sample rate ----------------------------------------------
 
 SAMPLE_RATE = 4000  # tests/rules/cycles_wrap.xml: wrap="4000"
@@ -265,21 +287,75 @@ class CountWrappingAtTheSampleRate(TsharkTestCase, unittest.TestCase):
                   "the model: one lost at the wrap, three in a row")
             check(sum(1 for m in marks.values() if "duplicate" in m) == 1, "the model: one duplicate")
             check(len(cycles) == 2, "the model: two cycles")
-            for two_pass in (False, True):
-                how = "-2" if two_pass else "one pass"
-                rows = self.env.field_rows(self.capture, ["frame.number"] + mark_fields("samples"), two_pass=two_pass)
-                for frame, row in sorted(rows.items()):
-                    got, want = mark_of(row, "samples"), marks.get(frame, {})
-                    check(got == want, "%s frame %d: %s, expected %s" % (how, frame, got, want))
-                    check(bool(row["samples.expert.cycle_lost"]) == ("lost" in want),
-                          "%s frame %d: cycle_lost expert %s" % (how, frame, row["samples.expert.cycle_lost"]))
-                out = self.env.tshark(["-r", self.capture, "-q", "-z", "samples,cycles"] +
-                                      (["-2"] if two_pass else [])).stdout
-                got = parse_report(out)
-                check([g["figures"] for g in got] == [figures(c) for c in cycles],
-                      "%s -z samples,cycles: %s, expected %s" % (how, [g["figures"] for g in got],
-                                                             [figures(c) for c in cycles]))
+            follows_the_model(self.env, check, self.capture, "samples", marks, cycles)
 
+
+# --- streams named by text and addresses ----------------------------------------------
+
+def named_frame(name, station, count):
+    """A frame of tests/rules/named_streams.xml."""
+    return (b"\x01\x0c\xcd\x04\x00\x02" + station + b"\x88\xb6" + bytes([len(name)]) + name + station +
+            struct.pack(">Hh", count & 0xFFFF, -1))
+
+
+NAMED_STREAMS = [
+    # name, station, period, start, messages, first count, dropped, repeated
+    (b"PUMP-1", b"\x02\x00\x00\x00\x00\x01", 1_000_000, 0, 40, 65530, {12}, {20}),
+    (b"PUMP-2", b"\x02\x00\x00\x00\x00\x01", 2_000_000, 300_000, 30, 0, set(), set()),
+    (b"PUMP-1", b"\x02\x00\x00\x00\x00\x02", 1_000_000, 500_000, 40, 9, {30, 31}, set()),  # another station
+    (b"PUMP-10", b"\x02\x00\x00\x00\x00\x01", 4_000_000, 100_000, 15, 100, set(), set()),  # a longer name
+    (b"", b"\x02\x00\x00\x00\x00\x03", 3_000_000, 0, 20, 5, set(), set()),  # no name at all
+    (b"TANK\x07", b"\x02\x00\x00\x00\x00\x01", 2_500_000, 0, 20, 0, set(), set()),  # a control character
+]
+
+
+def named_capture(seed=61850):
+    rng = random.Random(seed)
+    packets = []
+    for name, station, period, start, count, first, dropped, repeated in NAMED_STREAMS:
+        for k in range(count):
+            if k in dropped:
+                continue
+            t = 10**9 + start + k * period + rng.randint(-5000, 5000)
+            frame = named_frame(name, station, first + k)
+            packets.append((t, frame))
+            if k in repeated:
+                packets.append((t + 7_777, frame))
+    packets.sort(key=lambda p: p[0])
+    return packets
+
+
+def wireshark_text(name):
+    """A name as Wireshark's format_text() shows it: printable ASCII as is, a control
+    character by its C escape."""
+    escapes = {7: "\\a", 8: "\\b", 9: "\\t", 10: "\\n", 11: "\\v", 12: "\\f", 13: "\\r"}
+    return "".join(chr(b) if 32 <= b < 127 else escapes.get(b, "\\%03o" % b) for b in name)
+
+
+class StreamsNamedByText(TsharkTestCase, unittest.TestCase):
+    """Signature fields of text and addresses are compared byte for byte ("PUMP-1" is not
+    "PUMP-10", nor "PUMP-1" from another station) and named in -z as their items show
+    them; marks, losses and duplicates follow the model in one pass and -2."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "named_streams.xml"), "named")
+        cls.packets = named_capture()
+        cls.capture = cls.env.add_file("named.pcap", pcap_ns(cls.packets))
+
+    def test_streams_by_their_bytes(self):
+        messages = []
+        for frame, (t, data) in enumerate(self.packets, 1):
+            size = data[14]
+            name, station = data[15:15 + size], data[15 + size:21 + size]
+            messages.append((frame, t, (name, station), struct.unpack(">H", data[21 + size:23 + size])[0]))
+        marks, cycles = model(messages, window=8, bits=16)
+        with self.checks() as check:
+            check(len(cycles) == len(NAMED_STREAMS), "the model: a cycle per stream, %d" % len(cycles))
+            names = ['Name "%s", Station %s' % (wireshark_text(c["stream"]["key"][0]),
+                                                 ":".join("%02x" % b for b in c["stream"]["key"][1]))
+                     for c in cycles]
+            follows_the_model(self.env, check, self.capture, "named", marks, cycles, names)
 
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])
