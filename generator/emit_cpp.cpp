@@ -412,6 +412,7 @@ private:
     std::string protocol_row() const;
     void request_context();
     void cycles_tables();
+    void request_role();
     std::string extra_row(const Node& n) const;
     void condition_and_window_tables();
     void learn_tables();
@@ -752,9 +753,11 @@ void Emitter::protocol_struct() {
             o_ << "/* The " << c_string(analysis->name) << " analysis, compiled in from the runtime. */\n"
                << "extern \"C\" const struct dg_analysis " << analysis->symbol << ";\n";
         const size_t places = input_places();
+        if (p_.pairing->request) request_role();
         o_ << "static const dg_pairing " << f << "_pairing = { " << timeout << ", "
            << (analysis ? "&" + analysis->symbol : std::string("NULL")) << ", " << (p_.pairing->ordered ? 1 : 0)
-           << ", " << (places ? f + "_input_places" : std::string("NULL")) << ", " << places << " };\n";
+           << ", " << (places ? f + "_input_places" : std::string("NULL")) << ", " << places
+           << (p_.pairing->request ? ", &" + f + "_request_role" : std::string()) << " };\n";
         if (!p_.request_fields.empty()) request_context();
     }
     if (p_.cycles) cycles_tables();
@@ -840,6 +843,19 @@ void Emitter::cycles_tables() {
        << (tests.empty() ? std::string("NULL") : f + "_cycle_tests") << ", "
        << (tests.empty() ? std::string("NULL") : f + "_cycle_ranges") << ", " << c.sequence_step << "u, "
        << (c.lost_by_period ? 1 : 0) << ", " << c.sequence_wrap << "u, " << (c.requests_only ? 1 : 0) << " };\n";
+}
+
+// <request>: the field's slot and the values that make a message a request.
+void Emitter::request_role() {
+    const std::string& f = p_.filter;
+    const CycleField& r = *p_.pairing->request;
+    std::vector<std::string> ranges;
+    if (r.in_list.empty()) ranges.push_back("{ " + hex(1) + ", " + hex(UINT64_MAX) + " }");
+    for (const ValueRange& v : r.in_list) ranges.push_back("{ " + hex(v.low) + ", " + hex(v.high) + " }");
+    o_ << "/* <request>, line " << r.line << ": a message whose " << c_string(r.field.target->name)
+       << " is one of these is a request, any other value a response. */\n"
+       << c_array("static const dg_range " + f + "_request_ranges", ranges) << "static const dg_request_role " << f
+       << "_request_role = { " << r.field.target->slot << ", " << ranges.size() << ", " << f << "_request_ranges };\n";
 }
 
 // request{...}: the key fields where a response reads them before it is

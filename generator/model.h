@@ -323,6 +323,14 @@ struct AnalysisInput {
     int index = -1;
 };
 
+// A field <cycles> reads (<signature>, <sequence>, <only> or <never>), or
+// <pairing>'s <request>: a field, and the values that hold.
+struct CycleField {
+    FieldRef field;
+    std::vector<ValueRange> in_list;  // <only>/<never>: the values that hold (none given: not 0)
+    int line = 0;
+};
+
 struct Pairing {
     int line = 0;
     std::vector<PairingKey> keys;
@@ -337,15 +345,12 @@ struct Pairing {
     // with the key values the walk decoded before its first request{...}
     bool keys_decoded = false;
     std::string analysis;   // "" or the name of a protocol analysis (analyses.h)
+    // <request field="XPATH" in="LIST"/>: the message says which it is (its
+    // value in the list: a request; decoded and not in it: a response)
+    std::optional<CycleField> request;
 };
 
 // --- periodic traffic (<cycles> in <root>) ---
-// A field <cycles> reads: <signature>, <sequence>, <only> or <never>.
-struct CycleField {
-    FieldRef field;
-    std::vector<ValueRange> in_list;  // <only>/<never>: the values that hold (none given: not 0)
-    int line = 0;
-};
 
 // Messages with the same signature values (and sender) are a stream; a
 // stream whose messages come at a regular period is a cycle.

@@ -501,7 +501,8 @@ void Parser::parse_heuristic(xmlNode* el, Protocol& proto) {
     proto.heuristics.push_back(h);
 }
 
-// Request/response pairing: <pairing timeout="0.1" analysis="ethercat-esc"><key field="XPATH"/>...</pairing>
+// Request/response pairing: <pairing timeout="0.1" analysis="ethercat-esc"><key field="XPATH"/>...
+// [<request field="XPATH" in="LIST"/>]</pairing>
 void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
     int line = line_of(el);
     if (proto.pairing) {
@@ -541,12 +542,21 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
     }
     std::vector<xmlNode*> key_elements, input_elements;
     for (xmlNode* c = el->children; c; c = c->next) {
-        if (c->type == XML_ELEMENT_NODE && element_name(c) == "key")
+        if (c->type == XML_ELEMENT_NODE && element_name(c) == "key") {
             key_elements.push_back(c);
-        else if (c->type == XML_ELEMENT_NODE && element_name(c) == "input")
+        } else if (c->type == XML_ELEMENT_NODE && element_name(c) == "input") {
             input_elements.push_back(c);
-        else
-            unexpected_child(c, "pairing", {"key", "input"});
+        } else if (c->type == XML_ELEMENT_NODE && element_name(c) == "request") {
+            CycleField f;
+            std::map<std::string, std::string> rattrs;
+            if (pairing.request)
+                diags_.error(line_of(c), "only one <request> in <pairing> (the first is on line " +
+                                             std::to_string(pairing.request->line) + "): list its values in 'in'");
+            else if (parse_cycle_field(c, kCycleTestAttributes, f, rattrs))
+                pairing.request = f;
+        } else {
+            unexpected_child(c, "pairing", {"key", "input", "request"});
+        }
     }
     // What the analysis reads: checked against its list by analysis_inputs.cpp.
     for (xmlNode* c : input_elements) {
@@ -581,6 +591,7 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
         defer(pairing.keys[i].field, el->parent, pairing.keys[i].line, "field");
     for (AnalysisInput& input : pairing.inputs)
         defer(input.field, el->parent, input.line, "field");
+    if (pairing.request) defer(pairing.request->field, el->parent, pairing.request->line, "field");
 }
 
 // Periodic traffic: <cycles window="8" sender="yes" lost="sequence|period" requests="yes"><signature field="XPATH"/>...

@@ -132,6 +132,7 @@ private:
     const Node* fixed_offset_blocker(const Node& n, uint64_t& offset) const;
     void check_validity();  // valid="LIST" fields and <heuristic>
     void check_pairing();
+    void check_request_role(const CycleField& f);
     void check_cycles();
     bool check_cycle_field(const CycleField& f, const char* element, int role, int test,
                            std::map<const Node*, int>& seen);
@@ -908,7 +909,30 @@ void Validator::check_pairing() {
         if (!inserted)
             diags_.error(key.line, "key field " + quote(*t) + " is already a key (line " + std::to_string(it->second) +
                                        ")");
-    }    check_analysis_inputs(proto_, diags_);
+    }
+    check_analysis_inputs(proto_, diags_);
+    if (proto_.pairing->request) check_request_role(*proto_.pairing->request);
+}
+
+// <request>: one numeric value per message, read once the message is decoded
+// (from its slot).
+void Validator::check_request_role(const CycleField& f) {
+    Node* t = f.field.target;
+    if (!t) return;  // the parser reported the XPath
+    if (!t->is_numeric()) {
+        diags_.error(f.line, "request field " + quote(*t) + at_line(*t) +
+                                 " is not numeric: <request> reads a leaf of 1-64 bits shown as a number, bool, enum "
+                                 "or nondisplay, or an integer computed value");
+        return;
+    }
+    for (const Node* r = t; r; r = r->parent)
+        if (r->is_repeated()) {
+            diags_.error(f.line, "request field " + quote(*t) + at_line(*t) + " is inside repeated node " + quote(*r) +
+                                     at_line(*r) + ": a message says once whether it is a request; use a field "
+                                                   "outside every repeat");
+            return;
+        }
+    mark_slot(t);
 }
 
 // <cycles>: numeric fields, each read for one thing, the sequence count no

@@ -325,12 +325,23 @@ typedef struct dg_input_place {
     guint32 size, stride, instances;
 } dg_input_place;
 
+/* <request field="XPATH" in="LIST"/>: the message says whether it is a
+ * request. Once it is decoded, the field's value (in its slot) in one of the
+ * ranges: a request; decoded and in none: a response; not decoded: the
+ * transport's direction, as without it. */
+typedef struct dg_request_role {
+    gint16 slot;
+    guint16 range_count;
+    const dg_range *ranges;
+} dg_request_role;
+
 typedef struct dg_pairing {
     double timeout;          /* seconds a request waits for its response */
     const struct dg_analysis *analysis; /* NULL, or the protocol analysis the rule file names */
     guint8 ordered;          /* order="request": responses come in their requests' order (per connection) */
     const dg_input_place *places; /* the registers the analysis reads (NULL: none bound) */
     guint16 place_count;
+    const dg_request_role *request; /* NULL: the transport's direction (or the order) decides */
 } dg_pairing;
 
 /* request{Name} in computed values: a response reads fields of its paired

@@ -707,6 +707,14 @@ guint8 direction_of(const packet_info *pinfo)
     return DG_DIR_ANY;
 }
 
+/* Request or response, as the pairing takes the message: what its <request>
+ * field says when it was decoded, else the transport's direction. */
+guint8 message_role(const dg_state *st, const dg_request_role *r)
+{
+    if (!r || !st->present[r->slot]) return st->direction;
+    return in_ranges(r->ranges, 0, r->range_count, st->slots[r->slot].value) ? DG_DIR_REQUEST : DG_DIR_RESPONSE;
+}
+
 /* Whether the protocol below this message is Ethernet's type field. Asked
  * before the walk: then the last layer is ours and the one before it is what
  * called us (the walk's hand-offs add layers after ours). */
@@ -886,9 +894,8 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     if (p->pairing) {
         if (st.request_pending) request_walked(&st);
         const dg_view view = {st.views, st.view_count};
-        fp = dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count,
-                                                        st.wants_view ? &view : NULL, offset, messages - 1,
-                                                        st.direction);
+        fp = dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, st.wants_view ? &view : NULL, offset,
+                                messages - 1, message_role(&st, p->pairing->request));
         if (st.tap) st.tap->pairing = fp;
         if (p->request_context) request_end(&st, fp, subtree);
     }

@@ -133,6 +133,20 @@ TEST(Emit, CyclesOfRequestsOnly) {
         << emit_cpp(*f.proto, "rules.xml");
 }
 
+TEST(Emit, RequestRoleFromTheMessage) {
+    Front f = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n"
+                        "  <pairing><key field=\"node[@name='Transaction']\"/>\n"
+                        "    <request field=\"node[@name='Kind']\" in=\"1,3-4\"/></pairing>\n"
+                        "  <node name=\"Transaction\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
+                        "  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\"/>\n</root>\n");
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const std::string code = emit_cpp(*f.proto, "rules.xml");
+    EXPECT_TRUE(contains(code, "static const dg_range t_request_ranges[] = {\n    { 0x1, 0x1 },\n    { 0x3, 0x4 },\n};"))
+        << code;
+    EXPECT_TRUE(contains(code, "static const dg_request_role t_request_role = { 0, 2, t_request_ranges };")) << code;
+    EXPECT_TRUE(contains(code, ", 0, &t_request_role };")) << code;
+}
+
 TEST(FieldType, EveryDisplayTypeOnWholeBytes) {
     Front f = front_end(rules("  <node name=\"mac\" length=\"6byte\" displaytype=\"address\"/>\n"
                               "  <node name=\"ip\" length=\"4byte\" displaytype=\"address\"/>\n"

@@ -237,10 +237,7 @@ class TestComputedKey(TsharkTestCase, unittest.TestCase):
 
     @classmethod
     def prepare(cls):
-        path = cls.env.path("computed_key.xml")
-        with open(path, "w", encoding="utf-8") as f:
-            f.write(cls.RULES)
-        cls.install(path, "txnp")
+        cls.install_text("computed_key.xml", cls.RULES, "txnp")
 
     def test_other_bytes_are_a_new_request_the_same_bytes_a_duplicate(self):
         path = self.env.path("computed_key.pcap")
@@ -254,6 +251,68 @@ class TestComputedKey(TsharkTestCase, unittest.TestCase):
                 mode = "-2" if two_pass else "one pass"
                 check(pairs == {3: 2, 6: 4, 9: 7, 12: 11}, "%s: responses answer 2, 4, 7 and 11 (%s)" % (mode, pairs))
                 check(duplicates == {5, 8}, "%s: only frames 5 and 8 are duplicates (%s)" % (mode, sorted(duplicates)))
+
+
+class TestRequestRole(TsharkTestCase, unittest.TestCase):
+    """<request field="Kind" in="1"/>: the message says whether it is a request, whichever
+    side sends it. A request from the server's port (a station asking its master) is
+    answered by the message to that port; two peers that both use the port pair by Kind; a
+    message without Kind goes by the port as before."""
+
+    RULES = """<root name="Transactions Protocol" abbreviation="TXNP" byteorder="big">
+  <hook table="udp.port" value="%d"/>
+  <pairing timeout="1">
+    <key field="node[@name='Transaction']"/>
+    <request field="node[@name='Kind']" in="1"/>
+  </pairing>
+  <node name="Transaction" length="2byte" displaytype="numberhex"/>
+  <node name="Has kind" length="1byte" displaytype="numberdec"/>
+  <node name="Kind" length="1byte" displaytype="numberdec" if="../node[@name='Has kind']" in="1"/>
+  <node name="Data" length="rest" displaytype="origin"/>
+</root>
+""" % PORT
+    # (ms, sent by the server, source port, destination port, transaction, kind: None when the
+    # message has none)
+    CAPTURE = [(0, False, 40000, PORT, 1, 1),      # 1: a request to the server
+               (1, True, PORT, 40000, 1, 2),       # 2: answers 1
+               (10, True, PORT, 40000, 2, 1),      # 3: a request from the server's port
+               (11, False, 40000, PORT, 2, 2),     # 4: answers 3, though sent to the port
+               (20, True, PORT, PORT, 3, 1),       # 5: peers on the same port: a request
+               (21, False, PORT, PORT, 3, 2),      # 6: answers 5
+               (30, False, 40000, PORT, 4, None),  # 7: no Kind: to the port, a request
+               (31, True, PORT, 40000, 4, None),   # 8: from the port, answers 7
+               (40, True, PORT, 40000, 5, 1),      # 9: a request from the port, never answered
+               (1100, False, 40000, PORT, 6, 1),   # 10
+               (1101, True, PORT, 40000, 6, 2)]    # 11: answers 10, proves 9 lost (older than the timeout)
+    PAIRS = {2: 1, 4: 3, 6: 5, 8: 7, 11: 10}
+    LOST = {9: 11}
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("request_role.xml", cls.RULES, "txnp")
+
+    @staticmethod
+    def message(from_server, sport, dport, transaction, kind, n):
+        head = struct.pack(">HB", transaction, 0) if kind is None else struct.pack(">HBB", transaction, 1, kind)
+        payload = head + struct.pack(">I", n)
+        u = struct.pack("!HHHH", sport, dport, 8 + len(payload), 0) + payload
+        src, dst = (SERVER, CLIENT) if from_server else (CLIENT, SERVER)
+        ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src, dst)
+        ip = ip[:10] + struct.pack("!H", pcapgen.ip_checksum(ip)) + ip[12:]
+        return b"\x02\x00\x00\x00\x00\x02\x02\x00\x00\x00\x00\x01\x08\x00" + ip + u
+
+    def test_the_message_says_which_it_is(self):
+        path = self.env.path("request_role.pcap")
+        write_frames(path, [(ms, self.message(*m, n)) for n, (ms, *m) in enumerate(self.CAPTURE, 1)])
+        with self.checks() as check:
+            for two_pass in (True, False):
+                mode = "-2" if two_pass else "one pass"
+                rows = decode(self.env, path, two_pass)
+                pairs = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
+                check(pairs == self.PAIRS, "%s: each response answers its request (%s)" % (mode, pairs))
+                flagged = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
+                want = set(self.LOST) if two_pass else set(self.LOST.values())
+                check(flagged == want, "%s: no_response on %s only (%s)" % (mode, sorted(want), sorted(flagged)))
 
 
 if __name__ == "__main__":

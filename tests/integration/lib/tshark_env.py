@@ -337,6 +337,14 @@ class TsharkTestCase:
         cls.env.install_plugin(cls.args.dissgen, os.path.join(cls.args.source_dir, rules), extra_args)
         cls.env.assert_plugin_loaded(protocol)
 
+    @classmethod
+    def install_text(cls, name, rules, protocol):
+        """Write a rule file's text into cls.env as `name`, install its plugin, check it loads."""
+        path = cls.env.path(name)
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(rules)
+        cls.install(path, protocol)
+
     @contextlib.contextmanager
     def checks(self):
         print(flush=True)     # the checks' lines start on their own, after unittest's "test_x ... "
