@@ -1110,7 +1110,10 @@ FieldType computed_field_type(const Node& n) {
         case Display::Float: return {"FT_DOUBLE", "BASE_NONE", 0};
         case Display::Bool: return {"FT_BOOLEAN", "BASE_NONE", 0};
         case Display::NumberHex: return {"FT_UINT" + std::to_string(n.bits), "BASE_HEX", 0};
-        case Display::Enum: return {"FT_UINT64", "BASE_HEX|BASE_VAL64_STRING", 0};
+        case Display::Enum:  // masked to 32 bits or fewer: as wide as its mask (check_computed)
+            if (n.bits <= 32)
+                return {"FT_UINT" + std::to_string(n.bits), n.has_enum_ranges() ? "BASE_HEX|BASE_RANGE_STRING" : "BASE_HEX", 0};
+            return {"FT_UINT64", "BASE_HEX|BASE_VAL64_STRING", 0};
         default: return {"FT_INT64", "BASE_DEC", 0};
     }
 }

@@ -853,7 +853,9 @@ void Validator::assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, c
 bool Validator::widen_masked_values(Node& n, const Node& owner, const std::vector<const Node*>& holders) {
     bool widened = false;
     auto widen = [&](const Node& c) {
-        if (!c.is_computed() || c.display != Display::NumberHex || c.bits == 64) return;
+        // (an enum with ranges stays as masked: Wireshark has no 64-bit range_string)
+        const bool widens = c.display == Display::NumberHex || (c.display == Display::Enum && !c.has_enum_ranges());
+        if (!c.is_computed() || !widens || c.bits == 64) return;
         const_cast<Node&>(c).bits = 64;  // the validator owns the model it checks
         widened = true;
     };
@@ -925,6 +927,7 @@ void Validator::check_request_role(const CycleField& f) {
                                  "or nondisplay, or an integer computed value");
         return;
     }
+    check_list_fits(f.line, f.in_list, f.field);
     for (const Node* r = t; r; r = r->parent)
         if (r->is_repeated()) {
             diags_.error(f.line, "request field " + quote(*t) + at_line(*t) + " is inside repeated node " + quote(*r) +
@@ -957,8 +960,10 @@ void Validator::check_cycles() {
     std::map<const Node*, int> seen;
     for (const CycleField& f : c.signature) check_cycle_field(f, "signature", 1, 0, seen);
     int test = 0;
-    for (const CycleField& f : c.only) check_cycle_field(f, "only", 3, test++, seen);
-    for (const CycleField& f : c.never) check_cycle_field(f, "never", 4, test++, seen);
+    for (const CycleField& f : c.only)
+        if (check_cycle_field(f, "only", 3, test++, seen)) check_list_fits(f.line, f.in_list, f.field);
+    for (const CycleField& f : c.never)
+        if (check_cycle_field(f, "never", 4, test++, seen)) check_list_fits(f.line, f.in_list, f.field);
     if (!c.sequence || !check_cycle_field(*c.sequence, "sequence", 2, 0, seen)) return;
     const Node& t = *c.sequence->field.target;  // decoded more than once in a message: the last value counts
     const unsigned width = t.value_bits();
@@ -1061,8 +1066,15 @@ void Validator::check_computed(Node& n) {
                                  "; a computed value is shown as numberdec, numberhex, int, bool, enum, float or "
                                  "nondisplay");
     }
-    // A hex value masked to 16 bits is a 16-bit field: 0x6000, not 0x0000000000006000.
-    n.bits = n.display == Display::NumberHex ? expr_value_bits(*n.value) : 64;
+    // A hex value or enum masked to 16 bits is a 16-bit field: 0x6000, not 0x0000000000006000.
+    n.bits = n.display == Display::NumberHex || n.display == Display::Enum ? expr_value_bits(*n.value) : 64;
+    if (n.display == Display::Enum && n.bits < 64)
+        for (const EnumItem& e : n.enums)
+            if ((e.is_range ? e.high : e.value) >> n.bits)
+                diags_.error(e.line, "enum value " + std::to_string(e.is_range ? e.high : e.value) +
+                                         " does not fit computed value " +
+                                         quote(n) + ", masked to " + std::to_string(n.bits) +
+                                         " bits by its last '&': it is never computed");
 }
 
 // Resolves the fields of an expression, checks that index has a repeat to
@@ -1448,15 +1460,17 @@ void Validator::check_datetime_length(const Node& n) {
 // Range items become a range_string: at most 32 bits, no two items overlapping.
 void Validator::check_enum_ranges(const Node& n) {
     if (!n.has_enum_ranges()) return;
-    // A computed value is a 64-bit field: Wireshark has no range_string for it
-    // (registered as one, its names were read as a val64_string and crashed).
-    if (n.is_computed()) {
+    // A computed value is a 64-bit field unless masked (check_computed sets its
+    // width later): Wireshark has no 64-bit range_string field (registered as
+    // one, its names were read as a val64_string and crashed).
+    const unsigned bits = n.is_computed() ? expr_value_bits(*n.value) : n.bits;
+    if (n.is_computed() && bits > 32) {
         diags_.error(n.line, "enum ranges need a field of at most 32 bits; computed value " + quote(n) +
-                                 " is 64 bits: list single values, or give the ranges to a field (an overlay "
-                                 "over the bytes)");
+                                 " is 64 bits: mask it ({X} & 0xFF), list single values, or give the ranges to a "
+                                 "field (an overlay over the bytes)");
         return;
     }
-    if (n.bits > 32) {
+    if (bits > 32) {
         diags_.error(n.line, "enum ranges need a field of at most 32 bits; " + quote(n) + " is " +
                                  std::to_string(n.bits) + " bits");
         return;

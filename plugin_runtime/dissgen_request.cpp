@@ -50,11 +50,18 @@ gboolean read_keys(const dg_state *st, guint64 *keys)
     return TRUE;
 }
 
-/* First pass: what the waiting request of this message's key kept. A message
- * that goes to the hooked port is a request: it answers nothing. */
+/* Whether the message may be a response, before it is decoded: a message
+ * that goes to the hooked port is a request and answers nothing, unless the
+ * pairing's <request> field says which it is (known only once decoded). */
+gboolean may_answer(const dg_state *st)
+{
+    return st->direction != DG_DIR_REQUEST || st->p->pairing->request;
+}
+
+/* First pass: what the waiting request of this message's key kept. */
 const dg_request_values *find_request(const dg_state *st)
 {
-    if (st->direction == DG_DIR_REQUEST) return NULL;
+    if (!may_answer(st)) return NULL;
     const dg_request_context *rc = st->p->request_context;
     guint64 *keys = wmem_alloc_array(st->pinfo->pool, guint64, rc->key_count);
     if (!read_keys(st, keys)) return NULL;
@@ -118,7 +125,7 @@ void request_begin(dg_state *st)
     if (PINFO_FD_VISITED(st->pinfo)) {
         v = (const dg_request_values *)p_get_proto_data(wmem_file_scope(), st->pinfo, *st->p->proto,
                                                         frame_key + message);
-    } else if (st->p->request_context->key_count == 0 && st->direction != DG_DIR_REQUEST) {
+    } else if (st->p->request_context->key_count == 0 && may_answer(st)) {
         st->request_pending = TRUE; /* find_from_walk(), once the keys are decoded */
         v = NULL;
     } else {

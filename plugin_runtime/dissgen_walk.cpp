@@ -253,11 +253,11 @@ void dissect_computed(dg_state *st, const dg_node *n, proto_tree *tree, gint off
         break;
     case DG_SHOW_BOOL: item = proto_tree_add_boolean(tree, *n->hf, st->tvb, offset, length, v.integer != 0); break;
     case DG_SHOW_HEX:
+    case DG_SHOW_ENUM:
         /* a value masked to 32 bits or fewer has a field that wide (no wider value reaches it) */
         item = n->bits <= 32 ? proto_tree_add_uint(tree, *n->hf, st->tvb, offset, length, (guint32)bits)
                              : proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, length, bits);
         break;
-    case DG_SHOW_ENUM: item = proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, length, bits); break;
     default: item = proto_tree_add_int64(tree, *n->hf, st->tvb, offset, length, v.integer); break;
     }
     proto_item_set_generated(item);

@@ -208,6 +208,21 @@ TEST(FieldType, ComputedHexIsAsWideAsItsMask) {
     expect_type(p, "dec", "FT_INT64", "BASE_DEC");
 }
 
+TEST(FieldType, ComputedEnumIsAsWideAsItsMask) {
+    Front f = front_end(rules("  <node name=\"raw\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"lo\" value=\"{raw} &amp; 0x3\" displaytype=\"enum\">\n"
+                              "    <enum value=\"0\" name=\"I\"/><enum value=\"1-2\" name=\"S\"/></node>\n"
+                              "  <node name=\"hi\" value=\"{raw} &amp; 0xFFFF0\" displaytype=\"enum\">\n"
+                              "    <enum value=\"16\" name=\"x\"/></node>\n"
+                              "  <node name=\"all\" value=\"{raw} + 1\" displaytype=\"enum\">\n"
+                              "    <enum value=\"1\" name=\"y\"/></node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Protocol& p = *f.proto;
+    expect_type(p, "lo", "FT_UINT8", "BASE_HEX|BASE_RANGE_STRING");
+    expect_type(p, "hi", "FT_UINT32", "BASE_HEX");
+    expect_type(p, "all", "FT_UINT64", "BASE_HEX|BASE_VAL64_STRING");
+}
+
 TEST(FieldType, EnumsOfFiveToEightBytesUseVal64) {
     Front f = front_end(rules("  <node name=\"e40\" length=\"5byte\" displaytype=\"enum\"><enum value=\"0xffffffffff\" name=\"max\"/></node>\n"
                               "  <node name=\"e48\" length=\"6byte\" displaytype=\"enum\"/>\n"

@@ -395,6 +395,27 @@ TEST(Conditions, InValuesMustFitTheFieldTheyTest) {
     EXPECT_EQ(std::count(m.begin(), m.end(), '\n'), 2) << m;
 }
 
+TEST(Conditions, RequestAndCycleTestValuesMustFitTheirFields) {
+    // <request>, <only> and <never> test a field's value as 'in' does: a value it cannot hold never matches.
+    Front f = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n"
+                        "  <pairing><key field=\"node[@name='Ref']\"/>\n"
+                        "    <request field=\"node[@name='Kind']\" in=\"0x100-0x1ff\"/></pairing>\n"
+                        "  <cycles><signature field=\"node[@name='Ref']\"/>\n"
+                        "    <only field=\"node[@name='Class']\" in=\"1-3\"/>\n"
+                        "    <never field=\"node[@name='Flag']\" in=\"2\"/></cycles>\n"
+                        "  <node name=\"Ref\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+                        "  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+                        "  <node name=\"Class\" length=\"7bit\" displaytype=\"numberdec\"/>\n"
+                        "  <node name=\"Flag\" length=\"1bit\" displaytype=\"numberdec\"/>\n</root>\n");
+    const std::string m = f.messages();
+    EXPECT_TRUE(f.ok()) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:3: warning: 'in' value 0x100-0x1ff does not fit the 8-bit field 'Kind' (line 8): "
+                            "it never matches")) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:6: warning: 'in' value 2 does not fit the 1-bit field 'Flag' (line 10): "
+                            "it never matches")) << m;
+    EXPECT_EQ(std::count(m.begin(), m.end(), '\n'), 2) << m;
+}
+
 TEST(Conditions, InValuesOnAComputedValueFitItsSixtyFourBits) {
     // A computed value takes no bytes but is a 64-bit integer: any 'in' value may match it.
     Front f = front_end(rules("  <node name=\"b\" length=\"1byte\" displaytype=\"numberdec\"/>\n"

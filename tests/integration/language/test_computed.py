@@ -28,7 +28,7 @@ from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 
 ARGS = None
 ETHERTYPE = 0x88B6
-FIELDS = ["frame.number", "calc.temperature", "calc.alarm", "calc.mixed", "calc.high_byte", "calc.kind", "calc.ratio",
+FIELDS = ["frame.number", "calc.temperature", "calc.alarm", "calc.mixed", "calc.high_byte", "calc.kind", "calc.parity", "calc.ratio",
           "calc.negated", "calc.magnitude", "calc.safe_ratio", "calc.secret", "calc.registers.register", "calc.registers.flags.flag_index", "calc.tail_bytes", "calc.tail",
           "_ws.col.Info"]
 
@@ -64,6 +64,7 @@ def expected(start, count, raw, values):
         "calc.mixed": "0x%016x" % ((((start << 4) | count) & 0xFFFF) ^ 0x5A),
         "calc.high_byte": "0x%02x" % (start >> 8),  # masked to 8 bits: an 8-bit field
         "calc.kind": str(count % 3),
+        "calc.parity": "0x%02x" % (count & 1),  # masked to 8 bits: an 8-bit field
         "calc.ratio": None if count == 2 else str(c_div(start, count - 2)),
         "calc.negated": str(-start + -1 + (0 if count else 1)),
         "calc.magnitude": str(abs(raw)),

@@ -81,10 +81,10 @@ def write(path, messages=MESSAGES):
     write_frames(path, [(m[0], frame(m[1], m[2], m[3], n + 1, *m[4:])) for n, m in enumerate(messages)])
 
 
-def decode(env, path, two_pass):
+def decode(env, path, two_pass, more=()):
     """{frame number: {field: its values, comma-separated}}."""
     fields = ["frame.number", "txnp.request_in", "txnp.response_in", "txnp.expert.no_response",
-              "txnp.no_response_to", "txnp.time"]
+              "txnp.no_response_to", "txnp.time"] + list(more)
     return {n: {f: ",".join(v) for f, v in r.items()} for n, r in env.field_rows(path, fields, two_pass).items()}
 
 
@@ -268,7 +268,10 @@ class TestRequestRole(TsharkTestCase, unittest.TestCase):
   <node name="Transaction" length="2byte" displaytype="numberhex"/>
   <node name="Has kind" length="1byte" displaytype="numberdec"/>
   <node name="Kind" length="1byte" displaytype="numberdec" if="../node[@name='Has kind']" in="1"/>
-  <node name="Data" length="rest" displaytype="origin"/>
+  <node name="Number" length="4byte" displaytype="numberdec"/>
+  <node name="Answer" if="../node[@name='Kind']" in="2">
+    <node name="Asked" value="request{Number}" displaytype="numberdec"/>
+  </node>
 </root>
 """ % PORT
     # (ms, sent by the server, source port, destination port, transaction, kind: None when the
@@ -307,12 +310,18 @@ class TestRequestRole(TsharkTestCase, unittest.TestCase):
         with self.checks() as check:
             for two_pass in (True, False):
                 mode = "-2" if two_pass else "one pass"
-                rows = decode(self.env, path, two_pass)
+                rows = decode(self.env, path, two_pass, ["txnp.answer.asked", "txnp.expert.no_request_context"])
                 pairs = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
                 check(pairs == self.PAIRS, "%s: each response answers its request (%s)" % (mode, pairs))
                 flagged = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
                 want = set(self.LOST) if two_pass else set(self.LOST.values())
                 check(flagged == want, "%s: no_response on %s only (%s)" % (mode, sorted(want), sorted(flagged)))
+                # request{Number} in each response with Kind: its request's number, whichever port it went to
+                asked = {n: r["txnp.answer.asked"] for n, r in rows.items() if r["txnp.answer.asked"]}
+                want = {n: str(m) for n, m in self.PAIRS.items() if self.CAPTURE[n - 1][-1] == 2}
+                check(asked == want, "%s: request{Number} %s, expected %s" % (mode, asked, want))
+                missed = sorted(n for n, r in rows.items() if r["txnp.expert.no_request_context"])
+                check(not missed, "%s: no 'request not known' note (%s)" % (mode, missed))
 
 
 if __name__ == "__main__":
