@@ -259,14 +259,17 @@ bool expr_op_needs_integers(ExprOp op) {
     }
 }
 
+uint64_t expr_mask(const Expr& e) {
+    if (e.op != ExprOp::BitAnd || e.is_float) return ~uint64_t{0};
+    for (const Expr& a : e.args)
+        if (a.op == ExprOp::Int && a.integer >= 0) return static_cast<uint64_t>(a.integer);
+    return ~uint64_t{0};
+}
+
 unsigned expr_value_bits(const Expr& e) {
-    if (e.op != ExprOp::BitAnd || e.is_float) return 64;
-    for (const Expr& a : e.args) {
-        if (a.op != ExprOp::Int || a.integer < 0) continue;
-        const uint64_t mask = static_cast<uint64_t>(a.integer);
-        for (unsigned bits : {8u, 16u, 32u})
-            if (mask >> bits == 0) return bits;
-    }
+    const uint64_t mask = expr_mask(e);
+    for (unsigned bits : {8u, 16u, 32u})
+        if (mask >> bits == 0) return bits;
     return 64;
 }
 

@@ -78,5 +78,8 @@ bool expr_op_needs_integers(ExprOp op);
 // constant on either side, 8, 16 or 32 bits, the least that holds the constant
 // (0xFFFF: 16, 0xFFFFFF: 32); else 64.
 unsigned expr_value_bits(const Expr& e);
+// The constant of an expression whose last operator is '&' with a constant on
+// either side (the values it can take are at most that); all ones otherwise.
+uint64_t expr_mask(const Expr& e);
 
 }  // namespace dissgen

@@ -880,9 +880,15 @@ void Validator::share_filter_name(Node& n, const Node& owner) {
             return;
         }
     std::string mismatch = shared_field_mismatch(owner, n);
-    if (!mismatch.empty() && widen_masked_values(n, owner, holders)) mismatch = shared_field_mismatch(owner, n);
+    const Node* differs = &n;
+    if (!mismatch.empty() && widen_masked_values(n, owner, holders)) {
+        mismatch = shared_field_mismatch(owner, n);
+        // a holder that is no masked value keeps its width, no longer the widened field's
+        for (const Node* h : holders)
+            if (mismatch.empty() && h != &owner && !(mismatch = shared_field_mismatch(owner, *h)).empty()) differs = h;
+    }
     if (!mismatch.empty()) {
-        diags_.error(n.line, "alternatives " + quote(owner) + at_line(owner) + " and " + quote(n) + at_line(n) +
+        diags_.error(n.line, "alternatives " + quote(owner) + at_line(owner) + " and " + quote(*differs) + at_line(*differs) +
                                  " share the filter name '" + name + "' but not its field type (" + mismatch +
                                  "); give one of them a 'filter' attribute");
         return;
@@ -1068,13 +1074,13 @@ void Validator::check_computed(Node& n) {
     }
     // A hex value or enum masked to 16 bits is a 16-bit field: 0x6000, not 0x0000000000006000.
     n.bits = n.display == Display::NumberHex || n.display == Display::Enum ? expr_value_bits(*n.value) : 64;
+    const uint64_t mask = expr_mask(*n.value);
     if (n.display == Display::Enum && n.bits < 64)
         for (const EnumItem& e : n.enums)
-            if ((e.is_range ? e.high : e.value) >> n.bits)
+            if ((e.is_range ? e.high : e.value) > mask)
                 diags_.error(e.line, "enum value " + std::to_string(e.is_range ? e.high : e.value) +
-                                         " does not fit computed value " +
-                                         quote(n) + ", masked to " + std::to_string(n.bits) +
-                                         " bits by its last '&': it is never computed");
+                                         " is above the mask of computed value " + quote(n) + " (" + hex(mask) +
+                                         ", its last '&'): it is never computed");
 }
 
 // Resolves the fields of an expression, checks that index has a repeat to

@@ -469,9 +469,10 @@ figures figures_of(const cycle *c)
     return f;
 }
 
-/* A field compared by its bytes, as its item shows them: text in quotes
- * up to its first NUL (non-printable characters escaped), an IPv4 address dotted, other bytes
- * in hex separated by colons (a MAC address, a GUID, raw bytes). */
+/* A field compared by its bytes: text in quotes up to its first NUL
+ * (non-printable characters escaped), an IPv4 address dotted as its item
+ * shows it, other bytes in hex separated by colons, in capture order (a MAC
+ * address, a GUID, raw bytes). */
 void append_bytes(GString *t, const dg_node *n, const guint8 *b, guint32 length)
 {
     if (n->show == DG_SHOW_STRING || n->show == DG_SHOW_STRINGZ) {
@@ -483,8 +484,12 @@ void append_bytes(GString *t, const dg_node *n, const guint8 *b, guint32 length)
         return;
     }
     g_string_append_printf(t, "%s ", n->name);
-    for (guint32 i = 0; i < length; i++)
-        g_string_append_printf(t, n->show == DG_SHOW_IPV4 ? (i ? ".%u" : "%u") : (i ? ":%02x" : "%02x"), b[i]);
+    if (n->show == DG_SHOW_IPV4) { /* its item reads it in the node's byte order */
+        const gboolean little = (n->flags & DG_LITTLE) != 0;
+        for (guint32 i = 0; i < length; i++) g_string_append_printf(t, i ? ".%u" : "%u", b[little ? length - 1 - i : i]);
+        return;
+    }
+    for (guint32 i = 0; i < length; i++) g_string_append_printf(t, i ? ":%02x" : "%02x", b[i]);
 }
 
 /* "Connection ID 0x00ff0001, sender 192.168.1.10:2222": each signature field

@@ -80,6 +80,23 @@ TEST(SharedFilterNames, MaskedHexValuesOfOneNameKeepSixtyFourBits) {
     EXPECT_NE(code.find("\"tst.low\", FT_UINT8, BASE_HEX"), std::string::npos) << code;  // alone: narrowed
 }
 
+TEST(SharedFilterNames, WideningStopsAtAFieldThatIsNoMaskedValue) {
+    // A masked value and a 16-bit field share a name; a third, 64 bits wide, would widen the
+    // masked value, but the 16-bit field keeps its width: an error, not a field of two types.
+    Front f = front_end(rules("  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"Word\" length=\"2byte\" displaytype=\"numberhex\"/>\n"
+                              "  <node name=\"V\" filter=\"x\" value=\"{Word} &amp; 0xFFFF\" displaytype=\"numberhex\"\n"
+                              "        if=\"../node[@name='Kind']\" in=\"1\"/>\n"
+                              "  <node name=\"V\" filter=\"x\" length=\"2byte\" displaytype=\"numberhex\"\n"
+                              "        if=\"../node[@name='Kind']\" in=\"2\"/>\n"
+                              "  <node name=\"V\" filter=\"x\" length=\"8byte\" displaytype=\"numberhex\"\n"
+                              "        if=\"../node[@name='Kind']\" in=\"3\"/>\n"));
+    EXPECT_FALSE(f.ok());
+    EXPECT_TRUE(contains(f.messages(), "rules.xml:8: error: alternatives 'V' (line 4) and 'V' (line 6) share the "
+                                       "filter name 'tst.x' but not its field type"))
+        << f.messages();
+}
+
 TEST(SharedFilterNames, NamesThatDifferWarn) {
     Front f = front_end(rules(
         "  <node name=\"K\" length=\"1byte\" displaytype=\"numberdec\"/>\n"

@@ -196,7 +196,7 @@ def named_streams_frames():
     """Its streams, then one message cut in its name, in its address and after it."""
     import test_rule_cycles as m
     whole = m.named_frame(b"PUMP-1", b"\x02\x00\x00\x00\x00\x01", 7)
-    return [(frame, len(frame)) for _t, frame in m.named_capture()] + [(whole[:c], len(whole)) for c in (18, 24, 27)]
+    return [(frame, len(frame)) for _t, frame in m.named_capture()] + [(whole[:c], len(whole)) for c in (18, 24, 27, 31)]
 
 
 def polled_cycles_frames():

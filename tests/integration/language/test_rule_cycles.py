@@ -292,9 +292,12 @@ class CountWrappingAtTheSampleRate(TsharkTestCase, unittest.TestCase):
 
 # --- streams named by text and addresses ----------------------------------------------
 
+SOURCE = bytes([7, 0, 168, 192])  # 192.168.0.7, little-endian
+
+
 def named_frame(name, station, count):
     """A frame of tests/rules/named_streams.xml."""
-    return (b"\x01\x0c\xcd\x04\x00\x02" + station + b"\x88\xb6" + bytes([len(name)]) + name + station +
+    return (b"\x01\x0c\xcd\x04\x00\x02" + station + b"\x88\xb6" + bytes([len(name)]) + name + station + SOURCE +
             struct.pack(">Hh", count & 0xFFFF, -1))
 
 
@@ -335,7 +338,8 @@ def wireshark_text(name):
 class StreamsNamedByText(TsharkTestCase, unittest.TestCase):
     """Signature fields of text and addresses are compared byte for byte ("PUMP-1" is not
     "PUMP-10", nor "PUMP-1" from another station) and named in -z as their items show
-    them; marks, losses and duplicates follow the model in one pass and -2."""
+    them (a little-endian IPv4 address too); marks, losses and duplicates follow the model
+    in one pass and -2."""
 
     @classmethod
     def prepare(cls):
@@ -348,12 +352,12 @@ class StreamsNamedByText(TsharkTestCase, unittest.TestCase):
         for frame, (t, data) in enumerate(self.packets, 1):
             size = data[14]
             name, station = data[15:15 + size], data[15 + size:21 + size]
-            messages.append((frame, t, (name, station), struct.unpack(">H", data[21 + size:23 + size])[0]))
+            messages.append((frame, t, (name, station), struct.unpack(">H", data[25 + size:27 + size])[0]))
         marks, cycles = model(messages, window=8, bits=16)
         with self.checks() as check:
             check(len(cycles) == len(NAMED_STREAMS), "the model: a cycle per stream, %d" % len(cycles))
-            names = ['Name "%s", Station %s' % (wireshark_text(c["stream"]["key"][0]),
-                                                 ":".join("%02x" % b for b in c["stream"]["key"][1]))
+            names = ['Name "%s", Station %s, Source 192.168.0.7' % (wireshark_text(c["stream"]["key"][0]),
+                                                                     ":".join("%02x" % b for b in c["stream"]["key"][1]))
                      for c in cycles]
             follows_the_model(self.env, check, self.capture, "named", marks, cycles, names)
 
