@@ -748,7 +748,8 @@ void Emitter::protocol_struct() {
         std::snprintf(timeout, sizeof timeout, "%.9g", p_.pairing->timeout);
         const Analysis* analysis = find_analysis(p_.pairing->analysis);
         o_ << "\n/* Request/response pairing (<pairing>, line " << p_.pairing->line
-           << "): timeout in seconds, analysis, responses in the order of their requests. */\n";
+           << "): timeout in seconds, analysis, responses in the order of their requests, the registers the "
+              "analysis reads, what says a message is a request (<request>; NULL: its direction). */\n";
         if (analysis)
             o_ << "/* The " << c_string(analysis->name) << " analysis, compiled in from the runtime. */\n"
                << "extern \"C\" const struct dg_analysis " << analysis->symbol << ";\n";
@@ -757,7 +758,7 @@ void Emitter::protocol_struct() {
         o_ << "static const dg_pairing " << f << "_pairing = { " << timeout << ", "
            << (analysis ? "&" + analysis->symbol : std::string("NULL")) << ", " << (p_.pairing->ordered ? 1 : 0)
            << ", " << (places ? f + "_input_places" : std::string("NULL")) << ", " << places
-           << (p_.pairing->request ? ", &" + f + "_request_role" : std::string()) << " };\n";
+           << ", " << (p_.pairing->request ? "&" + f + "_request_role" : std::string("NULL")) << " };\n";
         if (!p_.request_fields.empty()) request_context();
     }
     if (p_.cycles) cycles_tables();

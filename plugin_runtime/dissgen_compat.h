@@ -34,6 +34,21 @@ extern "C" {
     (WIRESHARK_VERSION_MAJOR > (major) ||                                            \
      (WIRESHARK_VERSION_MAJOR == (major) && WIRESHARK_VERSION_MINOR >= (minor)))
 
+/* format_text() takes its bytes as const guchar * in 4.0 and as const char *
+ * in later versions: the pointer's type is deduced from the declaration. */
+#include <epan/strutil.h>
+template <typename Char>
+static inline char *dg_format_text_with(char *(*format)(wmem_allocator_t *, const Char *, size_t),
+                                        wmem_allocator_t *scope, const guint8 *text, size_t length)
+{
+    return format(scope, reinterpret_cast<const Char *>(text), length);
+}
+/* Text for display: non-printable characters escaped, as Wireshark shows strings. */
+static inline char *dg_format_text(wmem_allocator_t *scope, const guint8 *text, size_t length)
+{
+    return dg_format_text_with(format_text, scope, text, length);
+}
+
 /* 4.4 installs wsutil/plugins.h (absent in 4.0) with the plugin description
  * flags; its loader calls an optional plugin_describe(). */
 #if DG_WS_AT_LEAST(4, 4)

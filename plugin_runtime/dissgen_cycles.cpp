@@ -54,7 +54,6 @@
 #include "dissgen_values.h"
 
 #include <epan/addr_resolv.h>
-#include <epan/strutil.h>
 #include <epan/expert.h>
 #include <epan/to_str.h>
 #include <epan/proto_data.h>
@@ -478,7 +477,7 @@ void append_bytes(GString *t, const dg_node *n, const guint8 *b, guint32 length)
     if (n->show == DG_SHOW_STRING || n->show == DG_SHOW_STRINGZ) {
         const guint8 *nul = (const guint8 *)memchr(b, 0, length); /* the text ends there, as its item shows it */
         const guint32 text = nul ? (guint32)(nul - b) : length;
-        char *shown = format_text(NULL, b, text);
+        char *shown = dg_format_text(NULL, b, text);
         g_string_append_printf(t, "%s \"%s\"", n->name, shown);
         wmem_free(NULL, shown);
         return;

@@ -632,7 +632,7 @@ TEST(Pairing, InputsAreNumberedInTheirExtraAndNeverQuiet) {
     }
     EXPECT_TRUE(registers > 0) << "the analysis reads registers";
     EXPECT_TRUE(contains(code, "static const dg_pairing tst_pairing = { 1, &dg_ethercat_esc, 1, tst_input_places, " +
-                                   std::to_string(registers) + " };"))
+                                   std::to_string(registers) + ", NULL };"))
         << code;
 }
 
@@ -648,14 +648,14 @@ TEST(Pairing, DefaultTimeoutIsOneSecondAndNoAnalysis) {
     Front f = front_end(rules("  <pairing><key field=\"node[@name='Id']\"/></pairing>\n"
                               "  <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
-    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 1, NULL, 0 };"));
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 1, NULL, 0, NULL };"));
 }
 
 TEST(Pairing, ResponsesInAnyOrder) {
     Front f = front_end(rules("  <pairing order=\"any\"><key field=\"node[@name='Id']\"/></pairing>\n"
                               "  <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
-    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 0, NULL, 0 };"));
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 0, NULL, 0, NULL };"));
 }
 
 // The analyses' table of EtherCAT commands (ethercat_commands.h) names each
