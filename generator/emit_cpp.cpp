@@ -817,6 +817,12 @@ std::string Emitter::protocol_row() const {
 // <cycles>: the window, the sequence count's width, whether the sender is
 // part of the signature, and the values each <only>/<never> test holds for
 // (a test without 'in': any value but 0).
+// The dg_range rows of a field's test: its 'in' list, or any value but 0.
+void append_test_ranges(const CycleField& t, std::vector<std::string>& ranges) {
+    if (t.in_list.empty()) ranges.push_back("{ " + hex(1) + ", " + hex(UINT64_MAX) + " }");
+    for (const ValueRange& r : t.in_list) ranges.push_back("{ " + hex(r.low) + ", " + hex(r.high) + " }");
+}
+
 void Emitter::cycles_tables() {
     const std::string& f = p_.filter;
     const Cycles& c = *p_.cycles;
@@ -824,8 +830,7 @@ void Emitter::cycles_tables() {
     auto add_tests = [&](const std::vector<CycleField>& fields, const char* element) {
         for (const CycleField& t : fields) {
             const size_t first = ranges.size();
-            if (t.in_list.empty()) ranges.push_back("{ " + hex(1) + ", " + hex(UINT64_MAX) + " }");
-            for (const ValueRange& r : t.in_list) ranges.push_back("{ " + hex(r.low) + ", " + hex(r.high) + " }");
+            append_test_ranges(t, ranges);
             tests.push_back("/* <" + std::string(element) + ">, line " + std::to_string(t.line) + " */ { " +
                             std::to_string(first) + ", " + std::to_string(ranges.size() - first) + " }");
         }
@@ -851,8 +856,7 @@ void Emitter::request_role() {
     const std::string& f = p_.filter;
     const CycleField& r = *p_.pairing->request;
     std::vector<std::string> ranges;
-    if (r.in_list.empty()) ranges.push_back("{ " + hex(1) + ", " + hex(UINT64_MAX) + " }");
-    for (const ValueRange& v : r.in_list) ranges.push_back("{ " + hex(v.low) + ", " + hex(v.high) + " }");
+    append_test_ranges(r, ranges);
     o_ << "/* <request>, line " << r.line << ": a message whose " << c_string(r.field.target->name)
        << " is one of these is a request, any other value a response. */\n"
        << c_array("static const dg_range " + f + "_request_ranges", ranges) << "static const dg_request_role " << f

@@ -966,10 +966,8 @@ void Validator::check_cycles() {
     std::map<const Node*, int> seen;
     for (const CycleField& f : c.signature) check_cycle_field(f, "signature", 1, 0, seen);
     int test = 0;
-    for (const CycleField& f : c.only)
-        if (check_cycle_field(f, "only", 3, test++, seen)) check_list_fits(f.line, f.in_list, f.field);
-    for (const CycleField& f : c.never)
-        if (check_cycle_field(f, "never", 4, test++, seen)) check_list_fits(f.line, f.in_list, f.field);
+    for (const CycleField& f : c.only) check_cycle_field(f, "only", 3, test++, seen);
+    for (const CycleField& f : c.never) check_cycle_field(f, "never", 4, test++, seen);
     if (!c.sequence || !check_cycle_field(*c.sequence, "sequence", 2, 0, seen)) return;
     const Node& t = *c.sequence->field.target;  // decoded more than once in a message: the last value counts
     const unsigned width = t.value_bits();
@@ -1015,6 +1013,7 @@ bool Validator::check_cycle_field(const CycleField& f, const char* element, int 
                                  "): each field has one part in it");
         return false;
     }
+    check_list_fits(f.line, f.in_list, f.field);  // <only>/<never>: a value the field cannot hold never matches
     t->cycle_role = role;
     t->cycle_test = test;
     return true;
