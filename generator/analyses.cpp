@@ -24,7 +24,10 @@ const std::vector<Analysis>& analyses() {
     // message is its runtime's own list (e.g. ethercat_inputs.h).
     static const std::vector<Analysis> list = [] {
         std::vector<Analysis> out = runtime_list().analyses;
-        for (Analysis& a : out) a.inputs = inputs_of(a.name);
+        for (Analysis& a : out) {
+            a.inputs = inputs_of(a.name);
+            a.times_cycles = a.name == "ethercat-esc" && DG_ESC_TIMES_CYCLES;
+        }
         return out;
     }();
     return list;
@@ -38,6 +41,11 @@ const Analysis* find_analysis(const std::string& name) {
 
 const Analysis* analysis_of(const Protocol& proto) {
     return proto.pairing ? find_analysis(proto.pairing->analysis) : nullptr;
+}
+
+bool analysis_times_cycles(const Protocol& proto) {
+    const Analysis* a = analysis_of(proto);
+    return a && a->times_cycles;
 }
 
 std::vector<std::string> analysis_runtime_sources(const Protocol& proto) {

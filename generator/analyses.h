@@ -32,6 +32,8 @@ struct Analysis {
     // what it reads from each message, every one required, in the order of
     // its dg_view (the runtime's list, e.g. ethercat_inputs.h)
     std::vector<AnalysisInputSpec> inputs;
+    // it times the rule file's <cycles> itself (its runtime's dg_analysis.times_cycles)
+    bool times_cycles = false;
 };
 
 // Every analysis, in the order of plugin_runtime/runtime.list.
@@ -42,6 +44,9 @@ const Analysis* find_analysis(const std::string& name);
 
 // The analysis `proto`'s pairing names, or nullptr.
 const Analysis* analysis_of(const Protocol& proto);
+
+// Whether `proto`'s analysis times its <cycles> (the generic cycle analysis stays out).
+bool analysis_times_cycles(const Protocol& proto);
 
 // The runtime sources a plugin of `proto` compiles beyond the generic runtime:
 // those of the analysis its pairing names, none without one.

@@ -2,6 +2,7 @@
 #include "runtime_names.h"
 
 #include "../plugin_runtime/dissgen_names.h"
+#include "analyses.h"
 
 namespace dissgen {
 
@@ -52,7 +53,7 @@ bool applies(const NameGroup& g, const Protocol& proto) {
         case When::Reassembly: return reassembles(proto);
         case When::Pairing: return proto.pairing != nullptr;
         case When::RequestContext: return proto.pairing && !proto.request_fields.empty();
-        case When::Cycles: return proto.cycles != nullptr;
+        case When::Cycles: return proto.cycles != nullptr && !analysis_times_cycles(proto);
         case When::Analysis: return proto.pairing && proto.pairing->analysis == g.analysis;
     }
     return false;

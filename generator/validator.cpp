@@ -134,6 +134,7 @@ private:
     void check_pairing();
     void check_request_role(const CycleField& f);
     void check_cycles();
+    void check_cycles_of_ethercat(const Cycles& c);
     bool check_cycle_field(const CycleField& f, const char* element, int role, int test,
                            std::map<const Node*, int>& seen);
     void check_hook_list(const Node& n);
@@ -945,14 +946,12 @@ void Validator::check_request_role(const CycleField& f) {
 }
 
 // <cycles>: numeric fields, each read for one thing, the sequence count no
-// wider than its field; no analysis that times the protocol's cycles itself.
+// wider than its field; with the EtherCAT analysis, which times frames by
+// their returns, nothing it does not do.
 void Validator::check_cycles() {
     if (!proto_.cycles) return;
     Cycles& c = *proto_.cycles;
-    if (proto_.pairing && proto_.pairing->analysis == DG_ANALYSIS_ETHERCAT_ESC)
-        diags_.error(c.line, "<cycles> cannot be used with <pairing analysis=\"" DG_ANALYSIS_ETHERCAT_ESC
-                             "\">, which finds EtherCAT's cycles itself (" +
-                                 proto_.filter + ".cycle)");
+    if (proto_.pairing && proto_.pairing->analysis == DG_ANALYSIS_ETHERCAT_ESC) check_cycles_of_ethercat(c);
     if (c.requests_only && !proto_.pairing)
         diags_.error(c.line, "requests=\"yes\" times the requests of a <pairing>, and this protocol has none: "
                              "add <pairing> with the key fields that tie a response to its request");
@@ -988,6 +987,22 @@ void Validator::check_cycles() {
     if (c.sequence_step > 1 && c.sequence_step > top >> 1)
         diags_.error(c.sequence->line, "step=\"" + std::to_string(c.sequence_step) +
                                            "\" is not below half the range of a " + range);
+}
+
+// The ethercat-esc analysis times each frame as sent, with its return and its
+// working counters: EtherCAT frames carry no count, and come from the master.
+void Validator::check_cycles_of_ethercat(const Cycles& c) {
+    const std::string with = " does not apply with <pairing analysis=\"" DG_ANALYSIS_ETHERCAT_ESC
+                             "\">, which times each frame as sent with its return: ";
+    if (c.sequence)
+        diags_.error(c.sequence->line, "<sequence>" + with + "EtherCAT frames carry no count (remove it)");
+    if (c.lost_by_period || c.lost_line)
+        diags_.error(c.line, std::string("lost=\"") + (c.lost_by_period ? "period" : "sequence") + "\"" + with +
+                                 "a frame not returned is counted lost by the analysis (remove it)");
+    if (c.by_sender)
+        diags_.error(c.line, "sender=\"yes\"" + with + "every frame is the master's (remove it)");
+    if (c.requests_only)
+        diags_.error(c.line, "requests=\"yes\"" + with + "only frames as sent are timed already (remove it)");
 }
 
 bool Validator::check_cycle_field(const CycleField& f, const char* element, int role, int test,

@@ -352,8 +352,7 @@ mark *time_message(capture_state *c, const dg_cycle_input *in, const dg_frame_pa
         if (fp->role == DG_ROLE_RESPONSE) request_answered(c, fp->txn, pinfo);
         if (fp->role != DG_ROLE_REQUEST) return NULL;
     }
-    const guint32 all_only = cy->only_count >= 32 ? G_MAXUINT32 : ((guint32)1 << cy->only_count) - 1;
-    if (!in->count || in->never || (in->only_held & all_only) != all_only) return NULL;
+    if (!dg_cycle_input_in_stream(cy, in)) return NULL;
     stream *s = stream_of(c, in, pinfo);
     s->messages++;
     mark m = {};

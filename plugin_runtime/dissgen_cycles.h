@@ -28,6 +28,14 @@ typedef struct dg_cycle_input {
     gboolean never;            /* a <never> test held */
 } dg_cycle_input;
 
+/* Whether a message belongs to a stream: a signature field was decoded,
+ * every <only> test held and no <never> test did. */
+static inline gboolean dg_cycle_input_in_stream(const dg_cycles *c, const dg_cycle_input *in)
+{
+    const guint32 all_only = c->only_count >= 32 ? G_MAXUINT32 : ((guint32)1 << c->only_count) - 1;
+    return in->count && !in->never && (in->only_held & all_only) == all_only;
+}
+
 extern "C" {
 
 /* At registration: the fields, expert infos, -z P,cycles and the

@@ -444,7 +444,7 @@ void fill_buffer(guint8 **buffer, guint *capacity, tvbuff_t *tvb, guint length, 
 /* The view kept after a message's `length` bytes by fill_buffer(). */
 dg_view kept_view(const guint8 *buffer, guint length, guint count)
 {
-    dg_view v = {count ? (const dg_view_value *)(const void *)(buffer + view_start(length)) : NULL, count};
+    dg_view v = {count ? (const dg_view_value *)(const void *)(buffer + view_start(length)) : NULL, count, NULL};
     return v;
 }
 

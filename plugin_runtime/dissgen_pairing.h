@@ -103,9 +103,15 @@ typedef struct dg_view_value {
     guint32 instance;   /* the instance of its repeated node (0 for a message's own input) */
 } dg_view_value;
 
+struct dg_cycle_input;
+
 typedef struct dg_view {
     const dg_view_value *values;
     guint count;
+    /* <cycles> with an analysis that times them (dg_analysis.times_cycles):
+     * what the walk decoded for them in the message being dissected, first
+     * pass; NULL otherwise, and in a request's view the pairing kept */
+    const struct dg_cycle_input *cycle;
 } dg_view;
 
 /* The register the pairing's analysis reads as its input `input`, where
@@ -124,6 +130,10 @@ static inline const dg_input_place *dg_input_place_of(const dg_protocol *p, guin
  * data came back unchanged). */
 typedef struct dg_analysis {
     const char *name;        /* the rule file's <pairing analysis="..."> */
+    /* TRUE: the analysis times the rule file's <cycles> itself, with what it
+     * knows of the protocol (dg_view.cycle), under the names P.cycle...: the
+     * generic cycle analysis (dissgen_cycles.h) stays out */
+    gboolean times_cycles;
     /* Registers the analysis's own fields and expert infos (once, at start-up). */
     void (*register_info)(int proto, const char *filter);
     /* Capture-wide state, allocated in wmem_file_scope (e.g. the EtherCAT
@@ -169,6 +179,13 @@ typedef struct dg_analysis {
      * NULL: it may be. */
     gboolean (*key_changed)(const dg_view *request, const dg_view *message);
 } dg_analysis;
+
+/* Whether the protocol's analysis times its <cycles> (and the generic cycle
+ * analysis stays out). */
+static inline gboolean dg_analysis_times_cycles(const dg_protocol *p)
+{
+    return p->pairing && p->pairing->analysis && p->pairing->analysis->times_cycles;
+}
 
 /* C linkage like dissgen_runtime.h's entry points: plain symbol names. */
 extern "C" {

@@ -212,7 +212,7 @@ void dg_register(dg_protocol *p, hf_register_info *hf, int hf_count, gint **ett,
     register_stats_tree(p);
     if (p->reassembly) reassembly_table_register(p->reassembly, &addresses_reassembly_table_functions);
     if (p->pairing) dg_pairing_register(p);
-    if (p->cycles) dg_cycles_register(p);
+    if (p->cycles && !dg_analysis_times_cycles(p)) dg_cycles_register(p);
     learned_register(p);
     /* To compare the compiled walks with the table walk (dissgen_state.h). */
     table_walk_only = g_getenv("DISSGEN_TABLE_WALK") != NULL;

@@ -893,14 +893,15 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     const dg_frame_pairing *fp = NULL;
     if (p->pairing) {
         if (st.request_pending) request_walked(&st);
-        const dg_view view = {st.views, st.view_count};
+        const gboolean analysis_cycles = st.wants_cycles && dg_analysis_times_cycles(p);
+        const dg_view view = {st.views, st.view_count, analysis_cycles ? &st.cycle : NULL};
         fp = dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, st.wants_view ? &view : NULL, offset,
                                 messages - 1, message_role(&st, p->pairing->request));
         if (st.tap) st.tap->pairing = fp;
         if (p->request_context) request_end(&st, fp, subtree);
     }
 
-    if (p->cycles) {
+    if (p->cycles && !dg_analysis_times_cycles(p)) {
         dg_cycles_dissect(p, tvb, pinfo, subtree, st.wants_cycles ? &st.cycle : NULL, fp, messages - 1);
     }
 

@@ -280,7 +280,7 @@ void *esc_capture_new(const dg_protocol *p)
     h->records = wmem_array_new(wmem_file_scope(), sizeof(record *));
     h->registers = esc_registers_of(p);
     h->bus = bus_new(static_cast<const dg_bus *>(p->analysis_data), &h->registers);
-    h->cycles = cycles_new(&h->registers);
+    h->cycles = cycles_new(&h->registers, p->cycles);
     return h;
 }
 
@@ -527,7 +527,7 @@ guint32 esc_sent(void *capture, tvbuff_t *, const dg_view *view, packet_info *pi
     guint n = frame_datagrams(view, &header_length, d, max_datagrams);
     bus_frame f = {};
     bus_sent(h->bus, d, n, &f);
-    cycle_mark c = cycles_sent(h->cycles, d, n, pinfo);
+    cycle_mark c = cycles_sent(h->cycles, view ? view->cycle : NULL, d, n, pinfo);
     if (c.cycle) bus_set_cycle(&f, &c);
     return new_record(h, NULL, &f);
 }
@@ -596,6 +596,7 @@ constexpr dg_analysis esc_analysis(void)
 {
     dg_analysis a = {};
     a.name = DG_ANALYSIS_ETHERCAT_ESC;
+    a.times_cycles = DG_ESC_TIMES_CYCLES; /* with the frames' returns and working counters (ethercat_cycles.cpp) */
     a.register_info = esc_register;
     a.capture_new = esc_capture_new;
     a.is_response = esc_is_response;  /* is_returned: none, esc_direction() says so, marked or not */

@@ -1232,13 +1232,11 @@ esc_registers esc_registers_of(const dg_protocol *p)
     r.station = dg_input_place_of(p, ESC_REG_STATION);
     r.alias = dg_input_place_of(p, ESC_REG_ALIAS);
     r.al_status = dg_input_place_of(p, ESC_REG_AL_STATUS);
-    r.sii_configuration = dg_input_place_of(p, ESC_REG_SII_CONFIGURATION);
     r.sii_control = dg_input_place_of(p, ESC_REG_SII_CONTROL);
     r.sii_address = dg_input_place_of(p, ESC_REG_SII_ADDRESS);
     r.sii_data = dg_input_place_of(p, ESC_REG_SII_DATA);
     r.fmmus = dg_input_place_of(p, ESC_REG_FMMU);
     r.syncmanagers = dg_input_place_of(p, ESC_REG_SYNCMANAGER);
-    r.receive_times = dg_input_place_of(p, ESC_REG_RECEIVE_TIMES);
     r.system_time = dg_input_place_of(p, ESC_REG_SYSTEM_TIME);
     return r;
 }

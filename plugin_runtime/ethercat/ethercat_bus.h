@@ -82,9 +82,9 @@ struct bus_frame {
  * the model learns nothing from that register. */
 struct esc_registers {
     const dg_input_place *station, *alias, *al_status;
-    const dg_input_place *sii_configuration, *sii_control, *sii_address, *sii_data;
+    const dg_input_place *sii_control, *sii_address, *sii_data;
     const dg_input_place *fmmus, *syncmanagers;
-    const dg_input_place *receive_times, *system_time;
+    const dg_input_place *system_time;
 };
 esc_registers esc_registers_of(const dg_protocol *p);
 

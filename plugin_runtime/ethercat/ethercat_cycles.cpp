@@ -2,22 +2,21 @@
 /* The cycles of an EtherCAT capture (see ethercat_cycles.h and the manual,
  * "Cycles"), decided on the first pass from what came before each frame:
  *
- *  - A frame's signature is the command, address (ADP and ADO, or the
- *    logical address) and data length of each of its datagrams, in order.
- *  - A signature that transfers a mailbox or does what only a start-up
- *    does is never a cycle: a non-logical datagram addressing ESC memory at
- *    0x1000 or above (the mailboxes), the SyncManager 0/1 status bytes
- *    (which masters poll for mail), the SII interface or the DC port
- *    receive times (latched to measure the topology); the registers where
- *    the rule file's register map puts them (0x0805, 0x080D, 0x0500-0x050F
- *    and 0x0900-0x090F in rules/ethercat.xml).
+ *  - What is timed is what the rule file's <cycles> says (the manual,
+ *    "Cycles of any protocol"): a frame's signature is the values of its
+ *    <signature> fields, in decoding order (in rules/ethercat.xml the
+ *    command, address and data length of each datagram); a frame in which
+ *    an <only> test failed or a <never> test held is in no signature (in
+ *    rules/ethercat.xml: a datagram that transfers a mailbox or does what
+ *    only a start-up does). Without <cycles>, nothing is timed.
  *  - A period is the time from a frame sent to the next one sent with its
  *    signature. It is regular when it is above 0, the previous frame came
  *    back before this one was sent (not a retry after a timeout) and this
  *    frame is not a poll: sent less than one round trip after that return
  *    (a master sending the same frame again as soon as it is back, as while
  *    waiting for a state or an EEPROM read).
- *  - A signature becomes a cycle with its first window of `window` (8)
+ *  - A signature becomes a cycle with its first window of `window` (8; the
+ *    <cycles window="...">)
  *    regular periods in a row, all within half of their median either way
  *    (and that median below 2^32 ns): the frame that completes the window is
  *    the cycle's first marked frame. From then on every frame sent with that
@@ -38,7 +37,9 @@
 #include "ethercat_cycles.h"
 #include "ethercat_commands.h"
 
+#include "../dissgen_cycles.h"
 #include "../dissgen_periods.h"
+#include "../dissgen_values.h"
 
 #include <epan/stat_tap_ui.h>
 #include <epan/stats_tree.h>
@@ -55,7 +56,6 @@ namespace {
 
 using namespace dg_periods;
 
-const guint window = 8;
 const guint ring = 16; /* the last frames of a cycle whose return may still come */
 
 struct sig_datagram {
@@ -65,10 +65,11 @@ struct sig_datagram {
 
 struct cycle {
     guint16 number;
-    guint count;             /* datagrams of its signature */
-    const sig_datagram *sig;
+    guint count;             /* datagrams of its first frame */
+    const sig_datagram *sig; /* ... as -z ecatr,cycles names them */
     running_median periods;  /* its periods */
-    guint32 window_periods[window]; /* the qualifying window's: not carried by a marked frame */
+    guint window;                        /* its detection window's periods */
+    guint32 window_periods[most_window]; /* the qualifying window's: not carried by a marked frame */
     guint frames;            /* marked frames */
     guint32 first_frame;     /* the first marked frame */
     double jitter_sum, jitter_squares;
@@ -82,17 +83,20 @@ struct cycle {
     cycle *next;
 };
 
+/* The frames whose <signature> fields have the same values. */
 struct signature {
     guint32 hash;
-    guint count;
-    sig_datagram *d;
-    gboolean eligible;
+    guint value_count;
+    guint64 *values;             /* the <signature> fields' values, in decoding order */
+    guint16 *nodes;              /* the node of each */
+    guint count;                 /* datagrams of its first frame, */
+    sig_datagram *d;             /* ... which name it */
     guint32 last_sent_frame;
     nstime_t last_sent;
     guint32 last_answered_frame; /* the last of its frames answered, and when */
     nstime_t last_return;
     nstime_t last_rtt;
-    guint32 recent[window];      /* its last regular periods, a ring */
+    guint32 recent[most_window]; /* its last regular periods, a ring */
     guint regular;               /* how many in a row (up to window) */
     guint next_slot;
     cycle *cyc;
@@ -107,7 +111,15 @@ struct dc_reference {
     gint64 at;   /* capture time, ns */
 };
 
+/* A frame sent in a signature, until its return comes. */
+struct sent_frame {
+    guint32 frame;
+    signature *sig;              /* NULL: in no signature, or returned */
+};
+
 struct cycle_model {
+    const dg_cycles *declared;   /* the rule file's <cycles>; NULL: none */
+    guint window;
     wmem_map_t *signatures;      /* signature -> itself */
     cycle *first, *last;
     guint16 cycles;
@@ -115,12 +127,11 @@ struct cycle_model {
     esc_registers regs;          /* where the registers it reads sit */
     dc_reference dc32, dc64;
     guint32 last_frame;          /* the last frame the first pass brought here */
-    /* the last frames sent and their signatures, so that most returns find
-     * theirs without hashing their datagrams again */
-    struct {
-        guint32 frame;
-        signature *sig;
-    } recent_sent[ring];
+    /* the last frames sent and their signatures, so that returns find
+     * theirs; a frame whose slot is reused before its return came moves to
+     * `overtaken` (frame -> signature; a frame never returned stays there) */
+    sent_frame recent_sent[ring];
+    wmem_map_t *overtaken;
 };
 
 namespace {
@@ -134,66 +145,62 @@ guint sig_hash(gconstpointer p) { return ((const signature *)p)->hash; }
 gboolean sig_equal(gconstpointer a, gconstpointer b)
 {
     const signature *x = (const signature *)a, *y = (const signature *)b;
-    if (x->hash != y->hash || x->count != y->count) return FALSE;
-    for (guint i = 0; i < x->count; i++)
-        if (x->d[i].cmd != y->d[i].cmd || x->d[i].adp != y->d[i].adp || x->d[i].ado != y->d[i].ado ||
-            x->d[i].length != y->d[i].length)
-            return FALSE;
-    return TRUE;
+    return x->hash == y->hash && x->value_count == y->value_count &&
+           !memcmp(x->values, y->values, x->value_count * sizeof(guint64)) &&
+           !memcmp(x->nodes, y->nodes, x->value_count * sizeof(guint16));
 }
 
-/* Whether a datagram's bytes overlap the `bytes` bytes from `offset` into
- * instance `instance` of register r (never when r is unbound). */
-gboolean overlaps(const sig_datagram *d, const dg_input_place *r, guint instance, guint32 offset, guint32 bytes)
+/* The signature of a frame sent (its <cycles> input `in`, its n datagrams),
+ * or NULL when it is in none. */
+signature *signature_of(cycle_model *m, const dg_cycle_input *in, const datagram *d, guint n)
 {
-    if (!r || instance >= r->instances) return FALSE;
-    guint64 lo = register_address(r, instance, offset);
-    return d->ado < lo + bytes && (guint64)d->ado + d->length > lo;
-}
-
-/* Mailbox transfers and start-up work: never cyclic process data. What the
- * slave controller has there: the mailboxes in its process memory; a
- * SyncManager's status byte 5 bytes into its block (SyncManagers 0 and 1,
- * the mailboxes, are polled for mail); the SII interface's 16 bytes from
- * its configuration register; the four ports' receive times, 4 bytes each,
- * latched to measure the topology. */
-gboolean mailbox_or_startup(const cycle_model *m, const sig_datagram *d)
-{
-    if (d->cmd == dg_ecat_commands::NOP || dg_ecat_commands::is_logical(d->cmd)) return FALSE;
-    const esc_registers *r = &m->regs;
-    return (guint)d->ado + d->length > process_ram || overlaps(d, r->syncmanagers, 0, 5, 1) ||
-           overlaps(d, r->syncmanagers, 1, 5, 1) || overlaps(d, r->sii_configuration, 0, 0, 16) ||
-           overlaps(d, r->receive_times, 0, 0, 16);
-}
-
-signature *signature_of(cycle_model *m, const datagram *d, guint n)
-{
-    sig_datagram probe_d[max_datagrams];
-    guint32 h = 2166136261u ^ n;
-    for (guint i = 0; i < n; i++) {
-        probe_d[i].cmd = d[i].cmd;
-        probe_d[i].adp = d[i].adp;
-        probe_d[i].ado = d[i].ado;
-        probe_d[i].length = d[i].length;
-        h = (h ^ d[i].cmd) * 16777619u;
-        h = (h ^ ((guint32)d[i].adp | (guint32)d[i].ado << 16)) * 16777619u;
-        h = (h ^ d[i].length) * 16777619u;
-    }
-    signature probe; /* what sig_hash() and sig_equal() read, no more (not its ring) */
+    if (!m->declared || !in || !n || !dg_cycle_input_in_stream(m->declared, in)) return NULL;
+    guint32 h = 2166136261u;
+    for (guint i = 0; i < in->count; i++) h = dg_rt::hash_mix(h, in->values[i] ^ ((guint64)in->nodes[i] << 48));
+    signature probe; /* what sig_hash() and sig_equal() read, no more */
     probe.hash = h;
-    probe.count = n;
-    probe.d = probe_d;
+    probe.value_count = in->count;
+    probe.values = in->values;
+    probe.nodes = in->nodes;
     signature *s = (signature *)wmem_map_lookup(m->signatures, &probe);
     if (s) return s;
     s = wmem_new0(wmem_file_scope(), signature);
     s->hash = h;
+    s->value_count = in->count;
+    s->values = (guint64 *)wmem_memdup(wmem_file_scope(), in->values, in->count * sizeof(guint64));
+    s->nodes = (guint16 *)wmem_memdup(wmem_file_scope(), in->nodes, in->count * sizeof(guint16));
     s->count = n;
-    s->d = (sig_datagram *)wmem_memdup(wmem_file_scope(), probe_d, n * sizeof(sig_datagram));
-    s->eligible = n > 0;
-    for (guint i = 0; i < n; i++)
-        if (mailbox_or_startup(m, &s->d[i])) s->eligible = FALSE;
+    s->d = wmem_alloc_array(wmem_file_scope(), sig_datagram, n);
+    for (guint i = 0; i < n; i++) s->d[i] = {d[i].cmd, d[i].adp, d[i].ado, d[i].length};
     wmem_map_insert(m->signatures, s, s);
     return s;
+}
+
+/* First pass: the frame sent is in signature s (NULL: none), in the ring of
+ * frames whose return may still come. */
+void remember_sent(cycle_model *m, guint32 frame, signature *s)
+{
+    sent_frame *slot = &m->recent_sent[frame % ring];
+    if (slot->sig) {
+        if (!m->overtaken) m->overtaken = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+        wmem_map_insert(m->overtaken, GUINT_TO_POINTER(slot->frame), slot->sig);
+    }
+    slot->frame = frame;
+    slot->sig = s;
+}
+
+/* First pass: the signature of the frame sent as `frame`, whose return came
+ * (once: it is forgotten); NULL when it was in none. */
+signature *returned_signature(cycle_model *m, guint32 frame)
+{
+    sent_frame *slot = &m->recent_sent[frame % ring];
+    if (slot->frame == frame) {
+        signature *s = slot->sig;
+        slot->sig = NULL;
+        return s;
+    }
+    if (!m->overtaken) return NULL;
+    return (signature *)wmem_map_remove(m->overtaken, GUINT_TO_POINTER(frame));
 }
 
 cycle *new_cycle(cycle_model *m, signature *s, guint32 frame)
@@ -203,6 +210,7 @@ cycle *new_cycle(cycle_model *m, signature *s, guint32 frame)
     c->count = s->count;
     c->sig = s->d;
     c->first_frame = frame;
+    c->window = m->window;
     c->wkc_high = wmem_alloc0_array(wmem_file_scope(), guint16, s->count ? s->count : 1);
     if (m->last)
         m->last->next = c;
@@ -210,8 +218,8 @@ cycle *new_cycle(cycle_model *m, signature *s, guint32 frame)
         m->first = c;
     m->last = c;
     /* the window's periods, oldest first; the last is the marking frame's own */
-    for (guint i = 0; i + 1 < window; i++) {
-        guint32 p = s->recent[(s->next_slot + i) % window];
+    for (guint i = 0; i + 1 < m->window; i++) {
+        guint32 p = s->recent[(s->next_slot + i) % m->window];
         c->window_periods[i] = p;
         c->periods.add(p);
     }
@@ -222,23 +230,25 @@ void capture_cleanup(void) { current = NULL; }
 
 } /* namespace */
 
-cycle_model *cycles_new(const esc_registers *r)
+cycle_model *cycles_new(const esc_registers *r, const dg_cycles *declared)
 {
     cycle_model *m = wmem_new0(wmem_file_scope(), cycle_model);
     m->regs = *r;
+    m->declared = declared;
+    m->window = declared ? MIN(MAX(declared->window, 1u), most_window) : most_window;
     m->signatures = wmem_map_new(wmem_file_scope(), sig_hash, sig_equal);
     current = m;
     return m;
 }
 
-cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_info *pinfo)
+cycle_mark cycles_sent(cycle_model *m, const dg_cycle_input *in, const datagram *d, guint n,
+                       const packet_info *pinfo)
 {
     cycle_mark mark = {0, 0, 0};
     m->last_frame = pinfo->num;
-    signature *s = signature_of(m, d, n);
-    m->recent_sent[pinfo->num % ring].frame = pinfo->num;
-    m->recent_sent[pinfo->num % ring].sig = s;
-    if (!s->eligible) return mark;
+    signature *s = signature_of(m, in, d, n);
+    remember_sent(m, pinfo->num, s);
+    if (!s) return mark;
     guint32 previous = s->last_sent_frame;
     nstime_t previous_time = s->last_sent;
     s->last_sent_frame = pinfo->num;
@@ -253,9 +263,9 @@ cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_
             return mark;
         }
         s->recent[s->next_slot] = clamp_period(period);
-        s->next_slot = (s->next_slot + 1) % window;
-        if (s->regular < window) s->regular++;
-        if (s->regular < window || !steady_median(s->recent, window)) return mark;
+        s->next_slot = (s->next_slot + 1) % m->window;
+        if (s->regular < m->window) s->regular++;
+        if (s->regular < m->window || !steady_median(s->recent, m->window)) return mark;
         s->cyc = new_cycle(m, s, pinfo->num);
     }
     cycle *c = s->cyc;
@@ -285,11 +295,8 @@ void cycles_returned(cycle_model *m, const datagram *s, const datagram *b, guint
 {
     m->last_frame = pinfo->num;
     if (!txn) return;
-    guint slot = txn->request_frame % ring;
-    signature *sig = m->recent_sent[slot].frame == txn->request_frame && m->recent_sent[slot].sig->count == n
-                         ? m->recent_sent[slot].sig
-                         : signature_of(m, s, n);
-    if (!sig->eligible) return;
+    signature *sig = returned_signature(m, txn->request_frame);
+    if (!sig) return;
     if (txn->request_frame >= sig->last_answered_frame) {
         sig->last_answered_frame = txn->request_frame;
         sig->last_return = pinfo->abs_ts;
@@ -442,12 +449,12 @@ figures figures_of(const cycle *c)
     guint32 *all = g_new(guint32, total + 1);
     c->periods.copy_to(all);
     qsort(all, total, sizeof *all, compare_u32);
-    guint32 win[window];
+    guint32 win[most_window];
     memcpy(win, c->window_periods, sizeof win);
-    qsort(win, window - 1, sizeof *win, compare_u32);
+    qsort(win, c->window - 1, sizeof *win, compare_u32);
     guint n = 0, w = 0;
     for (guint i = 0; i < total; i++) {
-        if (w < window - 1 && all[i] == win[w])
+        if (w + 1 < c->window && all[i] == win[w])
             w++;
         else
             all[n++] = all[i];

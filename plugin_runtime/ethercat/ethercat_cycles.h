@@ -20,12 +20,13 @@ struct cycle_mark {
 
 struct cycle_model;   /* capture-wide, wmem_file_scope */
 
-/* r: where the registers sit that tell start-up and mailbox traffic (the
- * SII interface, the port receive times, the mailbox SyncManagers' status)
- * and the reference clock's system time; unbound ones tell nothing. */
-cycle_model *cycles_new(const esc_registers *r);
-/* First pass, a frame as sent: its n datagrams. */
-cycle_mark cycles_sent(cycle_model *m, const datagram *d, guint n, const packet_info *pinfo);
+/* r: where the reference clock's system time sits (unbound: no drift);
+ * declared: the rule file's <cycles> (NULL: none, nothing is timed). */
+cycle_model *cycles_new(const esc_registers *r, const dg_cycles *declared);
+/* First pass, a frame as sent: what the walk decoded of it for <cycles>
+ * (NULL: nothing), its n datagrams. */
+cycle_mark cycles_sent(cycle_model *m, const dg_cycle_input *in, const datagram *d, guint n,
+                       const packet_info *pinfo);
 /* First pass, a returned frame answering `txn`: s and b its first n datagrams
  * as sent and as returned. */
 void cycles_returned(cycle_model *m, const datagram *s, const datagram *b, guint n, const dg_transaction *txn,

@@ -36,7 +36,7 @@ std::vector<dg_view_value> two_datagrams() {
 
 TEST(EthercatView, DatagramsComeFromTheWalksValues) {
     std::vector<dg_view_value> values = two_datagrams();
-    dg_view view = {values.data(), (guint)values.size()};
+    dg_view view = {values.data(), (guint)values.size(), nullptr};
     datagram d[max_datagrams];
     guint header_length = 0;
     ASSERT_EQ(frame_datagrams(&view, &header_length, d, max_datagrams), 2u);
@@ -65,7 +65,7 @@ TEST(EthercatView, DatagramsComeFromTheWalksValues) {
 TEST(EthercatView, ADatagramWithoutItsWorkingCounterDoesNotCount) {
     std::vector<dg_view_value> values = two_datagrams();
     values.pop_back();
-    dg_view view = {values.data(), (guint)values.size()};
+    dg_view view = {values.data(), (guint)values.size(), nullptr};
     datagram d[max_datagrams];
     guint header_length = 0;
     EXPECT_EQ(frame_datagrams(&view, &header_length, d, max_datagrams), 1u);
@@ -78,7 +78,7 @@ TEST(EthercatView, ADatagramWithoutItsWorkingCounterDoesNotCount) {
 TEST(EthercatView, DataBeforeItsDatagramEndsTheDatagrams) {
     std::vector<dg_view_value> values = two_datagrams();
     values.back() = value(ESC_IN_WKC, 1, 3, 20, 2);  // 20 - 4 = 16, the second's command
-    dg_view view = {values.data(), (guint)values.size()};
+    dg_view view = {values.data(), (guint)values.size(), nullptr};
     datagram d[max_datagrams];
     guint header_length = 0;
     EXPECT_EQ(frame_datagrams(&view, &header_length, d, max_datagrams), 1u);
@@ -86,7 +86,7 @@ TEST(EthercatView, DataBeforeItsDatagramEndsTheDatagrams) {
 
 TEST(EthercatView, AtMostMaxDatagramsAndNoneWithoutAView) {
     std::vector<dg_view_value> values = two_datagrams();
-    dg_view view = {values.data(), (guint)values.size()};
+    dg_view view = {values.data(), (guint)values.size(), nullptr};
     datagram d[max_datagrams];
     guint header_length = 7;
     EXPECT_EQ(frame_datagrams(&view, &header_length, d, 1), 1u);

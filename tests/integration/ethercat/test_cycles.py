@@ -13,8 +13,10 @@ The -z ecatr,cycles figures are compared with the same computation.
 
 Generated captures: two tasks (1 ms LRW + FRMW 0x0910, 10 ms LRW to another logical address)
 with known injected jitter; the same with gaps (frames not captured) and lost returns; a
-mailbox exchange and a back-to-back status poll that must not become cycles; a capture that
-starts mid-flight (a return first). Then every capture of the corpus (../shared/corpus/ethercat,
+mailbox exchange and a back-to-back status poll that must not become cycles; returns that come
+after 16 other frames were sent; a capture that starts mid-flight (a return first). The rule
+file's <cycles> decides what is timed: without its <never> and with window="2" the mailbox is
+cyclic from its third frame; without <cycles>, nothing is. Then every capture of the corpus (../shared/corpus/ethercat,
 or --corpus DIR; skipped when absent).
 """
 
@@ -99,6 +101,22 @@ def mailbox_and_polls(rounds=200):
             packets.append(pr.Packet(ecat_frame(MASTER, dgs), t))
             packets.append(pr.Packet(returned(MASTER, dgs, 1), t + 30_000))
     packets.sort(key=lambda p: p.ts)
+    return packets
+
+
+def late_returns(cycles=40):
+    """Task A (LRW 0x00010000) every 1 ms, each frame back only after 16 other frames were sent
+    (reads of an AL status that no slave answers), so that 17 frames sent lie between a frame
+    and its return: the return still finds its frame's signature, and task A is a cycle."""
+    packets = []
+    for n in range(cycles):
+        t = T0 + n * 1_000_000
+        dgs = [(12, 0x10, 0x0000, 0x0001, bytes([n & 0xFF, 0, 0, 0]), 0)]
+        packets.append(pr.Packet(ecat_frame(MASTER, dgs), t))
+        for k in range(16):
+            poll = [(4, 0x50 + k, 0x1001 + k, 0x0130, b"\0\0", 0)]
+            packets.append(pr.Packet(ecat_frame(MASTER, poll), t + 10_000 + k * 10_000))
+        packets.append(pr.Packet(returned(MASTER, dgs, 1), t + 300_000))
     return packets
 
 
@@ -462,6 +480,14 @@ class TestCycles(TsharkTestCase, unittest.TestCase):
             ref, two, cap = self.check_capture(check, "mailbox", path, expect_cycles=0)
             check(not any(r["ecatr.cycle"] for r in two.values()), "no frame carries ecatr.cycle")
 
+    def test_returns_after_many_frames_sent(self):
+        path = self.generated("late-returns", late_returns())
+        with self.checks() as check:
+            ref, two, cap = self.check_capture(check, "late returns", path, expect_cycles=1)
+            check(len(ref.cycles[0]["frames"]) == 40 - WINDOW,
+                  "task A is a cycle from its 9th frame, its returns 17 frames sent later (%d marked)" % len(
+                      ref.cycles[0]["frames"]))
+
     def test_capture_starting_mid_flight(self):
         path = self.generated("mid-flight", mid_flight())
         with self.checks() as check:
@@ -480,6 +506,75 @@ class TestCycles(TsharkTestCase, unittest.TestCase):
             for f in files:
                 path = self.env.readable(os.path.join(self.corpus_dir, f))
                 self.check_capture(check, f, path)
+
+
+def shipped_rules():
+    with open(os.path.join(ARGS.source_dir, "rules", "ethercat.xml"), encoding="utf-8") as f:
+        return f.read()
+
+
+def shipped_rules_changed(old, new):
+    """rules/ethercat.xml with `old` (once in it) replaced by `new`."""
+    text = shipped_rules()
+    if text.count(old) != 1:
+        raise AssertionError("rules/ethercat.xml no longer holds %r once" % old)
+    return text.replace(old, new)
+
+
+NEVER = "<never field=\"node[@name='Datagrams']/node[@name='Datagram']/node[@name='Not cyclic']\"/>"
+
+
+class TestCyclesAsDeclared(TsharkTestCase, unittest.TestCase):
+    """What the analysis times is what the rule file's <cycles> says: without its <never>
+    the mailbox traffic is cyclic, its window decides the first marked frame."""
+    @classmethod
+    def prepare(cls):
+        rules = shipped_rules_changed(NEVER, "").replace("<cycles>", "<cycles window=\"2\">", 1)
+        cls.install_text("ethercat-window-2.xml", rules, "ecatr")
+
+    def test_mailbox_traffic_cyclic_from_its_third_frame(self):
+        path = self.env.path("mailbox.pcap")
+        write_pcap(path, mailbox_and_polls(rounds=20))
+        os.chmod(path, 0o644)
+        rows = self.env.field_rows(path, FIELDS, two_pass=True, display_filter="ecatr")
+        cap = pr.Capture.read(path)
+        with self.checks() as check:
+            by_ado = {}
+            for n, r in sorted(rows.items()):
+                if is_request(r):
+                    ado = pr.ecat_datagrams(cap.packets[n - 1])[0]["ado"]
+                    by_ado.setdefault(ado, []).append(r["ecatr.cycle"][0] if r["ecatr.cycle"] else None)
+            for ado in (0x1000, 0x080D, 0x1100):
+                marks = by_ado.get(ado, [])
+                check(marks[:2] == [None, None] and len(marks) == 20 and None not in marks[2:] and
+                      len(set(marks[2:])) == 1,
+                      "FPxx 0x%04x every ms: one cycle from its 3rd frame on (window 2, no <never>): %s" % (
+                          ado, marks[:4]))
+            polls = by_ado.get(0x0130, [])
+            check(len(polls) == 240 and not any(polls),
+                  "the AL status polls, sent again as soon as back, are in no cycle (%d)" % len(polls))
+            z = parse_cycles(self.env.tshark(["-r", path, "-q", "-z", "ecatr,cycles"]).stdout)
+            check(sorted(z) == [1, 2, 3], "-z ecatr,cycles lists 3 cycles (%s)" % sorted(z))
+
+
+class TestCyclesUndeclared(TsharkTestCase, unittest.TestCase):
+    """The analysis with no <cycles> in the rule file times nothing."""
+    @classmethod
+    def prepare(cls):
+        text = shipped_rules()
+        start, end = text.index("  <cycles>"), text.index("</cycles>") + len("</cycles>")
+        cls.install_text("ethercat-no-cycles.xml", text[:start] + text[end:], "ecatr")
+
+    def test_no_cycle_without_the_declaration(self):
+        path = self.env.path("two-tasks.pcap")
+        write_pcap(path, two_tasks(cycles=50))
+        os.chmod(path, 0o644)
+        rows = self.env.field_rows(path, FIELDS, two_pass=True, display_filter="ecatr")
+        with self.checks() as check:
+            check(len(rows) > 100 and not any(r["ecatr.cycle"] for r in rows.values()),
+                  "no frame of %d carries ecatr.cycle" % len(rows))
+            z = self.env.tshark(["-r", path, "-q", "-z", "ecatr,cycles"]).stdout
+            check("No cycles" in z, "-z ecatr,cycles says: No cycles")
 
 
 def add_arguments(parser):
