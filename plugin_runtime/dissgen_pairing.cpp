@@ -1128,12 +1128,48 @@ void dg_pairing_register(const dg_protocol *p)
     register_cleanup_routine(capture_cleanup);
 }
 
+namespace {
+
+/* Over TCP or UDP, when a message's direction is known, its client is one
+ * more key value: a request's sender, a response's receiver (its address,
+ * and over TCP its port: the connection). Two clients using the same key
+ * values (Modbus/TCP transaction 1 from two masters) are then paired apart,
+ * as Wireshark pairs them by conversation. An address of up to 6 bytes is
+ * the value itself, a longer one (IPv6) its 64-bit FNV-1a hash. Returns the
+ * keys to pair by, and their count in *count. */
+const guint64 *with_client(const guint64 *keys, guint *count, const packet_info *pinfo, guint8 direction)
+{
+    if ((pinfo->ptype != PT_TCP && pinfo->ptype != PT_UDP) ||
+        (direction != DG_DIR_REQUEST && direction != DG_DIR_RESPONSE))
+        return keys;
+    const gboolean request = direction == DG_DIR_REQUEST;
+    const address *client = request ? &pinfo->src : &pinfo->dst;
+    const guint32 port = pinfo->ptype == PT_TCP ? (request ? pinfo->srcport : pinfo->destport) : 0;
+    const guint8 *bytes = (const guint8 *)client->data;
+    guint64 value = 0;
+    if (client->len <= 6) {
+        for (int i = 0; i < client->len; i++) value = value << 8 | bytes[i];
+        value = value << 16 | (port & 0xffff);
+    } else {
+        value = 14695981039346656037ull;
+        for (int i = 0; i < client->len; i++) value = (value ^ bytes[i]) * 1099511628211ull;
+        value = (value ^ port) * 1099511628211ull;
+    }
+    guint64 *out = wmem_alloc_array(pinfo->pool, guint64, *count + 1);
+    memcpy(out, keys, *count * sizeof(guint64));
+    out[(*count)++] = value;
+    return out;
+}
+
+} // namespace
+
 const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree,
                                            const guint64 *keys, guint key_count, const dg_view *view, gint length,
                                            guint message, guint8 direction)
 {
     /* A message cut short before its first key field answers and asks nothing. */
     if (key_count == 0) return NULL;
+    keys = with_client(keys, &key_count, pinfo, direction);
     kept *k = capture ? record_of(capture, pinfo, message, FALSE) : NULL;
     const dg_transaction *fresh = NULL;
     if (!k || !k->role) {
@@ -1149,9 +1185,11 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *, tvbuff_t *tvb, p
     return fp;
 }
 
-const dg_transaction *dg_pairing_waiting(const guint64 *keys, guint key_count, const packet_info *pinfo)
+const dg_transaction *dg_pairing_waiting(const guint64 *keys, guint key_count, const packet_info *pinfo,
+                                        guint8 direction)
 {
     if (!capture || key_count == 0) return NULL;
+    keys = with_client(keys, &key_count, pinfo, direction);
     pair_key probe = {key_count, (guint64 *)keys};
     const key_entry *e = (const key_entry *)wmem_map_lookup(capture->keys, &probe);
     if (!e) return NULL;

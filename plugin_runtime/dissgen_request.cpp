@@ -58,6 +58,13 @@ gboolean may_answer(const dg_state *st)
     return st->direction != DG_DIR_REQUEST || st->p->pairing->request;
 }
 
+/* The direction the pairing will give the message if it answers a request:
+ * a response, when a <request> field will say so; else the transport's. */
+guint8 answer_direction(const dg_state *st)
+{
+    return st->p->pairing->request ? (guint8)DG_DIR_RESPONSE : st->direction;
+}
+
 /* First pass: what the waiting request of this message's key kept. */
 const dg_request_values *find_request(const dg_state *st)
 {
@@ -65,7 +72,7 @@ const dg_request_values *find_request(const dg_state *st)
     const dg_request_context *rc = st->p->request_context;
     guint64 *keys = wmem_alloc_array(st->pinfo->pool, guint64, rc->key_count);
     if (!read_keys(st, keys)) return NULL;
-    const dg_transaction *t = dg_pairing_waiting(keys, rc->key_count, st->pinfo);
+    const dg_transaction *t = dg_pairing_waiting(keys, rc->key_count, st->pinfo, answer_direction(st));
     return t ? t->values : NULL;
 }
 
@@ -81,7 +88,8 @@ void save(const dg_state *st, const dg_request_values *v)
 void find_from_walk(const dg_state *st)
 {
     st->request_pending = FALSE;
-    const dg_transaction *t = st->key_count ? dg_pairing_waiting(st->keys, st->key_count, st->pinfo) : NULL;
+    const dg_transaction *t =
+        st->key_count ? dg_pairing_waiting(st->keys, st->key_count, st->pinfo, answer_direction(st)) : NULL;
     st->request = t ? t->values : NULL;
     save(st, st->request);
 }

@@ -55,10 +55,10 @@ PAIRS = {3: 2, 6: 5, 9: 8, 10: 7, 14: 13}
 LOST = {4: 5, 15: 17}  # lost request: the frame that proves it
 
 
-def frame(direction, transaction, unit, n, client_port=40000):
+def frame(direction, transaction, unit, n, client_port=40000, client=CLIENT):
     payload = struct.pack(">HBBI", transaction, unit, 3, n)
     sport, dport = (client_port, PORT) if direction == "request" else (PORT, client_port)
-    src, dst = (CLIENT, SERVER) if direction == "request" else (SERVER, CLIENT)
+    src, dst = (client, SERVER) if direction == "request" else (SERVER, client)
     u = struct.pack("!HHHH", sport, dport, 8 + len(payload), 0) + payload
     ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src, dst)
     ip = ip[:10] + struct.pack("!H", pcapgen.ip_checksum(ip)) + ip[12:]
@@ -77,7 +77,7 @@ def write_frames(path, frames):
 
 
 def write(path, messages=MESSAGES):
-    """messages: (ms, direction, transaction, unit[, the client's port: its connection])."""
+    """messages: (ms, direction, transaction, unit[, the client's port[, its address]])."""
     write_frames(path, [(m[0], frame(m[1], m[2], m[3], n + 1, *m[4:])) for n, m in enumerate(messages)])
 
 
@@ -130,6 +130,31 @@ class TestTransactions(TsharkTestCase, unittest.TestCase):
                 times = {n: r["txnp.time"] for n, r in rows.items() if r["txnp.time"]}
                 want = {n: "%.9f" % ((MESSAGES[n - 1][0] - MESSAGES[m - 1][0]) / 1000) for n, m in PAIRS.items()}
                 check(times == want, "%s: round trips are the timestamps' differences (%s)" % (mode, times))
+
+
+class TestTwoClients(TsharkTestCase, unittest.TestCase):
+    """Two clients using the same key values are paired apart: a response answers the
+    request of the client it is sent to (as Wireshark's Modbus/TCP pairs by conversation)."""
+    OTHER = b"\x0a\x00\x00\x03"
+
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "transactions.xml"), "txnp")
+
+    def test_each_response_answers_its_own_client(self):
+        a, b = (40000, CLIENT), (40000, self.OTHER)
+        messages = [(0, "request", 1, 1) + a, (1, "request", 1, 1) + b,    # 1, 2: the same key
+                    (2, "response", 1, 1) + b, (3, "response", 1, 1) + a,  # 3 answers 2, 4 answers 1
+                    (10, "request", 2, 1) + b, (11, "response", 2, 1) + a, # 6: an orphan (A asked nothing)
+                    (12, "response", 2, 1) + b]                            # 7 answers 5
+        path = self.env.path("two-clients.pcap")
+        write(path, messages)
+        with self.checks() as check:
+            for two_pass in (True, False):
+                rows = decode(self.env, path, two_pass)
+                got = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
+                check(got == {3: 2, 4: 1, 7: 5}, "%s: each response answers its client's request (%s)" % (
+                    "-2" if two_pass else "one pass", got))
 
 
 class TestTransactionsDecimalKey(TestTransactions):
