@@ -357,10 +357,15 @@ const char* length_kind_of(const Node& n) {
     return "DG_LEN_CHILDREN";
 }
 
+// A reference to a field's value: its slot, the arithmetic on it, and whether
+// the slot holds a signed value (an int, or a computed value: -3 is a
+// negative length, not 2^64 - 3).
 std::string ref_of(const FieldRef* r) {
-    if (!r || !r->target) return "{-1, 0, 0}";
+    if (!r || !r->target) return "{-1, 0, 0, 0}";
     std::string op = r->op ? std::string("'") + r->op + "'" : "0";
-    return "{" + std::to_string(r->target->slot) + ", " + op + ", " + std::to_string(r->operand) + "}";
+    const bool is_signed = r->target->is_computed() || r->target->display == Display::Int;
+    return "{" + std::to_string(r->target->slot) + ", " + op + ", " + (is_signed ? "1" : "0") + ", " +
+           std::to_string(r->operand) + "}";
 }
 
 // Slots of a subtree are consecutive because they are numbered in document order.

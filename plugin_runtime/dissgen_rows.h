@@ -56,7 +56,7 @@ constexpr dg_node_row dg_node_of(guint8 kind, const char *name, int *hf, int *et
     r.n.hf = hf;
     r.n.ett = ett;
     r.n.slot = r.n.repeat_slot = r.n.if_slot = -1;
-    r.n.length_ref = r.n.count = dg_ref{-1, 0, 0};
+    r.n.length_ref = r.n.count = dg_ref{-1, 0, 0, 0};
     return r;
 }
 
@@ -107,7 +107,7 @@ constexpr dg_extra_row dg_node_extra() {
     r.e.encoding = ENC_UTF_8;
     r.e.units_per_second = 1000000000;
     r.e.reassemble_id = r.e.reassemble_seq = r.e.reassemble_last = r.e.reassemble_more = -1;
-    r.e.reassemble_offset = dg_ref{-1, 0, 0};
+    r.e.reassemble_offset = dg_ref{-1, 0, 0, 0};
     return r;
 }
 

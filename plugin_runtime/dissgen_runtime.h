@@ -43,9 +43,10 @@ enum dg_flags {
 
 /* A run-time value taken from an earlier field, with optional arithmetic. */
 typedef struct dg_ref {
-    gint16 slot;    /* -1: none */
-    char op;        /* 0, '+', '-' or '*' */
-    gint32 operand; /* the generator accepts at most 999999999 */
+    gint16 slot;       /* -1: none */
+    char op;           /* 0, '+', '-' or '*' */
+    guint8 is_signed;  /* the field keeps a signed value (an int, a computed value): -3 is -3 */
+    gint32 operand;    /* the generator accepts at most 999999999 */
 } dg_ref;
 
 typedef struct dg_range {

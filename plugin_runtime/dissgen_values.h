@@ -51,7 +51,10 @@ static inline gboolean in_ranges(const dg_range *ranges, guint16 first, guint16 
  * "* 999999999" (the largest operand the generator accepts) in range. */
 static inline gint64 ref_arith(guint64 value, const dg_ref *ref)
 {
-    gint64 v = value > (G_GUINT64_CONSTANT(1) << 31) ? (G_GINT64_CONSTANT(1) << 31) : (gint64)value;
+    const gint64 limit = G_GINT64_CONSTANT(1) << 31;
+    gint64 v = ref->is_signed && (gint64)value < 0 ? MAX((gint64)value, -limit)
+               : value > (guint64)limit          ? limit
+                                                 : (gint64)value;
     switch (ref->op) {
     case '+': v += ref->operand; break;
     case '-': v -= ref->operand; break;

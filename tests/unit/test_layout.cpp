@@ -134,7 +134,7 @@ TEST(Layout, WindowChildrenArePlacedAndSortedByAddress) {
     // each quiet within its size (nothing reads them): a walk nobody sees steps over them
     EXPECT_TRUE(contains(code, "{ 5, TRUE, 0x0, 4, 0, 1 },\n    { 4, TRUE, 0x110, 2, 0, 1 },\n    { 6, TRUE, 0x600, 16, 16, 16 },"))
         << code;
-    EXPECT_TRUE(contains(code, "{ {1, '-', 16}, 0, 3, 256, FALSE }")) << code;
+    EXPECT_TRUE(contains(code, "{ {1, '-', 0, 16}, 0, 3, 256, FALSE }")) << code;
     EXPECT_TRUE(contains(code, "tst_conditions = { tst_ranges, NULL };")) << "no <when> rows: " << code;
     EXPECT_FALSE(contains(code, ".peeks(")) << code;
     EXPECT_TRUE(contains(code, ".windows(tst_windows).places(tst_places)")) << code;

@@ -232,7 +232,7 @@ TEST(RuntimeRanges, OnlyTheGivenRangesCount) {
 }
 
 TEST(RuntimeRefs, Arithmetic) {
-    dg_ref none = {0, 0, 5}, plus = {0, '+', 5}, minus = {0, '-', 5}, times = {0, '*', 5};
+    dg_ref none = {0, 0, 0, 5}, plus = {0, '+', 0, 5}, minus = {0, '-', 0, 5}, times = {0, '*', 0, 5};
     EXPECT_EQ(ref_arith(7, &none), 7);
     EXPECT_EQ(ref_arith(7, &plus), 12);
     EXPECT_EQ(ref_arith(7, &minus), 2);
@@ -242,12 +242,24 @@ TEST(RuntimeRefs, Arithmetic) {
 
 TEST(RuntimeRefs, LargeValuesClampAtTwoToThe31) {
     const gint64 limit = G_GINT64_CONSTANT(1) << 31;
-    dg_ref none = {0, 0, 0}, times = {0, '*', 999999999}, minus = {0, '-', 1};
+    dg_ref none = {0, 0, 0, 0}, times = {0, '*', 0, 999999999}, minus = {0, '-', 0, 1};
     EXPECT_EQ(ref_arith(G_GUINT64_CONSTANT(1) << 31, &none), limit);
     EXPECT_EQ(ref_arith((G_GUINT64_CONSTANT(1) << 31) + 1, &none), limit);
     EXPECT_EQ(ref_arith(G_MAXUINT64, &none), limit);
     EXPECT_EQ(ref_arith(G_MAXUINT64, &minus), limit - 1);
     EXPECT_EQ(ref_arith(G_MAXUINT64, &times), limit * 999999999) << "no overflow";
+}
+
+// A signed field's (an int's, a computed value's) negative value stays negative, so that
+// a length or count from it is reported negative; an unsigned one's top values clamp.
+TEST(RuntimeRefs, SignedValuesStayNegative) {
+    const gint64 limit = G_GINT64_CONSTANT(1) << 31;
+    dg_ref signed_none = {0, 0, 1, 0}, signed_minus = {0, '-', 1, 8}, unsigned_none = {0, 0, 0, 0};
+    EXPECT_EQ(ref_arith((guint64)G_GINT64_CONSTANT(-3), &signed_none), -3);
+    EXPECT_EQ(ref_arith(5, &signed_minus), -3);
+    EXPECT_EQ(ref_arith((guint64)G_MININT64, &signed_none), -limit) << "no overflow";
+    EXPECT_EQ(ref_arith((guint64)G_GINT64_CONSTANT(-3), &unsigned_none), limit);
+    EXPECT_EQ(ref_arith(G_MAXUINT64 >> 1, &signed_none), limit) << "a large positive one still clamps";
 }
 
 TEST(RuntimeTime, UnitsBecomeSecondsAndNanoseconds) {
@@ -426,7 +438,7 @@ TEST(RuntimeConditions, PeekReadsABitFieldAheadUpToTheEndOfItsList) {
 
 TEST(RuntimeRefs, ValueOfAPresentField) {
     Message m;
-    dg_ref ref = {1, '*', 4};
+    dg_ref ref = {1, '*', 0, 4};
     m.set(1, 6);
     gint64 v = -1;
     EXPECT_TRUE(ref_value(&m.st, &ref, &m.nodes[0], "length", NULL, 0, &v));

@@ -144,8 +144,9 @@ TEST(TypedValues, HandOffAndReassemblyTables) {
     EXPECT_EQ(frame->reassemble_offset->operand, 32);
     std::string code = emit_cpp(*f.proto, "t.xml");
     // The id, offset and last fields get value slots 0, 1 and 2.
-    EXPECT_TRUE(contains(code, "dg_node_extra().dissector(\"eth_withoutfcs\").reassemble_id(0).reassemble_offset({1, '*', 32})"
-                               ".reassemble_last(2),")) << code;
+    EXPECT_TRUE(contains(code, "dg_node_extra().dissector(\"eth_withoutfcs\").reassemble_id(0).reassemble_offset({1, '*', 0, 32})"))
+        << code;
+    EXPECT_TRUE(contains(code, ".reassemble_last(2),")) << code;
     EXPECT_TRUE(contains(code, "static reassembly_table tst_reassembly;"));
     EXPECT_TRUE(contains(code, ".reassembly(&tst_reassembly, &tst_fragment_items)")) << code;
     std::string fields = list_fields(*f.proto);

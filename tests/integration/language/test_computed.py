@@ -9,7 +9,7 @@ computed again here from the bytes, with C's rules (integer division
 truncates, 64-bit wrapping), and compared with what tshark shows, in one pass
 and with -2: reals, booleans, hex, enums, signed values, the instance index,
 a hex value as wide as its mask, c ? a : b (its unchosen value undefined), an undefined value
-(division by zero: no item), a computed length, a summary.
+(division by zero: no item), a computed length, a summary; a negative computed length is reported negative.
 Needs no corpus.
 
     test_computed.py --dissgen build/bin/dissgen --source-dir .
@@ -151,6 +151,40 @@ class TestComputed(TsharkTestCase, unittest.TestCase):
                   "every [Register] has its Value's position and 2 bytes")
             check(all(size == "0" for name, size, _ in places if name == "calc.ratio"),
                   "a value without covers is zero-length")
+
+
+NEGATIVE_LENGTH_RULES = """<root name="Negative length" abbreviation="NEGL" ethertype="0x88b7">
+  <node name="Count" length="1byte" displaytype="numberdec"/>
+  <node name="Body length" value="{Count} - 8" displaytype="numberdec"/>
+  <node name="Body" length="../node[@name='Body length']" displaytype="origin"/>
+</root>
+"""
+
+
+class TestNegativeComputedLength(TsharkTestCase, unittest.TestCase):
+    """A length from a computed value below 0 is reported as negative where it is, not taken
+    for 2^31 bytes (the computed value is signed, as a length written as ../X - 8 is)."""
+    @classmethod
+    def prepare(cls):
+        cls.install_text("negative_length.xml", NEGATIVE_LENGTH_RULES, "negl")
+
+    def test_reported_negative(self):
+        macs = b"\x02\x00\x00\x00\x00\x02\x02\x00\x00\x00\x00\x01"
+        frames = [macs + struct.pack(">H", 0x88B7) + bytes([count]) + b"\x01\x02\x03" + b"\x00" * 42
+                  for count in (5, 10)]
+        out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
+        for i, f in enumerate(frames):
+            out.append(struct.pack("<IIII", 1_700_000_000 + i, 0, len(f), len(f)) + f)
+        path = self.env.add_file("negative.pcap", b"".join(out))
+        rows = self.env.field_rows(path, ["frame.number", "negl.body_length", "negl.body", "_ws.expert.message"],
+                                   aggregator="|")
+        with self.checks() as check:
+            check(rows[1]["negl.body_length"] == ["-3"] and not rows[1]["negl.body"] and
+                  rows[1]["_ws.expert.message"] == ["The length of 'Body' is negative (-3)"],
+                  "count 5: body length -3, no body, the length reported negative (%s)" % rows[1])
+            ours = [m for m in rows[2]["_ws.expert.message"] if "'Body'" in m]
+            check(rows[2]["negl.body_length"] == ["2"] and rows[2]["negl.body"] == ["01 02"] and not ours,
+                  "count 10: a body of 2 bytes, nothing reported on it (%s)" % rows[2])
 
 
 if __name__ == "__main__":
