@@ -383,11 +383,14 @@ void container_decoded(dg_state *st, const dg_node *n, gint start, gint end)
 }
 
 /* The container's summary on its item and, outside other summaries, in the
- * Info column (or in sink, for a repeated node's instances). */
+ * Info column (or in sink, for a repeated node's instances); an empty one
+ * nowhere. */
 void show_summary(dg_state *st, const dg_node *n, proto_item *item, gboolean in_summary, dg_summaries *sink)
 {
     const char *text = summary_text(st, n);
     gsize text_len = st->text->len;
+    /* A summary all of whose parts were absent says nothing: no "Name: ", no ", " in Info. */
+    if (text_len == 0) return;
     if (item) label_container(n, item, text);
     if (in_summary || !st->want_info) return;
     if (sink) {

@@ -296,6 +296,47 @@ class ContainerLabels(unittest.TestCase):
                 self.assertEqual(seen, self.expected(*case))
 
 
+
+EMPTY_SUMMARY_RULES = """<root name="Empty summary" abbreviation="EMPS" ethertype="0x88b8">
+  <node name="Head" summary="kind {Kind}">
+    <node name="Kind" length="1byte" displaytype="numberdec"/>
+  </node>
+  <node name="Body" summary="{?extra {Extra}}">
+    <node name="Extra" length="1byte" displaytype="numberdec" if="../../node[@name='Head']/node[@name='Kind']" in="1"/>
+  </node>
+</root>
+"""
+
+
+class EmptySummaries(unittest.TestCase):
+    """A summary all of whose parts are absent says nothing: no ", " in the Info column and
+    a bare "Body" item, not "Body: " (compiled summaries and the table walk alike)."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.env = TsharkEnv()
+        rules = cls.env.path("empty_summary.xml")
+        with open(rules, "w", encoding="utf-8") as f:
+            f.write(EMPTY_SUMMARY_RULES)
+        cls.env.install_plugin(ARGS.dissgen, rules)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.env.cleanup()
+
+    def test_nothing_where_nothing_is_summarised(self):
+        cap = self.env.add_file("empty.pcap", pcap([ethernet(bytes([1, 7]), ethertype=0x88B8),
+                                                    ethernet(bytes([2, 7]), ethertype=0x88B8)]))
+        for walk in ({}, {"DISSGEN_TABLE_WALK": "1"}):
+            for extra in ([], ["-2"]):
+                info = self.env.tshark(["-r", cap, "-T", "fields", "-e", "_ws.col.Info"] + extra,
+                                       extra_env=walk).stdout.splitlines()
+                self.assertEqual(info, ["kind 1, extra 7", "kind 2"], "%s %s" % (walk, extra))
+                tree = self.env.tshark(["-r", cap, "-V", "-O", "emps"] + extra, extra_env=walk).stdout
+                bodies = [line.strip() for line in tree.splitlines() if line.strip().startswith("Body")]
+                self.assertEqual(bodies, ["Body: extra 7", "Body"], "%s %s" % (walk, extra))
+
+
 if __name__ == "__main__":
     ARGS, status = run_unittests()
     if status == 0 and not os.path.isdir(corpus_dir()):
