@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -327,7 +328,18 @@ std::string build_report_plugin(const std::string& rules, BusInput& bus, const s
 // "" when `path` is open for writing, else a message for the user.
 std::string open_report(const std::string& path, std::ofstream& out) {
     out.open(path, std::ios::binary);
-    return out ? "" : "cannot write " + path;
+    return out ? "" : "cannot write " + path + ": " + std::strerror(errno);
+}
+
+// Why the report could not be written at `path`, found before the capture is
+// read (a missing folder, one that cannot be written); "" when it can be.
+std::string report_path_problem(const std::string& path) {
+    fs::path folder = fs::path(path).parent_path();
+    if (folder.empty()) folder = ".";
+    std::error_code ec;
+    if (!fs::is_directory(folder, ec)) return "cannot write " + path + ": no folder " + folder.string();
+    if (access(folder.c_str(), W_OK) != 0) return "cannot write " + path + ": " + std::strerror(errno);
+    return "";
 }
 
 // The runtime files and compile options of a plugin of `path` ("" for every
@@ -391,6 +403,10 @@ std::string choose_protocol(const std::vector<std::string>& known, const std::st
         std::cerr << "dissgen: report: " << tshark << " has no EtherCAT plugin of dissgen (no protocol with "
                      "the " DG_ANALYSIS_ETHERCAT_ESC " analysis's fields) and no plugin whose rules declare "
                      "<cycles> or <pairing>: install one first, e.g. dissgen install rules/ethercat.xml\n";
+        if (geteuid() == 0)
+            std::cerr << "dissgen: report: (run as root, tshark reads no per-user plugin folder: a plugin that "
+                         "`dissgen install` put in your home is not seen; run the report as that user, or install "
+                         "it with --system)\n";
         return "";
     }
     std::cerr << "dissgen: report: several protocols have cycles or pairing (";
@@ -401,6 +417,10 @@ std::string choose_protocol(const std::vector<std::string>& known, const std::st
 
 int cmd_report(const std::vector<std::string>& captures, const std::string& out_path, std::string rules,
                const std::string& wanted, BusInput& bus, const std::string& argv0) {
+    if (std::string problem = report_path_problem(out_path); !problem.empty()) {
+        std::cerr << "dissgen: report: " << problem << "\n";
+        return 1;
+    }
     CaptureStream stream;
     if (const char* t = std::getenv("DISSGEN_TSHARK"); t && *t) stream.tshark = t;
     std::string plugin_root;

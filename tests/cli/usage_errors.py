@@ -71,6 +71,19 @@ def main(argv=None):
                 failed += 1
                 print("FAILED: dissgen %s: exit %d (want 0), stdout %r, stderr %r, files %s" % (
                     " ".join(arguments), p.returncode, p.stdout[:40], p.stderr[:80], os.listdir(tmp)))
+        # A report whose folder is missing says so before it reads the capture (tshark is
+        # never started: a wrong DISSGEN_TSHARK would say otherwise).
+        env = dict(os.environ, DISSGEN_TSHARK=os.path.join(tmp, "no-such-tshark"))
+        p = subprocess.run([dissgen, "report", "c.pcap", "-o", "missing/r.html"], capture_output=True, text=True,
+                           cwd=tmp, env=env)
+        want = "dissgen: report: cannot write missing/r.html: no folder missing"
+        if p.returncode == 1 and p.stderr.splitlines() == [want] and not os.listdir(tmp):
+            passed += 1
+            print("ok: dissgen report -o missing/r.html: exit 1, %r" % want)
+        else:
+            failed += 1
+            print("FAILED: dissgen report -o missing/r.html: exit %d (want 1), stderr %r (want %r)" % (
+                p.returncode, p.stderr, want))
     print("%d passed, %d failed" % (passed, failed))
     return 0 if failed == 0 else 1
 
