@@ -101,6 +101,7 @@ struct dg_state {
     gboolean wants_cycles;
     dg_cycle_input cycle;
     guint cycle_capacity;
+    gboolean cycle_on_stack;     /* cycle's arrays are dg_message_buffers' (not to be realloc'ed) */
     /* request{...}: what the paired request kept, NULL when it is not known */
     mutable const dg_request_values *request;
     mutable gboolean request_missed; /* a value read the request, and it is not known */
@@ -286,6 +287,27 @@ static inline const guint8 *signature_bytes(dg_state *st, gint offset, gint leng
     return b;
 }
 
+/* Room for twice as many signature values: the arrays start on the stack
+ * (dg_message_buffers), and move to pinfo->pool when a message has more. */
+static inline void grow_cycle_input(dg_state *st)
+{
+    dg_cycle_input *in = &st->cycle;
+    const guint old = st->cycle_capacity, c = old ? 2 * old : 8;
+    wmem_allocator_t *pool = st->pinfo->pool;
+    if (st->cycle_on_stack) {
+        in->values = (guint64 *)wmem_memdup(pool, in->values, old * sizeof(guint64));
+        in->nodes = (guint16 *)wmem_memdup(pool, in->nodes, old * sizeof(guint16));
+        in->bytes = (const guint8 **)wmem_memdup(pool, in->bytes, old * sizeof(const guint8 *));
+        in->lengths = (guint32 *)wmem_memdup(pool, in->lengths, old * sizeof(guint32));
+        st->cycle_on_stack = FALSE;
+    }
+    in->values = (guint64 *)wmem_realloc(pool, in->values, c * sizeof(guint64));
+    in->nodes = (guint16 *)wmem_realloc(pool, in->nodes, c * sizeof(guint16));
+    in->bytes = (const guint8 **)wmem_realloc(pool, in->bytes, c * sizeof(const guint8 *));
+    in->lengths = (guint32 *)wmem_realloc(pool, in->lengths, c * sizeof(guint32));
+    st->cycle_capacity = c;
+}
+
 /* A leaf the cycle analysis reads (dg_extra.cycle_role), first pass. */
 static inline void cycle_record(dg_state *st, const dg_node *n, guint64 value, gint offset, gint length)
 {
@@ -294,14 +316,7 @@ static inline void cycle_record(dg_state *st, const dg_node *n, guint64 value, g
     if (x->cycle_role == DG_CYCLE_SIGNATURE) {
         const guint8 *bytes = NULL;
         if (!(n->flags & DG_NUMERIC) && !(bytes = signature_bytes(st, offset, length, &value))) return;
-        if (in->count == st->cycle_capacity) {
-            st->cycle_capacity = st->cycle_capacity ? 2 * st->cycle_capacity : 8;
-            const gsize c = st->cycle_capacity;
-            in->values = (guint64 *)wmem_realloc(st->pinfo->pool, in->values, c * sizeof(guint64));
-            in->nodes = (guint16 *)wmem_realloc(st->pinfo->pool, in->nodes, c * sizeof(guint16));
-            in->bytes = (const guint8 **)wmem_realloc(st->pinfo->pool, in->bytes, c * sizeof(const guint8 *));
-            in->lengths = (guint32 *)wmem_realloc(st->pinfo->pool, in->lengths, c * sizeof(guint32));
-        }
+        if (in->count == st->cycle_capacity) grow_cycle_input(st);
         in->values[in->count] = value;
         in->bytes[in->count] = bytes;
         in->lengths[in->count] = bytes ? (guint32)length : 0;

@@ -782,10 +782,15 @@ guint count_message(const dg_protocol *p, packet_info *pinfo)
 /* The buffers one message's state starts in, on dg_dissect's stack. The
  * values of one message live there when they fit (most rule files): two
  * allocations fewer per message. Nothing keeps them after it. */
-enum { stack_slots = 128 };
+enum { stack_slots = 128, stack_cycle_values = 64 };
 struct dg_message_buffers {
     dg_slot slots[stack_slots];
     guint8 present[stack_slots];
+    /* <cycles>: the first signature values of a message (dg_cycle_input) */
+    guint64 cycle_values[stack_cycle_values];
+    guint16 cycle_nodes[stack_cycle_values];
+    const guint8 *cycle_bytes[stack_cycle_values];
+    guint32 cycle_lengths[stack_cycle_values];
     dg_text info_text, scratch_text;
     char info_buf[256], scratch_buf[256];
 };
@@ -811,6 +816,14 @@ void begin_message(dg_state *st, dg_message_buffers *b, const dg_protocol *p, tv
     /* The analysis reads its inputs on the first pass only (dissgen_pairing.h). */
     st->wants_view = p->pairing && p->pairing->analysis && !PINFO_FD_VISITED(pinfo);
     st->wants_cycles = p->cycles && !PINFO_FD_VISITED(pinfo);
+    if (st->wants_cycles) {
+        st->cycle.values = b->cycle_values;
+        st->cycle.nodes = b->cycle_nodes;
+        st->cycle.bytes = b->cycle_bytes;
+        st->cycle.lengths = b->cycle_lengths;
+        st->cycle_capacity = stack_cycle_values;
+        st->cycle_on_stack = TRUE;
+    }
     /* Summaries are text for the Info column and for container items; build
      * them only when someone sees them: tshark -T fields and -V have a visible
      * tree and no columns, summary lines have columns and no tree, and a
