@@ -197,9 +197,7 @@ stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info 
         probe.src = pinfo->src; /* shallow: copied below if the stream is new */
         probe.port = pinfo->srcport;
     }
-    guint32 h = 2166136261u;
-    for (guint i = 0; i < in->count; i++) h = dg_rt::hash_mix(h, in->values[i] ^ ((guint64)in->nodes[i] << 48));
-    h = dg_rt::hash_mix(h, probe.port);
+    guint32 h = dg_rt::hash_mix(dg_cycle_input_hash(in), probe.port);
     if (probe.src.type != AT_NONE) h = add_address_to_hash(h, &probe.src);
     probe.hash = h;
     stream *s = (stream *)wmem_map_lookup(c->streams, &probe);

@@ -12,6 +12,7 @@
 #pragma once
 
 #include "dissgen_runtime.h"
+#include "dissgen_values.h"
 
 /* What the walk decoded of one message for <cycles> (first pass). */
 typedef struct dg_cycle_input {
@@ -34,6 +35,15 @@ static inline gboolean dg_cycle_input_in_stream(const dg_cycles *c, const dg_cyc
 {
     const guint32 all_only = c->only_count >= 32 ? G_MAXUINT32 : ((guint32)1 << c->only_count) - 1;
     return in->count && !in->never && (in->only_held & all_only) == all_only;
+}
+
+/* The 32-bit hash of a message's signature values and their nodes (a
+ * stream's, before its sender is added). */
+static inline guint32 dg_cycle_input_hash(const dg_cycle_input *in)
+{
+    guint32 h = 2166136261u;
+    for (guint i = 0; i < in->count; i++) h = dg_rt::hash_mix(h, in->values[i] ^ ((guint64)in->nodes[i] << 48));
+    return h;
 }
 
 extern "C" {

@@ -25,6 +25,7 @@
  */
 #include "dissgen_pairing.h"
 #include "dissgen_periods.h"
+#include "dissgen_values.h"
 
 
 #include <epan/conversation.h>
@@ -1151,8 +1152,7 @@ const guint64 *with_client(const guint64 *keys, guint *count, const packet_info 
         for (int i = 0; i < client->len; i++) value = value << 8 | bytes[i];
         value = value << 16 | (port & 0xffff);
     } else {
-        value = 14695981039346656037ull;
-        for (int i = 0; i < client->len; i++) value = (value ^ bytes[i]) * 1099511628211ull;
+        value = dg_rt::fnv1a64(14695981039346656037ull, bytes, (gsize)client->len);
         value = (value ^ port) * 1099511628211ull;
     }
     guint64 *out = wmem_alloc_array(pinfo->pool, guint64, *count + 1);

@@ -281,9 +281,7 @@ static inline const guint8 *signature_bytes(dg_state *st, gint offset, gint leng
     if (length < 0 || !tvb_bytes_exist(st->tvb, offset, length)) return NULL;
     const guint8 *b = length ? (const guint8 *)tvb_memdup(st->pinfo->pool, st->tvb, offset, length)
                              : (const guint8 *)"";
-    guint64 h = 14695981039346656037ull ^ (guint64)length;
-    for (gint i = 0; i < length; i++) h = (h ^ b[i]) * 1099511628211ull;
-    *hash = h;
+    *hash = fnv1a64(14695981039346656037ull ^ (guint64)length, b, (gsize)length);
     return b;
 }
 
@@ -292,7 +290,7 @@ static inline const guint8 *signature_bytes(dg_state *st, gint offset, gint leng
 static inline void grow_cycle_input(dg_state *st)
 {
     dg_cycle_input *in = &st->cycle;
-    const guint old = st->cycle_capacity, c = old ? 2 * old : 8;
+    const guint old = st->cycle_capacity, c = 2 * old; /* begin_message gave the first */
     wmem_allocator_t *pool = st->pinfo->pool;
     if (st->cycle_on_stack) {
         in->values = (guint64 *)wmem_memdup(pool, in->values, old * sizeof(guint64));

@@ -82,6 +82,14 @@ static inline gboolean is_repeated(const dg_node *n)
            (n->extra && (n->extra->repeat_rest || n->extra->offsets_slot >= 0));
 }
 
+/* 64-bit FNV-1a of n bytes, from h (14695981039346656037 to start): a value
+ * that stands for bytes (a signature field's text, an IPv6 client). */
+static inline guint64 fnv1a64(guint64 h, const guint8 *b, gsize n)
+{
+    for (gsize i = 0; i < n; i++) h = (h ^ b[i]) * G_GUINT64_CONSTANT(1099511628211);
+    return h;
+}
+
 /* Folds a 64-bit word into a 32-bit hash (a stream's signature, a learn's
  * keys): the word's bits mixed (MurmurHash3's finaliser step), then FNV's
  * multiply. Start from 2166136261u. */

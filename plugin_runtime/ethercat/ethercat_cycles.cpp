@@ -39,7 +39,6 @@
 
 #include "../dissgen_cycles.h"
 #include "../dissgen_periods.h"
-#include "../dissgen_values.h"
 
 #include <epan/stat_tap_ui.h>
 #include <epan/stats_tree.h>
@@ -155,8 +154,7 @@ gboolean sig_equal(gconstpointer a, gconstpointer b)
 signature *signature_of(cycle_model *m, const dg_cycle_input *in, const datagram *d, guint n)
 {
     if (!m->declared || !in || !n || !dg_cycle_input_in_stream(m->declared, in)) return NULL;
-    guint32 h = 2166136261u;
-    for (guint i = 0; i < in->count; i++) h = dg_rt::hash_mix(h, in->values[i] ^ ((guint64)in->nodes[i] << 48));
+    const guint32 h = dg_cycle_input_hash(in);
     signature probe; /* what sig_hash() and sig_equal() read, no more */
     probe.hash = h;
     probe.value_count = in->count;
