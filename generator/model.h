@@ -102,14 +102,17 @@ struct Finding {
 };
 
 // <learn name="..." value="EXPR" [if="EXPR"] [sender="yes"]> <key value="EXPR"
-// [lookup="EXPR"]/>... </learn> inside a node: once an instance of the node
-// is decoded (first pass), the value is learned under the keys' values (and
-// the sender's address); learned{NAME} in a later message reads the latest
-// value learned under its own keys (lookup, else value) in an earlier one.
+// [lookup="EXPR"] [span="EXPR"]/>... </learn> inside a node: once an
+// instance of the node is decoded (first pass), the value is learned under
+// the keys' values (and the sender's address); learned{NAME} in a later
+// message reads the latest value learned under its own keys (lookup, else
+// value) in an earlier one. A key with a span learns a range: the values
+// value .. value + span - 1, any of which finds it.
 struct LearnKey {
     Expr value;
     std::optional<Expr> lookup;  // how a reader computes the key, when not as the learner does
-    std::string value_text, lookup_text;
+    std::optional<Expr> span;    // how many key values from this one the value is learned under
+    std::string value_text, lookup_text, span_text;
     int line = 0;
 };
 

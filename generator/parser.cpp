@@ -55,7 +55,7 @@ const std::vector<std::string> kHeuristicAttributes = {"table", "enabled"};
 const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};
 const std::vector<std::string> kFindingAttributes = {"name", "severity", "group", "condition", "text"};
 const std::vector<std::string> kLearnAttributes = {"name", "value", "if", "sender"};
-const std::vector<std::string> kLearnKeyAttributes = {"value", "lookup"};
+const std::vector<std::string> kLearnKeyAttributes = {"value", "lookup", "span"};
 const std::vector<std::string> kPairingAttributes = {"timeout", "analysis", "order"};
 const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kInputAttributes = {"name", "field"};
@@ -901,6 +901,11 @@ void Parser::parse_learn(xmlNode* el, Node& node) {
             k.lookup_text = key_attrs["lookup"];
             k.lookup.emplace();
             ok = parse_expression_attribute(k.lookup_text, k.line, "lookup of " + what, *k.lookup) && ok;
+        }
+        if (key_attrs.count("span")) {
+            k.span_text = key_attrs["span"];
+            k.span.emplace();
+            ok = parse_expression_attribute(k.span_text, k.line, "span of " + what, *k.span) && ok;
         }
         l.keys.push_back(std::move(k));
     }

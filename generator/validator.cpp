@@ -245,7 +245,8 @@ void Validator::check_table_sizes() {
             if (l.condition) operations += compile_expression(*l.condition, false).size();
             for (const LearnKey& k : l.keys)
                 operations += compile_expression(k.value, false).size() +
-                              (k.lookup ? compile_expression(*k.lookup, false).size() : 0);
+                              (k.lookup ? compile_expression(*k.lookup, false).size() : 0) +
+                              (k.span ? compile_expression(*k.span, false).size() : 0);
         }
         over(n, operations, max_rows, "operations in computed values");
         if (n.slot >= 0) over(n, static_cast<size_t>(n.slot) + 1, 32767, "fields whose values are read");
@@ -259,7 +260,8 @@ void Validator::check_table_sizes() {
         key_rows += row.lookups.size();
         for (size_t i = 0; i < row.lookups.size(); ++i)
             operations += compile_expression(row.learn->keys[i].value, false).size() +
-                          (row.lookups[i] ? compile_expression(*row.lookups[i], false).size() : 0);
+                          (row.lookups[i] ? compile_expression(*row.lookups[i], false).size() : 0) +
+                          (row.learn->keys[i].span ? compile_expression(*row.learn->keys[i].span, false).size() : 0);
         const size_t rows = proto_.learns.size() + k + 1;
         for (auto [count, limit, what] : {std::make_tuple(rows, size_t{32767}, "learned{...} readers and <learn>s"),
                                           std::make_tuple(key_rows, max_rows, "keys of learned{...} readers"),
@@ -2120,9 +2122,18 @@ void Validator::check_learns(Node& n) {
             }
             check_integer_expr(n, e, ExprSite{key_reach, line, where, at_reader}, "the " + word + " of " + what);
         };
+        const LearnKey* spanned = nullptr;
         for (LearnKey& k : l.keys) {
             check_key(k.value, k.line, "key", reach, false);
             if (k.lookup) check_key(*k.lookup, k.line, "lookup", everywhere, true);
+            if (!k.span) continue;
+            check_key(*k.span, k.line, "span", reach, false);
+            if (spanned)
+                diags_.error(k.line, what + ": a second key with a span (the key on line " +
+                                         std::to_string(spanned->line) +
+                                         " has one): a reader's key finds one range, so one key may have a span");
+            else
+                spanned = &k;
         }
     }
 }

@@ -14,6 +14,13 @@
  * message before this one. Since each value knows when it was learned, every
  * pass reads the same: tshark -2 and the GUI, frames clicked in any order,
  * see what the first pass saw at that frame.
+ *
+ * A key with a span makes ranges: the learner's key value starts a range of
+ * span values, and its entry is the range (start and end are its keys). The
+ * ranges of one learn under the same other keys form a group; a reader's key
+ * finds, among the group's ranges that hold it, the value taught latest
+ * before the reader (EtherCAT's FMMUs: a logical address finds the slave
+ * whose window holds it).
  */
 #include "dissgen_state.h"
 
@@ -32,8 +39,9 @@ typedef struct {
     guint64 value;
 } taught;
 
-/* What one <learn> learned under one set of keys. */
-typedef struct {
+/* What one <learn> learned under one set of keys; or, in `groups`, the
+ * ranges a learn with a span learned under one set of its other keys. */
+typedef struct entry {
     guint32 hash;
     guint16 learn;
     guint16 key_count;
@@ -42,10 +50,14 @@ typedef struct {
     guint64 *keys;
     taught *values; /* in the order of their messages */
     guint count, capacity;
+    struct entry **ranges; /* a group's */
+    guint range_count, range_capacity;
 } entry;
 
-/* Per capture: the entries (wmem_file_scope, emptied when a file closes). */
+/* Per capture: the entries and groups of ranges (wmem_file_scope, emptied
+ * when a file closes). */
 wmem_map_t *entries = NULL;
+wmem_map_t *groups = NULL;
 
 guint entry_hash(gconstpointer k) { return ((const entry *)k)->hash; }
 
@@ -61,26 +73,41 @@ dg_expr_value evaluate(const dg_state *st, guint16 first, guint16 count)
     return dg_expr_eval(&st->p->exprs[first], count, &message_readers, st, st->instance);
 }
 
-/* The probe of learn `index`'s entry: its keys as the learner (lookup FALSE)
- * or a reader computes them, in keys[]; FALSE when one is undefined. */
-gboolean probe_of(const dg_state *st, guint16 index, gboolean lookup, guint64 *keys, entry *probe)
+/* The key of learn `index` with a span, or -1. */
+gint span_key(const dg_protocol *p, const dg_learn *l)
 {
-    const dg_learn *l = &st->p->learns[index];
-    memset(probe, 0, sizeof *probe);
-    if (l->keys_of) index = (guint16)(l->keys_of - 1); /* a reader's keys: the entries are its learn's */
-    probe->learn = index;
-    probe->key_count = l->key_count;
-    probe->keys = keys;
-    clear_address(&probe->src);
-    guint32 h = 2166136261u ^ index;
+    for (guint16 i = 0; i < l->key_count; i++)
+        if (p->learn_keys[l->key_first + i].span_count) return i;
+    return -1;
+}
+
+/* The keys of learn `index` as the learner (lookup FALSE) or a reader
+ * computes them, in keys[]; FALSE when one is undefined. */
+gboolean keys_of(const dg_state *st, const dg_learn *l, gboolean lookup, guint64 *keys)
+{
     for (guint16 i = 0; i < l->key_count; i++) {
         const dg_learn_key *k = &st->p->learn_keys[l->key_first + i];
         dg_expr_value v = lookup && k->lookup_count ? evaluate(st, k->lookup_first, k->lookup_count)
                                                     : evaluate(st, k->value_first, k->value_count);
         if (!v.defined) return FALSE;
         keys[i] = (guint64)v.integer;
-        h = hash_mix(h, keys[i]);
     }
+    return TRUE;
+}
+
+/* The probe of the entry (or group) of learn `index` under keys[0 .. count)
+ * (the sender too, with by_sender). */
+void probe_of(const dg_state *st, guint16 index, guint64 *keys, guint16 count, entry *probe)
+{
+    const dg_learn *l = &st->p->learns[index];
+    memset(probe, 0, sizeof *probe);
+    if (l->keys_of) index = (guint16)(l->keys_of - 1); /* a reader's keys: the entries are its learn's */
+    probe->learn = index;
+    probe->key_count = count;
+    probe->keys = keys;
+    clear_address(&probe->src);
+    guint32 h = 2166136261u ^ index;
+    for (guint16 i = 0; i < count; i++) h = hash_mix(h, keys[i]);
     if (l->by_sender) {
         probe->src = st->pinfo->src; /* shallow: copied when the entry is made */
         probe->port = st->pinfo->srcport;
@@ -88,7 +115,12 @@ gboolean probe_of(const dg_state *st, guint16 index, gboolean lookup, guint64 *k
         h = add_address_to_hash(h, &probe->src);
     }
     probe->hash = h;
-    return TRUE;
+}
+
+/* The keys without the spanned one, at keys[0 .. count - 1): a group's. */
+void drop_key(guint64 *keys, guint16 count, gint spanned)
+{
+    memmove(&keys[spanned], &keys[spanned + 1], (count - spanned - 1) * sizeof(guint64));
 }
 
 /* Whether (frame, message) comes before the value `t` was taught by. */
@@ -113,30 +145,39 @@ guint taught_before(const entry *e, guint32 frame, guint32 message)
     return low;
 }
 
-entry *new_entry(const entry *probe)
+entry *new_entry(wmem_map_t *map, const entry *probe)
 {
     entry *e = wmem_new0(wmem_file_scope(), entry);
     *e = *probe;
     e->keys = (guint64 *)wmem_memdup(wmem_file_scope(), probe->keys, probe->key_count * sizeof(guint64));
     copy_address_wmem(wmem_file_scope(), &e->src, &probe->src);
-    e->values = NULL;
-    e->count = e->capacity = 0;
-    wmem_map_insert(entries, e, e);
+    wmem_map_insert(map, e, e);
     return e;
+}
+
+void add_range(entry *group, entry *range)
+{
+    if (group->range_count == group->range_capacity) {
+        group->range_capacity = group->range_capacity ? 2 * group->range_capacity : 2;
+        group->ranges =
+            (entry **)wmem_realloc(wmem_file_scope(), group->ranges, group->range_capacity * sizeof(entry *));
+    }
+    group->ranges[group->range_count++] = range;
 }
 
 /* Records `value` as taught by (frame, message), in order: the first pass
  * meets the frames in order, so it is nearly always appended. Its message
  * teaching again replaces what it taught; the value the entry already had
- * is not recorded again. */
-void teach(entry *e, guint32 frame, guint32 message, guint64 value)
+ * is not recorded again, unless `renewed` (a range that an overlapping one
+ * taught later had overtaken is the latest again). */
+void teach(entry *e, guint32 frame, guint32 message, guint64 value, gboolean renewed)
 {
     guint at = taught_before(e, frame, message);
     if (at < e->count && e->values[at].frame == frame && e->values[at].message == message) {
         e->values[at].value = value;
         return;
     }
-    if (at > 0 && e->values[at - 1].value == value) return;
+    if (at > 0 && e->values[at - 1].value == value && !renewed) return;
     if (e->count == e->capacity) {
         e->capacity = e->capacity ? 2 * e->capacity : 2;
         e->values = (taught *)wmem_realloc(wmem_file_scope(), e->values, e->capacity * sizeof(taught));
@@ -144,6 +185,60 @@ void teach(entry *e, guint32 frame, guint32 message, guint64 value)
     memmove(&e->values[at + 1], &e->values[at], (e->count - at) * sizeof(taught));
     e->values[at] = {frame, message, value};
     e->count++;
+}
+
+gint64 range_start(const entry *r) { return (gint64)r->keys[r->key_count - 2]; }
+gint64 range_end(const entry *r) { return (gint64)r->keys[r->key_count - 1]; }
+
+/* Whether a range of `group` that overlaps `r` was taught after r's latest
+ * value: teaching r again, even the same value, makes r the one that holds
+ * the overlap. */
+gboolean overtaken(const entry *group, const entry *r)
+{
+    if (!r->count) return FALSE;
+    const taught *last = &r->values[r->count - 1];
+    for (guint i = 0; i < group->range_count; i++) {
+        const entry *o = group->ranges[i];
+        if (o != r && o->count && range_start(o) < range_end(r) && range_start(r) < range_end(o) &&
+            before(last->frame, last->message, &o->values[o->count - 1]))
+            return TRUE;
+    }
+    return FALSE;
+}
+
+/* The entry learn `index` teaches under keys[0 .. key_count) in this
+ * message, and in *group the group of ranges it is in (NULL without a span);
+ * NULL when a span is undefined, not positive or runs past the integers. A
+ * range's entry is found by its start and end. */
+entry *learning_entry(dg_state *st, guint16 index, guint64 *keys, entry **group)
+{
+    *group = NULL;
+    const dg_learn *l = &st->p->learns[index];
+    const gint spanned = span_key(st->p, l);
+    entry probe;
+    if (spanned < 0) {
+        probe_of(st, index, keys, l->key_count, &probe);
+        entry *e = (entry *)wmem_map_lookup(entries, &probe);
+        return e ? e : new_entry(entries, &probe);
+    }
+    const dg_learn_key *k = &st->p->learn_keys[l->key_first + spanned];
+    dg_expr_value span = evaluate(st, k->span_first, k->span_count);
+    const gint64 start = (gint64)keys[spanned];
+    gint64 end;
+    if (!span.defined || span.integer <= 0 || __builtin_add_overflow(start, span.integer, &end)) return NULL;
+    drop_key(keys, l->key_count, spanned);
+    const guint16 others = (guint16)(l->key_count - 1);
+    keys[others] = (guint64)start;
+    keys[others + 1] = (guint64)end;
+    probe_of(st, index, keys, (guint16)(others + 2), &probe);
+    entry *e = (entry *)wmem_map_lookup(entries, &probe);
+    const gboolean made = !e;
+    if (made) e = new_entry(entries, &probe);
+    probe_of(st, index, keys, others, &probe);
+    *group = (entry *)wmem_map_lookup(groups, &probe);
+    if (!*group) *group = new_entry(groups, &probe);
+    if (made) add_range(*group, e);
+    return e;
 }
 
 } // namespace
@@ -154,15 +249,34 @@ gboolean read_learned(const void *context, gint16 index, guint64 *value)
 {
     const dg_state *st = (const dg_state *)context;
     if (!entries || index < 0 || index >= st->p->learn_count) return FALSE;
+    const dg_learn *l = &st->p->learns[index];
     guint64 keys[DG_MAX_LEARN_KEYS];
+    if (l->key_count > G_N_ELEMENTS(keys) || !keys_of(st, l, TRUE, keys)) return FALSE;
+    const gint spanned = span_key(st->p, l);
     entry probe;
-    if (st->p->learns[index].key_count > G_N_ELEMENTS(keys)) return FALSE;
-    if (!probe_of(st, (guint16)index, TRUE, keys, &probe)) return FALSE;
-    const entry *e = (const entry *)wmem_map_lookup(entries, &probe);
-    if (!e) return FALSE;
-    guint n = taught_before(e, st->pinfo->num, st->message);
-    if (n == 0) return FALSE;
-    *value = e->values[n - 1].value;
+    if (spanned < 0) {
+        probe_of(st, (guint16)index, keys, l->key_count, &probe);
+        const entry *e = (const entry *)wmem_map_lookup(entries, &probe);
+        if (!e) return FALSE;
+        guint n = taught_before(e, st->pinfo->num, st->message);
+        if (n == 0) return FALSE;
+        *value = e->values[n - 1].value;
+        return TRUE;
+    }
+    /* the latest value taught before this message by a range that holds the key */
+    const gint64 at = (gint64)keys[spanned];
+    drop_key(keys, l->key_count, spanned);
+    probe_of(st, (guint16)index, keys, (guint16)(l->key_count - 1), &probe);
+    const entry *group = (const entry *)wmem_map_lookup(groups, &probe);
+    const taught *latest = NULL;
+    for (guint i = 0; group && i < group->range_count; i++) {
+        const entry *r = group->ranges[i];
+        if (at < range_start(r) || at >= range_end(r)) continue;
+        guint n = taught_before(r, st->pinfo->num, st->message);
+        if (n && (!latest || before(latest->frame, latest->message, &r->values[n - 1]))) latest = &r->values[n - 1];
+    }
+    if (!latest) return FALSE;
+    *value = latest->value;
     return TRUE;
 }
 
@@ -177,19 +291,20 @@ void learn_values(dg_state *st, const dg_node *n)
             if (!holds.defined || holds.integer == 0) continue;
         }
         dg_expr_value v = evaluate(st, l->value_first, l->value_count);
-        guint64 keys[DG_MAX_LEARN_KEYS];
-        entry probe;
-        if (!v.defined || l->key_count > G_N_ELEMENTS(keys) || !probe_of(st, index, FALSE, keys, &probe)) continue;
-        entry *e = (entry *)wmem_map_lookup(entries, &probe);
-        if (!e) e = new_entry(&probe);
-        teach(e, st->pinfo->num, st->message, (guint64)v.integer);
+        guint64 keys[DG_MAX_LEARN_KEYS + 1]; /* a range's: its start and end at the end */
+        if (!v.defined || l->key_count > DG_MAX_LEARN_KEYS || !keys_of(st, l, FALSE, keys)) continue;
+        entry *group;
+        entry *e = learning_entry(st, index, keys, &group);
+        if (e) teach(e, st->pinfo->num, st->message, (guint64)v.integer, group && overtaken(group, e));
     }
 }
 
 void learned_register(const dg_protocol *p)
 {
-    if (p->learn_count && !entries)
+    if (p->learn_count && !entries) {
         entries = wmem_map_new_autoreset(wmem_epan_scope(), wmem_file_scope(), entry_hash, entry_equal);
+        groups = wmem_map_new_autoreset(wmem_epan_scope(), wmem_file_scope(), entry_hash, entry_equal);
+    }
 }
 
 } // namespace dg_rt

@@ -149,10 +149,13 @@ typedef struct dg_learn {
 #define DG_MAX_LEARN_KEYS 16
 
 /* A key of a <learn>: its value as the learner computes it, and as a reader
- * of learned{...} does (lookup; lookup_count 0: as the learner). */
+ * of learned{...} does (lookup; lookup_count 0: as the learner). With a span
+ * (span_count > 0; one key of a learn at most) the learner's value starts a
+ * range of span values and a reader's key finds the range that holds it. */
 typedef struct dg_learn_key {
     guint16 value_first, value_count;
     guint16 lookup_first, lookup_count;
+    guint16 span_first, span_count;
 } dg_learn_key;
 
 /* The most entries an offset table may have; longer ones are malformed. */

@@ -172,6 +172,7 @@ TESTS = {
     "computed": integration("test_computed.py"),
     "learned": integration("test_learned.py"),
     "learned_layout": integration("test_learned_layout.py"),
+    "learned_ranges": integration("test_learned_ranges.py"),
     "rule_findings": integration("test_rule_findings.py"),
     "rule_cycles": integration("test_rule_cycles.py"),
     "polled_cycles": integration("test_polled_cycles.py"),

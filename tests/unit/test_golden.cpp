@@ -40,6 +40,7 @@ TEST(Golden, LayoutRules) { check_golden("tests/rules/layout.xml", "dissgen_layo
 TEST(Golden, SummaryParts) { check_golden("tests/rules_ok/summary_parts.xml", "dissgen_summary_parts.cpp.golden"); }
 // <learn> and learned{Name}: values from earlier frames.
 TEST(Golden, LearnedValues) { check_golden("tests/rules/learned.xml", "dissgen_learned.cpp.golden"); }
+TEST(Golden, LearnedRanges) { check_golden("tests/rules/learned_ranges.xml", "dissgen_learned_ranges.cpp.golden"); }
 
 TEST(Golden, OutputIsDeterministicAndHasNoPaths) {
     Front f = front_end(read_file(source_path("rules/ethercat.xml")));

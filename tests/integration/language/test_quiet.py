@@ -370,6 +370,13 @@ def learned_frames():
     return [m.frame(sender, m.configure(*f) if kind == "configure" else m.data(*f)) for sender, kind, f in messages]
 
 
+def learned_ranges_frames():
+    """tests/rules/learned_ranges.xml: test_learned_ranges.py's windows and data, some unmapped."""
+    import test_learned_ranges as m
+    messages = m.scripted() + m.random_messages(random.Random(12), 80)
+    return [m.frame(m.window(*f) if kind == "window" else m.data(*f)) for kind, f in messages]
+
+
 def overlays_frames():
     """tests/rules/overlays.xml: test_overlays.py's messages, well-formed and malformed."""
     import test_overlays as m
@@ -451,6 +458,7 @@ CAPTURES = {
     "tests/rules/bit_fields.xml": bit_fields_frames,
     "tests/rules/learned.xml": learned_frames,
     "tests/rules/learned_layout.xml": learned_layout_frames,
+    "tests/rules/learned_ranges.xml": learned_ranges_frames,
     "tests/rules/entry_list.xml": entry_list_frames,
     "tests/rules/goose.xml": goose_frames,
     "tests/rules/capture_cut.xml": capture_cut_frames,

@@ -1,0 +1,171 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Values learned for ranges of keys (<key span="...">) with real tshark:
+tests/rules/learned_ranges.xml on ethertype 0x88c4.
+
+A Window message gives a device the addresses start .. start + size - 1 of a segment; each
+byte of a later Data message of that segment looks its address up and shows the device whose
+window holds it (Owner) and its offset in that window, or raises win.finding.unmapped. The
+expected values come from a model of the frames in order (the truth of the bytes): where
+windows overlap the one taught latest wins, a window of size 0 or cut short teaches nothing, a
+window taught again with the same start and size keeps its place, each segment has its own
+windows. The same values in one pass, with -2, and with -2 and a display filter that keeps
+every third frame. Needs no corpus.
+
+    test_learned_ranges.py --dissgen build/bin/dissgen --source-dir .
+"""
+
+import os
+import random
+import struct
+import sys
+import unittest
+import xml.etree.ElementTree as ET
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
+from pcapgen import raw_pcap_bytes  # noqa: E402
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
+
+ETHERTYPE = 0x88C4
+SENDER = b"\x02\0\0\0\0\x01"
+
+
+def frame(payload):
+    return b"\x02\0\0\0\0\xff" + SENDER + struct.pack("!H", ETHERTYPE) + payload
+
+
+def window(segment, device, start, size, cut=False):
+    data = struct.pack("!BBBHB", 1, segment, device, start, size)
+    return data[:5] if cut else data
+
+
+def data(segment, address, values):
+    return struct.pack("!BBHB", 2, segment, address, len(values)) + bytes(values)
+
+
+def expected(messages):
+    """{frame: [(address, owner, offset) of each byte]} of the Data frames (owner, offset
+    None where no window holds the byte), by a model of the rules: the windows taught by
+    earlier frames, the latest taught first."""
+    windows, out = [], []  # windows: [(segment, start, end, device)], latest last
+    out = {}
+    for number, (kind, fields) in enumerate(messages, 1):
+        if kind == "window":
+            segment, device, start, size, cut = fields
+            if cut or size == 0:
+                continue
+            taught = (segment, start, start + size, device)
+            if windows and windows[-1] == taught:
+                continue
+            windows = [w for w in windows if w[:3] != taught[:3]] + [taught]
+            continue
+        segment, address, values = fields
+        row = []
+        for i in range(len(values)):
+            at = (address + i)
+            holder = next((w for w in reversed(windows) if w[0] == segment and w[1] <= at < w[2]), None)
+            row.append((at, holder[3], at - holder[1]) if holder else (at, None, None))
+        out[number] = row
+    return out
+
+
+def scripted():
+    """Each rule of the construct once, in order."""
+    return [
+        ("data", (0, 0x100, [1])),                # 1: nothing learned: unmapped
+        ("window", (0, 7, 0x100, 4, False)),      # 2: device 7: 0x100..0x103
+        ("window", (0, 8, 0x104, 2, False)),      # 3: device 8: 0x104..0x105
+        ("data", (0, 0xFF, [0, 1, 2, 3, 4, 5, 6, 7])),  # 4: 0xff unmapped, 7 x4, 8 x2, 0x106 unmapped
+        ("window", (0, 9, 0x102, 3, False)),      # 5: device 9 overlaps both: 0x102..0x104
+        ("data", (0, 0x100, [0] * 6)),            # 6: 7 7 9 9 9 8
+        ("window", (0, 5, 0x200, 0, False)),      # 7: size 0: teaches nothing
+        ("window", (0, 6, 0x200, 4, True)),       # 8: cut short: teaches nothing
+        ("data", (0, 0x200, [1, 2])),             # 9: unmapped
+        ("data", (1, 0x100, [1])),                # 10: segment 1 has no windows
+        ("window", (0, 7, 0x100, 4, False)),      # 11: device 7 again, latest now: 7 7 7 7 8 8
+        ("data", (0, 0x100, [0] * 6)),            # 12
+        ("window", (0, 3, 0xFFFF, 1, False)),     # 13: the last address
+        ("data", (0, 0xFFFF, [1])),               # 14: device 3
+    ]
+
+
+def random_messages(rng, count):
+    out = []
+    for _ in range(count):
+        segment = rng.randrange(2)
+        if rng.random() < 0.25:
+            out.append(("window", (segment, rng.randrange(1, 12), 0x100 + rng.randrange(64), rng.randrange(0, 12),
+                                   rng.random() < 0.05)))
+        else:
+            out.append(("data", (segment, 0xF8 + rng.randrange(80), [rng.randrange(256)] * rng.randrange(1, 10))))
+    return out
+
+
+def capture(messages):
+    return raw_pcap_bytes([frame(window(*f) if kind == "window" else data(*f)) for kind, f in messages])
+
+
+def descendants(field, name):
+    return [f for f in field.iter("field") if f.get("name") == name]
+
+
+class TestLearnedRanges(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        cls.install(os.path.join("tests", "rules", "learned_ranges.xml"), "win")
+
+    def decoded(self, path, two_pass, display_filter=None):
+        """{frame: [(address, owner, offset) of each byte]} of the Data frames, from PDML, and
+        how many bytes have an unmapped finding where they have an owner, or none where they
+        have none (a finding's expert item sits at its byte's position)."""
+        args = ["-r", path, "-T", "pdml"] + (["-2"] if two_pass else [])
+        args += ["-Y", display_filter] if display_filter else []
+        root = ET.fromstring(self.env.tshark(args).stdout)
+        out, misplaced = {}, 0
+        for packet in root.iter("packet"):
+            number = int(descendants(packet, "frame.number")[0].get("show"))
+            data_fields = descendants(packet, "win.data")
+            if not data_fields:
+                continue
+            unmapped = [e.get("pos") for e in descendants(packet, "_ws.expert")
+                        if descendants(e, "win.finding.unmapped")]
+            row = []
+            for byte in descendants(data_fields[0], "win.data.byte"):
+                def value(name):
+                    found = descendants(byte, name)
+                    return int(found[0].get("show"), 0) if found else None
+                owner, offset = value("win.data.byte.owner"), value("win.data.byte.offset")
+                if unmapped.count(byte.get("pos")) != (owner is None):
+                    misplaced += 1
+                row.append((value("win.data.byte.byte_address"), owner, offset))
+            out[number] = row
+        return out, misplaced
+
+    def check_capture(self, name, messages):
+        path = self.env.add_file(name, capture(messages))
+        want = expected(messages)
+        with self.checks() as check:
+            for two_pass in (False, True):
+                got, misplaced = self.decoded(path, two_pass)
+                mode = "-2" if two_pass else "one pass"
+                wrong = {n: (got.get(n), w) for n, w in want.items() if got.get(n) != w}
+                check(not wrong and set(got) == set(want),
+                      "%s: each byte finds the window that holds it (frame: (got, want)) %s" % (mode, wrong))
+                check(misplaced == 0, "%s: win.finding.unmapped exactly on the bytes no window holds (%d wrong)"
+                      % (mode, misplaced))
+            kept = {n: w for n, w in want.items() if n % 3 == 0}
+            got, _ = self.decoded(path, True, display_filter="frame.number % 3 == 0")
+            check(got == kept, "-2 -Y 'frame.number %% 3 == 0': the same values on the frames kept (%s)" %
+                  {n: (got.get(n), w) for n, w in kept.items() if got.get(n) != w})
+
+    def test_each_rule_once(self):
+        self.check_capture("scripted.pcap", scripted())
+
+    def test_random_frames_against_a_model(self):
+        rng = random.Random(20261201)
+        self.check_capture("random.pcap", random_messages(rng, 400))
+
+
+if __name__ == "__main__":
+    sys.exit(run_unittests()[1])
