@@ -50,8 +50,9 @@ typedef struct entry {
     guint64 *keys;
     taught *values; /* in the order of their messages */
     guint count, capacity;
-    struct entry **ranges; /* a group's */
+    struct entry **ranges; /* a group's, by their start */
     guint range_count, range_capacity;
+    guint64 widest; /* a group's: the longest of its ranges */
 } entry;
 
 /* Per capture: the entries and groups of ranges (wmem_file_scope, emptied
@@ -155,6 +156,23 @@ entry *new_entry(wmem_map_t *map, const entry *probe)
     return e;
 }
 
+gint64 range_start(const entry *r) { return (gint64)r->keys[r->key_count - 2]; }
+gint64 range_end(const entry *r) { return (gint64)r->keys[r->key_count - 1]; }
+
+/* The number of the group's ranges that start at or before `at`. */
+guint starting_by(const entry *group, gint64 at)
+{
+    guint low = 0, high = group->range_count;
+    while (low < high) {
+        guint mid = low + (high - low) / 2;
+        if (range_start(group->ranges[mid]) <= at)
+            low = mid + 1;
+        else
+            high = mid;
+    }
+    return low;
+}
+
 void add_range(entry *group, entry *range)
 {
     if (group->range_count == group->range_capacity) {
@@ -162,7 +180,11 @@ void add_range(entry *group, entry *range)
         group->ranges =
             (entry **)wmem_realloc(wmem_file_scope(), group->ranges, group->range_capacity * sizeof(entry *));
     }
-    group->ranges[group->range_count++] = range;
+    const guint at = starting_by(group, range_start(range));
+    memmove(&group->ranges[at + 1], &group->ranges[at], (group->range_count - at) * sizeof(entry *));
+    group->ranges[at] = range;
+    group->range_count++;
+    group->widest = MAX(group->widest, (guint64)range_end(range) - (guint64)range_start(range));
 }
 
 /* Records `value` as taught by (frame, message), in order: the first pass
@@ -186,9 +208,6 @@ void teach(entry *e, guint32 frame, guint32 message, guint64 value, gboolean ren
     e->values[at] = {frame, message, value};
     e->count++;
 }
-
-gint64 range_start(const entry *r) { return (gint64)r->keys[r->key_count - 2]; }
-gint64 range_end(const entry *r) { return (gint64)r->keys[r->key_count - 1]; }
 
 /* Whether a range of `group` that overlaps `r` was taught after r's latest
  * value: teaching r again, even the same value, makes r the one that holds
@@ -269,9 +288,11 @@ gboolean read_learned(const void *context, gint16 index, guint64 *value)
     probe_of(st, (guint16)index, keys, (guint16)(l->key_count - 1), &probe);
     const entry *group = (const entry *)wmem_map_lookup(groups, &probe);
     const taught *latest = NULL;
-    for (guint i = 0; group && i < group->range_count; i++) {
-        const entry *r = group->ranges[i];
-        if (at < range_start(r) || at >= range_end(r)) continue;
+    /* the ranges that may hold it: those that start at or before it, back to the widest's length */
+    for (guint i = group ? starting_by(group, at) : 0; i > 0;) {
+        const entry *r = group->ranges[--i];
+        if ((guint64)at - (guint64)range_start(r) >= group->widest) break;
+        if (at >= range_end(r)) continue;
         guint n = taught_before(r, st->pinfo->num, st->message);
         if (n && (!latest || before(latest->frame, latest->message, &r->values[n - 1]))) latest = &r->values[n - 1];
     }
