@@ -191,8 +191,14 @@ private:
             pos_ += 5;
             return true;
         }
-        if (c == '\0') return fail("expected a number, {field}, index or '(' but the expression ends");
-        return fail("expected a number, {field}, index or '(' but found '" + s_.substr(pos_, 1) + "'");
+        if (s_.compare(pos_, 6, "offset") == 0 &&
+            (pos_ + 6 >= s_.size() || !std::isalnum(static_cast<unsigned char>(s_[pos_ + 6])))) {
+            out.op = ExprOp::Offset;
+            pos_ += 6;
+            return true;
+        }
+        if (c == '\0') return fail("expected a number, {field}, index, offset or '(' but the expression ends");
+        return fail("expected a number, {field}, index, offset or '(' but found '" + s_.substr(pos_, 1) + "'");
     }
 
     bool number(Expr& out) {
@@ -328,6 +334,10 @@ void compile_into(const Expr& e, bool as_float, std::vector<ExprRow>& out) {
         return;
     case ExprOp::Index:
         out.push_back({"DG_OP_INDEX"});
+        if (as_float) out.push_back({"DG_OP_TO_FLOAT"});
+        return;
+    case ExprOp::Offset:
+        out.push_back({"DG_OP_OFFSET"});
         if (as_float) out.push_back({"DG_OP_TO_FLOAT"});
         return;
     case ExprOp::Defined:  // of a value of any type, giving an integer

@@ -29,6 +29,7 @@ struct Node;
 
 enum class ExprOp {
     Int, Float, Field, Index, RequestField,    // operands
+    Offset,                                    // offset: where a computed value sits in its message
     Learned,                                   // learned{Name}: a <learn>'s value from earlier messages
     Neg, Not, BitNot, Defined,                 // unary; Defined: defined(X), 1 when X is, else 0
     Mul, Div, Mod, Add, Sub, Shl, Shr,         // binary, arithmetic

@@ -87,6 +87,8 @@ private:
         // instance its fields and `index` belong to is the reader's
         // (check_lookups_at_readers)
         bool at_reader = false;
+        // a computed value's own: it has a place in the message (`offset`)
+        bool at_computed = false;
     };
     bool check_expr(Node& n, Expr& e);
     bool check_expr(Node& n, Expr& e, const ExprSite& at);
@@ -1103,7 +1105,7 @@ void Validator::check_computed(Node& n) {
 // count, and types it: an operand that is a decimal or a float field makes
 // its operator work in double (comparisons and logic give 0 or 1).
 bool Validator::check_expr(Node& n, Expr& e) {
-    return check_expr(n, e, ExprSite{n.doc_index, n.line, " in the value of " + quote(n)});
+    return check_expr(n, e, ExprSite{n.doc_index, n.line, " in the value of " + quote(n), false, true});
 }
 
 bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
@@ -1117,6 +1119,12 @@ bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
     case ExprOp::Index:
         if (at.at_reader || inside_repeat(n)) return true;
         diags_.error(at.line, "'index'" + in + ": it is not inside a repeated node, so there is no instance to count");
+        return false;
+    case ExprOp::Offset:
+        if (at.at_computed) return true;
+        diags_.error(at.line, "'offset'" + in +
+                                  ": only a computed value has a place in the message; compute it there "
+                                  "(<node name=\"Here\" value=\"offset\"/>) and read {Here}");
         return false;
     case ExprOp::RequestField: return check_request_field(n, e);
     case ExprOp::Learned: return check_learned(n, e, at);
@@ -1337,8 +1345,8 @@ bool Validator::check_defined(const Node& n, Expr& e) {
     if (x.op != ExprOp::Field && x.op != ExprOp::RequestField && x.op != ExprOp::Learned) {
         diags_.error(n.line, "defined(...) in the value of " + quote(n) +
                                  " asks about one field, {Name}, request{Name} or learned{Name}: " +
-                                 (x.op == ExprOp::Int || x.op == ExprOp::Float || x.op == ExprOp::Index
-                                      ? "a number or index is always defined"
+                                 (x.op == ExprOp::Int || x.op == ExprOp::Float || x.op == ExprOp::Index || x.op == ExprOp::Offset
+                                      ? "a number, index or offset is always defined"
                                       : "an expression is undefined when a field it reads is (but for a value ?: "
                                         "does not choose); ask about that field"));
         return false;

@@ -19,6 +19,9 @@ dg_expr_value operand(const dg_expr_op *op, const dg_expr_readers *readers, cons
     case DG_OP_INT: return integer_value(op->integer);
     case DG_OP_FLOAT: return real_value(op->real);
     case DG_OP_INDEX: return integer_value(index);
+    case DG_OP_OFFSET:
+        if (!readers->offset || !readers->offset(context, &raw)) return undefined_value();
+        return integer_value(wrap(raw));
     case DG_OP_LEARNED:
         if (!readers->learned || !readers->learned(context, op->slot, &raw)) return undefined_value();
         return integer_value(wrap(raw));
@@ -126,7 +129,7 @@ dg_expr_value dg_expr_eval(const dg_expr_op *ops, guint count, const dg_expr_rea
     guint depth = 0;
     for (guint k = 0; k < count; ++k) {
         const guint8 code = ops[k].code;
-        if (code <= DG_OP_INDEX) {
+        if (code <= DG_OP_OFFSET) {
             if (depth == DG_EXPR_STACK) return undefined_value();
             stack[depth++] = operand(&ops[k], readers, context, index);
         } else if (code <= DG_OP_DEFINED) {

@@ -31,6 +31,7 @@ enum dg_expr_code {
     DG_OP_REQUEST_FIELD, DG_OP_REQUEST_FIELD_SIGNED, DG_OP_REQUEST_FIELD_FLOAT,
     DG_OP_LEARNED,      /* learned{Name}: an integer, `slot` the <learn>'s row */
     DG_OP_INDEX,        /* the instance number of the innermost repeat */
+    DG_OP_OFFSET,       /* where the computed value sits: bytes from its message's start */
     DG_OP_TO_FLOAT,     /* the integer on top becomes a double */
     /* unary, on integers (F: on doubles) */
     DG_OP_NEG, DG_OP_NOT, DG_OP_BITNOT, DG_OP_FNEG, DG_OP_FNOT,
@@ -71,11 +72,16 @@ typedef struct dg_expr_value {
     gdouble real;
 } dg_expr_value;
 
+/* Where the value being computed sits in its message (DG_OP_OFFSET), or FALSE. */
+typedef gboolean (*dg_offset_reader)(const void *context, guint64 *value);
+
 /* How an expression reads what is not in its operations: the message's
- * fields, the paired request's kept values (DG_OP_REQUEST_FIELD*) and what
- * earlier messages taught (DG_OP_LEARNED); a NULL reader: those are undefined. */
+ * fields, the paired request's kept values (DG_OP_REQUEST_FIELD*), what
+ * earlier messages taught (DG_OP_LEARNED) and its place in the message
+ * (DG_OP_OFFSET); a NULL reader: those are undefined. */
 typedef struct dg_expr_readers {
     dg_slot_reader field, request, learned;
+    dg_offset_reader offset;
 } dg_expr_readers;
 
 /* Evaluates ops[0 .. count); the result's is_float tells which member holds it. */

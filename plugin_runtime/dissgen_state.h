@@ -87,6 +87,7 @@ struct dg_state {
     dg_tap_data *tap;     /* what the stats tree counts; NULL when nobody listens */
     guint8 direction;     /* DG_DIR_REQUEST/RESPONSE when a port hook matched, else DG_DIR_ANY */
     guint32 instance;     /* the instance number of the innermost repeat (computed values' index) */
+    gint here;            /* where the computed value being evaluated sits (its `offset`) */
     guint lists;          /* lists of siblings open: list_starts[0 .. lists) */
     /* the values of the <pairing> key fields (DG_KEY), in decoding order */
     guint64 *keys;

@@ -227,12 +227,20 @@ gboolean read_slot(const void *context, gint16 slot, guint64 *value)
     return TRUE;
 }
 
+/* `offset` in a computed value: where it sits (dg_state.here). */
+gboolean read_offset(const void *context, guint64 *value)
+{
+    *value = (guint64)((const dg_state *)context)->here;
+    return TRUE;
+}
+
 /* value="EXPR": a generated item at the current offset, taking no bytes; an
  * undefined value (a field not decoded, a division by zero) shows nothing. */
 void dissect_computed(dg_state *st, const dg_node *n, proto_tree *tree, gint offset)
 {
     if (!tree && !value_wanted(st, n)) return;
     const dg_extra *x = n->extra;
+    st->here = offset;
     dg_expr_value v = dg_expr_eval(&st->p->exprs[x->expr_first], x->expr_count, &message_readers, st,
                                    st->instance);
     if (!v.defined) return;
@@ -853,7 +861,7 @@ namespace dg_rt {
 
 gboolean table_walk_only = FALSE;
 
-const dg_expr_readers message_readers = {read_slot, read_request, read_learned};
+const dg_expr_readers message_readers = {read_slot, read_request, read_learned, read_offset};
 
 void dissect_node(dg_state *st, const dg_node *n, proto_tree *tree, gint *offset, gint end, gboolean in_summary)
 {

@@ -20,7 +20,7 @@ guint8 code_of(const std::string& name) {
     static const std::map<std::string, guint8> codes = {
         {"DG_OP_INT", DG_OP_INT}, {"DG_OP_FLOAT", DG_OP_FLOAT}, {"DG_OP_FIELD", DG_OP_FIELD},
         {"DG_OP_FIELD_SIGNED", DG_OP_FIELD_SIGNED}, {"DG_OP_FIELD_FLOAT", DG_OP_FIELD_FLOAT},
-        {"DG_OP_INDEX", DG_OP_INDEX}, {"DG_OP_LEARNED", DG_OP_LEARNED}, {"DG_OP_TO_FLOAT", DG_OP_TO_FLOAT}, {"DG_OP_NEG", DG_OP_NEG},
+        {"DG_OP_INDEX", DG_OP_INDEX}, {"DG_OP_OFFSET", DG_OP_OFFSET}, {"DG_OP_LEARNED", DG_OP_LEARNED}, {"DG_OP_TO_FLOAT", DG_OP_TO_FLOAT}, {"DG_OP_NEG", DG_OP_NEG},
         {"DG_OP_NOT", DG_OP_NOT}, {"DG_OP_BITNOT", DG_OP_BITNOT}, {"DG_OP_FNEG", DG_OP_FNEG},
         {"DG_OP_FNOT", DG_OP_FNOT}, {"DG_OP_DEFINED", DG_OP_DEFINED}, {"DG_OP_MUL", DG_OP_MUL}, {"DG_OP_DIV", DG_OP_DIV}, {"DG_OP_MOD", DG_OP_MOD},
         {"DG_OP_ADD", DG_OP_ADD}, {"DG_OP_SUB", DG_OP_SUB}, {"DG_OP_SHL", DG_OP_SHL}, {"DG_OP_SHR", DG_OP_SHR},
@@ -61,6 +61,12 @@ std::string escaped(const std::string& expr) {
     return out;
 }
 
+// `offset`: the computed value sits at byte 21 of its message.
+gboolean offset_21(const void*, guint64* value) {
+    *value = 21;
+    return TRUE;
+}
+
 Evaluated evaluate(const std::string& expr, const Slots& by_name, guint32 index = 0, const std::string& display = "") {
     Front f = front_end(rules("  <node name=\"A\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
                               "  <node name=\"S\" length=\"1byte\" displaytype=\"int\"/>\n"
@@ -86,7 +92,7 @@ Evaluated evaluate(const std::string& expr, const Slots& by_name, guint32 index 
         const Node* n = find(*f.proto, names[name]);
         if (n->slot >= 0) slots[static_cast<gint16>(n->slot)] = value;
     }
-    const dg_expr_readers readers = {read_slot, nullptr, nullptr};
+    const dg_expr_readers readers = {read_slot, nullptr, nullptr, offset_21};
     out.v = dg_expr_eval(ops.data(), static_cast<guint>(ops.size()), &readers, &slots, index);
     return out;
 }
@@ -153,6 +159,11 @@ TEST(ComputedEval, TheLongestConditionalChainTheParserTakesFitsTheStack) {
 
 TEST(ComputedEval, IntegerArithmeticAsInC) {
     EXPECT_EQ(integer("{A} + index + 1", {{A, 40000}, {C, 5}}, 3), 40004);
+    // where the value sits, as the walk's reader gives it (here 21): alignment padding
+    EXPECT_EQ(integer("offset"), 21);
+    EXPECT_EQ(integer("(4 - offset % 4) % 4 + index", kFields, 2), 5);
+    EXPECT_NE(evaluate("offsets", kFields).error.find("expected a number, {field}, index, offset or '('"),
+              std::string::npos);
     EXPECT_EQ(integer("{S}"), -2);                 // an int field is signed
     EXPECT_EQ(integer("{C} - 5"), -2);
     EXPECT_EQ(integer("7 / 2"), 3);
@@ -220,8 +231,8 @@ TEST(ComputedEval, DefinedAsksWhetherAFieldWasDecoded) {
     EXPECT_EQ(integer("defined({A}) && {A} / 0", {{C, 3}}), 0);  // the left side decides
     EXPECT_DOUBLE_EQ(real("defined({A}) * 0.5"), 0.5);
     // a field only: a number, index or expression is an error, and so is a missing '('
-    EXPECT_NE(evaluate("defined(3)", kFields).error.find("asks about one field, {Name}, request{Name} or learned{Name}: a number "
-                                                         "or index is always defined"), std::string::npos);
+    EXPECT_NE(evaluate("defined(3)", kFields).error.find("asks about one field, {Name}, request{Name} or learned{Name}: a number, "
+                                                         "index or offset is always defined"), std::string::npos);
     EXPECT_NE(evaluate("defined({A} + 1)", kFields).error.find("ask about that field"), std::string::npos);
     EXPECT_NE(evaluate("defined {A}", kFields).error.find("expected '(' after 'defined'"), std::string::npos);
 }
@@ -242,7 +253,7 @@ TEST(ComputedEval, RealsWhenADecimalTakesPart) {
 // field of the request (DG_OP_REQUEST_FIELD*), over a reader that has it or not.
 dg_expr_value request_operand(guint8 code, guint8 bits, const Slots& request) {
     const dg_expr_op op{code, bits, 0, 0, 0.0};
-    const dg_expr_readers readers = {read_slot, read_slot, nullptr};
+    const dg_expr_readers readers = {read_slot, read_slot, nullptr, nullptr};
     return dg_expr_eval(&op, 1, &readers, &request, 0);
 }
 
@@ -290,7 +301,8 @@ TEST(ComputedEval, LearnedValuesReadByTheirRowAndUndefinedWhenNotLearned) {
     const dg_expr_readers readers = {
         [](const void* c, gint16 slot, guint64* v) { return read_slot(static_cast<const Context*>(c)->fields, slot, v); },
         nullptr,
-        [](const void* c, gint16 row, guint64* v) { return read_slot(static_cast<const Context*>(c)->learned, row, v); }};
+        [](const void* c, gint16 row, guint64* v) { return read_slot(static_cast<const Context*>(c)->learned, row, v); },
+        nullptr};
     std::vector<dg_expr_op> scaled = ops_of("Scaled"), known = ops_of("Known");
     dg_expr_value v = dg_expr_eval(scaled.data(), static_cast<guint>(scaled.size()), &readers, &context, 0);
     ASSERT_TRUE(v.defined);

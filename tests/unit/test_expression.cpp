@@ -61,19 +61,19 @@ TEST(Expression, Operands) {
 }
 
 TEST(Expression, MistakesSayWhere) {
-    EXPECT_EQ(parsed(""), "error: expected a number, {field}, index or '(' but the expression ends at character 1");
-    EXPECT_EQ(parsed("1 +"), "error: expected a number, {field}, index or '(' but the expression ends at character 4");
+    EXPECT_EQ(parsed(""), "error: expected a number, {field}, index, offset or '(' but the expression ends at character 1");
+    EXPECT_EQ(parsed("1 +"), "error: expected a number, {field}, index, offset or '(' but the expression ends at character 4");
     EXPECT_EQ(parsed("(1"), "error: missing ')' at character 3");
     EXPECT_EQ(parsed("{A"), "error: missing '}' at character 1");
     EXPECT_EQ(parsed("{}"), "error: empty field name '{}' at character 1");
     EXPECT_EQ(parsed("1 2"), "error: unexpected '2' at character 3");
     EXPECT_EQ(parsed("0x"), "error: bad number '0x' at character 1");
     EXPECT_EQ(parsed("12ab"), "error: bad number '12a' at character 1");
-    EXPECT_EQ(parsed("indexes"), "error: expected a number, {field}, index or '(' but found 'i' at character 1");
+    EXPECT_EQ(parsed("indexes"), "error: expected a number, {field}, index, offset or '(' but found 'i' at character 1");
     EXPECT_EQ(parsed("9223372036854775808"), "error: number '9223372036854775808' is above 9223372036854775807 at character 1");
-    EXPECT_EQ(parsed("A + 1"), "error: expected a number, {field}, index or '(' but found 'A' at character 1");
+    EXPECT_EQ(parsed("A + 1"), "error: expected a number, {field}, index, offset or '(' but found 'A' at character 1");
     EXPECT_EQ(parsed("1 ? 2"), "error: missing ':' of '?' at character 6");
-    EXPECT_EQ(parsed("1 ? 2 : "), "error: expected a number, {field}, index or '(' but the expression ends at character 9");
+    EXPECT_EQ(parsed("1 ? 2 : "), "error: expected a number, {field}, index, offset or '(' but the expression ends at character 9");
     EXPECT_EQ(parsed("1 : 2"), "error: unexpected ':' at character 3");
     // A number after the first character: the message quotes that number, not what follows it.
     EXPECT_EQ(parsed("{A} + 12ab - 3"), "error: bad number '12a' at character 7");
@@ -119,7 +119,7 @@ TEST(Expression, RequestOperand) {
     EXPECT_EQ(parsed("request{A}*{B}"), "(* request{A} {B})");
     EXPECT_EQ(parsed("request{A"), "error: missing '}' at character 8");
     EXPECT_EQ(parsed("request{}"), "error: empty field name '{}' at character 8");
-    EXPECT_EQ(parsed("request"), "error: expected a number, {field}, index or '(' but found 'r' at character 1");
+    EXPECT_EQ(parsed("request"), "error: expected a number, {field}, index, offset or '(' but found 'r' at character 1");
 }
 
 // A response reads its request: the first request-only node of the name,

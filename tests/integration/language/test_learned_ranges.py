@@ -9,7 +9,9 @@ window holds it (Owner) and its offset in that window, or raises win.finding.unm
 expected values come from a model of the frames in order (the truth of the bytes): where
 windows overlap the one taught latest wins, a window of size 0 or cut short teaches nothing, a
 window taught again with the same start and size keeps its place, each segment has its own
-windows. The same values in one pass, with -2, and with -2 and a display filter that keeps
+windows. A Pieces message is laid out piece by piece, each from its address to the end of the
+window that holds it or of its bytes (a byte no window holds alone): each piece's address,
+owner and length are checked against the model too. The same values in one pass, with -2, and with -2 and a display filter that keeps
 every third frame. Needs no corpus.
 
     test_learned_ranges.py --dissgen build/bin/dissgen --source-dir .
@@ -44,6 +46,26 @@ def data(segment, address, values):
     return struct.pack("!BBHB", 2, segment, address, len(values)) + bytes(values)
 
 
+def pieces(segment, address, values):
+    return struct.pack("!BBHB", 3, segment, address, len(values)) + bytes(values)
+
+
+def holder(windows, segment, at):
+    """The window (segment, start, end, device) taught latest that holds `at`, or None."""
+    return next((w for w in reversed(windows) if w[0] == segment and w[1] <= at < w[2]), None)
+
+
+def laid_out(windows, segment, address, count):
+    """[(address, owner, length) of each piece] of a Pieces message."""
+    out = []
+    while count > 0:
+        w = holder(windows, segment, address)
+        length = min(w[2] - address, count) if w else 1
+        out.append((address, w[3] if w else None, length))
+        address, count = address + length, count - length
+    return out
+
+
 def expected(messages):
     """{frame: [(address, owner, offset) of each byte]} of the Data frames (owner, offset
     None where no window holds the byte), by a model of the rules: the windows taught by
@@ -61,11 +83,14 @@ def expected(messages):
             windows = [w for w in windows if w[:3] != taught[:3]] + [taught]
             continue
         segment, address, values = fields
+        if kind == "pieces":
+            out[number] = laid_out(windows, segment, address, len(values))
+            continue
         row = []
         for i in range(len(values)):
-            at = (address + i)
-            holder = next((w for w in reversed(windows) if w[0] == segment and w[1] <= at < w[2]), None)
-            row.append((at, holder[3], at - holder[1]) if holder else (at, None, None))
+            at = address + i
+            w = holder(windows, segment, at)
+            row.append((at, w[3], at - w[1]) if w else (at, None, None))
         out[number] = row
     return out
 
@@ -87,6 +112,10 @@ def scripted():
         ("data", (0, 0x100, [0] * 6)),            # 12
         ("window", (0, 3, 0xFFFF, 1, False)),     # 13: the last address
         ("data", (0, 0xFFFF, [1])),               # 14: device 3
+        ("pieces", (0, 0xFE, [0] * 10)),          # 15: 0xfe, 0xff alone; 7 x4, 8 x2; 0x106, 0x107 alone
+        ("pieces", (0, 0x101, [0] * 2)),          # 16: one piece, cut by the bytes' end
+        ("window", (0, 9, 0x102, 3, False)),      # 17: device 9 again, latest now
+        ("pieces", (0, 0x100, [0] * 7)),          # 18: 7 holds 0x100: to its end, x4; 9 x1, 8 x1, 0x106
     ]
 
 
@@ -98,16 +127,27 @@ def random_messages(rng, count):
             out.append(("window", (segment, rng.randrange(1, 12), 0x100 + rng.randrange(64), rng.randrange(0, 12),
                                    rng.random() < 0.05)))
         else:
-            out.append(("data", (segment, 0xF8 + rng.randrange(80), [rng.randrange(256)] * rng.randrange(1, 10))))
+            out.append((rng.choice(["data", "pieces"]),
+                        (segment, 0xF8 + rng.randrange(80), [rng.randrange(256)] * rng.randrange(1, 10))))
     return out
 
 
 def capture(messages):
-    return raw_pcap_bytes([frame(window(*f) if kind == "window" else data(*f)) for kind, f in messages])
+    return raw_pcap_bytes([frame(payload(kind, f)) for kind, f in messages])
+
+
+def payload(kind, fields):
+    return {"window": window, "data": data, "pieces": pieces}[kind](*fields)
 
 
 def descendants(field, name):
     return [f for f in field.iter("field") if f.get("name") == name]
+
+
+def shown(field, name):
+    """The number a field inside `field` shows, or None when it is not there."""
+    found = descendants(field, name)
+    return int(found[0].get("show"), 0) if found else None
 
 
 class TestLearnedRanges(TsharkTestCase, unittest.TestCase):
@@ -125,6 +165,11 @@ class TestLearnedRanges(TsharkTestCase, unittest.TestCase):
         out, misplaced = {}, 0
         for packet in root.iter("packet"):
             number = int(descendants(packet, "frame.number")[0].get("show"))
+            laid = descendants(packet, "win.pieces.bytes.piece")
+            if laid:
+                out[number] = [(shown(p, "win.pieces.bytes.piece.byte_address"), shown(p, "win.pieces.bytes.piece.owner"),
+                                shown(p, "win.pieces.bytes.piece.piece_length")) for p in laid]
+                continue
             data_fields = descendants(packet, "win.data")
             if not data_fields:
                 continue
@@ -132,13 +177,10 @@ class TestLearnedRanges(TsharkTestCase, unittest.TestCase):
                         if descendants(e, "win.finding.unmapped")]
             row = []
             for byte in descendants(data_fields[0], "win.data.byte"):
-                def value(name):
-                    found = descendants(byte, name)
-                    return int(found[0].get("show"), 0) if found else None
-                owner, offset = value("win.data.byte.owner"), value("win.data.byte.offset")
+                owner, offset = shown(byte, "win.data.byte.owner"), shown(byte, "win.data.byte.offset")
                 if unmapped.count(byte.get("pos")) != (owner is None):
                     misplaced += 1
-                row.append((value("win.data.byte.byte_address"), owner, offset))
+                row.append((shown(byte, "win.data.byte.byte_address"), owner, offset))
             out[number] = row
         return out, misplaced
 

@@ -374,7 +374,7 @@ def learned_ranges_frames():
     """tests/rules/learned_ranges.xml: test_learned_ranges.py's windows and data, some unmapped."""
     import test_learned_ranges as m
     messages = m.scripted() + m.random_messages(random.Random(12), 80)
-    return [m.frame(m.window(*f) if kind == "window" else m.data(*f)) for kind, f in messages]
+    return [m.frame(m.payload(kind, f)) for kind, f in messages]
 
 
 def overlays_frames():
