@@ -16,11 +16,13 @@
  * see what the first pass saw at that frame.
  *
  * A key with a span makes ranges: the learner's key value starts a range of
- * span values, and its entry is the range (start and end are its keys). The
- * ranges of one learn under the same other keys form a group; a reader's key
- * finds, among the group's ranges that hold it, the value taught latest
- * before the reader (EtherCAT's FMMUs: a logical address finds the slave
- * whose window holds it).
+ * span values (counted modulo 2^64, so that keys from unsigned 8-byte fields
+ * and negative ones are alike), and its entry is the range (start and end are
+ * its keys). The ranges of one learn under the same other keys form a group,
+ * kept by start; a reader's key finds, among the group's ranges that hold
+ * it, the value taught latest before the reader (EtherCAT's FMMUs: a logical
+ * address finds the slave whose window holds it). Each teaching has its
+ * number in the first pass, so that "latest" holds within one message too.
  */
 #include "dissgen_state.h"
 
@@ -32,10 +34,12 @@ using namespace dg_rt;
 
 namespace {
 
-/* The frame and message that taught a value, ordered as the first pass met them. */
+/* The frame and message that taught a value, and the teaching's number in
+ * the first pass (which of two ranges taught in one message is the later). */
 typedef struct {
     guint32 frame;
     guint32 message;
+    guint64 order;
     guint64 value;
 } taught;
 
@@ -59,6 +63,7 @@ typedef struct entry {
  * when a file closes). */
 wmem_map_t *entries = NULL;
 wmem_map_t *groups = NULL;
+guint64 teachings = 0; /* numbers the teachings, in the first pass's order */
 
 guint entry_hash(gconstpointer k) { return ((const entry *)k)->hash; }
 
@@ -156,21 +161,33 @@ entry *new_entry(wmem_map_t *map, const entry *probe)
     return e;
 }
 
-gint64 range_start(const entry *r) { return (gint64)r->keys[r->key_count - 2]; }
-gint64 range_end(const entry *r) { return (gint64)r->keys[r->key_count - 1]; }
+guint64 range_start(const entry *r) { return r->keys[r->key_count - 2]; }
+guint64 range_span(const entry *r) { return r->keys[r->key_count - 1] - range_start(r); }
+gboolean holds(const entry *r, guint64 key) { return key - range_start(r) < range_span(r); }
 
-/* The number of the group's ranges that start at or before `at`. */
-guint starting_by(const entry *group, gint64 at)
+/* The number of the group's ranges that start at or before `key`. */
+guint starting_by(const entry *group, guint64 key)
 {
     guint low = 0, high = group->range_count;
     while (low < high) {
         guint mid = low + (high - low) / 2;
-        if (range_start(group->ranges[mid]) <= at)
+        if (range_start(group->ranges[mid]) <= key)
             low = mid + 1;
         else
             high = mid;
     }
     return low;
+}
+
+/* Calls visit(range) on each range of `group` that starts less than `reach`
+ * below `key` (modulo 2^64): going down from the last one that starts by it,
+ * then from the top, for ranges that wrap past 2^64 to it. */
+template <typename Visit> void near_ranges(const entry *group, guint64 key, guint64 reach, Visit visit)
+{
+    const guint by = starting_by(group, key);
+    for (guint i = by; i > 0 && key - range_start(group->ranges[i - 1]) < reach; i--) visit(group->ranges[i - 1]);
+    for (guint i = group->range_count; i > by && key - range_start(group->ranges[i - 1]) < reach; i--)
+        visit(group->ranges[i - 1]);
 }
 
 void add_range(entry *group, entry *range)
@@ -184,7 +201,7 @@ void add_range(entry *group, entry *range)
     memmove(&group->ranges[at + 1], &group->ranges[at], (group->range_count - at) * sizeof(entry *));
     group->ranges[at] = range;
     group->range_count++;
-    group->widest = MAX(group->widest, (guint64)range_end(range) - (guint64)range_start(range));
+    group->widest = MAX(group->widest, range_span(range));
 }
 
 /* Records `value` as taught by (frame, message), in order: the first pass
@@ -197,6 +214,7 @@ void teach(entry *e, guint32 frame, guint32 message, guint64 value, gboolean ren
     guint at = taught_before(e, frame, message);
     if (at < e->count && e->values[at].frame == frame && e->values[at].message == message) {
         e->values[at].value = value;
+        e->values[at].order = ++teachings;
         return;
     }
     if (at > 0 && e->values[at - 1].value == value && !renewed) return;
@@ -205,30 +223,31 @@ void teach(entry *e, guint32 frame, guint32 message, guint64 value, gboolean ren
         e->values = (taught *)wmem_realloc(wmem_file_scope(), e->values, e->capacity * sizeof(taught));
     }
     memmove(&e->values[at + 1], &e->values[at], (e->count - at) * sizeof(taught));
-    e->values[at] = {frame, message, value};
+    e->values[at] = {frame, message, ++teachings, value};
     e->count++;
 }
 
 /* Whether a range of `group` that overlaps `r` was taught after r's latest
  * value: teaching r again, even the same value, makes r the one that holds
- * the overlap. */
+ * the overlap. The ranges that overlap r start less than its span plus the
+ * widest's below its last key. */
 gboolean overtaken(const entry *group, const entry *r)
 {
     if (!r->count) return FALSE;
-    const taught *last = &r->values[r->count - 1];
-    for (guint i = 0; i < group->range_count; i++) {
-        const entry *o = group->ranges[i];
-        if (o != r && o->count && range_start(o) < range_end(r) && range_start(r) < range_end(o) &&
-            before(last->frame, last->message, &o->values[o->count - 1]))
-            return TRUE;
-    }
-    return FALSE;
+    const guint64 last = r->values[r->count - 1].order;
+    gboolean found = FALSE;
+    near_ranges(group, range_start(r) + range_span(r) - 1, range_span(r) + group->widest - 1, [&](const entry *o) {
+        if (o != r && o->count && o->values[o->count - 1].order > last &&
+            (holds(o, range_start(r)) || holds(r, range_start(o))))
+            found = TRUE;
+    });
+    return found;
 }
 
 /* The entry learn `index` teaches under keys[0 .. key_count) in this
  * message, and in *group the group of ranges it is in (NULL without a span);
- * NULL when a span is undefined, not positive or runs past the integers. A
- * range's entry is found by its start and end. */
+ * NULL when a span is undefined or not positive. A range's entry is found by
+ * its start and end. */
 entry *learning_entry(dg_state *st, guint16 index, guint64 *keys, entry **group)
 {
     *group = NULL;
@@ -242,13 +261,12 @@ entry *learning_entry(dg_state *st, guint16 index, guint64 *keys, entry **group)
     }
     const dg_learn_key *k = &st->p->learn_keys[l->key_first + spanned];
     dg_expr_value span = evaluate(st, k->span_first, k->span_count);
-    const gint64 start = (gint64)keys[spanned];
-    gint64 end;
-    if (!span.defined || span.integer <= 0 || __builtin_add_overflow(start, span.integer, &end)) return NULL;
+    if (!span.defined || span.integer <= 0) return NULL;
+    const guint64 start = keys[spanned];
     drop_key(keys, l->key_count, spanned);
     const guint16 others = (guint16)(l->key_count - 1);
-    keys[others] = (guint64)start;
-    keys[others + 1] = (guint64)end;
+    keys[others] = start;
+    keys[others + 1] = start + (guint64)span.integer; /* modulo 2^64 */
     probe_of(st, index, keys, (guint16)(others + 2), &probe);
     entry *e = (entry *)wmem_map_lookup(entries, &probe);
     const gboolean made = !e;
@@ -282,20 +300,18 @@ gboolean read_learned(const void *context, gint16 index, guint64 *value)
         *value = e->values[n - 1].value;
         return TRUE;
     }
-    /* the latest value taught before this message by a range that holds the key */
-    const gint64 at = (gint64)keys[spanned];
+    /* the latest value taught before this message by a range that holds the
+     * key: one that starts less than the widest's span below it */
+    const guint64 key = keys[spanned];
     drop_key(keys, l->key_count, spanned);
     probe_of(st, (guint16)index, keys, (guint16)(l->key_count - 1), &probe);
     const entry *group = (const entry *)wmem_map_lookup(groups, &probe);
+    if (!group) return FALSE;
     const taught *latest = NULL;
-    /* the ranges that may hold it: those that start at or before it, back to the widest's length */
-    for (guint i = group ? starting_by(group, at) : 0; i > 0;) {
-        const entry *r = group->ranges[--i];
-        if ((guint64)at - (guint64)range_start(r) >= group->widest) break;
-        if (at >= range_end(r)) continue;
-        guint n = taught_before(r, st->pinfo->num, st->message);
-        if (n && (!latest || before(latest->frame, latest->message, &r->values[n - 1]))) latest = &r->values[n - 1];
-    }
+    near_ranges(group, key, group->widest, [&](const entry *r) {
+        guint n = holds(r, key) ? taught_before(r, st->pinfo->num, st->message) : 0;
+        if (n && (!latest || r->values[n - 1].order > latest->order)) latest = &r->values[n - 1];
+    });
     if (!latest) return FALSE;
     *value = latest->value;
     return TRUE;

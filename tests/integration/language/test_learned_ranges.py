@@ -209,5 +209,82 @@ class TestLearnedRanges(TsharkTestCase, unittest.TestCase):
         self.check_capture("random.pcap", random_messages(rng, 400))
 
 
+EDGE_RULES = """<root name="Range edges" abbreviation="EDGE" ethertype="0x88c4">
+  <node name="Kind" length="1byte" displaytype="numberdec"/>
+  <node name="Windows" if="../node[@name='Kind']" in="1">
+    <node name="Count" length="1byte" displaytype="numberdec"/>
+    <node name="Window" count="../node[@name='Count']">
+      <node name="Device" length="1byte" displaytype="numberdec"/>
+      <node name="Start" length="8byte" displaytype="numberhex"/>
+      <node name="Size" length="1byte" displaytype="numberdec"/>
+      <learn name="Owner" value="{Device}">
+        <key value="{Start}" span="{Size}" lookup="{Address}"/>
+      </learn>
+    </node>
+  </node>
+  <node name="Read" if="../node[@name='Kind']" in="2">
+    <node name="Address" length="8byte" displaytype="numberhex"/>
+    <node name="Owner" value="learned{Owner}" displaytype="numberdec"/>
+  </node>
+</root>
+"""
+
+
+def windows(*taught):
+    return struct.pack("!BB", 1, len(taught)) + b"".join(struct.pack("!BQB", *w) for w in taught)
+
+
+def read(address):
+    return struct.pack("!BQ", 2, address)
+
+
+# (message, the owner a read shows or None)
+EDGES = [
+    (windows((8, 0xFE, 4)), None),
+    (windows((7, 0x100, 4), (8, 0xFE, 4)), None),  # 8 taught again after 7 in one message: the later
+    (read(0x101), 8),
+    (read(0x103), 7),
+    (windows((7, 0x100, 4)), None),                # 7 again: it holds the overlap now
+    (read(0x101), 7),
+    (read(0xFF), 8),
+    (windows((5, 0x7FFFFFFFFFFFFFFE, 4)), None),   # across 2^63: keys of an unsigned 8-byte field
+    (read(0x7FFFFFFFFFFFFFFF), 5),
+    (read(0x8000000000000001), 5),
+    (read(0x8000000000000002), None),
+    (windows((6, 0xFFFFFFFFFFFFFFFE, 4)), None),   # past 2^64: modulo, to 0 and 1
+    (read(0xFFFFFFFFFFFFFFFF), 6),
+    (read(0x1), 6),
+    (read(0x2), None),
+    (read(0x100), 7),
+    (windows((9, 0x0, 0x40)), None),               # a wide window: reads below it still find theirs
+    (read(0x101), 7),
+    (read(0x3F), 9),
+    (read(0x1), 9),
+    (windows((7, 0x200, 4), (8, 0x1FE, 4), (7, 0x200, 4)), None),  # 7 twice in one message: the later
+    (read(0x201), 7),
+    (read(0x1FF), 8),
+]
+
+
+class TestRangeEdges(TsharkTestCase, unittest.TestCase):
+    """Windows taught together in one message (the later one in it holds the overlap), keys
+    past 2^63 and windows that wrap past 2^64, as the manual says; one pass and -2."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("edges.xml", EDGE_RULES, "edge")
+
+    def test_edges(self):
+        path = self.env.add_file("edges.pcap", raw_pcap_bytes([frame(m) for m, _ in EDGES]))
+        want = {n: owner for n, (m, owner) in enumerate(EDGES, 1) if m[0] == 2}
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = self.env.field_rows(path, ["frame.number", "edge.read.owner"], two_pass)
+                got = {n: int(r["edge.read.owner"][0]) if r["edge.read.owner"] else None
+                       for n, r in rows.items() if n in want}
+                check(got == want, "%s: each read finds its window (frame: (got, want)) %s" % (
+                    "-2" if two_pass else "one pass", {n: (got.get(n), w) for n, w in want.items() if got.get(n) != w}))
+
+
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])
