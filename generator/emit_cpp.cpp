@@ -197,7 +197,7 @@ void layout_learns(Layout& l, const Protocol& proto) {
             const size_t key_first = l.learn_keys.size();
             for (const LearnKey& k : learn.keys)
                 l.learn_keys.push_back("{ " + add(&k.value) + ", " + add(k.lookup ? &*k.lookup : nullptr) + ", " +
-                                       add(k.span ? &*k.span : nullptr) + " }");
+                                       add(k.span ? &*k.span : nullptr) + ", " + add(k.id ? &*k.id : nullptr) + " }");
             const std::string value = add(&learn.value);
             const std::string condition = add(learn.condition ? &*learn.condition : nullptr);
             l.learns.push_back("/* " + learn.name + ", line " + std::to_string(learn.line) + " */ { " + value + ", " +
@@ -211,8 +211,9 @@ void layout_learns(Layout& l, const Protocol& proto) {
         const size_t key_first = l.learn_keys.size();
         for (size_t i = 0; i < learn.keys.size(); ++i) {
             const Expr* lookup = read->lookups[i] ? &*read->lookups[i] : nullptr;
+            // a reader looks windows up: the span only says which key it is, the id is the learner's
             const Expr* span = learn.keys[i].span ? &*learn.keys[i].span : nullptr;
-            l.learn_keys.push_back("{ " + add(&learn.keys[i].value) + ", " + add(lookup) + ", " + add(span) + " }");
+            l.learn_keys.push_back("{ " + add(&learn.keys[i].value) + ", " + add(lookup) + ", " + add(span) + ", 0, 0 }");
         }
         l.learns.push_back("/* learned{" + learn.name + "} at line " + std::to_string(read->line) + " */ { 0, 0, 0, 0, " +
                            std::to_string(key_first) + ", " + std::to_string(learn.keys.size()) + ", " +
@@ -586,7 +587,7 @@ void Emitter::learn_tables() {
     o_ << "/* <learn>s: value, if (first, count in exprs; 0, 0: none), keys (first, count), by sender. */\n";
     o_ << c_array("static const dg_learn " + p_.filter + "_learns", l_.learns);
     if (l_.learn_keys.empty()) return;
-    o_ << "/* Their keys: value, lookup, span (first, count in exprs; lookup 0, 0: as the value; span 0, 0: none). */\n";
+    o_ << "/* Their keys: value, lookup, span, id (first, count in exprs; lookup 0, 0: as the value; span, id 0, 0: none). */\n";
     o_ << c_array("static const dg_learn_key " + p_.filter + "_learn_keys", l_.learn_keys);
 }
 

@@ -106,13 +106,15 @@ struct Finding {
 // instance of the node is decoded (first pass), the value is learned under
 // the keys' values (and the sender's address); learned{NAME} in a later
 // message reads the latest value learned under its own keys (lookup, else
-// value) in an earlier one. A key with a span learns a range: the values
-// value .. value + span - 1, any of which finds it.
+// value) in an earlier one. A key with a span learns a window: the values
+// value .. value + span - 1, any of which finds it; with an id, the window is
+// what the id names, and its next teaching moves it.
 struct LearnKey {
     Expr value;
     std::optional<Expr> lookup;  // how a reader computes the key, when not as the learner does
     std::optional<Expr> span;    // how many key values from this one the value is learned under
-    std::string value_text, lookup_text, span_text;
+    std::optional<Expr> id;      // which window it is (with a span)
+    std::string value_text, lookup_text, span_text, id_text;
     int line = 0;
 };
 

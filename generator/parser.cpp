@@ -55,7 +55,7 @@ const std::vector<std::string> kHeuristicAttributes = {"table", "enabled"};
 const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};
 const std::vector<std::string> kFindingAttributes = {"name", "severity", "group", "condition", "text"};
 const std::vector<std::string> kLearnAttributes = {"name", "value", "if", "sender"};
-const std::vector<std::string> kLearnKeyAttributes = {"value", "lookup", "span"};
+const std::vector<std::string> kLearnKeyAttributes = {"value", "lookup", "span", "id"};
 const std::vector<std::string> kPairingAttributes = {"timeout", "analysis", "order"};
 const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kInputAttributes = {"name", "field"};
@@ -906,6 +906,11 @@ void Parser::parse_learn(xmlNode* el, Node& node) {
             k.span_text = key_attrs["span"];
             k.span.emplace();
             ok = parse_expression_attribute(k.span_text, k.line, "span of " + what, *k.span) && ok;
+        }
+        if (key_attrs.count("id")) {
+            k.id_text = key_attrs["id"];
+            k.id.emplace();
+            ok = parse_expression_attribute(k.id_text, k.line, "id of " + what, *k.id) && ok;
         }
         l.keys.push_back(std::move(k));
     }

@@ -248,7 +248,8 @@ void Validator::check_table_sizes() {
             for (const LearnKey& k : l.keys)
                 operations += compile_expression(k.value, false).size() +
                               (k.lookup ? compile_expression(*k.lookup, false).size() : 0) +
-                              (k.span ? compile_expression(*k.span, false).size() : 0);
+                              (k.span ? compile_expression(*k.span, false).size() : 0) +
+                              (k.id ? compile_expression(*k.id, false).size() : 0);
         }
         over(n, operations, max_rows, "operations in computed values");
         if (n.slot >= 0) over(n, static_cast<size_t>(n.slot) + 1, 32767, "fields whose values are read");
@@ -2134,6 +2135,10 @@ void Validator::check_learns(Node& n) {
         for (LearnKey& k : l.keys) {
             check_key(k.value, k.line, "key", reach, false);
             if (k.lookup) check_key(*k.lookup, k.line, "lookup", everywhere, true);
+            if (k.id && !k.span)
+                diags_.error(k.line, what + ": an id names a window, and this key has no span: add span=\"...\" "
+                                            "(how many keys from this one the window holds)");
+            if (k.id) check_key(*k.id, k.line, "id", reach, false);
             if (!k.span) continue;
             check_key(*k.span, k.line, "span", reach, false);
             if (spanned)

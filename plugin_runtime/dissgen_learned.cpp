@@ -15,14 +15,17 @@
  * pass reads the same: tshark -2 and the GUI, frames clicked in any order,
  * see what the first pass saw at that frame.
  *
- * A key with a span makes ranges: the learner's key value starts a range of
- * span values (counted modulo 2^64, so that keys from unsigned 8-byte fields
- * and negative ones are alike), and its entry is the range (start and end are
- * its keys). The ranges of one learn under the same other keys form a group,
- * kept by start; a reader's key finds, among the group's ranges that hold
- * it, the value taught latest before the reader (EtherCAT's FMMUs: a logical
- * address finds the slave whose window holds it). Each teaching has its
- * number in the first pass, so that "latest" holds within one message too.
+ * A key with a span teaches windows: the learner's key value starts a range
+ * of span keys (counted modulo 2^64, so that keys from unsigned 8-byte fields
+ * and negative ones are alike). A window is its range, or with the key's id
+ * what the id names (a slave's FMMU), which a later teaching moves or, with
+ * a span of 0, removes. Each teaching of a window is a record (range, value,
+ * when) that holds until the window's next teaching; the records of one learn
+ * under the same other keys form a group, kept by start. A reader's key
+ * finds, among the group's records that hold it at the reader's place, the
+ * one taught latest (EtherCAT: a logical address finds the slave whose FMMU
+ * holds it). Each teaching has its number in the first pass, so that
+ * "latest" holds within one message too.
  */
 #include "dissgen_state.h"
 
@@ -34,17 +37,26 @@ using namespace dg_rt;
 
 namespace {
 
-/* The frame and message that taught a value, and the teaching's number in
- * the first pass (which of two ranges taught in one message is the later). */
+/* The frame and message that taught a value, ordered as the first pass met them. */
 typedef struct {
     guint32 frame;
     guint32 message;
-    guint64 order;
     guint64 value;
 } taught;
 
-/* What one <learn> learned under one set of keys; or, in `groups`, the
- * ranges a learn with a span learned under one set of its other keys. */
+/* One teaching of a window: its range (span 0: the window removed), its
+ * value, when, and until when it holds: the window's next teaching, from
+ * whose message on readers see that one (G_MAXUINT32: still). */
+typedef struct record {
+    guint64 start, span;
+    guint64 value, order;
+    guint32 frame, message;
+    guint32 until_frame, until_message;
+} record;
+
+/* What one <learn> learned under one set of keys; a window (its latest
+ * record); or, in `groups`, the records of the windows a learn with a span
+ * learned under one set of its other keys. */
 typedef struct entry {
     guint32 hash;
     guint16 learn;
@@ -54,7 +66,8 @@ typedef struct entry {
     guint64 *keys;
     taught *values; /* in the order of their messages */
     guint count, capacity;
-    struct entry **ranges; /* a group's, by their start */
+    record *latest; /* a window's */
+    record **ranges; /* a group's, by their start */
     guint range_count, range_capacity;
     guint64 widest; /* a group's: the longest of its ranges */
 } entry;
@@ -79,7 +92,7 @@ dg_expr_value evaluate(const dg_state *st, guint16 first, guint16 count)
     return dg_expr_eval(&st->p->exprs[first], count, &message_readers, st, st->instance);
 }
 
-/* The key of learn `index` with a span, or -1. */
+/* The key of learn `index` with a span (a window), or -1. */
 gint span_key(const dg_protocol *p, const dg_learn *l)
 {
     for (guint16 i = 0; i < l->key_count; i++)
@@ -161,17 +174,24 @@ entry *new_entry(wmem_map_t *map, const entry *probe)
     return e;
 }
 
-guint64 range_start(const entry *r) { return r->keys[r->key_count - 2]; }
-guint64 range_span(const entry *r) { return r->keys[r->key_count - 1] - range_start(r); }
-gboolean holds(const entry *r, guint64 key) { return key - range_start(r) < range_span(r); }
+gboolean holds(const record *r, guint64 key) { return key - r->start < r->span; }
 
-/* The number of the group's ranges that start at or before `key`. */
+/* Whether record r holds at (frame, message): taught before it, and the
+ * window not taught again before it. */
+gboolean holds_at(const record *r, guint32 frame, guint32 message)
+{
+    const gboolean taught = r->frame < frame || (r->frame == frame && r->message < message);
+    const gboolean kept = frame < r->until_frame || (frame == r->until_frame && message <= r->until_message);
+    return taught && kept;
+}
+
+/* The number of the group's records that start at or before `key`. */
 guint starting_by(const entry *group, guint64 key)
 {
     guint low = 0, high = group->range_count;
     while (low < high) {
         guint mid = low + (high - low) / 2;
-        if (range_start(group->ranges[mid]) <= key)
+        if (group->ranges[mid]->start <= key)
             low = mid + 1;
         else
             high = mid;
@@ -179,103 +199,115 @@ guint starting_by(const entry *group, guint64 key)
     return low;
 }
 
-/* Calls visit(range) on each range of `group` that starts less than `reach`
- * below `key` (modulo 2^64): going down from the last one that starts by it,
- * then from the top, for ranges that wrap past 2^64 to it. */
+/* Calls visit(record) on each record of `group` that starts less than
+ * `reach` below `key` (modulo 2^64): going down from the last one that
+ * starts by it, then from the top, for ranges that wrap past 2^64 to it. */
 template <typename Visit> void near_ranges(const entry *group, guint64 key, guint64 reach, Visit visit)
 {
     const guint by = starting_by(group, key);
-    for (guint i = by; i > 0 && key - range_start(group->ranges[i - 1]) < reach; i--) visit(group->ranges[i - 1]);
-    for (guint i = group->range_count; i > by && key - range_start(group->ranges[i - 1]) < reach; i--)
+    for (guint i = by; i > 0 && key - group->ranges[i - 1]->start < reach; i--) visit(group->ranges[i - 1]);
+    for (guint i = group->range_count; i > by && key - group->ranges[i - 1]->start < reach; i--)
         visit(group->ranges[i - 1]);
 }
 
-void add_range(entry *group, entry *range)
+void add_range(entry *group, record *r)
 {
     if (group->range_count == group->range_capacity) {
         group->range_capacity = group->range_capacity ? 2 * group->range_capacity : 2;
         group->ranges =
-            (entry **)wmem_realloc(wmem_file_scope(), group->ranges, group->range_capacity * sizeof(entry *));
+            (record **)wmem_realloc(wmem_file_scope(), group->ranges, group->range_capacity * sizeof(record *));
     }
-    const guint at = starting_by(group, range_start(range));
-    memmove(&group->ranges[at + 1], &group->ranges[at], (group->range_count - at) * sizeof(entry *));
-    group->ranges[at] = range;
+    const guint at = starting_by(group, r->start);
+    memmove(&group->ranges[at + 1], &group->ranges[at], (group->range_count - at) * sizeof(record *));
+    group->ranges[at] = r;
     group->range_count++;
-    group->widest = MAX(group->widest, range_span(range));
+    group->widest = MAX(group->widest, r->span);
 }
 
 /* Records `value` as taught by (frame, message), in order: the first pass
  * meets the frames in order, so it is nearly always appended. Its message
  * teaching again replaces what it taught; the value the entry already had
- * is not recorded again, unless `renewed` (a range that an overlapping one
- * taught later had overtaken is the latest again). */
-void teach(entry *e, guint32 frame, guint32 message, guint64 value, gboolean renewed)
+ * is not recorded again. */
+void teach(entry *e, guint32 frame, guint32 message, guint64 value)
 {
     guint at = taught_before(e, frame, message);
     if (at < e->count && e->values[at].frame == frame && e->values[at].message == message) {
         e->values[at].value = value;
-        e->values[at].order = ++teachings;
         return;
     }
-    if (at > 0 && e->values[at - 1].value == value && !renewed) return;
+    if (at > 0 && e->values[at - 1].value == value) return;
     if (e->count == e->capacity) {
         e->capacity = e->capacity ? 2 * e->capacity : 2;
         e->values = (taught *)wmem_realloc(wmem_file_scope(), e->values, e->capacity * sizeof(taught));
     }
     memmove(&e->values[at + 1], &e->values[at], (e->count - at) * sizeof(taught));
-    e->values[at] = {frame, message, ++teachings, value};
+    e->values[at] = {frame, message, value};
     e->count++;
 }
 
-/* Whether a range of `group` that overlaps `r` was taught after r's latest
- * value: teaching r again, even the same value, makes r the one that holds
- * the overlap. The ranges that overlap r start less than its span plus the
- * widest's below its last key. */
-gboolean overtaken(const entry *group, const entry *r)
+/* Whether a record of `group` that still holds and overlaps `r` was taught
+ * after it: teaching r's window again, even alike, makes it the one that
+ * holds the overlap. The records that overlap r start less than its span
+ * plus the widest's below its last key. */
+gboolean overtaken(const entry *group, const record *r)
 {
-    if (!r->count) return FALSE;
-    const guint64 last = r->values[r->count - 1].order;
     gboolean found = FALSE;
-    near_ranges(group, range_start(r) + range_span(r) - 1, range_span(r) + group->widest - 1, [&](const entry *o) {
-        if (o != r && o->count && o->values[o->count - 1].order > last &&
-            (holds(o, range_start(r)) || holds(r, range_start(o))))
+    near_ranges(group, r->start + r->span - 1, r->span + group->widest - 1, [&](const record *o) {
+        if (o != r && o->until_frame == G_MAXUINT32 && o->order > r->order && (holds(o, r->start) || holds(r, o->start)))
             found = TRUE;
     });
     return found;
 }
 
-/* The entry learn `index` teaches under keys[0 .. key_count) in this
- * message, and in *group the group of ranges it is in (NULL without a span);
- * NULL when a span is undefined or not positive. A range's entry is found by
- * its start and end. */
-entry *learning_entry(dg_state *st, guint16 index, guint64 *keys, entry **group)
+/* Teaches `value` to the window of learn `index` under keys[0 .. key_count)
+ * (the spanned key at `spanned`): a new record, unless the window's latest
+ * one says the same and nothing taught since overlaps it. With an id, a span
+ * of 0 or less removes the window; without one it teaches nothing. */
+void teach_window(dg_state *st, guint16 index, guint64 *keys, gint spanned, guint64 value)
 {
-    *group = NULL;
     const dg_learn *l = &st->p->learns[index];
-    const gint spanned = span_key(st->p, l);
-    entry probe;
-    if (spanned < 0) {
-        probe_of(st, index, keys, l->key_count, &probe);
-        entry *e = (entry *)wmem_map_lookup(entries, &probe);
-        return e ? e : new_entry(entries, &probe);
-    }
     const dg_learn_key *k = &st->p->learn_keys[l->key_first + spanned];
-    dg_expr_value span = evaluate(st, k->span_first, k->span_count);
-    if (!span.defined || span.integer <= 0) return NULL;
+    const dg_expr_value span = evaluate(st, k->span_first, k->span_count);
+    if (!span.defined) return;
     const guint64 start = keys[spanned];
-    drop_key(keys, l->key_count, spanned);
+    const guint64 length = span.integer > 0 ? (guint64)span.integer : 0;
     const guint16 others = (guint16)(l->key_count - 1);
-    keys[others] = start;
-    keys[others + 1] = start + (guint64)span.integer; /* modulo 2^64 */
-    probe_of(st, index, keys, (guint16)(others + 2), &probe);
-    entry *e = (entry *)wmem_map_lookup(entries, &probe);
-    const gboolean made = !e;
-    if (made) e = new_entry(entries, &probe);
+    drop_key(keys, l->key_count, spanned);
+    guint16 window_keys = (guint16)(others + 1);
+    if (k->id_count) { /* the window is what the id names */
+        const dg_expr_value id = evaluate(st, k->id_first, k->id_count);
+        if (!id.defined) return;
+        keys[others] = (guint64)id.integer;
+    } else { /* the window is its range */
+        if (!length) return;
+        keys[others] = start;
+        keys[others + 1] = start + length; /* modulo 2^64 */
+        window_keys++;
+    }
+    entry probe;
+    probe_of(st, index, keys, window_keys, &probe);
+    entry *window = (entry *)wmem_map_lookup(entries, &probe);
+    record *last = window ? window->latest : NULL;
+    if ((!last || !last->span) && !length) return; /* removing a window not there */
     probe_of(st, index, keys, others, &probe);
-    *group = (entry *)wmem_map_lookup(groups, &probe);
-    if (!*group) *group = new_entry(groups, &probe);
-    if (made) add_range(*group, e);
-    return e;
+    entry *group = (entry *)wmem_map_lookup(groups, &probe);
+    if (last && last->start == start && last->span == length && last->value == value &&
+        (!length || !overtaken(group, last)))
+        return;
+    const guint32 frame = st->pinfo->num, message = st->message;
+    record *r = wmem_new(wmem_file_scope(), record);
+    *r = {start, length, value, ++teachings, frame, message, G_MAXUINT32, G_MAXUINT32};
+    if (last) {
+        last->until_frame = frame;
+        last->until_message = message;
+    }
+    if (!group) group = new_entry(groups, &probe);
+    if (length) add_range(group, r);
+    if (!window) {
+        probe_of(st, index, keys, window_keys, &probe);
+        window = new_entry(entries, &probe);
+    }
+    window->latest = r;
 }
 
 } // namespace
@@ -300,17 +332,17 @@ gboolean read_learned(const void *context, gint16 index, guint64 *value)
         *value = e->values[n - 1].value;
         return TRUE;
     }
-    /* the latest value taught before this message by a range that holds the
-     * key: one that starts less than the widest's span below it */
+    /* the latest record that holds the key at this message: one that starts
+     * less than the widest's span below it */
     const guint64 key = keys[spanned];
     drop_key(keys, l->key_count, spanned);
     probe_of(st, (guint16)index, keys, (guint16)(l->key_count - 1), &probe);
     const entry *group = (const entry *)wmem_map_lookup(groups, &probe);
     if (!group) return FALSE;
-    const taught *latest = NULL;
-    near_ranges(group, key, group->widest, [&](const entry *r) {
-        guint n = holds(r, key) ? taught_before(r, st->pinfo->num, st->message) : 0;
-        if (n && (!latest || r->values[n - 1].order > latest->order)) latest = &r->values[n - 1];
+    const record *latest = NULL;
+    near_ranges(group, key, group->widest, [&](const record *r) {
+        if (holds(r, key) && holds_at(r, st->pinfo->num, st->message) && (!latest || r->order > latest->order))
+            latest = r;
     });
     if (!latest) return FALSE;
     *value = latest->value;
@@ -328,11 +360,17 @@ void learn_values(dg_state *st, const dg_node *n)
             if (!holds.defined || holds.integer == 0) continue;
         }
         dg_expr_value v = evaluate(st, l->value_first, l->value_count);
-        guint64 keys[DG_MAX_LEARN_KEYS + 1]; /* a range's: its start and end at the end */
+        guint64 keys[DG_MAX_LEARN_KEYS + 1]; /* a window's range: its start and end at the end */
         if (!v.defined || l->key_count > DG_MAX_LEARN_KEYS || !keys_of(st, l, FALSE, keys)) continue;
-        entry *group;
-        entry *e = learning_entry(st, index, keys, &group);
-        if (e) teach(e, st->pinfo->num, st->message, (guint64)v.integer, group && overtaken(group, e));
+        const gint spanned = span_key(st->p, l);
+        if (spanned >= 0) {
+            teach_window(st, index, keys, spanned, (guint64)v.integer);
+            continue;
+        }
+        entry probe;
+        probe_of(st, index, keys, l->key_count, &probe);
+        entry *e = (entry *)wmem_map_lookup(entries, &probe);
+        teach(e ? e : new_entry(entries, &probe), st->pinfo->num, st->message, (guint64)v.integer);
     }
 }
 

@@ -151,11 +151,14 @@ typedef struct dg_learn {
 /* A key of a <learn>: its value as the learner computes it, and as a reader
  * of learned{...} does (lookup; lookup_count 0: as the learner). With a span
  * (span_count > 0; one key of a learn at most) the learner's value starts a
- * range of span values and a reader's key finds the range that holds it. */
+ * window of span keys and a reader's key finds the window that holds it; with
+ * an id (id_count > 0) the window is what the id names, moved by its next
+ * teaching. */
 typedef struct dg_learn_key {
     guint16 value_first, value_count;
     guint16 lookup_first, lookup_count;
     guint16 span_first, span_count;
+    guint16 id_first, id_count;
 } dg_learn_key;
 
 /* The most entries an offset table may have; longer ones are malformed. */

@@ -6,10 +6,10 @@ tests/rules/learned_ranges.xml on ethertype 0x88c4.
 A Window message gives a device the addresses start .. start + size - 1 of a segment; each
 byte of a later Data message of that segment looks its address up and shows the device whose
 window holds it (Owner) and its offset in that window, or raises win.finding.unmapped. The
-expected values come from a model of the frames in order (the truth of the bytes): where
-windows overlap the one taught latest wins, a window of size 0 or cut short teaches nothing, a
-window taught again with the same start and size keeps its place, each segment has its own
-windows. A Pieces message is laid out piece by piece, each from its address to the end of the
+expected values come from a model of the frames in order (the truth of the bytes): each device
+has one window per segment (the key's id), which its next Window message moves, or removes with
+size 0; where windows overlap the one taught latest wins; a Window cut short teaches nothing;
+each segment has its own windows. A Pieces message is laid out piece by piece, each from its address to the end of the
 window that holds it or of its bytes (a byte no window holds alone): each piece's address,
 owner and length are checked against the model too. The same values in one pass, with -2, and with -2 and a display filter that keeps
 every third frame. Needs no corpus.
@@ -66,6 +66,12 @@ def laid_out(windows, segment, address, count):
     return out
 
 
+def overtaken(windows, w):
+    """Whether a window taught after w overlaps it (teaching w again makes it the latest)."""
+    later = windows[windows.index(w) + 1:]
+    return any(o[0] == w[0] and o[1] < w[2] and w[1] < o[2] for o in later)
+
+
 def expected(messages):
     """{frame: [(address, owner, offset) of each byte]} of the Data frames (owner, offset
     None where no window holds the byte), by a model of the rules: the windows taught by
@@ -75,12 +81,14 @@ def expected(messages):
     for number, (kind, fields) in enumerate(messages, 1):
         if kind == "window":
             segment, device, start, size, cut = fields
-            if cut or size == 0:
+            if cut:
                 continue
             taught = (segment, start, start + size, device)
-            if windows and windows[-1] == taught:
-                continue
-            windows = [w for w in windows if w[:3] != taught[:3]] + [taught]
+            if taught in windows and not overtaken(windows, taught):
+                continue  # said again: no change
+            windows = [w for w in windows if (w[0], w[3]) != (segment, device)]
+            if size:
+                windows.append(taught)
             continue
         segment, address, values = fields
         if kind == "pieces":
@@ -104,7 +112,7 @@ def scripted():
         ("data", (0, 0xFF, [0, 1, 2, 3, 4, 5, 6, 7])),  # 4: 0xff unmapped, 7 x4, 8 x2, 0x106 unmapped
         ("window", (0, 9, 0x102, 3, False)),      # 5: device 9 overlaps both: 0x102..0x104
         ("data", (0, 0x100, [0] * 6)),            # 6: 7 7 9 9 9 8
-        ("window", (0, 5, 0x200, 0, False)),      # 7: size 0: teaches nothing
+        ("window", (0, 5, 0x200, 0, False)),      # 7: size 0: device 5 had no window, nothing
         ("window", (0, 6, 0x200, 4, True)),       # 8: cut short: teaches nothing
         ("data", (0, 0x200, [1, 2])),             # 9: unmapped
         ("data", (1, 0x100, [1])),                # 10: segment 1 has no windows
@@ -116,6 +124,13 @@ def scripted():
         ("pieces", (0, 0x101, [0] * 2)),          # 16: one piece, cut by the bytes' end
         ("window", (0, 9, 0x102, 3, False)),      # 17: device 9 again, latest now
         ("pieces", (0, 0x100, [0] * 7)),          # 18: 7 holds 0x100: to its end, x4; 9 x1, 8 x1, 0x106
+        ("window", (0, 8, 0x120, 2, False)),      # 19: device 8 moves: 0x105 is no one's
+        ("data", (0, 0x103, [0] * 4)),            # 20: 7, 9, unmapped, unmapped
+        ("window", (0, 9, 0x102, 0, False)),      # 21: device 9's window removed: 7 holds 0x102.. again
+        ("data", (0, 0x102, [0] * 3)),            # 22: 7, 7, unmapped
+        ("data", (0, 0x120, [0] * 2)),            # 23: 8, 8 at its new place
+        ("window", (0, 7, 0x100, 4, True)),       # 24: cut short: device 7 keeps its window
+        ("data", (0, 0x100, [0])),                # 25: 7
     ]
 
 
