@@ -366,8 +366,11 @@ void Parser::unexpected_child(xmlNode* child, const std::string& parent,
     std::string name = element_name(child);
     std::string msg = "unknown element <" + name + "> in <" + parent + ">";
     std::string near = remembered_suggestion(name, allowed);
+    static const std::vector<std::string> kNodeOnly = {"enum", "when", "finding", "learn"};
     if (allowed.empty())
         msg += "; <" + parent + "> has no child elements";
+    else if (parent == "root" && std::find(kNodeOnly.begin(), kNodeOnly.end(), name) != kNodeOnly.end())
+        msg += "; <" + name + "> goes inside a <node>, whose fields it reads";
     else if (!near.empty())
         msg += "; did you mean <" + near + ">?";
     else
