@@ -54,35 +54,51 @@ typedef struct record {
     guint32 until_frame, until_message;
 } record;
 
-/* What one <learn> learned under one set of keys; a window (its latest
- * record); or, in `groups`, the records of the windows a learn with a span
- * learned under one set of its other keys. */
-typedef struct entry {
+/* Who an entry, window or group belongs to: a learn, its keys and, with
+ * sender="yes", the sender. First member of each, so one hash serves all. */
+typedef struct identity {
     guint32 hash;
     guint16 learn;
     guint16 key_count;
     guint32 port;
     address src;
     guint64 *keys;
+} identity;
+
+/* What one <learn> without a span learned under one set of keys. */
+typedef struct entry {
+    identity id;
     taught *values; /* in the order of their messages */
     guint count, capacity;
-    record *latest; /* a window's */
-    record **ranges; /* a group's, by their start */
-    guint range_count, range_capacity;
-    guint64 widest; /* a group's: the longest of its ranges */
 } entry;
 
-/* Per capture: the entries and groups of ranges (wmem_file_scope, emptied
+/* A window of a learn with a span: its range, or what its id names. */
+typedef struct learned_window {
+    identity id;
+    record *latest;
+} learned_window;
+
+/* The records of the windows one learn with a span learned under one set of
+ * its other keys, by their start. */
+typedef struct window_group {
+    identity id;
+    record **ranges;
+    guint range_count, range_capacity;
+    guint64 widest; /* the longest of its ranges */
+} window_group;
+
+/* Per capture: the entries, windows and groups (wmem_file_scope, emptied
  * when a file closes). */
 wmem_map_t *entries = NULL;
+wmem_map_t *windows = NULL;
 wmem_map_t *groups = NULL;
 guint64 teachings = 0; /* numbers the teachings, in the first pass's order */
 
-guint entry_hash(gconstpointer k) { return ((const entry *)k)->hash; }
+guint identity_hash(gconstpointer k) { return ((const identity *)k)->hash; }
 
-gboolean entry_equal(gconstpointer a, gconstpointer b)
+gboolean identity_equal(gconstpointer a, gconstpointer b)
 {
-    const entry *x = (const entry *)a, *y = (const entry *)b;
+    const identity *x = (const identity *)a, *y = (const identity *)b;
     return x->hash == y->hash && x->learn == y->learn && x->key_count == y->key_count && x->port == y->port &&
            addresses_equal(&x->src, &y->src) && memcmp(x->keys, y->keys, x->key_count * sizeof(guint64)) == 0;
 }
@@ -114,9 +130,9 @@ gboolean keys_of(const dg_state *st, const dg_learn *l, gboolean lookup, guint64
     return TRUE;
 }
 
-/* The probe of the entry (or group) of learn `index` under keys[0 .. count)
- * (the sender too, with by_sender). */
-void probe_of(const dg_state *st, guint16 index, guint64 *keys, guint16 count, entry *probe)
+/* The identity of the entry, window or group of learn `index` under
+ * keys[0 .. count) (the sender too, with by_sender). */
+void probe_of(const dg_state *st, guint16 index, guint64 *keys, guint16 count, identity *probe)
 {
     const dg_learn *l = &st->p->learns[index];
     memset(probe, 0, sizeof *probe);
@@ -164,14 +180,16 @@ guint taught_before(const entry *e, guint32 frame, guint32 message)
     return low;
 }
 
-entry *new_entry(wmem_map_t *map, const entry *probe)
+/* A new T (entry, window or group) of identity `probe`, in `map`. */
+template <typename T> T *new_keyed(wmem_map_t *map, const identity *probe)
 {
-    entry *e = wmem_new0(wmem_file_scope(), entry);
-    *e = *probe;
-    e->keys = (guint64 *)wmem_memdup(wmem_file_scope(), probe->keys, probe->key_count * sizeof(guint64));
-    copy_address_wmem(wmem_file_scope(), &e->src, &probe->src);
-    wmem_map_insert(map, e, e);
-    return e;
+    T *made = wmem_new0(wmem_file_scope(), T);
+    identity *id = &made->id;
+    *id = *probe;
+    id->keys = (guint64 *)wmem_memdup(wmem_file_scope(), probe->keys, probe->key_count * sizeof(guint64));
+    copy_address_wmem(wmem_file_scope(), &id->src, &probe->src);
+    wmem_map_insert(map, id, made);
+    return made;
 }
 
 gboolean holds(const record *r, guint64 key) { return key - r->start < r->span; }
@@ -186,7 +204,7 @@ gboolean holds_at(const record *r, guint32 frame, guint32 message)
 }
 
 /* The number of the group's records that start at or before `key`. */
-guint starting_by(const entry *group, guint64 key)
+guint starting_by(const window_group *group, guint64 key)
 {
     guint low = 0, high = group->range_count;
     while (low < high) {
@@ -202,7 +220,7 @@ guint starting_by(const entry *group, guint64 key)
 /* Calls visit(record) on each record of `group` that starts less than
  * `reach` below `key` (modulo 2^64): going down from the last one that
  * starts by it, then from the top, for ranges that wrap past 2^64 to it. */
-template <typename Visit> void near_ranges(const entry *group, guint64 key, guint64 reach, Visit visit)
+template <typename Visit> void near_ranges(const window_group *group, guint64 key, guint64 reach, Visit visit)
 {
     const guint by = starting_by(group, key);
     for (guint i = by; i > 0 && key - group->ranges[i - 1]->start < reach; i--) visit(group->ranges[i - 1]);
@@ -210,7 +228,7 @@ template <typename Visit> void near_ranges(const entry *group, guint64 key, guin
         visit(group->ranges[i - 1]);
 }
 
-void add_range(entry *group, record *r)
+void add_range(window_group *group, record *r)
 {
     if (group->range_count == group->range_capacity) {
         group->range_capacity = group->range_capacity ? 2 * group->range_capacity : 2;
@@ -249,7 +267,7 @@ void teach(entry *e, guint32 frame, guint32 message, guint64 value)
  * after it: teaching r's window again, even alike, makes it the one that
  * holds the overlap. The records that overlap r start less than its span
  * plus the widest's below its last key. */
-gboolean overtaken(const entry *group, const record *r)
+gboolean overtaken(const window_group *group, const record *r)
 {
     gboolean found = FALSE;
     near_ranges(group, r->start + r->span - 1, r->span + group->widest - 1, [&](const record *o) {
@@ -284,13 +302,13 @@ void teach_window(dg_state *st, guint16 index, guint64 *keys, gint spanned, guin
         keys[others + 1] = start + length; /* modulo 2^64 */
         window_keys++;
     }
-    entry probe;
+    identity probe;
     probe_of(st, index, keys, window_keys, &probe);
-    entry *window = (entry *)wmem_map_lookup(entries, &probe);
+    learned_window *window = (learned_window *)wmem_map_lookup(windows, &probe);
     record *last = window ? window->latest : NULL;
     if ((!last || !last->span) && !length) return; /* removing a window not there */
     probe_of(st, index, keys, others, &probe);
-    entry *group = (entry *)wmem_map_lookup(groups, &probe);
+    window_group *group = (window_group *)wmem_map_lookup(groups, &probe);
     if (last && last->start == start && last->span == length && last->value == value &&
         (!length || !overtaken(group, last)))
         return;
@@ -301,11 +319,11 @@ void teach_window(dg_state *st, guint16 index, guint64 *keys, gint spanned, guin
         last->until_frame = frame;
         last->until_message = message;
     }
-    if (!group) group = new_entry(groups, &probe);
+    if (!group) group = new_keyed<window_group>(groups, &probe);
     if (length) add_range(group, r);
     if (!window) {
         probe_of(st, index, keys, window_keys, &probe);
-        window = new_entry(entries, &probe);
+        window = new_keyed<learned_window>(windows, &probe);
     }
     window->latest = r;
 }
@@ -322,7 +340,7 @@ gboolean read_learned(const void *context, gint16 index, guint64 *value)
     guint64 keys[DG_MAX_LEARN_KEYS];
     if (l->key_count > G_N_ELEMENTS(keys) || !keys_of(st, l, TRUE, keys)) return FALSE;
     const gint spanned = span_key(st->p, l);
-    entry probe;
+    identity probe;
     if (spanned < 0) {
         probe_of(st, (guint16)index, keys, l->key_count, &probe);
         const entry *e = (const entry *)wmem_map_lookup(entries, &probe);
@@ -337,7 +355,7 @@ gboolean read_learned(const void *context, gint16 index, guint64 *value)
     const guint64 key = keys[spanned];
     drop_key(keys, l->key_count, spanned);
     probe_of(st, (guint16)index, keys, (guint16)(l->key_count - 1), &probe);
-    const entry *group = (const entry *)wmem_map_lookup(groups, &probe);
+    const window_group *group = (const window_group *)wmem_map_lookup(groups, &probe);
     if (!group) return FALSE;
     const record *latest = NULL;
     near_ranges(group, key, group->widest, [&](const record *r) {
@@ -367,18 +385,19 @@ void learn_values(dg_state *st, const dg_node *n)
             teach_window(st, index, keys, spanned, (guint64)v.integer);
             continue;
         }
-        entry probe;
+        identity probe;
         probe_of(st, index, keys, l->key_count, &probe);
         entry *e = (entry *)wmem_map_lookup(entries, &probe);
-        teach(e ? e : new_entry(entries, &probe), st->pinfo->num, st->message, (guint64)v.integer);
+        teach(e ? e : new_keyed<entry>(entries, &probe), st->pinfo->num, st->message, (guint64)v.integer);
     }
 }
 
 void learned_register(const dg_protocol *p)
 {
     if (p->learn_count && !entries) {
-        entries = wmem_map_new_autoreset(wmem_epan_scope(), wmem_file_scope(), entry_hash, entry_equal);
-        groups = wmem_map_new_autoreset(wmem_epan_scope(), wmem_file_scope(), entry_hash, entry_equal);
+        entries = wmem_map_new_autoreset(wmem_epan_scope(), wmem_file_scope(), identity_hash, identity_equal);
+        windows = wmem_map_new_autoreset(wmem_epan_scope(), wmem_file_scope(), identity_hash, identity_equal);
+        groups = wmem_map_new_autoreset(wmem_epan_scope(), wmem_file_scope(), identity_hash, identity_equal);
     }
 }
 
