@@ -211,9 +211,8 @@ void layout_learns(Layout& l, const Protocol& proto) {
         const size_t key_first = l.learn_keys.size();
         for (size_t i = 0; i < learn.keys.size(); ++i) {
             const Expr* lookup = read->lookups[i] ? &*read->lookups[i] : nullptr;
-            // a reader looks windows up: the span only says which key it is, the id is the learner's
-            const Expr* span = learn.keys[i].span ? &*learn.keys[i].span : nullptr;
-            l.learn_keys.push_back("{ " + add(&learn.keys[i].value) + ", " + add(lookup) + ", " + add(span) + ", 0, 0 }");
+            // which key has a span, and its id, the runtime takes from the learner's keys
+            l.learn_keys.push_back("{ " + add(&learn.keys[i].value) + ", " + add(lookup) + ", 0, 0, 0, 0 }");
         }
         l.learns.push_back("/* learned{" + learn.name + "} at line " + std::to_string(read->line) + " */ { 0, 0, 0, 0, " +
                            std::to_string(key_first) + ", " + std::to_string(learn.keys.size()) + ", " +
@@ -587,7 +586,7 @@ void Emitter::learn_tables() {
     o_ << "/* <learn>s: value, if (first, count in exprs; 0, 0: none), keys (first, count), by sender. */\n";
     o_ << c_array("static const dg_learn " + p_.filter + "_learns", l_.learns);
     if (l_.learn_keys.empty()) return;
-    o_ << "/* Their keys: value, lookup, span, id (first, count in exprs; lookup 0, 0: as the value; span, id 0, 0: none). */\n";
+    o_ << "/* Their keys: value, lookup, span, id (first, count in exprs; lookup 0, 0: as the value; span, id 0, 0: none, or a reader's: its learn's). */\n";
     o_ << c_array("static const dg_learn_key " + p_.filter + "_learn_keys", l_.learn_keys);
 }
 

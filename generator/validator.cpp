@@ -263,8 +263,7 @@ void Validator::check_table_sizes() {
         key_rows += row.lookups.size();
         for (size_t i = 0; i < row.lookups.size(); ++i)
             operations += compile_expression(row.learn->keys[i].value, false).size() +
-                          (row.lookups[i] ? compile_expression(*row.lookups[i], false).size() : 0) +
-                          (row.learn->keys[i].span ? compile_expression(*row.learn->keys[i].span, false).size() : 0);
+                          (row.lookups[i] ? compile_expression(*row.lookups[i], false).size() : 0);
         const size_t rows = proto_.learns.size() + k + 1;
         for (auto [count, limit, what] : {std::make_tuple(rows, size_t{32767}, "learned{...} readers and <learn>s"),
                                           std::make_tuple(key_rows, max_rows, "keys of learned{...} readers"),

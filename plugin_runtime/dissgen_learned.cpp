@@ -108,9 +108,11 @@ dg_expr_value evaluate(const dg_state *st, guint16 first, guint16 count)
     return dg_expr_eval(&st->p->exprs[first], count, &message_readers, st, st->instance);
 }
 
-/* The key of learn `index` with a span (a window), or -1. */
+/* The key of learn `l` with a span (a window), or -1; a reader's keys have
+ * their learn's. */
 gint span_key(const dg_protocol *p, const dg_learn *l)
 {
+    if (l->keys_of) l = &p->learns[l->keys_of - 1];
     for (guint16 i = 0; i < l->key_count; i++)
         if (p->learn_keys[l->key_first + i].span_count) return i;
     return -1;
