@@ -126,16 +126,8 @@ class TestLearned(TsharkTestCase, unittest.TestCase):
         path = self.env.add_file(name, capture(messages))
         want = expected(messages)
         with self.checks() as check:
-            for two_pass in (False, True):
-                got = self.decoded(path, two_pass)
-                mode = "-2" if two_pass else "one pass"
-                wrong = {n: (got.get(n), w) for n, w in want.items() if got.get(n) != w}
-                check(not wrong and set(got) == set(want),
-                      "%s: each Data frame reads what earlier frames taught (frame: (got, want)) %s" % (mode, wrong))
-            kept = {n: w for n, w in want.items() if n % 3 == 0}
-            got = self.decoded(path, True, display_filter="frame.number % 3 == 0")
-            check(got == kept, "-2 -Y 'frame.number %% 3 == 0': the same values on the frames kept (%s)" %
-                  {n: (got.get(n), w) for n, w in kept.items() if got.get(n) != w})
+            self.check_every_pass(check, lambda two_pass, shown: self.decoded(path, two_pass, shown), want,
+                                  "each Data frame reads what earlier frames taught")
 
     def test_each_rule_once(self):
         self.check_capture("scripted.pcap", scripted())

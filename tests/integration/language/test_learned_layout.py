@@ -142,16 +142,8 @@ class TestLearnedLayout(TsharkTestCase, unittest.TestCase):
             if w["not_mapped"]:  # raw to the end of the frame, Ethernet's padding included
                 w["unmapped"] = frame(items[n - 1][0])[16:].hex(" ")
         with self.checks() as check:
-            for two_pass in (False, True):
-                got = self.decoded(path, two_pass)
-                wrong = {n: (got.get(n), w) for n, w in want.items() if got.get(n) != w}
-                check(not wrong and set(got) == set(want), "%s: each Data frame laid out by the mapping of its "
-                      "time (%d frames; frame: (got, want)) %s" % ("-2" if two_pass else "one pass", len(want),
-                                                                   dict(list(wrong.items())[:2])))
-            kept = {n: w for n, w in want.items() if n % 3 == 0}
-            got = self.decoded(path, True, display_filter="frame.number % 3 == 0")
-            check(got == kept, "-2 -Y 'frame.number %% 3 == 0': the same layouts on the frames kept (%s)" %
-                  dict(list({n: (got.get(n), w) for n, w in kept.items() if got.get(n) != w}.items())[:2]))
+            self.check_every_pass(check, lambda two_pass, shown: self.decoded(path, two_pass, shown), want,
+                                  "each Data frame laid out by the mapping of its time")
         return want
 
     def test_each_rule_once(self):

@@ -356,6 +356,25 @@ class TsharkTestCase:
         if not check.count:
             self.fail("no check was made")
 
+    def check_every_pass(self, check, decoded, want, what):
+        """Checks that what earlier frames taught reads the same however tshark shows it:
+        decoded(two_pass, display_filter) -> {frame: value} gives `want` in one pass and with
+        -2 (the same frames, no more), and with -2 -Y 'frame.number % 3 == 0' the same values
+        on the frames that filter keeps. `what`: the property, for the checks' lines."""
+        def differing(got, wanted):
+            wrong = dict(list({n: (got.get(n), w) for n, w in wanted.items() if got.get(n) != w}.items())[:3])
+            extra = sorted(set(got) - set(wanted))[:5]
+            return ("; frame: (got, want) %s" % wrong if wrong else "") + \
+                ("; frames not expected: %s" % extra if extra else "")
+        for two_pass in (False, True):
+            got = decoded(two_pass, None)
+            check(got == want, "%s: %s (%d frames%s)" % ("-2" if two_pass else "one pass", what, len(want),
+                                                        differing(got, want)))
+        kept = {n: w for n, w in want.items() if n % 3 == 0}
+        got = decoded(True, "frame.number % 3 == 0")
+        check(got == kept, "-2 -Y 'frame.number %% 3 == 0': the same on the %d frames kept%s" % (
+            len(kept), differing(got, kept)))
+
 
 def run_unittests(add_arguments=None):
     """The entry point of every tests/integration/*/test_*.py: parses --dissgen and
