@@ -31,6 +31,12 @@ machine, so differences of a few percent show.
                otherwise (a conditional member, and an alternative never decoded)
     bitlist    base with the status word as a packed list of 16 one-bit flags (count from
                a computed value): 16 items where base has one
+    learned    base + a <learn> of the start by function, read back (learned{...}) in every
+               packet: the start the previous packet of that function had
+    window     base + a window of 16 registers per function (a <learn> key with a span and
+               an id, taught again alike by every packet) and, per register, the function
+               whose window holds its number (learned{...} with a lookup)
+    offset     base + per register a computed value holding where it sits (`offset`)
 
 Each row gives the instructions per packet that tshark spends in
 epan_dissect_run_with_taps (the dissection of a packet, from the frame through Ethernet,
@@ -114,8 +120,23 @@ def rules(kind):
                    '      <node name="Never flag" length="16bit" displaytype="numberhex"/>\n'
                    '    </node>\n'
                    '  </node>\n')
+    if kind in ("learned", "window"):  # taught by the count, once the function and start are known
+        key = ('      <key value="{Function}"/>\n' if kind == "learned" else
+               '      <key value="{Function} * 16" span="16" id="{Function}" lookup="{Function} * 16 + index"/>\n')
+        value = "{Start}" if kind == "learned" else "{Function}"
+        out[-1] = out[-1].replace(
+            '  <node name="Count" length="1byte" displaytype="numberdec"/>\n',
+            '  <node name="Count" length="1byte" displaytype="numberdec">\n'
+            '    <learn name="Taught" value="%s">\n%s    </learn>\n'
+            '  </node>\n' % (value, key))
+    if kind == "learned":
+        out.append('  <node name="Previous start" value="learned{Taught}" displaytype="numberdec"/>\n')
     out.append('  <node name="Register" count="../node[@name=\'Count\']">\n'
                '    <node name="Value" length="2byte" displaytype="numberhex"/>\n')
+    if kind == "window":
+        out.append('    <node name="Owner" value="learned{Taught}" displaytype="numberdec"/>\n')
+    if kind == "offset":
+        out.append('    <node name="Place" value="offset" displaytype="numberdec"/>\n')
     if kind == "finding":
         out[-1] = out[-1].replace('displaytype="numberhex"/>\n', 'displaytype="numberhex">\n'
                                   '      <finding name="saturated" severity="warning" condition="{Value} == 0xffff"'
@@ -129,7 +150,7 @@ def rules(kind):
 
 
 KINDS = ["base", "branch", "unused", "validity", "computed", "overlay", "pairing", "request", "finding", "cycles",
-         "bitgroup", "bitif", "bitlist"]
+         "bitgroup", "bitif", "bitlist", "learned", "window", "offset"]
 REFERENCE = {"request": "pairing", "unused": "branch", "bitif": "bitgroup"}
 
 
