@@ -93,6 +93,7 @@ private:
     bool check_expr(Node& n, Expr& e);
     bool check_expr(Node& n, Expr& e, const ExprSite& at);
     const Node* find_before(int reach, const std::string& name);
+    const Node* find_readable_before(int reach, const std::string& name, const Node& reader);
     std::vector<std::string> names_before(int reach) const;
     // Every node of each name, in document order: names are looked up once
     // per expression operand, and a <group> used many times makes the tree
@@ -1058,6 +1059,26 @@ const Node* Validator::find_before(int reach, const std::string& name) {
     return past == named.begin() ? nullptr : *(past - 1);
 }
 
+// Whether `reader` sees one value of `t`: t is inside no repeated node that
+// does not contain the reader.
+bool one_instance_for(const Node* t, const Node& reader) {
+    for (const Node* r = t; r; r = r->parent)
+        if (r->is_repeated() && !is_ancestor_or_self(r, &reader)) return false;
+    return true;
+}
+
+// The closest node named `name` before `reach` that `reader` sees one value
+// of (a Tag outside a repeat, not the one inside a repeat decoded since);
+// when none, the closest of any kind, for the error to name.
+const Node* Validator::find_readable_before(int reach, const std::string& name, const Node& reader) {
+    const Node* closest = find_before(reach, name);
+    if (!closest || one_instance_for(closest, reader)) return closest;
+    const std::vector<const Node*>& named = nodes_by_name_.find(name)->second;
+    for (auto it = std::find(named.rbegin(), named.rend(), closest); it != named.rend(); ++it)
+        if (one_instance_for(*it, reader)) return *it;
+    return closest;
+}
+
 // The names of the nodes among the first reach - 1, each once, in document
 // order (of two as close, a misspelt name is offered the first).
 std::vector<std::string> Validator::names_before(int reach) const {
@@ -1130,7 +1151,7 @@ bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
     case ExprOp::Learned: return check_learned(n, e, at);
     case ExprOp::Defined: return check_defined(n, e);
     case ExprOp::Field: {
-        const Node* t = find_before(at.reach, e.name);
+        const Node* t = at.at_reader ? find_before(at.reach, e.name) : find_readable_before(at.reach, e.name, n);
         if (!t) {
             auto named = nodes_by_name_.find(e.name);
             if (named != nodes_by_name_.end()) {
@@ -2008,7 +2029,7 @@ void Validator::parse_finding_text(Node& n, Finding& f, const ExprSite& at) {
             return;
         }
         const std::string name = s.substr(open + 1, close - open - 1);
-        const Node* t = find_before(at.reach, name);
+        const Node* t = find_readable_before(at.reach, name, n);
         if (!t || t->is_container()) {
             diags_.error(at.line, "{" + name + "}" + at.in + ": no field of that name is decoded before it");
             return;

@@ -233,6 +233,32 @@ TEST(Computed, ResolvesTheClosestEarlierFieldAndTypes) {
     EXPECT_TRUE(hot.value->args[0].is_float);
 }
 
+TEST(Computed, SkipsANameInsideARepeatDecodedSinceForTheOneItSees) {
+    // the closest Tag is inside Inner, which does not hold the reader: the
+    // Tag between the two repeats is the one the reader has a value of
+    const std::string items = "  <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"Item\" count=\"../node[@name='Count']\">\n"
+                              "    <node name=\"Tag\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+                              "  </node>\n";
+    const std::string inner = "  <node name=\"Inner\" count=\"../node[@name='Count']\">\n"
+                              "    <node name=\"Tag\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+                              "  </node>\n";
+    Front f = front_end(rules(items + "  <node name=\"Tag\" length=\"1byte\" displaytype=\"numberhex\"/>\n" + inner +
+                              "  <node name=\"Double tag\" value=\"{Tag} * 2\">\n"
+                              "    <finding name=\"odd\" severity=\"note\" condition=\"{Tag} &gt; 1\" text=\"tag {Tag}\"/>\n"
+                              "  </node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Node& doubled = *f.proto->nodes[4];
+    EXPECT_EQ(doubled.value->args[0].target, f.proto->nodes[2].get());
+    EXPECT_EQ(doubled.findings[0].condition.args[0].target, f.proto->nodes[2].get());
+    EXPECT_EQ(doubled.findings[0].text_pieces[1].leaf, f.proto->nodes[2].get());
+    // with only Tags inside other repeats, the closest one is named in the error
+    Front none = front_end(rules(items + inner + "  <node name=\"Double tag\" value=\"{Tag} * 2\"/>\n"));
+    EXPECT_TRUE(contains(none.messages(), "rules.xml:9: error: {Tag} in the value of 'Double tag' is inside repeated node "
+                                          "'Inner' (line 6), which does not contain 'Double tag'"))
+        << none.messages();
+}
+
 TEST(Computed, Mistakes) {
     Front f = front_end(rules(std::string(kHead) +
                               "  <node name=\"Registers\" count=\"../node[@name='Count']\">\n"
