@@ -127,6 +127,14 @@ std::string ident_for(const Protocol& proto, const Node& n) {
     return out;
 }
 
+// The slot a summary of container x reads a leaf's value from: its kept copy
+// when the repeat it is kept across is inside x, so that a later instance
+// without it does not clear it.
+int shown_slot(const Node& x, const Node& leaf) {
+    if (leaf.kept_slot >= 0 && leaf.kept_escape != &x && is_ancestor_or_self(&x, leaf.kept_escape)) return leaf.kept_slot;
+    return leaf.slot;
+}
+
 // quiet: the nodes a walk nobody sees steps over, and their sizes (quiet.h).
 Layout make_layout(const Protocol& proto, const std::map<const Node*, uint64_t>& quiet) {
     Layout l;
@@ -164,7 +172,7 @@ Layout make_layout(const Protocol& proto, const std::map<const Node*, uint64_t>&
         if (!n->summary_pieces.empty()) {
             l.piece_first[n] = static_cast<int>(l.pieces.size());
             for (const SummaryPiece& p : n->summary_pieces)
-                l.pieces.push_back({p.text, p.leaf ? p.leaf->slot : -1, p.group,
+                l.pieces.push_back({p.text, p.leaf ? shown_slot(*n, *p.leaf) : -1, p.group,
                                     p.leaf && p.leaf->is_container() ? p.leaf->doc_index - 1 : -1, p.leaf});
         }
     }
@@ -379,7 +387,10 @@ std::pair<int, int> slot_span(const Node& n) {
         ++count;
     };
     visit(n);
-    for_each_node(n.children, visit);
+    for_each_node(n.children, [&](const Node& d) {
+        visit(d);
+        count += static_cast<int>(d.kept_after.size());  // kept copies of leaves inside d: after d's own slots
+    });
     return {first < 0 ? 0 : first, count};
 }
 
@@ -1035,7 +1046,7 @@ bool needs_extra(const Node& n) {
                             n.display == Display::Time)) ||
            (n.is_leaf() && n.display == Display::DateTime && n.datetime_unit() != "s+ns") ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
-           n.keeps_values || n.keeps_instances || n.is_computed() || n.has_unit_label() || n.is_overlay() ||
+           n.keeps_values || n.keeps_instances || n.kept_slot >= 0 || n.is_computed() || n.has_unit_label() || n.is_overlay() ||
            !n.findings.empty() || !n.learns.empty() || n.analysis_input >= 0 || n.cycle_role != 0 ||
            n.is_counted_list_of_no_bytes();
 }
@@ -1076,6 +1087,7 @@ std::string Emitter::extra_row(const Node& n) const {
     if (n.from_up) add("from_up", std::to_string(n.from_up));
     if (n.keeps_values) add("keep_values", "");
     if (n.keeps_instances) add("keep_instances", "");
+    if (n.kept_slot >= 0) add("kept_slot", std::to_string(n.kept_slot));
     if (n.has_unit_label()) add("unit", c_string(" " + n.unit));
     if (slot(n.overlay) >= 0) add("overlay", std::to_string(slot(n.overlay)));
     if (n.is_computed())

@@ -196,6 +196,12 @@ struct Node {
     unsigned bits = 0;                     // width of a numeric leaf (fixed length)
     int slot = -1;                         // value slot, -1 when nobody refers to it
     std::vector<SummaryPiece> summary_pieces;
+    // A leaf a summary names across a repeat (kept_escape) also keeps its last
+    // value in kept_slot, placed after that repeat's slots so that its new
+    // instances do not clear it; the repeat lists those leaves in kept_after.
+    int kept_slot = -1;
+    const Node* kept_escape = nullptr;
+    std::vector<Node*> kept_after;
 
     // --- display attributes, repeat="rest", direction, hand-off, reassembly ---
     std::string encoding = "utf-8";        // string, stringz: "ascii" or "utf-8"
@@ -406,6 +412,13 @@ struct Protocol {
     // readers whose lookups resolve to other fields (rows learns.size() + k)
     std::vector<std::unique_ptr<LearnedReadKeys>> learned_read_keys;
 };
+
+// Whether `ancestor` is n or a node around it.
+inline bool is_ancestor_or_self(const Node* ancestor, const Node* n) {
+    for (; n; n = n->parent)
+        if (n == ancestor) return true;
+    return false;
+}
 
 // Calls fn(node) for every node in document order.
 template <typename Fn>

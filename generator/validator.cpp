@@ -34,12 +34,6 @@ bool is_byte_display(Display d) {
            d == Display::Guid;
 }
 
-bool is_ancestor_or_self(const Node* ancestor, const Node* n) {
-    for (; n; n = n->parent)
-        if (n == ancestor) return true;
-    return false;
-}
-
 // Whether n or a node around it is repeated: `index` has an instance to count.
 bool inside_repeat(const Node& n) {
     for (const Node* r = &n; r; r = r->parent)
@@ -154,6 +148,7 @@ private:
     void assign_filter_names(std::vector<std::unique_ptr<Node>>& nodes, const std::string& prefix);
     void share_filter_name(Node& n, const Node& owner);
     void mark_slot(Node* n) { if (n) needs_slot_[n] = true; }
+    void keep_values_across_repeats();
     void assign_slots();
     void check_table_sizes();
     // display types, range enums, repeat="rest", direction, hand-off, reassembly
@@ -1039,11 +1034,48 @@ bool Validator::check_cycle_field(const CycleField& f, const char* element, int 
     return true;
 }
 
-void Validator::assign_slots() {
-    int next = 0;
-    for_each_node(proto_.nodes, [&](Node& n) {
-        if (needs_slot_.count(&n)) n.slot = next++;
+// The outermost repeated node strictly between container `x` and its leaf
+// `leaf`: whose new instances would clear what an earlier one decoded.
+const Node* repeat_between(const Node& x, const Node& leaf) {
+    const Node* outermost = nullptr;
+    for (const Node* r = leaf.parent; r && r != &x; r = r->parent)
+        if (r->is_repeated()) outermost = r;
+    return outermost;
+}
+
+// A summary shows the last value of a leaf its container decoded, though a
+// repeat between them began an instance without it since (a TLV list: each
+// instance one member): such leaves keep a copy. Of two repeats a leaf is
+// named across, the inner one is kept: a value from an earlier instance of
+// the summarised container itself is never shown.
+void Validator::keep_values_across_repeats() {
+    for_each_node(proto_.nodes, [&](Node& x) {
+        for (const SummaryPiece& p : x.summary_pieces) {
+            if (!p.leaf || p.leaf->is_container()) continue;
+            const Node* r = repeat_between(x, *p.leaf);
+            if (!r || (p.leaf->kept_escape && !is_ancestor_or_self(p.leaf->kept_escape, r))) continue;
+            p.leaf->kept_escape = r;
+        }
     });
+    for_each_node(proto_.nodes, [&](Node& n) {
+        if (n.kept_escape) const_cast<Node*>(n.kept_escape)->kept_after.push_back(&n);
+    });
+}
+
+// Slots in document order; a leaf's kept copy right after the slots of the
+// repeat it is kept across, so that every subtree's slots stay contiguous.
+void Validator::assign_slots() {
+    keep_values_across_repeats();
+    int next = 0;
+    std::function<void(std::vector<std::unique_ptr<Node>>&)> place = [&](std::vector<std::unique_ptr<Node>>& nodes) {
+        for (auto& child : nodes) {
+            Node& n = *child;
+            if (needs_slot_.count(&n) || n.kept_escape) n.slot = next++;
+            place(n.children);
+            for (Node* kept : n.kept_after) kept->kept_slot = next++;
+        }
+    };
+    place(proto_.nodes);
     proto_.slot_count = next;
 }
 

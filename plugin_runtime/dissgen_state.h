@@ -378,6 +378,10 @@ static inline __attribute__((always_inline)) void store(dg_state *st, const dg_n
     s->length = length;
     s->node = n;
     st->present[n->slot] = TRUE;
+    if (n->extra && n->extra->kept_slot >= 0) {
+        st->slots[n->extra->kept_slot] = *s;
+        st->present[n->extra->kept_slot] = TRUE;
+    }
 }
 
 /* Whether store() uses a leaf's value: a later node reads it (slot) or the

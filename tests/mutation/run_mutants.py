@@ -135,6 +135,7 @@ TESTS = {
     "dates_guids_shared_names": integration("test_dates_guids_shared_names.py"),
     "info_column": integration("test_info_column.py"),
     "empty_summaries": integration("test_info_column.py", "EmptySummaries.test_nothing_where_nothing_is_summarised"),
+    "summary_across_repeats": integration("test_info_column.py", "SummaryAcrossRepeats.test_last_value_of_the_instance"),
     "layout": integration("test_layout.py"),
     "bus_tables": integration("test_bus_tables.py"),
     "bus_identities": integration("test_bus_model.py", "TestBusModel.test_slave_identities_as_the_corpus_lists_them"),

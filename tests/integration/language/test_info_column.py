@@ -27,7 +27,7 @@ sys.dont_write_bytecode = True
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
 import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
 from pcaprewrite import Capture, ecat_datagrams  # noqa: E402
-from tshark_env import TsharkEnv, run_unittests  # noqa: E402
+from tshark_env import TsharkEnv, TsharkTestCase, run_unittests  # noqa: E402
 from test_enip import ethernet, pcap  # noqa: E402
 
 ARGS = None
@@ -308,21 +308,13 @@ EMPTY_SUMMARY_RULES = """<root name="Empty summary" abbreviation="EMPS" ethertyp
 """
 
 
-class EmptySummaries(unittest.TestCase):
+class EmptySummaries(TsharkTestCase, unittest.TestCase):
     """A summary all of whose parts are absent says nothing: no ", " in the Info column and
     a bare "Body" item, not "Body: " (compiled summaries and the table walk alike)."""
 
     @classmethod
-    def setUpClass(cls):
-        cls.env = TsharkEnv()
-        rules = cls.env.path("empty_summary.xml")
-        with open(rules, "w", encoding="utf-8") as f:
-            f.write(EMPTY_SUMMARY_RULES)
-        cls.env.install_plugin(ARGS.dissgen, rules)
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.env.cleanup()
+    def prepare(cls):
+        cls.install_text("empty_summary.xml", EMPTY_SUMMARY_RULES, "emps")
 
     def test_nothing_where_nothing_is_summarised(self):
         cap = self.env.add_file("empty.pcap", pcap([ethernet(bytes([1, 7]), ethertype=0x88B8),
@@ -335,6 +327,51 @@ class EmptySummaries(unittest.TestCase):
                 tree = self.env.tshark(["-r", cap, "-V", "-O", "emps"] + extra, extra_env=walk).stdout
                 bodies = [line.strip() for line in tree.splitlines() if line.strip().startswith("Body")]
                 self.assertEqual(bodies, ["Body: extra 7", "Body"], "%s %s" % (walk, extra))
+
+
+ACROSS_REPEATS_RULES = """<root name="Summary across repeats" abbreviation="SUMX" ethertype="0x88b9">
+  <node name="Count" length="1byte" displaytype="numberdec"/>
+  <node name="Record" count="../node[@name='Count']" summary="a={A} b={B}{? c={C}}">
+    <node name="Length" length="1byte" displaytype="numberdec"/>
+    <node name="Members" length="../node[@name='Length']">
+      <node name="Member" repeat="rest" summary="{Tag} a={A}">
+        <node name="Tag" length="1byte" displaytype="numberdec"/>
+        <node name="A" length="1byte" displaytype="numberdec" if="../node[@name='Tag']" in="1"/>
+        <node name="C" length="1byte" displaytype="numberdec" if="../node[@name='Tag']" in="3" otherwise="true"/>
+        <node name="B" length="1byte" displaytype="numberdec" otherwise="true"/>
+      </node>
+    </node>
+  </node>
+</root>
+"""
+
+
+class SummaryAcrossRepeats(TsharkTestCase, unittest.TestCase):
+    """A summary names leaves inside a list of tagged members (one member each, as TLVs):
+    it shows the last value its own instance decoded, though the last member held another
+    field; a later instance of the summarised container does not show an earlier one's, and
+    a member's own summary shows only that member's (compiled summaries and the table walk,
+    one pass and -2)."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("across_repeats.xml", ACROSS_REPEATS_RULES, "sumx")
+
+    def test_last_value_of_the_instance(self):
+        first = bytes([1, 7, 3, 8, 2, 9, 2, 4])  # A=7, C=8, B=9, B=4
+        second = bytes([2, 5])                   # B=5 only
+        frames = [ethernet(bytes([2, len(first)]) + first + bytes([len(second)]) + second, ethertype=0x88B9),
+                  ethernet(bytes([1, 2, 1, 6]), ethertype=0x88B9)]
+        cap = self.env.add_file("across.pcap", pcap(frames))
+        for walk in ({}, {"DISSGEN_TABLE_WALK": "1"}):
+            for extra in ([], ["-2"]):
+                info = self.env.tshark(["-r", cap, "-T", "fields", "-e", "_ws.col.Info"] + extra,
+                                       extra_env=walk).stdout.splitlines()
+                self.assertEqual(info, ["Record \u00d72: a=7 b=4 c=8, a=- b=5", "a=6 b=-"], "%s %s" % (walk, extra))
+                tree = self.env.tshark(["-r", cap, "-V", "-O", "sumx"] + extra, extra_env=walk).stdout
+                members = [line.strip() for line in tree.splitlines() if line.strip().startswith("Member:")]
+                self.assertEqual(members, ["Member: 1 a=7", "Member: 3 a=-", "Member: 2 a=-", "Member: 2 a=-",
+                                           "Member: 2 a=-", "Member: 1 a=6"], "%s %s" % (walk, extra))
 
 
 if __name__ == "__main__":
