@@ -309,6 +309,7 @@ NAMED_STREAMS = [
     (b"PUMP-10", b"\x02\x00\x00\x00\x00\x01", 4_000_000, 100_000, 15, 100, set(), set()),  # a longer name
     (b"", b"\x02\x00\x00\x00\x00\x03", 3_000_000, 0, 20, 5, set(), set()),  # no name at all
     (b"TANK\x07", b"\x02\x00\x00\x00\x00\x01", 2_500_000, 0, 20, 0, set(), set()),  # a control character
+    (b"IED1LD0/LLN0$GO$gcb1", b"\x02\x00\x00\x00\x00\x04", 5_000_000, 0, 10, 0, set(), set()),  # GOOSE's '/'
 ]
 
 
@@ -360,6 +361,12 @@ class StreamsNamedByText(TsharkTestCase, unittest.TestCase):
                                                                      ":".join("%02x" % b for b in c["stream"]["key"][1]))
                      for c in cycles]
             follows_the_model(self.env, check, self.capture, "named", marks, cycles, names)
+            # the statistics tree names each cycle as -z does; a top-level name would show only what
+            # follows its last '/', so each is shown as U+2215
+            tree = self.env.tshark(["-2", "-r", self.capture, "-q", "-z", "named.cycles,tree"]).stdout
+            shown = [m.group(1) for m in re.finditer(r"^Cycle \d+: (.*?)\s{2,}\d+\s", tree, re.M)]
+            check(shown == [n.replace("/", "\u2215") for n in names],
+                  "-2 -z named.cycles,tree names the cycles as -z named,cycles: %s" % shown)
 
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])
