@@ -1070,7 +1070,11 @@ std::string Emitter::extra_row(const Node& n) const {
     if (n.encoding == "ascii") add("encoding", "ENC_ASCII");
     if (n.display == Display::Time && (n.unit == "s" || n.unit == "ms" || n.unit == "us"))
         add("units_per_second", n.unit == "s" ? "1" : n.unit == "ms" ? "1000" : "1000000");
-    if (n.display == Display::DateTime && n.datetime_unit() != "s+ns") add("time_encoding", datetime_encoding(n));
+    if (n.display == Display::DateTime && n.is_computed()) {  // a count of its unit, not bytes
+        if (n.datetime_unit() != "ns") add("units_per_second", n.unit == "s" ? "1" : n.unit == "ms" ? "1000" : "1000000");
+    } else if (n.display == Display::DateTime && n.datetime_unit() != "s+ns") {
+        add("time_encoding", datetime_encoding(n));
+    }
     if (n.repeat_rest) add("repeat_rest", "");
     if (n.is_counted_list_of_no_bytes()) add("no_bytes", "");
     if (n.direction != Direction::Any)
@@ -1133,6 +1137,8 @@ FieldType computed_field_type(const Node& n) {
     switch (n.display) {
         case Display::Float: return {"FT_DOUBLE", "BASE_NONE", 0};
         case Display::Bool: return {"FT_BOOLEAN", "BASE_NONE", 0};
+        case Display::Time: return {"FT_RELATIVE_TIME", "BASE_NONE", 0};
+        case Display::DateTime: return {"FT_ABSOLUTE_TIME", "ABSOLUTE_TIME_UTC", 0};
         case Display::NumberHex: return {"FT_UINT" + std::to_string(n.bits), "BASE_HEX", 0};
         case Display::Enum:  // masked to 32 bits or fewer: as wide as its mask (check_computed)
             if (n.bits <= 32)

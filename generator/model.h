@@ -211,7 +211,8 @@ struct Node {
     // unit="°C" on a number: the label its item is shown with (not a time's or datetime's unit)
     bool has_unit_label() const { return unit_given && display != Display::Time && display != Display::DateTime; }
     // a datetime's encoding: its unit, or seconds and nanoseconds as two 32-bit values by default
-    std::string datetime_unit() const { return unit_given ? unit : "s+ns"; }
+    // (a computed datetime: a count of nanoseconds since 1970)
+    std::string datetime_unit() const { return unit_given ? unit : value ? "ns" : "s+ns"; }
     bool repeat_rest = false;              // repeat="rest": until the enclosing container ends
     Direction direction = Direction::Any;  // direction="request|response"
     std::optional<std::string> dissector;  // dissector="NAME": hand the bytes to that dissector

@@ -1138,10 +1138,21 @@ void Validator::check_computed(Node& n) {
     case Display::NumberDec: case Display::NumberHex: case Display::Int: case Display::Bool:
     case Display::Enum: case Display::Float: case Display::NonDisplay:
         break;
+    case Display::Time: case Display::DateTime:
+        // a count of the unit (since 1970 for a datetime): seconds and nanoseconds are one number here
+        if (n.value->is_float)
+            diags_.error(n.line, what + " is shown as " + display_name(n.display) + ", a count of " +
+                                     (n.unit_given ? "'" + n.unit + "'" : "nanoseconds") +
+                                     ", but its value has a fraction: compute a whole count, such as "
+                                     "{Seconds} * 1000000000 + {Fraction} * 1000000000 / 16777216");
+        if (n.display == Display::DateTime && n.unit_given && n.unit == "s+ns")
+            diags_.error(n.line, what + " is a datetime with unit 's+ns', two numbers; a computed datetime is one "
+                                     "count since 1970: unit 'ns' (the default), 'us', 'ms' or 's'");
+        break;
     default:
         diags_.error(n.line, what + " is shown as " + display_name(n.display) +
-                                 "; a computed value is shown as numberdec, numberhex, int, bool, enum, float or "
-                                 "nondisplay");
+                                 "; a computed value is shown as numberdec, numberhex, int, bool, enum, float, time, "
+                                 "datetime or nondisplay");
     }
     // A hex value or enum masked to 16 bits is a 16-bit field: 0x6000, not 0x0000000000006000.
     n.bits = n.display == Display::NumberHex || n.display == Display::Enum ? expr_value_bits(*n.value) : 64;

@@ -113,15 +113,24 @@ void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
     append_str(out, buf);
 }
 
-/* A computed value shown as a signed number or a double: its value is in
- * the slot, not in the bytes (it has none). */
-void append_computed_value(dg_text *out, const dg_node *n, guint64 value)
+/* A computed value shown as a signed number, a double or a time: its value
+ * is in the slot, not in the bytes (it has none). */
+void append_computed_value(const dg_state *st, dg_text *out, const dg_node *n, guint64 value)
 {
     char buf[64];
     if (n->show == DG_SHOW_FLOAT) {
         gdouble d;
         memcpy(&d, &value, sizeof d);
         g_snprintf(buf, sizeof buf, "%.*g", DBL_DIG, d);
+    } else if (n->show == DG_SHOW_TIME || n->show == DG_SHOW_DATETIME) {
+        const nstime_t t = count_time(n, (gint64)value);
+        if (n->show == DG_SHOW_DATETIME) {
+            append_str(out, abs_time_to_str(st->pinfo->pool, &t, ABSOLUTE_TIME_UTC, TRUE));
+            return;
+        }
+        append_str(out, rel_time_to_secs_str(st->pinfo->pool, &t));
+        append_str(out, " seconds");
+        return;
     } else {
         g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "d", (gint64)value);
     }
@@ -135,7 +144,7 @@ void append_bare_value(const dg_state *st, dg_text *out, const dg_slot *s)
     const dg_node *n = s->node;
     if (n->length_kind == DG_LEN_COMPUTED && n->show != DG_SHOW_HEX && n->show != DG_SHOW_BOOL &&
         n->show != DG_SHOW_ENUM) {
-        append_computed_value(out, n, s->value);
+        append_computed_value(st, out, n, s->value);
         return;
     }
     switch (n->show) {

@@ -74,6 +74,18 @@ static inline nstime_t time_of(const dg_node *n, guint64 value)
     return t;
 }
 
+/* A computed time's or datetime's signed count of units as an nstime: the
+ * seconds and nanoseconds of a negative count both negative, as Wireshark
+ * keeps a negative time. */
+static inline nstime_t count_time(const dg_node *n, gint64 count)
+{
+    const gint64 per_second = n->extra && n->extra->units_per_second ? n->extra->units_per_second : 1000000000;
+    nstime_t t;
+    t.secs = (time_t)(count / per_second);
+    t.nsecs = (int)((count % per_second) * (1000000000 / per_second));
+    return t;
+}
+
 /* Whether the node is decoded more than once: a count, a repeat flag,
  * repeat="rest" or an offset table. */
 static inline gboolean is_repeated(const dg_node *n)

@@ -260,6 +260,12 @@ void dissect_computed(dg_state *st, const dg_node *n, proto_tree *tree, gint off
         append_unit(n, item);
         break;
     case DG_SHOW_BOOL: item = proto_tree_add_boolean(tree, *n->hf, st->tvb, offset, length, v.integer != 0); break;
+    case DG_SHOW_TIME:
+    case DG_SHOW_DATETIME: {
+        const nstime_t t = count_time(n, v.integer);
+        item = proto_tree_add_time(tree, *n->hf, st->tvb, offset, length, &t);
+        break;
+    }
     case DG_SHOW_HEX:
     case DG_SHOW_ENUM:
         /* a value masked to 32 bits or fewer has a field that wide (no wider value reaches it) */

@@ -70,5 +70,23 @@ TEST(DatesAndGuids, EightByteSecondsAndUnitsOfTimeStayAsTheyWere) {
     EXPECT_TRUE(contains(bad.messages(), "bad unit 's+ns': expected 'ns', 'us', 'ms' or 's'")) << bad.messages();
 }
 
+TEST(DatesAndGuids, ComputedTimesAreCountsOfTheirUnit) {
+    Front f = front_end(rules("  <node name=\"secs\" length=\"4byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"at\" value=\"{secs} * 1000000000\" displaytype=\"datetime\"/>\n"
+                              "  <node name=\"day\" value=\"{secs} / 86400\" displaytype=\"datetime\" unit=\"s\"/>\n"
+                              "  <node name=\"since\" value=\"{secs} - 5\" displaytype=\"time\" unit=\"ms\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Protocol& p = *f.proto;
+    EXPECT_EQ(field_type(*find(p, "at")).type, "FT_ABSOLUTE_TIME");
+    EXPECT_EQ(field_type(*find(p, "at")).display, "ABSOLUTE_TIME_UTC");
+    EXPECT_EQ(field_type(*find(p, "since")).type, "FT_RELATIVE_TIME");
+    std::string code = emit_cpp(p, "t.xml");
+    // a count: nanoseconds the runtime's default, other units per second; no byte encoding
+    EXPECT_TRUE(contains(code, "dg_node_extra().value(0, 3),")) << code;
+    EXPECT_TRUE(contains(code, "dg_node_extra().units_per_second(1).value(3, 3),")) << code;
+    EXPECT_TRUE(contains(code, "dg_node_extra().units_per_second(1000).value(6, 3),")) << code;
+    EXPECT_FALSE(contains(code, "time_encoding(")) << code;
+}
+
 }  // namespace
 }  // namespace dissgen::testing

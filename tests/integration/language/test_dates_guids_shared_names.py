@@ -50,6 +50,20 @@ def times_message():
             + struct.pack("<I", BOOT_S) + OBJECT + OBJECT_BIG)
 
 
+# IEC 61850 UtcTime: seconds and a 24-bit fraction of a second (0x800001: just past .5)
+CLOCK = (1718454896, 0x800001)
+CLOCK_DELTAS = (1234567, 250)    # microseconds: 0.734567 s after, 0.499750 s before
+
+
+def clock_message(delta):
+    return bytes([10]) + struct.pack(">I", CLOCK[0]) + CLOCK[1].to_bytes(3, "big") + struct.pack("<I", delta)
+
+
+def offset_shown(us):
+    """An FT_RELATIVE_TIME of `us` microseconds as tshark prints it: '-0.499750000'."""
+    return "%s%d.%09d" % ("-" if us < 0 else "", abs(us) // 10 ** 6, abs(us) % 10 ** 6 * 1000)
+
+
 def short_message(option, secs, nsecs):
     return bytes([2, option]) + struct.pack("<II", secs, nsecs)
 
@@ -97,6 +111,26 @@ class DatesGuidsSharedNames(TsharkTestCase, unittest.TestCase):
         self.assertEqual(row["dtgd.times.object"], [str(uuid.UUID(bytes_le=OBJECT))])
         self.assertEqual(row["dtgd.times.object_big"], [str(uuid.UUID(bytes=OBJECT_BIG))])
         self.assertEqual(row["dtgd.times.object_big"], ["00112233-4455-6677-8899-aabbccddeeff"])
+
+    def test_computed_times_from_the_bytes(self):
+        """Computed datetime and time values: counts of their unit from other fields, to the
+        nanosecond, as the tree, -T fields, filters and the summary show them."""
+        cap = self.capture("clock.pcap", [clock_message(d) for d in CLOCK_DELTAS])
+        utc_ns = CLOCK[1] * 10 ** 9 // 2 ** 24
+        utc = shown(CLOCK[0], utc_ns)
+        rows = self.rows(cap, ["dtgd.clock.utc", "dtgd.clock.midnight", "dtgd.clock.offset"])
+        for frame, delta in enumerate(CLOCK_DELTAS, 1):
+            self.assertEqual(rows[frame]["dtgd.clock.utc"], [utc])
+            self.assertEqual(rows[frame]["dtgd.clock.midnight"], [shown(CLOCK[0] - CLOCK[0] % 86400, 0)])
+            self.assertEqual(rows[frame]["dtgd.clock.offset"], [offset_shown(delta - 500000)])
+        cases = {'dtgd.clock.utc == "%s.%09dZ"' % (datetime.datetime.fromtimestamp(CLOCK[0], datetime.timezone.utc)
+                                                  .strftime("%Y-%m-%d %H:%M:%S"), utc_ns): [1, 2],
+                 "dtgd.clock.offset < 0": [2], "dtgd.clock.offset > 0.7": [1]}
+        for flt, frames in cases.items():
+            with self.subTest(filter=flt):
+                self.assertEqual(sorted(self.rows(cap, ["dtgd.kind"], display_filter=flt)), frames)
+        info = self.env.tshark(["-r", cap, "-T", "fields", "-e", "_ws.col.Info"]).stdout.splitlines()
+        self.assertEqual(info, ["%s %s seconds" % (utc, offset_shown(d - 500000)) for d in CLOCK_DELTAS])
 
     def test_filters_compare_dates_and_guids(self):
         later = (NET_TIME[0] + 86400, 0)

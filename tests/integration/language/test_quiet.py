@@ -338,10 +338,10 @@ def rule_findings_frames():
 
 def dates_guids_frames():
     """tests/rules/dates_guids_shared.xml: test_dates_guids_shared_names.py's messages of
-    every kind (dates and GUIDs, each alternative sharing a filter name)."""
+    every kind (dates and GUIDs, each alternative sharing a filter name, computed times)."""
     import test_dates_guids_shared_names as m
     payloads = [m.times_message(), m.short_message(5, 1704067200, 500), m.long_message(7, 10**18 + 3),
-                m.other_message(4, 9), m.other_message(9, 1)]
+                m.other_message(4, 9), m.other_message(9, 1)] + [m.clock_message(d) for d in m.CLOCK_DELTAS]
     return [m.frame(p) for p in payloads * 4]
 
 
