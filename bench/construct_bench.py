@@ -43,7 +43,7 @@ epan_dissect_run_with_taps (the dissection of a packet, from the frame through E
 IP and UDP to ours, its tree and columns; not start-up, not the printing), and what the
 construct adds to its reference (request: pairing; unused: branch; the others: base), per
 packet and as a share of the reference.
-Takes about 8 minutes on 2 cores with the defaults.
+Takes about 10 minutes on 2 cores with the defaults.
 """
 import argparse
 import os
