@@ -74,15 +74,20 @@ static inline nstime_t time_of(const dg_node *n, guint64 value)
     return t;
 }
 
-/* A computed time's or datetime's signed count of units as an nstime: the
- * seconds and nanoseconds of a negative count both negative, as Wireshark
- * keeps a negative time. */
+/* A computed time's or datetime's signed count of units as an nstime. A
+ * negative length of time has negative seconds and nanoseconds, as Wireshark
+ * keeps one; a point before 1970 has whole seconds before it and nanoseconds
+ * after them (-0.5 s: 23:59:59.5 on Dec 31, 1969). */
 static inline nstime_t count_time(const dg_node *n, gint64 count)
 {
     const gint64 per_second = n->extra && n->extra->units_per_second ? n->extra->units_per_second : 1000000000;
     nstime_t t;
     t.secs = (time_t)(count / per_second);
     t.nsecs = (int)((count % per_second) * (1000000000 / per_second));
+    if (n->show == DG_SHOW_DATETIME && t.nsecs < 0) {
+        t.secs -= 1;
+        t.nsecs += 1000000000;
+    }
     return t;
 }
 

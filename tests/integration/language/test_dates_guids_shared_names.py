@@ -118,11 +118,14 @@ class DatesGuidsSharedNames(TsharkTestCase, unittest.TestCase):
         cap = self.capture("clock.pcap", [clock_message(d) for d in CLOCK_DELTAS])
         utc_ns = CLOCK[1] * 10 ** 9 // 2 ** 24
         utc = shown(CLOCK[0], utc_ns)
-        rows = self.rows(cap, ["dtgd.clock.utc", "dtgd.clock.midnight", "dtgd.clock.offset"])
+        rows = self.rows(cap, ["dtgd.clock.utc", "dtgd.clock.midnight", "dtgd.clock.offset", "dtgd.clock.before"])
         for frame, delta in enumerate(CLOCK_DELTAS, 1):
             self.assertEqual(rows[frame]["dtgd.clock.utc"], [utc])
             self.assertEqual(rows[frame]["dtgd.clock.midnight"], [shown(CLOCK[0] - CLOCK[0] % 86400, 0)])
             self.assertEqual(rows[frame]["dtgd.clock.offset"], [offset_shown(delta - 500000)])
+            # before 1970: the whole seconds before it, the nanoseconds after them
+            before_secs, before_us = divmod(-delta, 10 ** 6)
+            self.assertEqual(rows[frame]["dtgd.clock.before"], [shown(before_secs, before_us * 1000)])
         cases = {'dtgd.clock.utc == "%s.%09dZ"' % (datetime.datetime.fromtimestamp(CLOCK[0], datetime.timezone.utc)
                                                   .strftime("%Y-%m-%d %H:%M:%S"), utc_ns): [1, 2],
                  "dtgd.clock.offset < 0": [2], "dtgd.clock.offset > 0.7": [1]}
