@@ -127,12 +127,12 @@ std::string ident_for(const Protocol& proto, const Node& n) {
     return out;
 }
 
-// The slot a summary of container x reads a leaf's value from: its kept copy
-// when the repeat it is kept across is inside x, so that a later instance
-// without it does not clear it.
+// The slot a summary of container x reads a leaf's value from: its copy kept
+// across the repeat between them, which a later instance without it does not
+// clear; else its own.
 int shown_slot(const Node& x, const Node& leaf) {
-    if (leaf.kept_slot >= 0 && leaf.kept_escape != &x && is_ancestor_or_self(&x, leaf.kept_escape)) return leaf.kept_slot;
-    return leaf.slot;
+    auto kept = leaf.kept_slots.find(repeat_between(x, leaf));
+    return kept != leaf.kept_slots.end() ? kept->second : leaf.slot;
 }
 
 // quiet: the nodes a walk nobody sees steps over, and their sizes (quiet.h).
@@ -446,6 +446,7 @@ private:
     void range_strings(const Node& n);
     std::string rvals(const Node& n) const { return l_.ident.at(&n) + "_rvals"; }
     std::map<const Node*, int> extra_index_;
+    std::map<const Node*, int> kept_first_;  // a leaf's first row in P_kept_slots
     // alternatives sharing a filter name share the first one's field
     std::string hf(const Node& n) const { return "hf_" + l_.ident.at(n.shares_field ? n.shares_field : &n); }
     bool registers_hf(const Node& n) const { return has_hf(n) && !n.shares_field; }
@@ -1046,12 +1047,23 @@ bool needs_extra(const Node& n) {
                             n.display == Display::Time)) ||
            (n.is_leaf() && n.display == Display::DateTime && n.datetime_unit() != "s+ns") ||
            n.repeat_rest || n.direction != Direction::Any || n.dissector || n.reassembles() || n.is_located() ||
-           n.keeps_values || n.keeps_instances || n.kept_slot >= 0 || n.is_computed() || n.has_unit_label() || n.is_overlay() ||
+           n.keeps_values || n.keeps_instances || !n.kept_slots.empty() || n.is_computed() || n.has_unit_label() || n.is_overlay() ||
            !n.findings.empty() || !n.learns.empty() || n.analysis_input >= 0 || n.cycle_role != 0 ||
            n.is_counted_list_of_no_bytes();
 }
 
 void Emitter::extra_table() {
+    std::vector<std::string> kept;
+    for (const Node* n : l_.nodes)
+        if (!n->kept_slots.empty()) {
+            kept_first_[n] = static_cast<int>(kept.size());
+            for (const auto& [repeat, slot] : n->kept_slots)
+                kept.push_back("/* " + n->name + " across " + repeat->name + " */ " + std::to_string(slot));
+        }
+    if (!kept.empty()) {
+        o_ << "/* Slots where a leaf a summary names across a repeat keeps its last value. */\n"
+           << c_array("static const gint16 " + p_.filter + "_kept_slots", kept);
+    }
     std::vector<std::string> rows;
     for (const Node* n : l_.nodes)
         if (needs_extra(*n)) {
@@ -1091,7 +1103,9 @@ std::string Emitter::extra_row(const Node& n) const {
     if (n.from_up) add("from_up", std::to_string(n.from_up));
     if (n.keeps_values) add("keep_values", "");
     if (n.keeps_instances) add("keep_instances", "");
-    if (n.kept_slot >= 0) add("kept_slot", std::to_string(n.kept_slot));
+    if (!n.kept_slots.empty())
+        add("kept", p_.filter + "_kept_slots + " + std::to_string(kept_first_.at(&n)) + ", " +
+                        std::to_string(n.kept_slots.size()));
     if (n.has_unit_label()) add("unit", c_string(" " + n.unit));
     if (slot(n.overlay) >= 0) add("overlay", std::to_string(slot(n.overlay)));
     if (n.is_computed())

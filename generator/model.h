@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -196,11 +197,11 @@ struct Node {
     unsigned bits = 0;                     // width of a numeric leaf (fixed length)
     int slot = -1;                         // value slot, -1 when nobody refers to it
     std::vector<SummaryPiece> summary_pieces;
-    // A leaf a summary names across a repeat (kept_escape) also keeps its last
-    // value in kept_slot, placed after that repeat's slots so that its new
-    // instances do not clear it; the repeat lists those leaves in kept_after.
-    int kept_slot = -1;
-    const Node* kept_escape = nullptr;
+    // A leaf a summary names across a repeat also keeps its last value in a
+    // slot of that repeat's (kept_slots: repeat -> slot), placed after the
+    // repeat's slots so that its new instances do not clear it; the repeat
+    // lists those leaves in kept_after.
+    std::map<const Node*, int> kept_slots;
     std::vector<Node*> kept_after;
 
     // --- display attributes, repeat="rest", direction, hand-off, reassembly ---
@@ -272,6 +273,9 @@ struct Node {
     bool is_container() const { return !children.empty(); }
     bool is_leaf() const { return children.empty(); }
     bool is_repeated() const { return repeat.has_value() || count.has_value() || repeat_rest || offsets.has_value(); }
+    // Decoded more than once, each instance afresh: repeated, or a window's
+    // child laid out at a stride.
+    bool has_instances() const { return is_repeated() || stride.has_value(); }
     // A number whose length comes from a field: 1-8 bytes read at run time as 64 bits
     // (a PDO entry laid out by a learned mapping). A time needs a fixed length.
     bool is_number_sized_by_field() const;
@@ -419,6 +423,15 @@ inline bool is_ancestor_or_self(const Node* ancestor, const Node* n) {
     for (; n; n = n->parent)
         if (n == ancestor) return true;
     return false;
+}
+
+// The outermost node with instances strictly between container `x` and its
+// leaf `leaf`: whose new instances clear what an earlier one decoded.
+inline const Node* repeat_between(const Node& x, const Node& leaf) {
+    const Node* outermost = nullptr;
+    for (const Node* r = leaf.parent; r && r != &x; r = r->parent)
+        if (r->has_instances()) outermost = r;
+    return outermost;
 }
 
 // Calls fn(node) for every node in document order.

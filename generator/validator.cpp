@@ -1034,31 +1034,18 @@ bool Validator::check_cycle_field(const CycleField& f, const char* element, int 
     return true;
 }
 
-// The outermost repeated node strictly between container `x` and its leaf
-// `leaf`: whose new instances would clear what an earlier one decoded.
-const Node* repeat_between(const Node& x, const Node& leaf) {
-    const Node* outermost = nullptr;
-    for (const Node* r = leaf.parent; r && r != &x; r = r->parent)
-        if (r->is_repeated()) outermost = r;
-    return outermost;
-}
-
 // A summary shows the last value of a leaf its container decoded, though a
 // repeat between them began an instance without it since (a TLV list: each
-// instance one member): such leaves keep a copy. Of two repeats a leaf is
-// named across, the inner one is kept: a value from an earlier instance of
-// the summarised container itself is never shown.
+// instance one member): such leaves keep a copy for each repeat a summary
+// names them across, which that repeat's instances leave and the summarised
+// container's own next instance clears.
 void Validator::keep_values_across_repeats() {
     for_each_node(proto_.nodes, [&](Node& x) {
         for (const SummaryPiece& p : x.summary_pieces) {
             if (!p.leaf || p.leaf->is_container()) continue;
             const Node* r = repeat_between(x, *p.leaf);
-            if (!r || (p.leaf->kept_escape && !is_ancestor_or_self(p.leaf->kept_escape, r))) continue;
-            p.leaf->kept_escape = r;
+            if (r && p.leaf->kept_slots.emplace(r, -1).second) const_cast<Node*>(r)->kept_after.push_back(p.leaf);
         }
-    });
-    for_each_node(proto_.nodes, [&](Node& n) {
-        if (n.kept_escape) const_cast<Node*>(n.kept_escape)->kept_after.push_back(&n);
     });
 }
 
@@ -1070,9 +1057,9 @@ void Validator::assign_slots() {
     std::function<void(std::vector<std::unique_ptr<Node>>&)> place = [&](std::vector<std::unique_ptr<Node>>& nodes) {
         for (auto& child : nodes) {
             Node& n = *child;
-            if (needs_slot_.count(&n) || n.kept_escape) n.slot = next++;
+            if (needs_slot_.count(&n) || !n.kept_slots.empty()) n.slot = next++;
             place(n.children);
-            for (Node* kept : n.kept_after) kept->kept_slot = next++;
+            for (Node* kept : n.kept_after) kept->kept_slots[&n] = next++;
         }
     };
     place(proto_.nodes);

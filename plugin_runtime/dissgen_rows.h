@@ -86,7 +86,7 @@ struct dg_extra_row {
     constexpr dg_extra_row &from_up(guint8 levels) { e.from_up = levels; return *this; }
     constexpr dg_extra_row &keep_values() { e.keep_values = 1; return *this; }
     constexpr dg_extra_row &keep_instances() { e.keep_instances = 1; return *this; }
-    constexpr dg_extra_row &kept_slot(gint16 v) { e.kept_slot = v; return *this; }
+    constexpr dg_extra_row &kept(const gint16 *slots, guint8 count) { e.kept_slots = slots; e.kept_count = count; return *this; }
     constexpr dg_extra_row &unit(const char *label) { e.unit = label; return *this; }
     constexpr dg_extra_row &overlay(gint16 target_slot) { e.overlay_slot = target_slot; return *this; }
     constexpr dg_extra_row &value(guint16 first, guint16 count) { e.expr_first = first; e.expr_count = count; return *this; }

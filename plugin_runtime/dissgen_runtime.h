@@ -93,9 +93,10 @@ typedef struct dg_extra {
     guint8 keep_values = 0;   /* an offset leaf: the value of every instance is kept (up to DG_MAX_TABLE) */
     guint8 keep_instances = 0; /* request{...} reads it by position: each instance's value is kept, at its
                                 * instance number (up to DG_MAX_TABLE) */
-    /* A summary names this leaf across a repeat: its last value is also kept
-     * in this slot, which that repeat's new instances do not clear. -1: none. */
-    gint16 kept_slot = -1;
+    /* A summary names this leaf across repeats: its last value is also kept
+     * in these slots, one per repeat, which its new instances do not clear. */
+    const gint16 *kept_slots = nullptr;
+    guint8 kept_count = 0;
     const char *unit = nullptr; /* unit="°C" on a number: " °C", written after its value in summaries */
     /* overlay="XPATH": this container decodes the bytes of the node in
      * overlay_slot (a leaf or container decoded before it: its slot keeps

@@ -378,10 +378,11 @@ static inline __attribute__((always_inline)) void store(dg_state *st, const dg_n
     s->length = length;
     s->node = n;
     st->present[n->slot] = TRUE;
-    if (n->extra && n->extra->kept_slot >= 0) {
-        st->slots[n->extra->kept_slot] = *s;
-        st->present[n->extra->kept_slot] = TRUE;
-    }
+    if (n->extra && n->extra->kept_count)
+        for (guint8 i = 0; i < n->extra->kept_count; i++) {
+            st->slots[n->extra->kept_slots[i]] = *s;
+            st->present[n->extra->kept_slots[i]] = TRUE;
+        }
 }
 
 /* Whether store() uses a leaf's value: a later node reads it (slot) or the

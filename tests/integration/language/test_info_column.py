@@ -330,16 +330,30 @@ class EmptySummaries(TsharkTestCase, unittest.TestCase):
 
 
 ACROSS_REPEATS_RULES = """<root name="Summary across repeats" abbreviation="SUMX" ethertype="0x88b9">
-  <node name="Count" length="1byte" displaytype="numberdec"/>
-  <node name="Record" count="../node[@name='Count']" summary="a={A} b={B}{? c={C}}">
-    <node name="Length" length="1byte" displaytype="numberdec"/>
-    <node name="Members" length="../node[@name='Length']">
-      <node name="Member" repeat="rest" summary="{Tag} a={A}">
-        <node name="Tag" length="1byte" displaytype="numberdec"/>
-        <node name="A" length="1byte" displaytype="numberdec" if="../node[@name='Tag']" in="1"/>
-        <node name="C" length="1byte" displaytype="numberdec" if="../node[@name='Tag']" in="3" otherwise="true"/>
-        <node name="B" length="1byte" displaytype="numberdec" otherwise="true"/>
+  <node name="Message" summary="last a={A}">
+    <node name="Count" length="1byte" displaytype="numberdec"/>
+    <node name="Record" count="../node[@name='Count']" summary="a={A} b={B}{? c={C}}">
+      <node name="Length" length="1byte" displaytype="numberdec"/>
+      <node name="Members" length="../node[@name='Length']">
+        <node name="Member" repeat="rest" summary="{Tag} a={A}">
+          <node name="Tag" length="1byte" displaytype="numberdec"/>
+          <node name="A" length="1byte" displaytype="numberdec" if="../node[@name='Tag']" in="1"/>
+          <node name="C" length="1byte" displaytype="numberdec" if="../node[@name='Tag']" in="3" otherwise="true"/>
+          <node name="B" length="1byte" displaytype="numberdec" otherwise="true"/>
+        </node>
       </node>
+    </node>
+  </node>
+</root>
+"""
+
+ACROSS_STRIDE_RULES = """<root name="Summary across a stride" abbreviation="SUMS" ethertype="0x88ba">
+  <node name="Address" length="1byte" displaytype="numberhex"/>
+  <node name="Memory" length="rest" base="../node[@name='Address']" summary="value {Value}">
+    <node name="Slot {i}" filter="slot" at="0x0000" stride="2" instances="3" length="2byte">
+      <node name="Flag" length="1byte" displaytype="numberdec"/>
+      <node name="Value" length="1byte" displaytype="numberhex" if="../node[@name='Flag']" in="1"/>
+      <node name="Pad" length="1byte" displaytype="numberhex" otherwise="true"/>
     </node>
   </node>
 </root>
@@ -349,29 +363,35 @@ ACROSS_REPEATS_RULES = """<root name="Summary across repeats" abbreviation="SUMX
 class SummaryAcrossRepeats(TsharkTestCase, unittest.TestCase):
     """A summary names leaves inside a list of tagged members (one member each, as TLVs):
     it shows the last value its own instance decoded, though the last member held another
-    field; a later instance of the summarised container does not show an earlier one's, and
-    a member's own summary shows only that member's (compiled summaries and the table walk,
-    one pass and -2)."""
+    field; a later instance of the summarised container does not show an earlier one's, a
+    member's own summary shows only that member's, and a summary around them all the last
+    of the message; a window's children at a stride alike (compiled summaries and the table
+    walk, one pass and -2)."""
 
     @classmethod
     def prepare(cls):
         cls.install_text("across_repeats.xml", ACROSS_REPEATS_RULES, "sumx")
+        cls.install_text("across_stride.xml", ACROSS_STRIDE_RULES, "sums")
 
     def test_last_value_of_the_instance(self):
         first = bytes([1, 7, 3, 8, 2, 9, 2, 4])  # A=7, C=8, B=9, B=4
         second = bytes([2, 5])                   # B=5 only
         frames = [ethernet(bytes([2, len(first)]) + first + bytes([len(second)]) + second, ethertype=0x88B9),
-                  ethernet(bytes([1, 2, 1, 6]), ethertype=0x88B9)]
+                  ethernet(bytes([1, 2, 1, 6]), ethertype=0x88B9),
+                  ethernet(bytes([0, 1, 0x55, 0, 0, 0, 0]), ethertype=0x88BA)]
         cap = self.env.add_file("across.pcap", pcap(frames))
         for walk in ({}, {"DISSGEN_TABLE_WALK": "1"}):
             for extra in ([], ["-2"]):
                 info = self.env.tshark(["-r", cap, "-T", "fields", "-e", "_ws.col.Info"] + extra,
                                        extra_env=walk).stdout.splitlines()
-                self.assertEqual(info, ["Record \u00d72: a=7 b=4 c=8, a=- b=5", "a=6 b=-"], "%s %s" % (walk, extra))
+                self.assertEqual(info, ["last a=7", "last a=6", "value 0x55"], "%s %s" % (walk, extra))
                 tree = self.env.tshark(["-r", cap, "-V", "-O", "sumx"] + extra, extra_env=walk).stdout
-                members = [line.strip() for line in tree.splitlines() if line.strip().startswith("Member:")]
-                self.assertEqual(members, ["Member: 1 a=7", "Member: 3 a=-", "Member: 2 a=-", "Member: 2 a=-",
-                                           "Member: 2 a=-", "Member: 1 a=6"], "%s %s" % (walk, extra))
+                labels = [line.strip() for line in tree.splitlines()
+                          if line.strip().startswith(("Member:", "Record:", "Message:"))]
+                self.assertEqual(labels, ["Message: last a=7", "Record: a=7 b=4 c=8", "Member: 1 a=7", "Member: 3 a=-",
+                                          "Member: 2 a=-", "Member: 2 a=-", "Record: a=- b=5", "Member: 2 a=-",
+                                          "Message: last a=6", "Record: a=6 b=-", "Member: 1 a=6"],
+                                 "%s %s" % (walk, extra))
 
 
 if __name__ == "__main__":
