@@ -131,7 +131,9 @@ std::string ident_for(const Protocol& proto, const Node& n) {
 // across the repeat between them, which a later instance without it does not
 // clear; else its own.
 int shown_slot(const Node& x, const Node& leaf) {
-    auto kept = leaf.kept_slots.find(repeat_between(x, leaf));
+    const Node* repeat = repeat_between(x, leaf);
+    if (!repeat) return leaf.slot;
+    auto kept = leaf.kept_slots.find(repeat);
     return kept != leaf.kept_slots.end() ? kept->second : leaf.slot;
 }
 

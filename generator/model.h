@@ -142,6 +142,13 @@ struct LearnedReadKeys {
     int line = 0;                              // the reader's
 };
 
+struct Node;
+// Orders nodes as the document does, so that what is kept per node is
+// emitted in the same order on every run (not by address).
+struct InDocumentOrder {
+    bool operator()(const Node* a, const Node* b) const;
+};
+
 struct Node {
     // --- as written ---
     std::string name;
@@ -201,7 +208,7 @@ struct Node {
     // slot of that repeat's (kept_slots: repeat -> slot), placed after the
     // repeat's slots so that its new instances do not clear it; the repeat
     // lists those leaves in kept_after.
-    std::map<const Node*, int> kept_slots;
+    std::map<const Node*, int, InDocumentOrder> kept_slots;
     std::vector<Node*> kept_after;
 
     // --- display attributes, repeat="rest", direction, hand-off, reassembly ---
@@ -417,6 +424,8 @@ struct Protocol {
     // readers whose lookups resolve to other fields (rows learns.size() + k)
     std::vector<std::unique_ptr<LearnedReadKeys>> learned_read_keys;
 };
+
+inline bool InDocumentOrder::operator()(const Node* a, const Node* b) const { return a->doc_index < b->doc_index; }
 
 // Whether `ancestor` is n or a node around it.
 inline bool is_ancestor_or_self(const Node* ancestor, const Node* n) {
