@@ -34,6 +34,14 @@ bool is_byte_display(Display d) {
            d == Display::Guid;
 }
 
+// The repeated node around t (t itself included) that does not hold
+// `reader`, or nullptr: then the reader sees one value of t.
+const Node* repeat_outside(const Node* t, const Node& reader) {
+    for (const Node* r = t; r; r = r->parent)
+        if (r->is_repeated() && !is_ancestor_or_self(r, &reader)) return r;
+    return nullptr;
+}
+
 // Whether n or a node around it is repeated: `index` has an instance to count.
 bool inside_repeat(const Node& n) {
     for (const Node* r = &n; r; r = r->parent)
@@ -571,13 +579,11 @@ void Validator::check_reference(Node& n, const FieldRef& ref, const std::string&
         diags_.error(n.line, field + " is not decoded before " + quote(n) + "; it must come earlier in the file");
         return;
     }
-    for (const Node* r = t; r; r = r->parent) {
-        if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
-            diags_.error(n.line, field + " is inside repeated node " + quote(*r) + at_line(*r) +
-                                     ", which does not contain " + quote(n) +
-                                     "; use a field of the same instance or one outside every repeat");
-            return;
-        }
+    if (const Node* r = repeat_outside(t, n)) {
+        diags_.error(n.line, field + " is inside repeated node " + quote(*r) + at_line(*r) +
+                                 ", which does not contain " + quote(n) +
+                                 "; use a field of the same instance or one outside every repeat");
+        return;
     }
     mark_slot(const_cast<Node*>(t));
 }
@@ -1078,23 +1084,15 @@ const Node* Validator::find_before(int reach, const std::string& name) {
     return past == named.begin() ? nullptr : *(past - 1);
 }
 
-// Whether `reader` sees one value of `t`: t is inside no repeated node that
-// does not contain the reader.
-bool one_instance_for(const Node* t, const Node& reader) {
-    for (const Node* r = t; r; r = r->parent)
-        if (r->is_repeated() && !is_ancestor_or_self(r, &reader)) return false;
-    return true;
-}
-
 // The closest node named `name` before `reach` that `reader` sees one value
 // of (a Tag outside a repeat, not the one inside a repeat decoded since);
 // when none, the closest of any kind, for the error to name.
 const Node* Validator::find_readable_before(int reach, const std::string& name, const Node& reader) {
     const Node* closest = find_before(reach, name);
-    if (!closest || one_instance_for(closest, reader)) return closest;
+    if (!closest || !repeat_outside(closest, reader)) return closest;
     const std::vector<const Node*>& named = nodes_by_name_.find(name)->second;
     for (auto it = std::find(named.rbegin(), named.rend(), closest); it != named.rend(); ++it)
-        if (one_instance_for(*it, reader)) return *it;
+        if (!repeat_outside(*it, reader)) return *it;
     return closest;
 }
 
@@ -1204,13 +1202,12 @@ bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
                                      "or a computed value");
             return false;
         }
-        for (const Node* r = t; r && !at.at_reader; r = r->parent)
-            if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
-                diags_.error(at.line, "{" + e.name + "}" + in + " is inside repeated node " + quote(*r) + at_line(*r) +
-                                         ", which does not contain " + quote(n) +
-                                         "; use a field of the same instance or one outside every repeat");
-                return false;
-            }
+        if (const Node* r = at.at_reader ? nullptr : repeat_outside(t, n)) {
+            diags_.error(at.line, "{" + e.name + "}" + in + " is inside repeated node " + quote(*r) + at_line(*r) +
+                                     ", which does not contain " + quote(n) +
+                                     "; use a field of the same instance or one outside every repeat");
+            return false;
+        }
         e.target = const_cast<Node*>(t);
         e.is_float = t->display == Display::Float;
         mark_slot(e.target);
@@ -1735,9 +1732,7 @@ void Validator::check_offsets(Node& n) {
                              "where the next offset points, the last one to the end of its container");
     if (const Node* t = n.offsets->target) {
         const std::string field = "offsets field " + quote(*t) + at_line(*t);
-        const Node* outside = nullptr;  // a repeated container around t but not around n
-        for (const Node* r = t->parent; r && !outside; r = r->parent)
-            if (r->is_repeated() && !is_ancestor_or_self(r, &n)) outside = r;
+        const Node* outside = repeat_outside(t->parent, n);  // a repeated container around t but not around n
         if (!t->is_numeric())
             diags_.error(n.line, field + " is not numeric: it must be a leaf of 1-64 bits shown as numberhex, "
                                          "numberdec, bool, enum or nondisplay");
@@ -1805,13 +1800,12 @@ void Validator::check_overlay(Node& n) {
     } else if (t->is_computed()) {
         diags_.error(n.line, target + " is a computed value: it has no bytes to decode again");
     } else {
-        for (const Node* r = t; r; r = r->parent)
-            if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
-                diags_.error(n.line, target + (r == t ? " is repeated" : " is inside repeated node " + lines_of(*r)) +
-                                         ", which does not contain " + quote(n) +
-                                         "; use a node of the same instance or one outside every repeat");
-                return;
-            }
+        if (const Node* r = repeat_outside(t, n)) {
+            diags_.error(n.line, target + (r == t ? " is repeated" : " is inside repeated node " + lines_of(*r)) +
+                                     ", which does not contain " + quote(n) +
+                                     "; use a node of the same instance or one outside every repeat");
+            return;
+        }
         mark_slot(const_cast<Node*>(t));
     }
 }
@@ -1836,22 +1830,18 @@ void Validator::check_covers(Node& n) {
         diags_.error(n.line, what + ", a computed value: it has no bytes to show the value on");
         return;
     }
-    for (const Node* r = t; r; r = r->parent)
-        if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
-            diags_.error(n.line, what + ", inside repeated node " + quote(*r) + at_line(*r) + ", which does not contain " +
-                                     quote(n) + "; select a node of the same instance or one outside every repeat");
-            return;
-        }
+    if (const Node* r = repeat_outside(t, n)) {
+        diags_.error(n.line, what + ", inside repeated node " + quote(*r) + at_line(*r) + ", which does not contain " +
+                                 quote(n) + "; select a node of the same instance or one outside every repeat");
+        return;
+    }
     mark_slot(const_cast<Node*>(t));
 }
 
 // Whether the value of t is known when n starts: decoded earlier, in the same
 // repeat instance or outside every repeat.
 bool Validator::known_before(const Node* t, const Node& n) const {
-    if (!t || t->doc_index >= n.doc_index) return false;
-    for (const Node* r = t; r; r = r->parent)
-        if (r->is_repeated() && !is_ancestor_or_self(r, &n)) return false;
-    return true;
+    return t && t->doc_index < n.doc_index && !repeat_outside(t, n);
 }
 
 // peek: the target is a later sibling of n or of an ancestor, and every node
@@ -2064,12 +2054,11 @@ void Validator::parse_finding_text(Node& n, Finding& f, const ExprSite& at) {
             diags_.error(at.line, "{" + name + "}" + at.in + ": no field of that name is decoded before it");
             return;
         }
-        for (const Node* r = t; r; r = r->parent)
-            if (r->is_repeated() && !is_ancestor_or_self(r, &n)) {
-                diags_.error(at.line, "{" + name + "}" + at.in + " is inside repeated node " + quote(*r) + at_line(*r) +
-                                          ", which does not contain " + quote(n));
-                return;
-            }
+        if (const Node* r = repeat_outside(t, n)) {
+            diags_.error(at.line, "{" + name + "}" + at.in + " is inside repeated node " + quote(*r) + at_line(*r) +
+                                      ", which does not contain " + quote(n));
+            return;
+        }
         f.text_pieces.push_back({"", const_cast<Node*>(t)});
         mark_slot(const_cast<Node*>(t));
         i = close + 1;
