@@ -984,15 +984,17 @@ void Validator::check_cycles() {
     if (c.sequence_wrap && width < 64 && c.sequence_wrap - 1 > (uint64_t{1} << width) - 1)
         diags_.error(c.sequence->line, "wrap=\"" + std::to_string(c.sequence_wrap) + "\" is more values than sequence field " +
                                            quote(t) + at_line(t) + " holds (" + std::to_string(width) + " bits)");
-    // a step of half the count's range or more would make every advance look like a count going back
+    // a step of more than half the count's range would make every advance look like a count going back
     const uint64_t top = c.sequence_wrap        ? c.sequence_wrap - 1
                          : c.sequence_bits < 64 ? (uint64_t{1} << c.sequence_bits) - 1
                                                 : ~uint64_t{0};
     const std::string range = c.sequence_wrap ? "count wrapping at " + std::to_string(c.sequence_wrap)
                                               : std::to_string(c.sequence_bits) + "-bit sequence count";
-    if (c.sequence_step > 1 && c.sequence_step > top >> 1)
+    const uint64_t half = (top >> 1) + (top & 1);  // the largest advance taken as forward
+    if (c.sequence_step > half)
         diags_.error(c.sequence->line, "step=\"" + std::to_string(c.sequence_step) +
-                                           "\" is not below half the range of a " + range);
+                                           "\" is more than half the range of a " + range + " (" +
+                                           std::to_string(half) + ")");
 }
 
 // The ethercat-esc analysis times each frame as sent, with its return and its

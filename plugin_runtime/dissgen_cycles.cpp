@@ -10,11 +10,12 @@
  *  - With a sequence count of range R (2^bits, or wrap="R": 0 .. R - 1),
  *    from the stream's second message on, the step d = (count - previous
  *    count) mod R says: d = 0, the previous message again (a duplicate:
- *    P.cycle.duplicate, not timed); 1 <= d <= (R - 1) / 2, d - 1 messages
+ *    P.cycle.duplicate, not timed); 1 <= d <= R / 2, d - 1 messages
  *    lost right before this one (P.cycle.lost); a larger d, the count went
- *    back (a restart, or a message overtaken): nothing lost. A count of R or
- *    more (wrap= only) is no count: the message is timed as one without, and
- *    the stream's next count is its first again.
+ *    back (a restart, or a message overtaken): nothing lost. A message
+ *    without its count (the field not decoded, or with wrap= a count of R or
+ *    more) is timed as one without, and the stream's next count is its
+ *    first again: what came between is not known.
  *  - With lost="period" (no count), a cycle's period rounded to n >= 2 whole
  *    nominal periods means n - 1 messages lost right before this one; more
  *    than max_gap_periods is a pause: nothing lost, not regular.
@@ -238,13 +239,17 @@ cycle *new_cycle(capture_state *c, stream *s, guint window, guint32 frame)
     return cy;
 }
 
+/* Half the range 0 .. top of a count, rounded down: the largest advance
+ * taken as forward (4 of a 3-bit count's 8 values; what lies beyond went back). */
+guint64 half_range(guint64 top) { return (top >> 1) + (top & 1); }
+
 /* Messages lost before an advance of the count by `advance` (not 0) in a
  * stream whose count advances by `step` per message and runs up to `top`:
  * G_MAXUINT32 when the count went back (more than half the range: a
  * restart, a message overtaken) or jumped by no whole number of steps. */
 guint32 lost_before(guint64 advance, guint64 step, guint64 top)
 {
-    if (advance > top >> 1 || advance % step) return G_MAXUINT32;
+    if (advance > half_range(top) || advance % step) return G_MAXUINT32;
     return (guint32)MIN(advance / step - 1, (guint64)G_MAXUINT32 - 1);
 }
 
@@ -272,7 +277,11 @@ gboolean sequence_step(stream *s, const dg_cycle_input *in, const dg_cycles *cy,
     *lost = 0;
     const guint bits = cy->sequence_bits;
     const guint64 step = cy->sequence_step, wrap = cy->sequence_wrap;
-    if (!bits || !in->has_sequence) return TRUE;
+    if (!bits) return TRUE;
+    if (!in->has_sequence) { /* a message without its count: the next count starts afresh */
+        s->has_sequence = FALSE;
+        return TRUE;
+    }
     const guint64 mask = bits >= 64 ? G_MAXUINT64 : ((guint64)1 << bits) - 1;
     const guint64 count = in->sequence & mask;
     if (wrap && count >= wrap) { /* outside the count's range: no count, and the next one starts afresh */
@@ -284,7 +293,7 @@ gboolean sequence_step(stream *s, const dg_cycle_input *in, const dg_cycles *cy,
         const guint64 last = s->last_sequence;
         const guint64 advance = wrap ? (count >= last ? count - last : count + (wrap - last)) : (count - last) & mask;
         if (advance == 0) return FALSE;
-        if (!step && advance <= top >> 1 && (!s->learned_step || s->learned_step % advance == 0))
+        if (!step && advance <= half_range(top) && (!s->learned_step || s->learned_step % advance == 0))
             s->learned_step = advance;
         const guint64 by = step ? step : s->learned_step;
         *lost = by ? lost_before(advance, by, top) : G_MAXUINT32;

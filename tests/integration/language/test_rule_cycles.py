@@ -368,5 +368,60 @@ class StreamsNamedByText(TsharkTestCase, unittest.TestCase):
             check(shown == [n.replace("/", "\u2215") for n in names],
                   "-2 -z named.cycles,tree names the cycles as -z named,cycles: %s" % shown)
 
+# --- a 3-bit count, sometimes not sent --------------------------------------------------
+
+SMALL_COUNT_RULES = """<root name="Small count" abbreviation="SMALLC" ethertype="0x88b5">
+  <cycles>
+    <signature field="node[@name='Stream']"/>
+    <sequence field="node[@name='Count']" bits="3"/>
+  </cycles>
+  <node name="Stream" length="1byte" displaytype="numberdec"/>
+  <node name="Has count" length="1byte" displaytype="numberdec"/>
+  <node name="Count" length="1byte" displaytype="numberdec" if="../node[@name='Has count']" in="1"/>
+</root>
+"""
+
+
+def small_count_capture():
+    """Stream 1 every ms (±3 us): its count (3 bits) advancing by one, then by 4 (half the
+    range: three lost), by 5 (past half: the count went back), and across messages sent
+    without their count (SERCOS III's 'cycle count valid' clear), after which the next
+    count is the stream's first again; stream 2 from mid-capture, one message dropped."""
+    counts = [0, 1, 2, 3, 7, 0, 1, None, 3, 4, 5, 6, None, None, 1, 2, 3, 0, 1, 2, 3, 4, 5]
+    packets = []
+    for i, count in enumerate(counts):
+        t = 1_000_000_000 + i * 1_000_000 + (i * 7919) % 6001 - 3000
+        body = bytes([1, 0]) if count is None else bytes([1, 1, count])
+        packets.append((t, b"\x01\x0c\xcd\x04\0\x01\x02\0\0\0\0\x01\x88\xb5" + body + bytes(46 - len(body))))
+    for i in range(12):
+        if i != 7:
+            t = 1_000_400_000 + (10 + i) * 1_000_000
+            packets.append((t, b"\x01\x0c\xcd\x04\0\x01\x02\0\0\0\0\x01\x88\xb5" + bytes([2, 1, i % 8]) + bytes(43)))
+    packets.sort(key=lambda p: p[0])
+    return packets
+
+
+class TestSmallCount(TsharkTestCase, unittest.TestCase):
+    """A loss of half the count's range is a loss; a message without its count makes the
+    next count the stream's first (nothing counted lost across it, no false alarm)."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("small_count.xml", SMALL_COUNT_RULES, "smallc")
+        cls.packets = small_count_capture()
+        cls.capture = cls.env.add_file("small_count.pcap", pcap_ns(cls.packets))
+
+    def test_losses_by_a_small_count(self):
+        messages = [(frame, t, data[14], data[16] if data[15] else None)
+                    for frame, (t, data) in enumerate(self.packets, 1)]
+        marks, cycles = model(messages, window=8, bits=3)
+        lost = {frame: m["lost"] for frame, m in marks.items() if "lost" in m}
+        with self.checks() as check:
+            # the model itself: 3 lost before count 7 (3 -> 7), 1 in stream 2; nothing after
+            # the messages without a count, nor at 6 -> 1 across them
+            check(sorted(lost.values()) == [1, 3], "the model counts 3 and 1 lost: %s" % lost)
+            follows_the_model(self.env, check, self.capture, "smallc", marks, cycles)
+
+
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])

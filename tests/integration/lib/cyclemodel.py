@@ -34,14 +34,16 @@ def model(messages, window, bits, step=1, lost_by_period=False, wrap=None, irreg
     Returns ({frame: mark}, [cycle]) as the manual describes them."""
     mask = (1 << bits) - 1
     modulus = wrap or (1 << bits)
-    top = modulus - 1  # the highest count: an advance above top // 2 is the count going back
+    half = modulus // 2  # the largest advance forward: a larger one is the count going back
     streams, cycles, marks = {}, [], {}
     for frame, ts, key, seq in messages:
         s = streams.setdefault(key, {"key": key, "last_frame": 0, "last_ts": 0, "last_seq": None, "recent": [],
                                      "cycle": None, "lost": 0, "duplicates": 0, "step": step})
         lost, back = 0, False
         if seq is not None and wrap and (seq & mask) >= wrap:
-            seq, s["last_seq"] = None, None  # no count; the next one is the stream's first again
+            seq = None  # no count
+        if seq is None and bits:
+            s["last_seq"] = None  # a message without its count: the next one is the stream's first again
         if seq is not None:
             seq &= mask
             if s["last_seq"] is not None:
@@ -51,9 +53,9 @@ def model(messages, window, bits, step=1, lost_by_period=False, wrap=None, irreg
                     marks[frame] = {"cycle": s["cycle"]["number"] if s["cycle"] else 0,
                                     "duplicate": s["last_frame"]}
                     continue
-                if not step and advance <= top >> 1 and (not s["step"] or s["step"] % advance == 0):
+                if not step and advance <= half and (not s["step"] or s["step"] % advance == 0):
                     s["step"] = advance  # learned: the first advance, or a smaller one dividing it
-                if s["step"] and advance <= top >> 1 and advance % s["step"] == 0:
+                if s["step"] and advance <= half and advance % s["step"] == 0:
                     lost = min(advance // s["step"] - 1, 2**32 - 2)
                 else:
                     back = True
