@@ -15,6 +15,8 @@
  * C++ only, inside the runtime. */
 #pragma once
 
+#include "dissgen_text.h"
+
 #include <epan/stats_tree.h>
 #include <epan/tap.h>
 #include <epan/wmem_scopes.h>
@@ -188,14 +190,10 @@ inline void st_set(stats_tree *st, const char *name, int parent, guint64 value)
 }
 
 /* The statistics tree's node of cycle `number` ("Cycle N: TEXT", counting
- * its frames) under the root; its id, the parent of the cycle's rows. A
- * top-level name shows only what follows its last '/' (a text signature such
- * as GOOSE's "IED2LD0/LLN0$GO$gcbB"): each becomes U+2215, which looks alike. */
+ * its frames) under the root; its id, the parent of the cycle's rows. */
 inline int st_cycle_node(stats_tree *st, guint number, const char *text, guint frames)
 {
-    char **parts = g_strsplit(text, "/", -1);
-    char *shown = g_strjoinv("\xe2\x88\x95", parts);
-    g_strfreev(parts);
+    char *shown = dg_rt::stats_top_name(text);
     char *name = g_strdup_printf("Cycle %u: %s", number, shown);
     g_free(shown);
     int id = stats_tree_create_node(st, name, 0, STAT_DT_INT, TRUE);

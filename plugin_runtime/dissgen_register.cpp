@@ -88,7 +88,10 @@ const dg_protocol *stats_protocol;
 const char *stats_node_name(const dg_node *n, const char *what)
 {
     header_field_info *hfi = n->hf ? proto_registrar_get_nth(*n->hf) : NULL;
-    return g_strdup_printf("%s%s (%s)", n->name, what, hfi ? hfi->abbrev : stats_protocol->filter);
+    char *name = stats_top_name(n->name);
+    char *shown = g_strdup_printf("%s%s (%s)", name, what, hfi ? hfi->abbrev : stats_protocol->filter);
+    g_free(name);
+    return shown;
 }
 
 char **stats_node_names;   /* per node: that node's name, or NULL (no statistics) */

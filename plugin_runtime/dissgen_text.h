@@ -93,4 +93,16 @@ static inline void append_hex(dg_text *out, guint64 v, guint digits)
     text_append(out, buf, 2 + n);
 }
 
+/* A name for the top level of a statistics tree, g_free()d by the caller:
+ * there a name shows only what follows its last '/' (a field named
+ * "Read/Write", a text signature such as GOOSE's "IED2LD0/LLN0$GO$gcbB"), so
+ * each '/' becomes U+2215, which looks alike. */
+static inline char *stats_top_name(const char *text)
+{
+    char **parts = g_strsplit(text, "/", -1);
+    char *shown = g_strjoinv("\xe2\x88\x95", parts);
+    g_strfreev(parts);
+    return shown;
+}
+
 } // namespace dg_rt

@@ -1070,14 +1070,15 @@ class Everything(TsharkTestCase, unittest.TestCase):
 
     def test_statistics_tree_of_a_rule_file_ending_in_a_counted_node(self):
         """The tree's rows are kept per node: the last node of the file counted too (an enum
-        after a repeated node), each value and each number of instances as often as sent."""
+        after a repeated node), each value and each number of instances as often as sent.
+        A '/' in a node's name shows as U+2215 (the tree would show only what follows it)."""
         rules = ('<root name="Counted last" abbreviation="CLAST" filter="clast" byteorder="big">\n'
                  '  <hook table="udp.port" value="%d"/>\n'
                  '  <node name="Count" length="1byte" displaytype="numberdec"/>\n'
                  '  <node name="Item" count="../node[@name=\'Count\']">\n'
                  '    <node name="Value" length="1byte" displaytype="numberhex"/>\n'
                  '  </node>\n'
-                 '  <node name="Kind" length="1byte" displaytype="enum">'
+                 '  <node name="Kind/mode" length="1byte" displaytype="enum">'
                  '<enum value="1" name="One"/><enum value="2" name="Two"/></node>\n'
                  '</root>\n' % UDP_PORT)
         rng = random.Random(7)
@@ -1091,7 +1092,7 @@ class Everything(TsharkTestCase, unittest.TestCase):
             cap = env.add_file("counted_last.pcap", pcap(frames))
             out = env.tshark(["-r", cap, "-q", "-z", "clast,tree"]).stdout
         rows = {m.group(1).strip(): int(m.group(2)) for m in re.finditer(r"^(\S.*?|\s\S.*?)\s{2,}(\d+)\s", out, re.M)}
-        want = {"Messages": len(sent), "Kind (clast.kind)": len(sent),
+        want = {"Messages": len(sent), "Kind\u2215mode (clast.kind_mode)": len(sent),
                 "One": sum(k == 1 for _n, k in sent), "Two": sum(k == 2 for _n, k in sent),
                 "Item per message (clast.item)": len(sent)}
         want.update({str(c): sum(n == c for n, _k in sent) for c in (1, 2, 3)})
