@@ -9,12 +9,24 @@
  */
 #include "dissgen_state.h"
 
+#include <wsutil/sign_ext.h>
+
 #include <stdlib.h>
 #include <string.h>
 
 namespace dg_rt {
 
 /* --- references and offset tables ---------------------------------------- */
+
+/* The value a length, count or peek reference takes from its slot: an
+ * `int` leaf's sign is its top bit (a 1-byte -1 is -1, not 255). */
+static gint64 ref_slot_value(const dg_slot *s, const dg_ref *ref)
+{
+    guint64 v = s->value;
+    const dg_node *n = s->node;
+    if (ref->is_signed && n && n->show == DG_SHOW_INT && n->bits > 0 && n->bits < 64) v = ws_sign_ext64(v, n->bits);
+    return ref_arith(v, ref);
+}
 
 gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char *what, proto_tree *tree,
                    gint offset, gint64 *out)
@@ -31,7 +43,7 @@ gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char
                what, n->name);
         return FALSE;
     }
-    gint64 v = ref_arith(s->value, ref);
+    gint64 v = ref_slot_value(s, ref);
     if (v < 0) {
         report(st, tree, &st->p->ei->bad_length, offset, 0, "The %s of '%s' is negative (%" G_GINT64_MODIFIER "d)",
                what, n->name, v);
@@ -126,7 +138,7 @@ gint dg_rt::peek_value(const dg_state *st, const dg_peek *pk, gint node_start, g
         const dg_ref *ref = &st->p->peek_lengths[pk->length_first + i];
         const dg_slot *s = &st->slots[ref->slot];
         if (!st->present[ref->slot]) return DG_PEEK_ABSENT;
-        gint64 v = ref_arith(s->value, ref);
+        gint64 v = ref_slot_value(s, ref);
         if (v < 0) return DG_PEEK_ABSENT;
         at += v;
         if (at > limit) return peek_missing(st, list_end, at);

@@ -148,9 +148,12 @@ extern "C" guint dg_message_length(packet_info *, tvbuff_t *tvb, int offset, voi
     guint64 value = read_uint(tvb, offset + (gint)p->pdu_offset, n->length, encoding_of(n));
     if (n->flags & DG_GROUP) value = bit_field(value, n->shift, n->bits);
     gint64 total = (gint64)MIN(value, (guint64)G_MAXINT32) + p->pdu_add;
-    /* A length shorter than the length field itself cannot make progress. */
-    gint64 minimum = (gint64)(p->pdu_offset + n->length);
-    return (guint)CLAMP(total, minimum, (gint64)G_MAXINT32);
+    /* A length shorter than the bytes up to the end of the length field is
+     * malformed: tcp_dissect_pdus shows it as Wireshark's dissectors do (a
+     * malformed packet, the rest of the segment not decoded) rather than
+     * making messages up from what follows. 0 would ask for more data. */
+    if (total < (gint64)(p->pdu_offset + n->length)) return (guint)MAX(total, 1);
+    return (guint)MIN(total, (gint64)G_MAXINT32);
 }
 
 namespace {

@@ -12,6 +12,7 @@
 #include "dissgen_label.h"
 #include "dissgen_state.h"
 
+#include <epan/exceptions.h>
 #include <epan/proto_data.h>
 #include <epan/show_exception.h>
 #include <epan/tap.h>
@@ -210,7 +211,7 @@ void decode_leaf_value(dg_state *st, const dg_node *n, proto_tree *tree, gint of
         }
         decode_number(st, n, tree, offset, len);
         return;
-    } else if (len > 0 && tree) {
+    } else if ((len > 0 || n->show == DG_SHOW_STRING) && tree) { /* an empty text is a value: "" */
         item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, item_encoding(n));
         if (n->show == DG_SHOW_FLOAT) append_unit(n, item);
     }
@@ -234,12 +235,28 @@ gboolean read_offset(const void *context, guint64 *value)
     return TRUE;
 }
 
+/* Whether a computed value would say that its message's request is not
+ * known (P.expert.no_request_context): it reads request{...}, and no value
+ * has found the request missing yet. */
+gboolean would_miss_request(const dg_state *st, const dg_extra *x)
+{
+    if (!st->p->request_context || st->request_missed || (st->request && !st->request_pending)) return FALSE;
+    for (guint i = 0; i < x->expr_count; i++) {
+        const guint8 code = st->p->exprs[x->expr_first + i].code;
+        if (code == DG_OP_REQUEST_FIELD || code == DG_OP_REQUEST_FIELD_SIGNED || code == DG_OP_REQUEST_FIELD_FLOAT)
+            return TRUE;
+    }
+    return FALSE;
+}
+
 /* value="EXPR": a generated item at the current offset, taking no bytes; an
- * undefined value (a field not decoded, a division by zero) shows nothing. */
+ * undefined value (a field not decoded, a division by zero) shows nothing.
+ * Without a tree only a value someone reads is computed, and one that reads
+ * the request, whose note the Expert dialog and -z expert list. */
 void dissect_computed(dg_state *st, const dg_node *n, proto_tree *tree, gint offset)
 {
-    if (!tree && !value_wanted(st, n)) return;
     const dg_extra *x = n->extra;
+    if (!tree && !value_wanted(st, n) && !would_miss_request(st, x)) return;
     st->here = offset;
     dg_expr_value v = dg_expr_eval(&st->p->exprs[x->expr_first], x->expr_count, &message_readers, st,
                                    st->instance);
@@ -902,6 +919,14 @@ void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
 int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     col_set_str(pinfo->cinfo, COL_PROTOCOL, p->short_name);
+    if (tvb_reported_length(tvb) == 0) {
+        /* No bytes at all (an Ethernet frame that ends after its type): a
+         * dissector cannot take a message of 0 bytes by what it returns, so,
+         * as Wireshark's own dissectors do, it is reported malformed by the
+         * exception; the caller (ethertype, udp) shows it under our protocol. */
+        if (tree) proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA);
+        THROW(ReportedBoundsError);
+    }
     /* Several messages in one packet (a TCP segment): each adds its Info text. */
     const guint messages = count_message(p, pinfo);
     const gboolean on_ethertype = carried_by_ethertype(p, pinfo);

@@ -1,0 +1,142 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Messages at the edges of what a rule file says, with real tshark, in one pass and -2:
+
+- an Ethernet frame that ends after its type: no bytes for the protocol, which still
+  takes the frame (its Protocol column) and reports it malformed once, as Wireshark's
+  own dissectors do;
+- a length or count from an `int` leaf that is negative (a 1-byte -1 is -1, not 255):
+  P.expert.bad_length on it, and nothing after it read as items;
+- a zero-length `string`: an item with the empty text, which `== ""` finds;
+- a stream message whose length (pdulength) is shorter than the bytes up to its length
+  field: malformed, and no messages made up from the bytes after it;
+- a response whose request is not in the capture: its note
+  (P.expert.no_request_context) is in `-z expert` also without a tree.
+
+    test_message_edges.py --dissgen build/bin/dissgen --source-dir .
+"""
+import os
+import struct
+import sys
+import unittest
+
+sys.dont_write_bytecode = True
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
+from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
+from test_enip import TcpFlow, pcap, udp  # noqa: E402
+
+PORT = 47611
+RULES = """<root name="Edges" abbreviation="EDGE" ethertype="0x88b5" byteorder="little"
+      pdulength="node[@name='Size']">
+  <hook table="udp.port" value="%d"/>
+  <hook table="tcp.port" value="%d"/>
+  <pairing>
+    <key field="node[@name='Transaction']"/>
+  </pairing>
+  <node name="Kind" length="2byte" displaytype="numberhex"/>
+  <node name="Size" length="2byte" displaytype="numberdec"/>
+  <node name="Transaction" length="1byte" displaytype="numberdec"/>
+  <node name="Reference" length="1byte" displaytype="numberdec" direction="request"/>
+  <node name="First" value="request{Reference}" displaytype="numberdec" direction="response"/>
+  <node name="Length" length="1byte" displaytype="int"/>
+  <node name="Text" length="../node[@name='Length']" displaytype="string"/>
+  <node name="Count" length="1byte" displaytype="int"/>
+  <node name="Item" count="../node[@name='Count']" length="1byte" displaytype="numberhex"/>
+  <node name="Trailer" length="1byte" displaytype="numberhex"/>
+</root>
+""" % (PORT, PORT + 1)
+
+
+def message(txn, text=b"hi", count=2, reference=9, request=True, length=None, count_byte=None):
+    body = bytes([txn]) + (bytes([reference]) if request else b"")
+    body += bytes([len(text) if length is None else length]) + text
+    body += bytes([count if count_byte is None else count_byte]) + bytes(range(0xA0, 0xA0 + count)) + b"\x99"
+    return struct.pack("<HH", 1, 4 + len(body)) + body
+
+
+def to_server(payload):
+    return udp(40000, PORT, payload)
+
+
+def from_server(payload):
+    return udp(PORT, 40000, payload, src=(10, 1, 1, 164), dst=(10, 1, 1, 167))
+
+
+# frame number -> what it is
+FRAMES = [
+    ("empty", b"\x02\0\0\0\0\x02\x02\0\0\0\0\x01\x88\xb5"),          # 14 bytes: no payload at all
+    ("request", to_server(message(5))),
+    ("response", from_server(message(5, request=False))),
+    ("orphan", from_server(message(7, request=False))),              # its request was not captured
+    ("negative length", to_server(message(8, text=b"", length=0xFF, count=0))),
+    ("negative count", to_server(message(9, text=b"ab", count=0, count_byte=0xFF))),
+    ("empty text", to_server(message(10, text=b"", count=1))),
+]
+TCP = TcpFlow(40001, PORT + 1)
+FRAMES += [
+    ("stream", TCP.segment(message(11))),
+    # Size 3: shorter than Kind and Size themselves; what follows is not a message
+    ("short length", TCP.segment(struct.pack("<HH", 1, 3) + message(12))),
+]
+NUMBER = {what: i for i, (what, _frame) in enumerate(FRAMES, 1)}
+
+
+class TestMessageEdges(TsharkTestCase, unittest.TestCase):
+    @classmethod
+    def prepare(cls):
+        cls.install_text("edges.xml", RULES, "edge")
+        cls.capture = cls.env.add_file("edges.pcap", pcap([f for _what, f in FRAMES]))
+
+    def rows(self, two_pass):
+        fields = ["frame.number", "_ws.col.Protocol", "_ws.malformed", "_ws.expert.message", "edge.kind",
+                  "edge.first", "edge.text", "edge.item", "edge.trailer", "edge.expert.bad_length",
+                  "edge.expert.no_request_context", "data"]
+        return self.env.field_rows(self.capture, fields, two_pass=two_pass, aggregator="|")
+
+    def test_each_edge_in_one_pass_and_two(self):
+        with self.checks() as check:
+            for two_pass in (False, True):
+                how = "-2" if two_pass else "one pass"
+                rows = self.rows(two_pass)
+                row = lambda what: rows[NUMBER[what]]  # noqa: E731
+                bad = [what for what, _f in FRAMES if row(what)["edge.expert.bad_length"]]
+                check(bad == ["negative length", "negative count"], "%s: bad_length on %s" % (how, bad))
+                malformed = [what for what, _f in FRAMES if row(what)["_ws.malformed"]]
+                # bad_length is a malformed expert too (Wireshark adds _ws.malformed to each)
+                check(malformed == ["empty", "negative length", "negative count", "short length"],
+                      "%s: malformed: %s" % (how, malformed))
+                check(row("empty")["_ws.col.Protocol"] == ["EDGE"] and not row("empty")["data"],
+                      "%s: the empty frame is ours: %s" % (how, row("empty")))
+                check(row("response")["edge.first"] == ["9"], "%s: request{Reference}: %s" % (how, row("response")))
+                check(row("request")["edge.text"] == ["hi"] and row("request")["edge.item"] == ["0xa0", "0xa1"],
+                      "%s: a plain request: %s" % (how, row("request")))
+                for what in ("negative length", "negative count"):
+                    check(not row(what)["edge.item"], "%s: %s reads no items: %s" % (how, what, row(what)["edge.item"]))
+                messages = " ".join(row("negative length")["_ws.expert.message"] +
+                                    row("negative count")["_ws.expert.message"])
+                check(messages.count("is negative (-1)") == 2, "%s: both say -1: %s" % (how, messages))
+                check(row("empty text")["edge.item"] == ["0xa0"], "%s: after an empty text: %s" % (how, row("empty text")))
+                check(row("stream")["edge.kind"] == ["0x0001"], "%s: a stream message: %s" % (how, row("stream")))
+                check(not row("short length")["edge.kind"],
+                      "%s: nothing made up after a short length: %s" % (how, row("short length")["edge.kind"]))
+                check(row("orphan")["edge.expert.no_request_context"] and
+                      not any(row(w)["edge.expert.no_request_context"] for w, _f in FRAMES if w != "orphan"),
+                      "%s: the request-context note on the orphan response only" % how)
+            for extra in ([], ["-2"]):  # -T fields shows an empty text as nothing: a filter tells
+                filtered = self.env.tshark(["-r", self.capture, "-Y", 'edge.text == ""', "-T", "fields",
+                                            "-e", "frame.number"] + extra).stdout.split()
+                check(filtered == [str(NUMBER["empty text"])], 'edge.text == "" finds the empty text: %s' % filtered)
+
+    def test_notes_without_a_tree(self):
+        """-z expert with no -V and no filter: tshark builds no tree, and the note of a
+        response whose request is not known is listed all the same."""
+        with self.checks() as check:
+            for extra in ([], ["-2"]):
+                out = self.env.tshark(["-r", self.capture, "-q", "-z", "expert"] + extra).stdout
+                check("The request of this response is not known" in out, "%s -z expert lists the note:\n%s" %
+                      (" ".join(extra) or "one pass", out))
+
+
+if __name__ == "__main__":
+    sys.exit(run_unittests()[1])
