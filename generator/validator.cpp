@@ -172,6 +172,7 @@ private:
     void check_layout(Node& n);
     void check_peek(Node& n, When& w);
     void check_offsets(Node& n);  // offsets="XPATH" from="XPATH"
+    void check_rest_reach(const Node& n);  // a rest leaf that leaves nothing for what follows
     void check_overlay(Node& n);  // overlay="XPATH"
     void check_covers(Node& n);   // covers="XPATH" on a computed value
     bool known_before(const Node* t, const Node& n) const;
@@ -206,6 +207,7 @@ void Validator::run() {
         check_display_direction_handoff(n);
         check_layout(n);
         check_offsets(n);
+        check_rest_reach(n);
         if (n.is_overlay()) check_overlay(n);
         if (n.covers) check_covers(n);
         if (n.is_computed()) check_computed(n);
@@ -1767,6 +1769,38 @@ void Validator::check_offsets(Node& n) {
         } else {
             mark_slot(const_cast<Node*>(f));
         }
+    }
+}
+
+// A `rest` leaf takes the bytes up to the end of the closest container
+// around it that has a length (or of the message): a node after a container
+// without one, inside that end, then finds no bytes and is reported
+// truncated in every message that reaches it. A group nested deeper than its
+// depth stands in as such a leaf.
+void Validator::check_rest_reach(const Node& n) {
+    if (!n.is_leaf() || n.length_kind != LengthKind::Rest || n.rest_keep || n.is_repeated()) return;
+    for (const Node* c = &n;; c = c->parent) {
+        const auto& siblings = c->parent ? c->parent->children : proto_.nodes;
+        if (c != &n) {
+            auto at = std::find_if(siblings.begin(), siblings.end(), [&](const auto& s) { return s.get() == c; });
+            for (auto s = at == siblings.end() ? at : at + 1; s != siblings.end(); ++s) {
+                const Node& after = **s;
+                if (after.is_computed() || after.takes_no_bytes() || after.is_overlay() ||
+                    are_alternatives(proto_, *c, after))
+                    continue;
+                const bool stand_in = n.filter && n.filter->rfind("deeper", 0) == 0;
+                diags_.warning(n.line, "leaf " + quote(n) + " takes the rest of the message (no container around it "
+                                       "has a length), so " + quote(after) + at_line(after) + " finds no bytes after it" +
+                                       (stand_in ? ": raise the group's depth to what the messages hold"
+                                                 : ": give a container around it a length, or leave the bytes after "
+                                                   "it with length=\"rest - N\""));
+                return;
+            }
+        }
+        const Node* p = c->parent;
+        if (!p || p->length_kind != LengthKind::Children || p->is_repeated() || p->is_window() || p->is_overlay() ||
+            p->at)
+            return;
     }
 }
 

@@ -684,5 +684,52 @@ TEST(Validator, BitFieldWithoutDisplaytypeIsShownInHex) {
     EXPECT_EQ(flags.shift, 0u);  // big-endian: the second nibble is the low one
 }
 
+TEST(RestLeaves, WarnWhenNothingIsLeftForWhatFollowsAContainerWithoutLength) {
+    // Blob takes the rest of the message, so Trailer never has bytes.
+    Front f = front_end(rules("  <node name=\"Wrap\">\n"
+                              "    <node name=\"Mask\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+                              "    <node name=\"Blob\" length=\"rest\"/>\n"
+                              "  </node>\n"
+                              "  <node name=\"Trailer\" length=\"2byte\" displaytype=\"numberhex\"/>\n"));
+    const std::string m = f.messages();
+    EXPECT_TRUE(f.ok()) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:4: warning: leaf 'Blob' takes the rest of the message (no container around "
+                            "it has a length), so 'Trailer' (line 6) finds no bytes after it")) << m;
+    // A length on the container, room left with rest - N, or an alternative after it: no warning.
+    for (const std::string& body :
+         {std::string("  <node name=\"Wrap\" length=\"3byte\">\n"
+                      "    <node name=\"Mask\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+                      "    <node name=\"Blob\" length=\"rest\"/>\n"
+                      "  </node>\n"
+                      "  <node name=\"Trailer\" length=\"2byte\" displaytype=\"numberhex\"/>\n"),
+          std::string("  <node name=\"Wrap\">\n"
+                      "    <node name=\"Mask\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+                      "    <node name=\"Blob\" length=\"rest - 2\"/>\n"
+                      "  </node>\n"
+                      "  <node name=\"Trailer\" length=\"2byte\" displaytype=\"numberhex\"/>\n"),
+          std::string("  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+                      "  <node name=\"Wrap\" if=\"../node[@name='Kind']\" in=\"1\">\n"
+                      "    <node name=\"Blob\" length=\"rest\"/>\n"
+                      "  </node>\n"
+                      "  <node name=\"Other\" length=\"2byte\" otherwise=\"true\"/>\n")}) {
+        Front g = front_end(rules(body));
+        EXPECT_TRUE(g.ok()) << g.messages();
+        EXPECT_FALSE(contains(g.messages(), "takes the rest")) << body << g.messages();
+    }
+}
+
+TEST(RestLeaves, AGroupNestedDeeperThanItsDepthSaysToRaiseIt) {
+    Front f = front_end(rules("  <group name=\"Diag\" depth=\"1\">\n"
+                              "    <node name=\"Mask\" length=\"1byte\" displaytype=\"numberhex\"/>\n"
+                              "    <node name=\"Inner\" if=\"../node[@name='Mask']\" in=\"1\"><use group=\"Diag\"/></node>\n"
+                              "  </group>\n"
+                              "  <node name=\"Diagnostics\"><use group=\"Diag\"/></node>\n"
+                              "  <node name=\"Trailer\" length=\"2byte\" displaytype=\"numberhex\"/>\n",
+                              "ethertype=\"0x88b5\""));
+    const std::string m = f.messages();
+    EXPECT_TRUE(contains(m, "warning: leaf 'Diag (nested deeper than 1 levels)' takes the rest of the message")) << m;
+    EXPECT_TRUE(contains(m, "'Trailer' (line 7) finds no bytes after it: raise the group's depth")) << m;
+}
+
 }  // namespace
 }  // namespace dissgen::testing
