@@ -1172,19 +1172,23 @@ void Parser::resolve_all() {
     }
 }
 
-// X in the first "@name='X'" (or "@name = \"X\"") of an XPath, "" if none.
+// X of each "@name='X'" (or "@name = \"X\"") of an XPath, in order.
 // A plain scan: std::regex recurses per character on long values.
-std::string named_in_xpath(const std::string& xpath) {
+std::vector<std::string> names_in_xpath(const std::string& xpath) {
+    std::vector<std::string> names;
     for (size_t at = xpath.find("@name"); at != std::string::npos; at = xpath.find("@name", at + 1)) {
         size_t i = xpath.find_first_not_of(" \t", at + 5);
         if (i == std::string::npos || xpath[i] != '=') continue;
         i = xpath.find_first_not_of(" \t", i + 1);
         if (i == std::string::npos || (xpath[i] != '\'' && xpath[i] != '"')) continue;
         size_t end = xpath.find(xpath[i], i + 1);
-        if (end != std::string::npos) return xpath.substr(i + 1, end - i - 1);
+        if (end != std::string::npos) names.push_back(xpath.substr(i + 1, end - i - 1));
     }
-    return "";
+    return names;
 }
+
+// The start of name_hint() for a name no node has.
+const std::string kNoNodeNamed = "; no node is named '";
 
 // Where an XPath that selected nothing was evaluated from, and, when it
 // names a node (@name='X'), whether any node has that name: the two usual
@@ -1193,11 +1197,17 @@ std::string Parser::nothing_selected_hint(const PendingRef& p) {
     std::string from = "<" + element_name(p.context) + ">";
     if (auto it = by_xml_.find(p.context); it != by_xml_.end()) from = "node '" + it->second->name + "'";
     std::string hint = " (evaluated from " + from + " on line " + std::to_string(line_of(p.context)) + ")";
-    const std::string wanted = named_in_xpath(p.ref->xpath);
-    if (wanted.empty()) return hint;
-    auto [known, added] = name_hints_.try_emplace(wanted);
-    if (added) known->second = name_hint(wanted);
-    return hint + known->second;
+    const std::vector<std::string> names = names_in_xpath(p.ref->xpath);
+    if (names.empty()) return hint;
+    // The first name no node has (misspelt), else where the path's first name is.
+    const std::string* first_hint = nullptr;
+    for (const std::string& wanted : names) {
+        auto [known, added] = name_hints_.try_emplace(wanted);
+        if (added) known->second = name_hint(wanted);
+        if (!first_hint) first_hint = &known->second;
+        if (known->second.rfind(kNoNodeNamed, 0) == 0) return hint + known->second;
+    }
+    return hint + *first_hint;
 }
 
 // Whether a node is named `wanted`, and where first, or the name most like it.
@@ -1212,7 +1222,7 @@ std::string Parser::name_hint(const std::string& wanted) const {
     std::vector<std::string> names;
     for (const auto& [name, line] : first_line) names.push_back(name);
     std::string near = closest_match(wanted, names);
-    return "; no node is named '" + wanted + "'" + (near.empty() ? "" : " (did you mean '" + near + "'?)");
+    return kNoNodeNamed + wanted + "'" + (near.empty() ? "" : " (did you mean '" + near + "'?)");
 }
 
 Node* Parser::resolve(const PendingRef& p) {
