@@ -168,6 +168,17 @@ TEST(ReportCyclesModel, SeriesLossesRepeatsAndRoundTrips) {
     EXPECT_EQ(m.no_response[1].frame, 2u);
 }
 
+TEST(ReportCyclesModel, EveryResponseOfAFrameHasItsRoundTrip) {
+    Rows r;  // one TCP segment holding two responses: P.time twice, as tshark joins them
+    r.add({{"frame.number", "1"}, {"frame.time_epoch", "100.000000000"}});
+    r.add({{"frame.number", "2"}, {"frame.time_epoch", "100.010000000"}, {"enipr.time", "0.009999000,0.000250000"}});
+    CyclesModel m;
+    r.feed(m);
+    ASSERT_EQ(m.round_trip.size(), 2u) << "as -z P,tree and the fields count them";
+    EXPECT_EQ(m.round_trip[0].ns, 9999000);
+    EXPECT_EQ(m.round_trip[1].ns, 250000);
+}
+
 TEST(ReportCyclesPage, TableAsPrintedChartsPerCycleEscaped) {
     Rows r;
     r.statistics = kStatistics;

@@ -152,8 +152,11 @@ void CyclesModelBuilder::add_stream_marks(const FieldRow& row, double t, uint32_
 }
 
 void CyclesModelBuilder::add_pairing(const FieldRow& row, double t) {
-    int64_t rtt = 0;
-    if (parse_seconds_ns(value(row, runtime_field::time), rtt)) model_.round_trip.push_back({t, rtt});
+    // a frame holding several responses (a TCP segment) has a round trip for each
+    for (std::string_view shown : split_values(value(row, runtime_field::time))) {
+        int64_t rtt = 0;
+        if (parse_seconds_ns(shown, rtt)) model_.round_trip.push_back({t, rtt});
+    }
     for (std::string_view request : split_values(value(row, runtime_field::no_response_to))) {
         uint64_t f = 0;
         if (!parse_uint(request, f)) continue;
