@@ -1082,13 +1082,12 @@ std::string Emitter::extra_row(const Node& n) const {
     auto add = [&](const char* setter, const std::string& args) { set.push_back(setter + ("(" + args + ")")); };
     auto slot = [](const std::optional<FieldRef>& r) { return r && r->target ? r->target->slot : -1; };
     if (n.encoding == "ascii") add("encoding", "ENC_ASCII");
-    if (n.display == Display::Time && (n.unit == "s" || n.unit == "ms" || n.unit == "us"))
+    // A time, or a computed datetime (a count of its unit, not bytes), in a unit coarser than ns.
+    const bool counts_units = n.display == Display::Time || (n.display == Display::DateTime && n.is_computed());
+    if (counts_units && (n.unit == "s" || n.unit == "ms" || n.unit == "us"))
         add("units_per_second", n.unit == "s" ? "1" : n.unit == "ms" ? "1000" : "1000000");
-    if (n.display == Display::DateTime && n.is_computed()) {  // a count of its unit, not bytes
-        if (n.datetime_unit() != "ns") add("units_per_second", n.unit == "s" ? "1" : n.unit == "ms" ? "1000" : "1000000");
-    } else if (n.display == Display::DateTime && n.datetime_unit() != "s+ns") {
+    if (n.display == Display::DateTime && !n.is_computed() && n.datetime_unit() != "s+ns")
         add("time_encoding", datetime_encoding(n));
-    }
     if (n.repeat_rest) add("repeat_rest", "");
     if (n.is_counted_list_of_no_bytes()) add("no_bytes", "");
     if (n.direction != Direction::Any)
