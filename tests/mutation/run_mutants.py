@@ -176,6 +176,8 @@ TESTS = {
     "learned_ranges": integration("test_learned_ranges.py"),
     "rule_findings": integration("test_rule_findings.py"),
     "rule_cycles": integration("test_rule_cycles.py"),
+    "small_count": integration("test_rule_cycles.py", "TestSmallCount"),
+    "message_edges": integration("test_message_edges.py"),
     "polled_cycles": integration("test_polled_cycles.py"),
     "overlays": integration("test_overlays.py"),
     "request_context": integration("test_request_context.py"),
