@@ -12,7 +12,6 @@
 #include "dissgen_label.h"
 #include "dissgen_state.h"
 
-#include <epan/exceptions.h>
 #include <epan/proto_data.h>
 #include <epan/show_exception.h>
 #include <epan/tap.h>
@@ -919,14 +918,6 @@ void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
 int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     col_set_str(pinfo->cinfo, COL_PROTOCOL, p->short_name);
-    if (tvb_reported_length(tvb) == 0) {
-        /* No bytes at all (an Ethernet frame that ends after its type): a
-         * dissector cannot take a message of 0 bytes by what it returns, so,
-         * as Wireshark's own dissectors do, it is reported malformed by the
-         * exception; the caller (ethertype, udp) shows it under our protocol. */
-        if (tree) proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA);
-        THROW(ReportedBoundsError);
-    }
     /* Several messages in one packet (a TCP segment): each adds its Info text. */
     const guint messages = count_message(p, pinfo);
     const gboolean on_ethertype = carried_by_ethertype(p, pinfo);
@@ -966,5 +957,9 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
         col_add_str(pinfo->cinfo, COL_INFO, info);
     else
         col_append_sep_str(pinfo->cinfo, COL_INFO, " | ", info);
-    return offset > 0 ? offset : st.packet_end;
+    /* The message is ours even when it took no bytes (an Ethernet frame that
+     * ends after its type: its expert info says what is missing); 0 would
+     * tell the caller (ethertype, udp) that it is not, and it would show the
+     * frame as undissected under our tree. */
+    return offset > 0 ? offset : MAX(st.packet_end, 1);
 }

@@ -238,10 +238,11 @@ class Malformed(unittest.TestCase):
         for _ in range(3000):
             body = bytes(rng.getrandbits(8) for _ in range(rng.randint(0, 200)))
             packets.append((ETH_HEADER + body, 14 + len(body)))
-        rows = self.decode(packets, ["_ws.col.Protocol"])
+        rows = self.decode(packets, ["_ws.col.Protocol", "_ws.malformed"])
         for (data, _), row in zip(packets, rows):
-            # Ethernet calls no subdissector for an empty payload.
-            self.assertEqual(row[0], "ECATR" if len(data) > 14 else "0x88a4")
+            self.assertEqual(row[0], "ECATR")
+            if len(data) == 14:  # no payload at all: ours, and malformed (our expert info)
+                self.assertTrue(row[1], "an empty EtherCAT frame is malformed")
 
 
 def main():

@@ -3,8 +3,8 @@
 """Messages at the edges of what a rule file says, with real tshark, in one pass and -2:
 
 - an Ethernet frame that ends after its type: no bytes for the protocol, which still
-  takes the frame (its Protocol column) and reports it malformed once, as Wireshark's
-  own dissectors do;
+  takes the frame (its Protocol column, no Data) with one expert info saying what is
+  missing;
 - a length or count from an `int` leaf that is negative (a 1-byte -1 is -1, not 255):
   P.expert.bad_length on it, and nothing after it read as items;
 - a zero-length `string`: an item with the empty text, which `== ""` finds;
@@ -106,7 +106,8 @@ class TestMessageEdges(TsharkTestCase, unittest.TestCase):
                 # bad_length is a malformed expert too (Wireshark adds _ws.malformed to each)
                 check(malformed == ["empty", "negative length", "negative count", "short length"],
                       "%s: malformed: %s" % (how, malformed))
-                check(row("empty")["_ws.col.Protocol"] == ["EDGE"] and not row("empty")["data"],
+                check(row("empty")["_ws.col.Protocol"] == ["EDGE"] and not row("empty")["data"] and
+                      row("empty")["_ws.expert.message"] == ["Truncated: 'Kind' needs 2 bytes, only 0 left"],
                       "%s: the empty frame is ours: %s" % (how, row("empty")))
                 check(row("response")["edge.first"] == ["9"], "%s: request{Reference}: %s" % (how, row("response")))
                 check(row("request")["edge.text"] == ["hi"] and row("request")["edge.item"] == ["0xa0", "0xa1"],
