@@ -442,9 +442,9 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
 
     proto_item *item = NULL;
     proto_tree *subtree = open_container(st, n, tree, start, &item);
-    if (past_end)
-        report_missing(st, subtree, n->length_kind == DG_LEN_FIELD ? &st->p->ei->past_end : &st->p->ei->truncated,
-                       end, start + length, start, end - start,
+    /* A length field past the end is the fault, where it points. */
+    if (past_end && n->length_kind == DG_LEN_FIELD)
+        report_missing(st, subtree, &st->p->ei->past_end, end, start + length, start, end - start,
                        "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)", n->name,
                        length, end - start);
     /* Decode what is there even when the length overruns. */
@@ -455,6 +455,12 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     else
         walk_list(st, n->walk, n->first_child, n->child_count, subtree, offset, inner_end,
                   in_summary || n->summary_count > 0);
+    /* A fixed length cut short: the child where the bytes ran out said so;
+     * only when none did (they all fit) is the container itself short. */
+    if (past_end && n->length_kind != DG_LEN_FIELD && !st->stopped)
+        report_missing(st, subtree, &st->p->ei->truncated, end, start + length, start, end - start,
+                       "Truncated: '%s' needs %" G_GINT64_MODIFIER "d bytes, only %d left", n->name, length,
+                       end - start);
     st->stopped = st->stopped || was_stopped;
     if (!st->stopped && length >= 0 && *offset < inner_end &&
         (n->length_kind == DG_LEN_FIXED || n->length_kind == DG_LEN_FIELD)) {

@@ -438,12 +438,15 @@ class Expected:
         inner_end = start + length if length >= 0 and not past_end else end
         item = Item(n.name, n.field, "1" if n.field else None)
         parent.children.append(item)
-        if past_end:
-            self.expert(item, "past_end" if n.lenkind == "field" else "truncated",
+        if past_end and n.lenkind == "field":  # the length field is the fault
+            self.expert(item, "past_end",
                         "'%s' has length %d, past the end of its data (%d bytes left)" % (n.name, length, end - start),
                         data_end=end, needed=start + length)
         was_stopped, self.stopped = self.stopped, False
         offset = self.node_list(n.children, item, offset, inner_end, in_summary or bool(n.pieces))
+        if past_end and n.lenkind != "field" and not self.stopped:  # no child ran out: the box is short
+            self.expert(item, "truncated", "Truncated: '%s' needs %d bytes, only %d left" % (n.name, length, end - start),
+                        data_end=end, needed=start + length)
         self.stopped = self.stopped or was_stopped
         if not self.stopped and length >= 0 and offset < inner_end:
             gap = self.buf[offset:inner_end]
