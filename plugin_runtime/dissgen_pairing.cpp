@@ -1131,33 +1131,41 @@ void dg_pairing_register(const dg_protocol *p)
 
 namespace {
 
+/* An endpoint as one key value: an address of up to 6 bytes and a port
+ * are the value itself, a longer address (IPv6) with its port the 64-bit
+ * FNV-1a hash. */
+guint64 endpoint_key(const address *a, guint32 port)
+{
+    const guint8 *bytes = (const guint8 *)a->data;
+    if (a->len > 6) return (dg_rt::fnv1a64(14695981039346656037ull, bytes, (gsize)a->len) ^ port) * 1099511628211ull;
+    guint64 value = 0;
+    for (int i = 0; i < a->len; i++) value = value << 8 | bytes[i];
+    return value << 16 | (port & 0xffff);
+}
+
 /* Over TCP or UDP, when a message's direction is known, its client is one
  * more key value: a request's sender, a response's receiver (its address,
- * and over TCP its port: the connection). Two clients using the same key
- * values (Modbus/TCP transaction 1 from two masters) are then paired apart,
- * as Wireshark pairs them by conversation. An address of up to 6 bytes is
- * the value itself, a longer one (IPv6) its 64-bit FNV-1a hash. Returns the
- * keys to pair by, and their count in *count. */
+ * and over TCP its port). Over TCP the other end is one more (a request's
+ * receiver, a response's sender, with its port): the key is the
+ * connection, so that requests sent from a server's port on two
+ * connections stay apart. Two clients using the same key values (Modbus/TCP
+ * transaction 1 from two masters) are then paired apart, as Wireshark pairs
+ * them by conversation. Over UDP the receiver is left out: a request sent
+ * to a broadcast or multicast address is answered from the device's own.
+ * Returns the keys to pair by, and their count in *count. */
 const guint64 *with_client(const guint64 *keys, guint *count, const packet_info *pinfo, guint8 direction)
 {
     if ((pinfo->ptype != PT_TCP && pinfo->ptype != PT_UDP) ||
         (direction != DG_DIR_REQUEST && direction != DG_DIR_RESPONSE))
         return keys;
     const gboolean request = direction == DG_DIR_REQUEST;
-    const address *client = request ? &pinfo->src : &pinfo->dst;
-    const guint32 port = pinfo->ptype == PT_TCP ? (request ? pinfo->srcport : pinfo->destport) : 0;
-    const guint8 *bytes = (const guint8 *)client->data;
-    guint64 value = 0;
-    if (client->len <= 6) {
-        for (int i = 0; i < client->len; i++) value = value << 8 | bytes[i];
-        value = value << 16 | (port & 0xffff);
-    } else {
-        value = dg_rt::fnv1a64(14695981039346656037ull, bytes, (gsize)client->len);
-        value = (value ^ port) * 1099511628211ull;
-    }
-    guint64 *out = wmem_alloc_array(pinfo->pool, guint64, *count + 1);
+    const gboolean tcp = pinfo->ptype == PT_TCP;
+    guint64 *out = wmem_alloc_array(pinfo->pool, guint64, *count + 2);
     memcpy(out, keys, *count * sizeof(guint64));
-    out[(*count)++] = value;
+    out[(*count)++] = endpoint_key(request ? &pinfo->src : &pinfo->dst,
+                                   tcp ? (request ? pinfo->srcport : pinfo->destport) : 0);
+    if (tcp)
+        out[(*count)++] = endpoint_key(request ? &pinfo->dst : &pinfo->src, request ? pinfo->destport : pinfo->srcport);
     return out;
 }
 

@@ -13,7 +13,8 @@ capture goes on for longer than the timeout after; one the capture ends exactly 
 is still in flight. A protocol whose only key is a computed value (its walk reads no byte)
 still tells a message sent again with other bytes from a duplicate by the message's bytes.
 A request overtaken by the answers to 16 later requests still waits, by 17 it is lost; only
-requests on its own connection count.
+requests on its own connection count. Over TCP the connection is the client: requests a server
+sends from its own port on two connections, with the same key, are paired apart.
 Needs no corpus.
 """
 
@@ -26,6 +27,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
 from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 import pcapgen  # noqa: E402
+from test_enip import TcpFlow  # noqa: E402
 
 ARGS = None
 PORT = 47480
@@ -347,6 +349,46 @@ class TestRequestRole(TsharkTestCase, unittest.TestCase):
                 check(asked == want, "%s: request{Number} %s, expected %s" % (mode, asked, want))
                 missed = sorted(n for n, r in rows.items() if r["txnp.expert.no_request_context"])
                 check(not missed, "%s: no 'request not known' note (%s)" % (mode, missed))
+
+
+class TestServerRequestsOnTwoConnections(TsharkTestCase, unittest.TestCase):
+    """Over TCP the key holds the connection (both ends), not just the request's sender: a
+    server asking both its clients from its own port with the same transaction (as an ADS
+    device sends notifications) pairs each answer with the request on its connection, and
+    neither request gives the other up."""
+
+    RULES = TestRequestRole.RULES.replace('table="udp.port"', 'table="tcp.port"')
+    SERVER_IP, CLIENT_IP = (10, 0, 0, 2), (10, 0, 0, 1)
+
+    @classmethod
+    def prepare(cls):
+        assert cls.RULES != TestRequestRole.RULES
+        cls.install_text("request_role_tcp.xml", cls.RULES, "txnp")
+
+    def test_each_connection_pairs_apart(self):
+        flows = {}
+        for client_port in (40000, 40001):
+            flows[client_port] = (TcpFlow(PORT, client_port, self.SERVER_IP, self.CLIENT_IP, seq=1000),
+                                  TcpFlow(client_port, PORT, self.CLIENT_IP, self.SERVER_IP, seq=5000))
+
+        def message(client_port, from_server, transaction, kind, n):
+            flow = flows[client_port][0 if from_server else 1]
+            return flow.segment(struct.pack(">HBBI", transaction, 1, kind, n))
+
+        capture = [message(40000, True, 7, 1, 1),    # 1: a request on connection A
+                   message(40001, True, 7, 1, 2),    # 2: the same key on connection B
+                   message(40001, False, 7, 2, 3),   # 3: answers 2
+                   message(40000, False, 7, 2, 4)]   # 4: answers 1
+        path = self.env.path("server_requests_tcp.pcap")
+        write_frames(path, [(ms, f) for ms, f in enumerate(capture)])
+        with self.checks() as check:
+            for two_pass in (True, False):
+                mode = "-2" if two_pass else "one pass"
+                rows = decode(self.env, path, two_pass)
+                pairs = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
+                check(pairs == {3: 2, 4: 1}, "%s: each answer pairs on its connection (%s)" % (mode, pairs))
+                lost = sorted(n for n, r in rows.items() if r["txnp.expert.no_response"])
+                check(not lost, "%s: no request given up (%s)" % (mode, lost))
 
 
 if __name__ == "__main__":
