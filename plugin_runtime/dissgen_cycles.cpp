@@ -23,9 +23,10 @@
  *    aside). It is regular when it is above 0 and no message was lost and
  *    the count did not go back in between.
  *  - A stream becomes a cycle with its first `window` regular periods in a
- *    row, all within half of their median either way (that median below
- *    2^32 ns): the message that completes the window is the cycle's first
- *    marked one, and every later message of the stream is in the cycle.
+ *    row, all within half of their median either way: the message that
+ *    completes the window is the cycle's first marked one, and every later
+ *    message of the stream is in the cycle. Periods are kept in 64-bit ns:
+ *    a heartbeat of a minute is a cycle too.
  *  - A marked message shows its period; a regular one joins the cycle's
  *    periods and has a jitter: the period minus the cycle's nominal period,
  *    the median (the lower of the two middle values for an even count) of
@@ -42,9 +43,9 @@
  *
  * Memory: a record per message of a stream that shows something (its
  * cycle, a loss, a duplicate), in wmem_file_scope, and a pointer per frame
- * (the table of first messages' records); per cycle 8 bytes per regular
+ * (the table of first messages' records); per cycle 16 bytes per regular
  * period (the running median and the figures of -z P,cycles) and, with
- * requests="yes", 4 bytes per round trip and per stream its last
+ * requests="yes", 8 bytes per round trip and per stream its last
  * pending_ring requests.
  */
 #include "dissgen_cycles.h"
@@ -101,7 +102,7 @@ struct stream {
     guint64 last_sequence;
     guint64 learned_step; /* step="learned": the count's advance per message, 0 until known */
     gboolean has_sequence;
-    guint32 recent[most_window]; /* its last regular periods, a ring */
+    guint64 recent[most_window]; /* its last regular periods, a ring */
     guint regular, next_slot;
     guint messages, lost, duplicates;
     cycle *cyc;
@@ -116,12 +117,12 @@ struct stream {
 struct cycle {
     guint32 number;
     const stream *s;
-    running_median periods;  /* the regular periods: the window's and the marked messages' */
-    u32_vec marked;          /* the marked messages' regular periods, for the quantiles */
+    running_median_of<guint64> periods; /* the regular periods: the window's and the marked messages' */
+    u64_vec marked;          /* the marked messages' regular periods, for the quantiles */
     guint frames;            /* marked messages */
     guint32 first_frame;
     double jitter_sum, jitter_squares;
-    u32_vec rtts;            /* requests="yes": the round trips of its messages answered, ns */
+    u64_vec rtts;            /* requests="yes": the round trips of its messages answered, ns */
     guint answered;
     guint32 latest_answered; /* the ordinal of the latest of its messages answered */
     cycle *next;
@@ -260,7 +261,7 @@ guint32 lost_before(guint64 advance, guint64 step, guint64 top)
  * back). Further out, a gap in whole periods depends on ppm of clock drift. */
 const guint64 max_gap_periods = 16;
 
-guint32 lost_in_gap(gint64 period, guint32 nominal)
+guint32 lost_in_gap(gint64 period, guint64 nominal)
 {
     if (period <= 0 || !nominal) return 0;
     const guint64 periods = ((guint64)period + nominal / 2) / nominal;
@@ -336,7 +337,7 @@ void request_answered(capture_state *c, const dg_transaction *txn, const packet_
     }
     cycle *cy = s->cyc;
     if (!cy || !ordinal) return;
-    cy->rtts.push(clamp_period(ns_of(&txn->round_trip)));
+    cy->rtts.push(period_of(ns_of(&txn->round_trip)));
     cy->answered++;
     cy->latest_answered = MAX(cy->latest_answered, ordinal);
 }
@@ -386,7 +387,7 @@ mark *time_message(capture_state *c, const dg_cycle_input *in, const dg_frame_pa
         if (!regular) {
             s->regular = 0;
         } else {
-            s->recent[s->next_slot] = clamp_period(period);
+            s->recent[s->next_slot] = period_of(period);
             s->next_slot = (s->next_slot + 1) % cy->window;
             if (s->regular < cy->window) s->regular++;
             if (s->regular == cy->window && steady_median(s->recent, cy->window))
@@ -400,8 +401,8 @@ mark *time_message(capture_state *c, const dg_cycle_input *in, const dg_frame_pa
         m.period_ns = period;
         cyc->frames++;
         if (regular) {
-            cyc->periods.add(clamp_period(period));
-            cyc->marked.push(clamp_period(period));
+            cyc->periods.add(period_of(period));
+            cyc->marked.push(period_of(period));
             m.jittered = TRUE;
             m.jitter_ns = period - (gint64)cyc->periods.median();
             cyc->jitter_sum += (double)m.jitter_ns;
@@ -454,8 +455,8 @@ void show(const mark *m, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 
 /* A cycle's whole-capture figures, from the capture's state. */
 struct figures {
-    guint32 nominal;
-    quantiles period, rtt;
+    guint64 nominal;
+    quantiles_of_t<guint64> period, rtt;
     double jitter_sd;
     guint unanswered;       /* requests="yes" */
 };
@@ -538,7 +539,7 @@ void cycles_draw(void *)
         g_free(name);
         printf("  first frame: %u\n", c->first_frame);
         printf("  messages: %u\n", c->frames);
-        printf("  nominal period (ns): %u\n", f.nominal);
+        printf("  nominal period (ns): %" G_GUINT64_FORMAT "\n", f.nominal);
         print_quantiles("period", &f.period);
         printf("  jitter std dev (ns): %.1f\n", f.jitter_sd);
         if (losses_counted()) printf("  messages lost: %u\n", c->s->lost);
@@ -575,13 +576,14 @@ tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *
         int id = st_cycle_node(st, c->number, text, c->frames);
         g_free(text);
         st_cycle_row(st, c->number, "messages", id, c->frames);
-        st_cycle_row(st, c->number, "nominal period (ns)", id, f.nominal);
-        st_quantile_rows(st, c->number, "period", &f.period, id);
-        st_cycle_row(st, c->number, "jitter std dev (ns)", id, (guint64)(f.jitter_sd + 0.5));
+        const st_time_unit unit = st_unit_of(f);
+        st_time_row(st, c->number, "nominal period", id, f.nominal, unit);
+        st_quantile_rows(st, c->number, "period", &f.period, id, unit);
+        st_time_row(st, c->number, "jitter std dev", id, (guint64)(f.jitter_sd + 0.5), unit);
         if (losses_counted()) st_cycle_row(st, c->number, "messages lost", id, c->s->lost);
         if (duplicates_counted()) st_cycle_row(st, c->number, "duplicates", id, c->s->duplicates);
         if (protocol->cycles->requests_only) {
-            st_quantile_rows(st, c->number, "round trip", &f.rtt, id);
+            st_quantile_rows(st, c->number, "round trip", &f.rtt, id, unit);
             st_cycle_row(st, c->number, "requests answered", id, c->answered);
             st_cycle_row(st, c->number, "requests unanswered", id, f.unanswered);
         }

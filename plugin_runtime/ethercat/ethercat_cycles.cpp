@@ -446,10 +446,10 @@ figures figures_of(const cycle *c)
     guint total = c->periods.count();
     guint32 *all = g_new(guint32, total + 1);
     c->periods.copy_to(all);
-    qsort(all, total, sizeof *all, compare_u32);
+    qsort(all, total, sizeof *all, compare_periods<guint32>);
     guint32 win[most_window];
     memcpy(win, c->window_periods, sizeof win);
-    qsort(win, c->window - 1, sizeof *win, compare_u32);
+    qsort(win, c->window - 1, sizeof *win, compare_periods<guint32>);
     guint n = 0, w = 0;
     for (guint i = 0; i < total; i++) {
         if (w + 1 < c->window && all[i] == win[w])
@@ -530,10 +530,11 @@ tap_packet_status st_packet(stats_tree *st, packet_info *pinfo, epan_dissect_t *
         int id = st_cycle_node(st, c->number, sig, c->frames);
         g_free(sig);
         st_cycle_row(st, c->number, "frames", id, c->frames);
-        st_cycle_row(st, c->number, "nominal period (ns)", id, f.nominal);
-        st_quantile_rows(st, c->number, "period", &f.period, id);
-        st_cycle_row(st, c->number, "jitter std dev (ns)", id, (guint64)(f.jitter_sd + 0.5));
-        st_quantile_rows(st, c->number, "round trip", &f.rtt, id);
+        const st_time_unit unit = st_unit_of(f);
+        st_time_row(st, c->number, "nominal period", id, f.nominal, unit);
+        st_quantile_rows(st, c->number, "period", &f.period, id, unit);
+        st_time_row(st, c->number, "jitter std dev", id, (guint64)(f.jitter_sd + 0.5), unit);
+        st_quantile_rows(st, c->number, "round trip", &f.rtt, id, unit);
         st_cycle_row(st, c->number, "frames returned", id, c->answered);
         st_cycle_row(st, c->number, "frames lost", id, f.lost);
         st_cycle_row(st, c->number, "working counter errors", id, c->wkc_errors);

@@ -210,9 +210,10 @@ class TestRuleCycles(TsharkTestCase, unittest.TestCase):
             self.assert_report(staged, cycles, check)
 
 
-def follows_the_model(env, check, capture, protocol, marks, cycles, names=None):
+def follows_the_model(env, check, capture, protocol, marks, cycles, names=None, duplicates=True):
     """In one pass and -2: each frame's marks and cycle expert infos are the model's, and
-    -z P,cycles lists the model's cycles with its figures (and `names`, when given)."""
+    -z P,cycles lists the model's cycles with its figures (and `names`, when given;
+    duplicates=False: no sequence count, the report counts none)."""
     for two_pass in (False, True):
         how = "-2" if two_pass else "one pass"
         rows = env.field_rows(capture, ["frame.number"] + mark_fields(protocol), two_pass=two_pass)
@@ -227,9 +228,11 @@ def follows_the_model(env, check, capture, protocol, marks, cycles, names=None):
         if names is not None:
             check([g["name"] for g in got] == names,
                   "%s -z %s,cycles names %s, expected %s" % (how, protocol, [g["name"] for g in got], names))
-        check([g["figures"] for g in got] == [figures(c) for c in cycles],
-              "%s -z %s,cycles: %s, expected %s" % (how, protocol, [g["figures"] for g in got],
-                                                   [figures(c) for c in cycles]))
+        want = [figures(c) for c in cycles]
+        for f in want if not duplicates else ():
+            del f["duplicates"]
+        check([g["figures"] for g in got] == want,
+              "%s -z %s,cycles: %s, expected %s" % (how, protocol, [g["figures"] for g in got], want))
 
 
 # --- a count wrapping at the sample rate ----------------------------------------------
@@ -421,6 +424,84 @@ class TestSmallCount(TsharkTestCase, unittest.TestCase):
             # the messages without a count, nor at 6 -> 1 across them
             check(sorted(lost.values()) == [1, 3], "the model counts 3 and 1 lost: %s" % lost)
             follows_the_model(self.env, check, self.capture, "smallc", marks, cycles)
+
+
+# --- periods of seconds and minutes -----------------------------------------------------
+
+LONG_PERIOD_RULES = """<root name="Heartbeats" abbreviation="BEAT" ethertype="0x88b5">
+  <cycles lost="period">
+    <signature field="node[@name='Stream']"/>
+  </cycles>
+  <node name="Stream" length="1byte" displaytype="numberdec"/>
+</root>
+"""
+
+
+def long_period_capture():
+    """Stream 1 every 4.3 s (just above 2^32 ns, +-5 ms), one message dropped (a gap of
+    8.6 s: one lost); stream 2 a heartbeat every 60 s (+-1 s), one dropped; stream 3 every
+    5 ms, then silent for 10 s (longer than 4.29 s, more than 16 periods: a pause)."""
+    rng = random.Random(4300)
+    packets = []
+    head = b"\x01\x0c\xcd\x04\0\x01\x02\0\0\0\0\x01\x88\xb5"
+    for stream, period, jitter, count, drop in ((1, 4_300_000_000, 5_000_000, 14, {11}),
+                                                (2, 60 * 10**9, 10**9, 12, {10})):
+        for i in range(count):
+            if i not in drop:
+                packets.append((10**9 + i * period + rng.randint(-jitter, jitter), head + bytes([stream]) + bytes(45)))
+    for i in range(20):
+        t = 10**9 + i * 5_000_000 + (10 * 10**9 if i >= 12 else 0) + rng.randint(-20_000, 20_000)
+        packets.append((t, head + bytes([3]) + bytes(45)))
+    packets.sort(key=lambda p: p[0])
+    return packets
+
+
+class TestLongPeriods(TsharkTestCase, unittest.TestCase):
+    """A period longer than 2^32 ns (4.29 s) is a period: a stream every 4.3 s or every
+    minute becomes a cycle, its figures are in nanoseconds to the end, a whole missing
+    period is one lost message, and a 10 s silence in a 5 ms cycle is a pause."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("heartbeats.xml", LONG_PERIOD_RULES, "beat")
+        cls.packets = long_period_capture()
+        cls.capture = cls.env.add_file("heartbeats.pcap", pcap_ns(cls.packets))
+
+    def test_periods_of_seconds_and_minutes(self):
+        messages = [(frame, t, data[14], None) for frame, (t, data) in enumerate(self.packets, 1)]
+        marks, cycles = model(messages, window=8, bits=0, lost_by_period=True)
+        with self.checks() as check:
+            # the model itself: three cycles, one lost in each of streams 1 and 2, and their
+            # longest period in ns beyond 32 bits
+            lost = sorted(m["lost"] for m in marks.values() if "lost" in m)
+            check(len(cycles) == 3 and lost == [1, 1], "the model: 3 cycles, 1 lost twice (%d, %s)" % (
+                len(cycles), lost))
+            longest = {figures(c)["period"][3] for c in cycles}
+            check(any(p > 2**32 for p in longest), "the model: periods beyond 2^32 ns (%s)" % longest)
+            follows_the_model(self.env, check, self.capture, "beat", marks, cycles, duplicates=False)
+            self.assert_tree_units(cycles, check)
+
+    def assert_tree_units(self, cycles, check):
+        """The statistics tree's rows hold a gint: a cycle's times are in ns while its longest
+        fits (2^31 - 1), else in the first of us, ms, s that holds it, rounded; the rows say which."""
+        out = self.env.tshark(["-2", "-r", self.capture, "-q", "-z", "beat.cycles,tree"]).stdout
+        have = {(int(m.group(1)), m.group(2)): int(m.group(3))
+                for m in re.finditer(r"^\s*Cycle (\d+) (\S.*?)\s{2,}(\d+)\s", out, re.M)}
+        want = {}
+        for c in cycles:
+            f, n = figures(c), c["number"]
+            unit, scale = next((u, k) for u, k in (("ns", 1), ("us", 10**3), ("ms", 10**6), ("s", 10**9))
+                               if max(f["nominal"], f["period"][3]) // k <= 2**31 - 1)
+            want[(n, "messages")] = f["messages"]
+            want[(n, "messages lost")] = f["lost"]
+            want[(n, "nominal period (%s)" % unit)] = (f["nominal"] + scale // 2) // scale
+            for name, value in zip(("min", "median", "p99", "max"), f["period"]):
+                want[(n, "period %s (%s)" % (name, unit))] = (value + scale // 2) // scale
+            want[(n, "jitter std dev (%s)" % unit)] = (int(float(f["jitter sd"]) + 0.5) + scale // 2) // scale
+        units = sorted({k[1].split("(")[1] for k in want if "(" in k[1]})
+        check(units == ["ns)", "us)"], "the model: rows in ns and in us (%s)" % units)
+        check(have == want, "-2 -z beat.cycles,tree: %s, expected %s" % (
+            sorted(set(have.items()) ^ set(want.items())), len(want)))
 
 
 if __name__ == "__main__":

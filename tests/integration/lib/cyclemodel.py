@@ -11,13 +11,14 @@ import struct
 def window_median(periods):
     v = sorted(periods)
     median = v[(len(v) - 1) // 2]
-    if median == 0 or median >= 0xFFFFFFFF or 2 * v[0] < median or 2 * v[-1] > 3 * median:
+    if median == 0 or 2 * v[0] < median or 2 * v[-1] > 3 * median:
         return 0
     return median
 
 
 def clamp(ns):
-    return 0 if ns < 0 else min(ns, 0xFFFFFFFF)
+    """A period as kept: 0 when time went backwards; any length (64-bit ns)."""
+    return max(ns, 0)
 
 
 MAX_GAP_PERIODS = 16  # lost="period": a longer gap is a pause, nothing lost
