@@ -132,18 +132,20 @@ gint64 leaf_length(dg_state *st, const dg_node *n, proto_tree *tree, gint offset
     return length;
 }
 
-/* A leaf longer than the `left` bytes there are: show the bytes that are
- * there, then say what is missing. */
+/* A leaf longer than the `left` bytes there are: in a malformed message,
+ * show the bytes that are there, then say what is missing. A frame the
+ * capture cut short (a snapshot length) shows none of the leaf, as
+ * Wireshark: its value is not known, and a part of it would match filters. */
 void report_short_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint64 length, gint left)
 {
+    const gint64 data_end = (gint64)offset + left, needed_end = (gint64)offset + length;
     /* An IPv4 address, a float, a datetime or a GUID has one size only: Wireshark throws on fewer bytes. */
     gboolean fixed_size = n->show == DG_SHOW_IPV4 || n->show == DG_SHOW_FLOAT || n->show == DG_SHOW_DATETIME ||
                           n->show == DG_SHOW_GUID;
-    if (!(n->flags & DG_NUMERIC) && !fixed_size && left > 0 && tree) {
+    if (!(n->flags & DG_NUMERIC) && !fixed_size && left > 0 && tree && !cut_by_capture(st, data_end, needed_end)) {
         proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, left, item_encoding(n));
         if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
     }
-    const gint64 data_end = (gint64)offset + left, needed_end = (gint64)offset + length;
     if (n->show == DG_SHOW_STRINGZ && n->length_kind == DG_LEN_CHILDREN)
         report_missing(st, tree, &st->p->ei->truncated, data_end, needed_end, offset, left,
                        "Truncated: '%s' has no NUL before the end of its data (%d bytes left)", n->name, left);

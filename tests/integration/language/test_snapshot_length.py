@@ -9,7 +9,9 @@ malformed, so as Wireshark shows it, it gets one "[Packet size limited during ca
 (_ws.short) and no expert info, every Word the capture kept is decoded, and neither Status nor
 Other (which one holds lies in the bytes not kept). The control: the same bytes really that short on the wire (caplen =
 length) are malformed (an expert info, no _ws.short); and a Length that runs past even the
-frame's length on the wire stays an error in a cut frame. One pass and -2.
+frame's length on the wire stays an error in a cut frame. A leaf the capture cut inside (an
+address, a text, bytes) shows none of its bytes (its value is not known; a part would match
+filters), while one really that short on the wire shows the bytes it has. One pass and -2.
 
     test_snapshot_length.py --dissgen build/bin/dissgen --source-dir .
 """
@@ -96,6 +98,46 @@ class SnapshotLength(TsharkTestCase, unittest.TestCase):
                 lie = rows[len(rows) - 1]["_ws.expert.message"]
                 check(any("'Body' has length 200, past the end" in m for m in lie),
                       "%s: a Length past the frame on the wire is an error in a cut frame: %s" % (how, lie))
+
+
+LEAVES_RULES = """<root name="Cut leaves" abbreviation="CUTL" ethertype="0x88b5">
+  <node name="Kind" length="1byte" displaytype="numberdec"/>
+  <node name="Station" length="6byte" displaytype="address"/>
+  <node name="Name" length="8byte" displaytype="string"/>
+  <node name="Payload" length="4byte" displaytype="origin"/>
+</root>
+"""
+
+
+class SnapshotInsideALeaf(TsharkTestCase, unittest.TestCase):
+    """Cut by the capture inside a leaf: no part of the leaf is shown, the leaves before it are."""
+    LEAVES = [("cutl.station", 1, 6), ("cutl.name", 7, 8), ("cutl.payload", 15, 4)]  # field, offset, length
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("cut_leaves.xml", LEAVES_RULES, "cutl")
+        cls.whole = (b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01\x88\xb5" + b"\x01" + b"\xc0\xa8\x01\x02\x01\x01" +
+                     b"ABCDEFGH" + b"\xde\xad\xbe\xef")
+        cls.cuts = list(range(HEADER + 2, len(cls.whole)))
+        records = [(c, cls.whole) for c in cls.cuts] + [(HEADER + 3, cls.whole[:HEADER + 3])]
+        cls.capture = cls.env.add_file("cut_leaves.pcap", pcap(records))
+
+    def test_no_part_of_a_cut_leaf(self):
+        fields = ["frame.number", "_ws.short", "_ws.expert.message"] + [f for f, _, _ in self.LEAVES]
+        with self.checks() as check:
+            for two_pass in (False, True):
+                how = "-2" if two_pass else "one pass"
+                rows = self.env.field_rows(self.capture, fields, two_pass=two_pass, aggregator="|")
+                for n, caplen in enumerate(self.cuts, 1):
+                    r = rows[n]
+                    kept = sorted(f for f, at, length in self.LEAVES if HEADER + at + length <= caplen)
+                    shown = sorted(f for f, _, _ in self.LEAVES if r[f])
+                    check(shown == kept and len(r["_ws.short"]) == 1 and not r["_ws.expert.message"],
+                          "%s frame %d (kept %d bytes): leaves %s, want %s; short %s, expert %s" % (
+                              how, n, caplen, shown, kept, r["_ws.short"], r["_ws.expert.message"]))
+                short = rows[len(self.cuts) + 1]
+                check(short["cutl.station"] == ["c0:a8"] and short["_ws.expert.message"] and not short["_ws.short"],
+                      "%s: really short on the wire, the bytes there and an expert: %s" % (how, short))
 
 
 if __name__ == "__main__":
