@@ -788,11 +788,14 @@ void Emitter::protocol_struct() {
     const bool valid = has_validity(p_);
     const std::string entry = valid ? "dg_valid_" : "dg_", of = valid ? "_validity" : "_protocol";
     if (valid) o_ << emit_validity(p_);
-    o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
-       << "    return " << entry << "dissect(&" << f << of << ", tvb, pinfo, tree);\n}\n\n";
+    // a message the valid fields refuse goes on, with the dissector's data, to the one our hook displaced
+    const std::string data = valid ? "void *data" : "void *data _U_", pass = valid ? ", data" : "";
+    o_ << "static int dissect_" << f << "(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, " << data << ")\n{\n"
+       << "    return " << entry << "dissect(&" << f << of << ", tvb, pinfo, tree" << pass << ");\n}\n\n";
     if (pdu)
-        o_ << "static int dissect_" << f << "_stream(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data _U_)\n{\n"
-           << "    return " << entry << "dissect_stream(&" << f << of << ", tvb, pinfo, tree);\n}\n\n";
+        o_ << "static int dissect_" << f << "_stream(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, " << data
+           << ")\n{\n"
+           << "    return " << entry << "dissect_stream(&" << f << of << ", tvb, pinfo, tree" << pass << ");\n}\n\n";
 }
 
 // The protocol's row: its names, entry points and tables; the tables it does not use stay NULL.

@@ -11,6 +11,7 @@
  * are longjmps).
  */
 #include "dissgen_state.h"
+#include "dissgen_validity.h"
 
 #include <epan/stats_tree.h>
 #include <epan/tap.h>
@@ -71,6 +72,17 @@ void follow_enabled_protocols(void)
     }
 }
 
+/* Whether a message of transport `ptype` could have come through `table`:
+ * a port table only on its own transport, any other table on any. */
+gboolean came_through(const char *table, port_type ptype, gboolean port_tables)
+{
+    const port_type own = strcmp(table, "udp.port") == 0   ? PT_UDP
+                          : strcmp(table, "tcp.port") == 0 ? PT_TCP
+                          : strcmp(table, "sctp.port") == 0 ? PT_SCTP
+                                                           : PT_NONE;
+    return port_tables ? own != PT_NONE && own == ptype : own == PT_NONE;
+}
+
 gboolean table_accepts_integers(const char *table)
 {
     switch (get_dissector_table_selector_type(table)) {
@@ -78,6 +90,23 @@ gboolean table_accepts_integers(const char *table)
     default: return FALSE;
     }
 }
+
+} // namespace
+
+int dg_displaced_dissect(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data)
+{
+    /* A port table of the message's own transport first: a protocol hooked
+     * on UDP and TCP port 3671 gives each its own displaced dissector. */
+    for (int port_tables = 1; port_tables >= 0; port_tables--)
+        for (guint i = 0; claims && i < claims->len; i++) {
+            const dg_claim *c = &g_array_index(claims, dg_claim, i);
+            if (c->displaced && c->value == pinfo->match_uint && came_through(c->table, pinfo->ptype, port_tables))
+                return call_dissector_only(c->displaced, tvb, pinfo, tree, data);
+        }
+    return 0;
+}
+
+namespace {
 
 /* --- statistics: tshark -z FILTER,tree, Statistics menu in Wireshark ---- */
 

@@ -66,6 +66,16 @@ guint32 service_port(packet_info *pinfo)
     return pinfo->destport;
 }
 
+/* A stream's segment: 0 when it does not start with a message of ours. */
+int dissect_valid_segment(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+{
+    gint have = (gint)tvb_captured_length(tvb);
+    /* Too few bytes to tell: only reassembly can bring the rest of the header. */
+    if (have >= (gint)v->header_length ? !dg_valid_at(v, tvb, pinfo, 0, have) : !pinfo->can_desegment) return 0;
+    tcp_dissect_pdus(tvb, pinfo, tree, TRUE, v->header_length, valid_message_length, dissect_valid_message, (void *)v);
+    return have;
+}
+
 } /* namespace */
 
 extern "C" {
@@ -81,19 +91,16 @@ gboolean dg_valid_at(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, gi
     return TRUE;
 }
 
-int dg_valid_dissect(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+int dg_valid_dissect(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data)
 {
-    if (!dg_valid_at(v, tvb, pinfo, 0, (gint)tvb_captured_length(tvb))) return 0;
+    if (!dg_valid_at(v, tvb, pinfo, 0, (gint)tvb_captured_length(tvb))) return dg_displaced_dissect(tvb, pinfo, tree, data);
     return dg_dissect(v->p, tvb, pinfo, tree);
 }
 
-int dg_valid_dissect_stream(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
+int dg_valid_dissect_stream(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data)
 {
-    gint have = (gint)tvb_captured_length(tvb);
-    /* Too few bytes to tell: only reassembly can bring the rest of the header. */
-    if (have >= (gint)v->header_length ? !dg_valid_at(v, tvb, pinfo, 0, have) : !pinfo->can_desegment) return 0;
-    tcp_dissect_pdus(tvb, pinfo, tree, TRUE, v->header_length, valid_message_length, dissect_valid_message, (void *)v);
-    return have;
+    const int taken = dissect_valid_segment(v, tvb, pinfo, tree);
+    return taken ? taken : dg_displaced_dissect(tvb, pinfo, tree, data);
 }
 
 gboolean dg_valid_heuristic(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
@@ -103,7 +110,7 @@ gboolean dg_valid_heuristic(const dg_validity *v, tvbuff_t *tvb, packet_info *pi
     const guint32 hooked = pinfo->match_uint, port = service_port(pinfo);
     if (port) pinfo->match_uint = port;
     if (v->p->pdu_node >= 0 && pinfo->ptype == PT_TCP)
-        dg_valid_dissect_stream(v, tvb, pinfo, tree);
+        dissect_valid_segment(v, tvb, pinfo, tree);
     else
         dg_dissect(v->p, tvb, pinfo, tree);
     pinfo->match_uint = hooked;

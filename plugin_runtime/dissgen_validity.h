@@ -53,13 +53,17 @@ extern "C" {
  * applies to this message and each value is in its list. */
 gboolean dg_valid_at(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, gint offset, gint available);
 
-/* dg_dissect for a message that passes the test; 0 otherwise. */
-int dg_valid_dissect(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+/* dg_dissect for a message that passes the test. One that fails goes to the
+ * dissector our hook displaced on the value it came through (Wireshark's
+ * own for that port), as if this protocol were not there; 0 when there is
+ * none, or it takes nothing. */
+int dg_valid_dissect(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);
 
 /* dg_dissect_stream that claims a segment only when the message it starts
- * with passes the test: a bad header starts no reassembly. A message inside
- * the segment that fails ends its messages; the rest is data. */
-int dg_valid_dissect_stream(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
+ * with passes the test: a bad header starts no reassembly (and the segment
+ * goes to the displaced dissector, as above). A message inside the segment
+ * that fails ends its messages; the rest is data. */
+int dg_valid_dissect_stream(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);
 
 /* The heuristic: TRUE (and the message dissected) when the test passes. */
 gboolean dg_valid_heuristic(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree);
@@ -69,3 +73,9 @@ gboolean dg_valid_heuristic(const dg_validity *v, tvbuff_t *tvb, packet_info *pi
 void dg_validity_handoff(const dg_validity *v);
 
 }
+
+/* A message refused on a hooked value: the dissector this plugin's hook
+ * displaced on the table and value it came through (pinfo->match_uint, the
+ * port table of its transport) dissects it; 0 when there is none
+ * (dissgen_register.cpp, which keeps the hooks). */
+int dg_displaced_dissect(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data);

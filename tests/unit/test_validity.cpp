@@ -88,8 +88,8 @@ TEST(Validity, EntriesTestFirstAndTheHeuristicIsRegistered) {
     ASSERT_TRUE(f.ok()) << f.messages();
     const std::string code = emit_cpp(*f.proto, "rules.xml");
     EXPECT_TRUE(contains(code, "#include \"dissgen_validity.h\"\n")) << code;
-    EXPECT_TRUE(contains(code, "return dg_valid_dissect(&tst_validity, tvb, pinfo, tree);")) << code;
-    EXPECT_TRUE(contains(code, "return dg_valid_dissect_stream(&tst_validity, tvb, pinfo, tree);")) << code;
+    EXPECT_TRUE(contains(code, "return dg_valid_dissect(&tst_validity, tvb, pinfo, tree, data);")) << code;
+    EXPECT_TRUE(contains(code, "return dg_valid_dissect_stream(&tst_validity, tvb, pinfo, tree, data);")) << code;
     EXPECT_FALSE(contains(code, "return dg_dissect(")) << code;
     EXPECT_TRUE(contains(code, "{ \"udp\", \"tst_udp\", \"Test over UDP\", TRUE }")) << code;
     EXPECT_TRUE(contains(code, "{ \"usb.bulk\", \"tst_usb.bulk\", \"Test over USB.BULK\", FALSE }")) << code;

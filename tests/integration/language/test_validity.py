@@ -17,6 +17,9 @@ pdulength on a tcp.port hook; <heuristic table="udp"/> and a disabled one on tcp
 - TCP on a port nobody registered: nothing until `--enable-heuristic mbl_tcp`, then
   every message;
 - a heuristic list this Wireshark does not have: a warning, and tshark goes on;
+- a message refused on a hooked value another dissector had (KNX/IP's UDP port 3671,
+  Modbus/TCP's TCP port 502) goes to that dissector, on UDP and on a TCP stream with
+  pdulength, as if the protocol were not there; accepted ones stay ours;
 - a message a heuristic found has its conversation's direction: over TCP the SYN says
   which port is the server's, otherwise the first message's receiver is; its request and
   response layouts decode as through a port hook, in one pass and with -2 (on ports where
@@ -284,6 +287,52 @@ class Validity(TsharkTestCase, unittest.TestCase):
         self.assertEqual(self.transactions(self.tcp_unregistered), [])
         self.assertEqual(self.transactions(self.tcp_unregistered, extra=["--enable-heuristic", "mbl_tcp"]),
                          list(range(20, 25)))
+
+
+GATE = """<root name="Gate" abbreviation="GATE" filter="gate"
+      pdulength="node[@name='Length']" pdulengthadd="2">
+  <hook table="udp.port" value="3671"/>
+  <hook table="tcp.port" value="502"/>
+  <node name="Magic" length="1byte" displaytype="numberhex" valid="0x42"/>
+  <node name="Length" length="1byte" displaytype="numberdec"/>
+  <node name="Body" length="rest" displaytype="origin"/>
+</root>
+"""
+KNX_SEARCH = bytes.fromhex("06100201000e" "08010a0000010e57")  # header, then the discovery endpoint
+MODBUS_READ = bytes.fromhex("000100000006" "0103" "00000001")
+
+
+class DisplacedDissector(TsharkTestCase, unittest.TestCase):
+    """A message the valid fields refuse on a hooked value goes to the dissector the hook
+    displaced there (Wireshark's kip on UDP 3671, mbtcp on TCP 502), one pass and -2."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("gate.xml", GATE, "gate")
+        udp = lambda p: pcapgen.udp_ethernet_frame(p, 3671)
+        ours = b"\x42\x03abc"
+        frames = [udp(ours), udp(KNX_SEARCH), udp(b"\x07")]
+        seq = 1000
+        for payload in (MODBUS_READ, ours, MODBUS_READ):
+            frames.append(pcapgen.tcp_ethernet_frame(payload, 41000, 502, seq))
+            seq += len(payload)
+        cls.capture = cls.env.add_file("displaced.pcap", pcapgen.raw_pcap_bytes(frames))
+        # the last protocol of each frame, as Wireshark's own dissectors decode them
+        cls.want = ["gate", "kip", "kip", "mbtcp", "gate", "mbtcp"]
+
+    def last_layers(self, extra):
+        out = self.env.tshark(["-r", self.capture, "-T", "fields", "-e", "frame.protocols"] + extra).stdout
+        # Modbus/TCP's payload is its "modbus" layer
+        return [line.split(":")[-1].replace("modbus", "mbtcp") for line in out.splitlines()]
+
+    def test_refused_messages_go_to_the_displaced_dissector(self):
+        with self.checks() as check:
+            for extra in ([], ["-2"]):
+                got = self.last_layers(extra)
+                check(got == self.want, "%s: %s, expected %s" % (extra or "one pass", got, self.want))
+            gone = self.last_layers(["--disable-protocol", "gate"])
+            check(gone[:4] == ["kip", "kip", "kip", "mbtcp"],
+                  "gate disabled: the displaced dissectors take everything: %s" % gone)
 
 
 class WithoutValidity(TsharkTestCase, unittest.TestCase):
