@@ -1085,6 +1085,7 @@ std::string Emitter::extra_row(const Node& n) const {
     auto add = [&](const char* setter, const std::string& args) { set.push_back(setter + ("(" + args + ")")); };
     auto slot = [](const std::optional<FieldRef>& r) { return r && r->target ? r->target->slot : -1; };
     if (n.encoding == "ascii") add("encoding", "ENC_ASCII");
+    if (n.encoding == "iso-8859-1") add("encoding", "ENC_ISO_8859_1");
     // A time, or a computed datetime (a count of its unit, not bytes), in a unit coarser than ns.
     const bool counts_units = n.display == Display::Time || (n.display == Display::DateTime && n.is_computed());
     if (counts_units && (n.unit == "s" || n.unit == "ms" || n.unit == "us"))

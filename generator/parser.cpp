@@ -1107,8 +1107,10 @@ void Parser::parse_text_direction_handoff_attributes(std::map<std::string, std::
     if (attrs.count("encoding")) {
         node.encoding = trim(attrs["encoding"]);
         node.encoding_given = true;
-        if (node.encoding != "ascii" && node.encoding != "utf-8")
-            diags_.error(line, "bad encoding '" + attrs["encoding"] + "': expected 'ascii' or 'utf-8'");
+        if (node.encoding == "latin-1") node.encoding = "iso-8859-1"; // one name per encoding in the model
+        if (node.encoding != "ascii" && node.encoding != "utf-8" && node.encoding != "iso-8859-1")
+            diags_.error(line, "bad encoding '" + attrs["encoding"] +
+                                   "': expected 'ascii', 'utf-8' or 'iso-8859-1' (also 'latin-1')");
     }
     if (attrs.count("unit")) {
         node.unit = trim(attrs["unit"]);

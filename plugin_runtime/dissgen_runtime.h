@@ -70,7 +70,7 @@ typedef struct dg_summary_piece {
 enum dg_direction { DG_DIR_ANY = 0, DG_DIR_REQUEST = 1, DG_DIR_RESPONSE = 2 };
 
 typedef struct dg_extra {
-    guint32 encoding;         /* string, stringz: ENC_ASCII or ENC_UTF_8 */
+    guint32 encoding;         /* string, stringz: ENC_ASCII, ENC_UTF_8 or ENC_ISO_8859_1 */
     guint32 units_per_second; /* time: 1000000000 (ns), 1000000 (us), 1000 (ms) or 1 (s) */
     guint8 repeat_rest;       /* repeat="rest": instances until the enclosing container ends */
     guint8 no_bytes;          /* count: instances that take no bytes (computed values, overlays) */

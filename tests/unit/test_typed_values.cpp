@@ -61,6 +61,19 @@ TEST(TypedValues, FieldTypesOfTheTypedDisplays) {
     EXPECT_TRUE(contains(code, "dg_node_extra().units_per_second(1),")) << code;
 }
 
+TEST(TypedValues, Latin1TextUnderEitherName) {
+    Front f = front_end(rules("  <node name=\"a\" length=\"8byte\" displaytype=\"string\" encoding=\"iso-8859-1\"/>\n"
+                              "  <node name=\"b\" displaytype=\"stringz\" encoding=\"latin-1\"/>\n"
+                              "  <node name=\"c\" length=\"8byte\" displaytype=\"string\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_EQ(find(*f.proto, "b")->encoding, "iso-8859-1");
+    const std::string code = emit_cpp(*f.proto, "t.xml");
+    size_t first = code.find("dg_node_extra().encoding(ENC_ISO_8859_1),");
+    ASSERT_NE(first, std::string::npos) << code;
+    EXPECT_NE(code.find("dg_node_extra().encoding(ENC_ISO_8859_1),", first + 1), std::string::npos) << code;
+    EXPECT_FALSE(contains(code, "ENC_ASCII")) << code;
+}
+
 TEST(TypedValues, LengthsFromAnIntOrTimeField) {
     Front f = front_end(rules("  <node name=\"n\" length=\"1byte\" displaytype=\"int\"/>\n"
                               "  <node name=\"data\" length=\"../node[@name='n']\"/>\n"));

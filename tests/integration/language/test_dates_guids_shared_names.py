@@ -208,6 +208,42 @@ class DatesGuidsSharedNames(TsharkTestCase, unittest.TestCase):
         self.assertNotIn("Malformed Packet", p.stdout)
 
 
+LATIN1_RULES = """<root name="Latin text" abbreviation="LATT" byteorder="big">
+  <hook table="udp.port" value="47490"/>
+  <node name="Station" summary="{Name}">
+    <node name="Name" length="8byte" displaytype="string" encoding="latin-1"/>
+  </node>
+  <node name="Label" displaytype="stringz" encoding="iso-8859-1"/>
+  <node name="Raw" length="8byte" displaytype="string"/>
+</root>
+"""
+
+
+class Latin1Text(TsharkTestCase, unittest.TestCase):
+    """encoding="latin-1" (or "iso-8859-1"): each byte is its character, as a KNX device
+    name or an older PLC's label holds it; the same bytes in UTF-8 are not text."""
+    NAME, LABEL = "Müller ß", "Größe"
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("latin1.xml", LATIN1_RULES, "latt")
+        payload = cls.NAME.encode("latin-1") + cls.LABEL.encode("latin-1") + b"\0" + cls.NAME.encode("latin-1")
+        cls.capture = cls.env.add_file("latin1.pcap", pcap([udp(50000, 47490, payload)]))
+
+    def test_latin1_text_from_the_bytes(self):
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = self.env.field_rows(self.capture, ["frame.number", "latt.station.name", "latt.label", "latt.raw",
+                                                          "_ws.col.Info"], two_pass=two_pass)
+                r = rows[1]
+                check(r["latt.station.name"] == [self.NAME] and r["latt.label"] == [self.LABEL],
+                      "latin-1 text as its bytes say: %s %s" % (r["latt.station.name"], r["latt.label"]))
+                check(r["latt.raw"] != [self.NAME], "the same bytes as UTF-8 are not that text: %s" % r["latt.raw"])
+                check(self.NAME in r["_ws.col.Info"][0], "the summary shows the name: %s" % r["_ws.col.Info"])
+            filtered = self.env.tshark(["-r", self.capture, "-Y", 'latt.station.name == "%s"' % self.NAME]).stdout
+            check(filtered.strip() != "", "a filter compares the text")
+
+
 if __name__ == "__main__":
     ARGS, status = run_unittests()
     sys.exit(status)
