@@ -432,7 +432,7 @@ private:
     std::string protocol_row() const;
     void request_context();
     void cycles_tables();
-    void request_role();
+    void request_role(const CycleField& r, const std::string& name, const std::string& says);
     std::string extra_row(const Node& n) const;
     void condition_and_window_tables();
     void learn_tables();
@@ -775,11 +775,15 @@ void Emitter::protocol_struct() {
             o_ << "/* The " << c_string(analysis->name) << " analysis, compiled in from the runtime. */\n"
                << "extern \"C\" const struct dg_analysis " << analysis->symbol << ";\n";
         const size_t places = input_places();
-        if (p_.pairing->request) request_role();
+        const std::optional<CycleField>& request = p_.pairing->request;
+        const std::optional<CycleField>& unanswered = p_.pairing->unanswered;
+        if (request) request_role(*request, "request_role", "is a request, any other value a response");
+        if (unanswered) request_role(*unanswered, "unanswered", "expects no response: it takes no part in pairing");
         o_ << "static const dg_pairing " << f << "_pairing = { " << timeout << ", "
            << (analysis ? "&" + analysis->symbol : std::string("NULL")) << ", " << (p_.pairing->ordered ? 1 : 0)
            << ", " << (places ? f + "_input_places" : std::string("NULL")) << ", " << places
-           << ", " << (p_.pairing->request ? "&" + f + "_request_role" : std::string("NULL")) << " };\n";
+           << ", " << (request ? "&" + f + "_request_role" : std::string("NULL"))
+           << (unanswered ? ", &" + f + "_unanswered" : std::string()) << " };\n";
         if (!p_.request_fields.empty()) request_context();
     }
     if (p_.cycles) cycles_tables();
@@ -875,16 +879,18 @@ void Emitter::cycles_tables() {
        << (c.lost_by_period ? 1 : 0) << ", " << c.sequence_wrap << "u, " << (c.requests_only ? 1 : 0) << " };\n";
 }
 
-// <request>: the field's slot and the values that make a message a request.
-void Emitter::request_role() {
+// <request> (<unanswered>): the field's slot and the values that make a
+// message a request (one that expects no response); `name` is the table's.
+void Emitter::request_role(const CycleField& r, const std::string& name, const std::string& says) {
     const std::string& f = p_.filter;
-    const CycleField& r = *p_.pairing->request;
+    const std::string element = name == "request_role" ? "request" : name;
     std::vector<std::string> ranges;
     append_test_ranges(r, ranges);
-    o_ << "/* <request>, line " << r.line << ": a message whose " << c_string(r.field.target->name)
-       << " is one of these is a request, any other value a response. */\n"
-       << c_array("static const dg_range " + f + "_request_ranges", ranges) << "static const dg_request_role " << f
-       << "_request_role = { " << r.field.target->slot << ", " << ranges.size() << ", " << f << "_request_ranges };\n";
+    o_ << "/* <" << element << ">, line " << r.line << ": a message whose " << c_string(r.field.target->name)
+       << " is one of these " << says << ". */\n"
+       << c_array("static const dg_range " + f + "_" + element + "_ranges", ranges) << "static const dg_request_role "
+       << f << "_" << name << " = { " << r.field.target->slot << ", " << ranges.size() << ", " << f << "_" << element
+       << "_ranges };\n";
 }
 
 // request{...}: the key fields where a response reads them before it is

@@ -371,6 +371,9 @@ struct Pairing {
     // <request field="XPATH" in="LIST"/>: the message says which it is (its
     // value in the list: a request; decoded and not in it: a response)
     std::optional<CycleField> request;
+    // <unanswered field="XPATH" in="LIST"/>: a message whose value is in the
+    // list expects no response (a notification): it takes no part in pairing
+    std::optional<CycleField> unanswered;
 };
 
 // --- periodic traffic (<cycles> in <root>) ---

@@ -549,16 +549,19 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
             key_elements.push_back(c);
         } else if (c->type == XML_ELEMENT_NODE && element_name(c) == "input") {
             input_elements.push_back(c);
-        } else if (c->type == XML_ELEMENT_NODE && element_name(c) == "request") {
+        } else if (c->type == XML_ELEMENT_NODE &&
+                   (element_name(c) == "request" || element_name(c) == "unanswered")) {
+            const std::string what = element_name(c);
+            std::optional<CycleField>& slot = what == "request" ? pairing.request : pairing.unanswered;
             CycleField f;
             std::map<std::string, std::string> rattrs;
-            if (pairing.request)
-                diags_.error(line_of(c), "only one <request> in <pairing> (the first is on line " +
-                                             std::to_string(pairing.request->line) + "): list its values in 'in'");
+            if (slot)
+                diags_.error(line_of(c), "only one <" + what + "> in <pairing> (the first is on line " +
+                                             std::to_string(slot->line) + "): list its values in 'in'");
             else if (parse_cycle_field(c, kCycleTestAttributes, f, rattrs))
-                pairing.request = f;
+                slot = f;
         } else {
-            unexpected_child(c, "pairing", {"key", "input", "request"});
+            unexpected_child(c, "pairing", {"key", "input", "request", "unanswered"});
         }
     }
     // What the analysis reads: checked against its list by analysis_inputs.cpp.
@@ -595,6 +598,7 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
     for (AnalysisInput& input : pairing.inputs)
         defer(input.field, el->parent, input.line, "field");
     if (pairing.request) defer(pairing.request->field, el->parent, pairing.request->line, "field");
+    if (pairing.unanswered) defer(pairing.unanswered->field, el->parent, pairing.unanswered->line, "field");
 }
 
 // Periodic traffic: <cycles window="8" sender="yes" lost="sequence|period" requests="yes"><signature field="XPATH"/>...

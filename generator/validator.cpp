@@ -137,7 +137,7 @@ private:
     const Node* fixed_offset_blocker(const Node& n, uint64_t& offset) const;
     void check_validity();  // valid="LIST" fields and <heuristic>
     void check_pairing();
-    void check_request_role(const CycleField& f);
+    void check_request_role(const CycleField& f, const std::string& element);
     void check_cycles();
     void check_cycles_of_ethercat(const Cycles& c);
     bool check_cycle_field(const CycleField& f, const char* element, int role, int test,
@@ -928,26 +928,28 @@ void Validator::check_pairing() {
                                        ")");
     }
     check_analysis_inputs(proto_, diags_);
-    if (proto_.pairing->request) check_request_role(*proto_.pairing->request);
+    if (proto_.pairing->request) check_request_role(*proto_.pairing->request, "request");
+    if (proto_.pairing->unanswered) check_request_role(*proto_.pairing->unanswered, "unanswered");
 }
 
-// <request>: one numeric value per message, read once the message is decoded
-// (from its slot).
-void Validator::check_request_role(const CycleField& f) {
+// <request> and <unanswered>: one numeric value per message, read once the
+// message is decoded (from its slot).
+void Validator::check_request_role(const CycleField& f, const std::string& element) {
     Node* t = f.field.target;
     if (!t) return;  // the parser reported the XPath
     if (!t->is_numeric()) {
-        diags_.error(f.line, "request field " + quote(*t) + at_line(*t) +
-                                 " is not numeric: <request> reads a leaf of 1-64 bits shown as a number, bool, enum "
-                                 "or nondisplay, or an integer computed value");
+        diags_.error(f.line, element + " field " + quote(*t) + at_line(*t) + " is not numeric: <" + element +
+                                 "> reads a leaf of 1-64 bits shown as a number, bool, enum or nondisplay, or an "
+                                 "integer computed value");
         return;
     }
     check_list_fits(f.line, f.in_list, f.field);
+    const std::string says = element == "request" ? "whether it is a request" : "whether it expects a response";
     for (const Node* r = t; r; r = r->parent)
         if (r->is_repeated()) {
-            diags_.error(f.line, "request field " + quote(*t) + at_line(*t) + " is inside repeated node " + quote(*r) +
-                                     at_line(*r) + ": a message says once whether it is a request; use a field "
-                                                   "outside every repeat");
+            diags_.error(f.line, element + " field " + quote(*t) + at_line(*t) + " is inside repeated node " +
+                                     quote(*r) + at_line(*r) + ": a message says once " + says +
+                                     "; use a field outside every repeat");
             return;
         }
     mark_slot(t);

@@ -353,6 +353,7 @@ typedef struct dg_pairing {
     const dg_input_place *places; /* the registers the analysis reads (NULL: none bound) */
     guint16 place_count;
     const dg_request_role *request; /* NULL: the transport's direction (or the order) decides */
+    const dg_request_role *unanswered; /* <unanswered>: a message in its ranges takes no part in pairing */
 } dg_pairing;
 
 /* request{Name} in computed values: a response reads fields of its paired

@@ -748,12 +748,25 @@ guint8 direction_of(const packet_info *pinfo)
     return DG_DIR_ANY;
 }
 
+/* Whether the message decoded the field of r with a value in its ranges. */
+gboolean role_holds(const dg_state *st, const dg_request_role *r)
+{
+    return in_ranges(r->ranges, 0, r->range_count, st->slots[r->slot].value);
+}
+
 /* Request or response, as the pairing takes the message: what its <request>
  * field says when it was decoded, else the transport's direction. */
 guint8 message_role(const dg_state *st, const dg_request_role *r)
 {
     if (!r || !st->present[r->slot]) return st->direction;
-    return in_ranges(r->ranges, 0, r->range_count, st->slots[r->slot].value) ? DG_DIR_REQUEST : DG_DIR_RESPONSE;
+    return role_holds(st, r) ? DG_DIR_REQUEST : DG_DIR_RESPONSE;
+}
+
+/* <unanswered>: a message that expects no response (a notification) asks
+ * nothing and answers nothing. */
+gboolean takes_part_in_pairing(const dg_state *st, const dg_request_role *unanswered)
+{
+    return !unanswered || !st->present[unanswered->slot] || !role_holds(st, unanswered);
 }
 
 /* Whether the protocol below this message is Ethernet's type field. Asked
@@ -949,8 +962,9 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
         if (st.request_pending) request_walked(&st);
         const gboolean analysis_cycles = st.wants_cycles && dg_analysis_times_cycles(p);
         const dg_view view = {st.views, st.view_count, analysis_cycles ? &st.cycle : NULL};
-        fp = dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, st.wants_view ? &view : NULL, offset,
-                                messages - 1, message_role(&st, p->pairing->request));
+        if (takes_part_in_pairing(&st, p->pairing->unanswered))
+            fp = dg_pairing_dissect(p, tvb, pinfo, subtree, st.keys, st.key_count, st.wants_view ? &view : NULL,
+                                    offset, messages - 1, message_role(&st, p->pairing->request));
         if (st.tap) st.tap->pairing = fp;
         if (p->request_context) request_end(&st, fp, subtree);
     }

@@ -391,5 +391,56 @@ class TestServerRequestsOnTwoConnections(TsharkTestCase, unittest.TestCase):
                 check(not lost, "%s: no request given up (%s)" % (mode, lost))
 
 
+class TestUnanswered(TsharkTestCase, unittest.TestCase):
+    """<unanswered field="Function" in="8"/>: a message that expects no response (a
+    notification) takes no part in pairing: never lost, never giving up an earlier request
+    with its key, never answered; the other requests pair and are lost as before."""
+
+    RULES = """<root name="Transactions Protocol" abbreviation="TXNP" byteorder="big">
+  <hook table="udp.port" value="%d"/>
+  <pairing timeout="1">
+    <key field="node[@name='Transaction']"/>
+    <unanswered field="node[@name='Function']" in="8"/>
+  </pairing>
+  <node name="Transaction" length="2byte" displaytype="numberhex"/>
+  <node name="Unit" length="1byte" displaytype="numberdec"/>
+  <node name="Function" length="1byte" displaytype="numberdec"/>
+  <node name="Data" length="4byte" displaytype="numberhex"/>
+</root>
+""" % PORT
+    # (ms, direction, transaction, function)
+    CAPTURE = [(0, "request", 1, 3),      # 1
+               (1, "response", 1, 3),     # 2: answers 1
+               (10, "request", 2, 8),     # 3: a notification
+               (20, "request", 2, 8),     # 4: another with the same key: 3 is not given up
+               (30, "request", 3, 3),     # 5: lost: the capture goes on past its timeout
+               (40, "response", 2, 8),    # 6: a notification the other way: answers nothing
+               (1500, "request", 4, 3),   # 7
+               (1501, "response", 4, 3)]  # 8: answers 7, and (in one pass) tells that 5 is lost
+    PAIRS, LOST = {2: 1, 8: 7}, {5: 8}
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("unanswered.xml", cls.RULES, "txnp")
+
+    def test_notifications_take_no_part_in_pairing(self):
+        def message(direction, transaction, function, n):
+            data = frame(direction, transaction, 1, n)
+            return data[:-5] + bytes([function]) + data[-4:]  # Function sits before the 4-byte Data
+        path = self.env.path("unanswered.pcap")
+        write_frames(path, [(ms, message(d, t, fn, n)) for n, (ms, d, t, fn) in enumerate(self.CAPTURE, 1)])
+        with self.checks() as check:
+            for two_pass in (True, False):
+                mode = "-2" if two_pass else "one pass"
+                rows = decode(self.env, path, two_pass, ["txnp.function"])
+                functions = [rows[n]["txnp.function"] for n in sorted(rows)]
+                check(functions == [str(m[3]) for m in self.CAPTURE], "%s: functions %s" % (mode, functions))
+                pairs = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
+                check(pairs == self.PAIRS, "%s: pairs %s" % (mode, pairs))
+                flagged = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
+                want = set(self.LOST) if two_pass else set(self.LOST.values())
+                check(flagged == want, "%s: no_response on %s only (%s)" % (mode, sorted(want), sorted(flagged)))
+
+
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])
