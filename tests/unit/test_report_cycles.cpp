@@ -179,6 +179,30 @@ TEST(ReportCyclesModel, EveryResponseOfAFrameHasItsRoundTrip) {
     EXPECT_EQ(m.round_trip[1].ns, 250000);
 }
 
+TEST(ReportCyclesModel, EveryMessageOfAFrameInItsCycle) {
+    Rows r;  // TCP segments of two messages each, as tshark joins their values
+    r.add({{"frame.number", "1"}, {"frame.time_epoch", "100.000000000"}, {"enipr.cycle", "1,2"},
+           {"enipr.cycle.period", "0.010000000,0.004000000"}, {"enipr.cycle.jitter", "0.000000100,-0.000000200"}});
+    r.add({{"frame.number", "2"}, {"frame.time_epoch", "100.010000000"}, {"enipr.cycle", "1,2"},
+           {"enipr.cycle.period", "0.010000000,0.004000000"}, {"enipr.cycle.jitter", "0.000000300"},
+           {"enipr.cycle.lost", "1"}});
+    r.add({{"frame.number", "3"}, {"frame.time_epoch", "100.020000000"}, {"enipr.cycle", "2,2"},
+           {"enipr.cycle.period", "0.004000000,0.000001000"}, {"enipr.cycle.lost", "2"}});
+    CyclesModel m;
+    r.feed(m);
+    ASSERT_EQ(m.cycles.size(), 2u);
+    EXPECT_EQ(m.cycles.at(1).period.size(), 2u);
+    EXPECT_EQ(m.cycles.at(2).period.size(), 4u);
+    EXPECT_EQ(m.cycles.at(2).period[0].ns, 4000000);
+    EXPECT_EQ(m.cycles.at(2).period[3].ns, 1000);
+    ASSERT_EQ(m.cycles.at(1).jitter.size(), 1u) << "frame 2's one jitter belongs to one of two messages: not shown";
+    EXPECT_EQ(m.cycles.at(1).jitter[0].ns, 100);
+    EXPECT_EQ(m.cycles.at(2).jitter[0].ns, -200);
+    ASSERT_EQ(m.lost.size(), 2u);
+    EXPECT_EQ(m.lost[0].cycle, 0u) << "a loss in a frame of two cycles: which one is not known";
+    EXPECT_EQ(m.lost[1].cycle, 2u);
+}
+
 TEST(ReportCyclesPage, TableAsPrintedChartsPerCycleEscaped) {
     Rows r;
     r.statistics = kStatistics;

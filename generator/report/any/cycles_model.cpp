@@ -130,18 +130,31 @@ void CyclesModelBuilder::add(const FieldRow& row) {
     if (frame >= frame_times_.size()) frame_times_.resize(frame + 1, std::nan(""));
     frame_times_[frame] = t;
     // A message of no cycle (yet) has no P.cycle but may still show losses.
-    if (!parse_uint(value(row, runtime_field::stream_cycle), cycle)) cycle = 0;
-    if (cycle > 0) add_cycle_message(row, t, static_cast<unsigned>(cycle));
+    // A frame of several messages (a TCP segment) has a P.cycle for each one
+    // in a cycle, and as many periods; its losses and repeats go to its cycle
+    // when all its messages are of one.
+    const std::vector<std::string_view> cycles = split_values(value(row, runtime_field::stream_cycle));
+    for (size_t i = 0; i < cycles.size(); ++i)
+        if (parse_uint(cycles[i], cycle) && cycle > 0)
+            add_cycle_message(row, t, static_cast<unsigned>(cycle), i, cycles.size());
+    auto same = [&](std::string_view c) { return c == cycles[0]; };
+    const bool one_cycle = !cycles.empty() && std::all_of(cycles.begin(), cycles.end(), same);
+    if (!one_cycle || !parse_uint(cycles[0], cycle)) cycle = 0;
     add_stream_marks(row, t, static_cast<uint32_t>(frame), static_cast<unsigned>(cycle));
     add_pairing(row, t);
 }
 
-void CyclesModelBuilder::add_cycle_message(const FieldRow& row, double t, unsigned number) {
+// Message `index` of the `count` in the frame that are in a cycle: each has
+// a period; only regular ones have a jitter, so a frame's jitters are
+// matched to its messages only when every one has one.
+void CyclesModelBuilder::add_cycle_message(const FieldRow& row, double t, unsigned number, size_t index, size_t count) {
     StreamCycle& c = model_.cycles[number];
     c.number = number;
+    const std::vector<std::string_view> periods = split_values(value(row, runtime_field::stream_period));
+    const std::vector<std::string_view> jitters = split_values(value(row, runtime_field::stream_jitter));
     int64_t period = 0, jitter = 0;
-    if (parse_seconds_ns(value(row, runtime_field::stream_period), period)) c.period.push_back({t, period});
-    if (parse_seconds_ns(value(row, runtime_field::stream_jitter), jitter)) c.jitter.push_back({t, jitter});
+    if (periods.size() == count && parse_seconds_ns(periods[index], period)) c.period.push_back({t, period});
+    if (jitters.size() == count && parse_seconds_ns(jitters[index], jitter)) c.jitter.push_back({t, jitter});
 }
 
 void CyclesModelBuilder::add_stream_marks(const FieldRow& row, double t, uint32_t frame, unsigned cycle) {
