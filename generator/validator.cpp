@@ -673,10 +673,11 @@ std::string valid_blocker(const Node& blocker, const Node& t) {
 // field sits at a fixed offset and is decoded in every message; an 'ifhook'
 // on it or a container only limits the messages it is tested in.
 // What keeps n from being at a fixed offset from the start of every message
-// (a field before it of no fixed length; n or a container of it repeated,
-// conditional, placed in a window or cut short by a length field), or
-// nullptr with `offset` set.
+// (n computed, so in no bytes; a field before it of no fixed length; n or a
+// container of it repeated, conditional, placed in a window or cut short by
+// a length field), or nullptr with `offset` set.
 const Node* Validator::fixed_offset_blocker(const Node& n, uint64_t& offset) const {
+    if (n.is_computed()) return &n;
     const Node* blocker = nullptr;
     offset_of(&n, offset, blocker);
     for (const Node* a = &n; a; a = a->parent) {

@@ -29,6 +29,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
 from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 import pcapgen  # noqa: E402
+from test_enip import udp  # noqa: E402
 
 ARGS = None
 PORT = 47502
@@ -490,6 +491,58 @@ class TestRequestByPosition(TsharkTestCase, unittest.TestCase):
                           r["batch.expert.no_request_context"] == "1" for r in orphan_rows),
                       "%s: responses without their requests: no word, no text, one note each (%s)"
                       % (mode, [(r["batch.answer.word"], r["batch.expert.no_request_context"]) for r in orphan_rows]))
+
+
+class TestComputedKey(TsharkTestCase, unittest.TestCase):
+    """A computed value as a pairing key ({Node A} + {Node B}: the same for a request and
+    its response, whose nodes are swapped): it has no bytes at a fixed offset, so a response
+    finds its request with the value its walk computed, and request{Quantity} reads it."""
+
+    RULES = """<root name="Computed key test" abbreviation="CKEY" byteorder="big">
+  <hook table="udp.port" value="47600"/>
+  <pairing>
+    <key field="node[@name='Transaction']"/>
+    <key field="node[@name='Node pair']"/>
+    <request field="node[@name='Is response']" in="0"/>
+  </pairing>
+  <node name="Transaction" length="1byte" displaytype="numberhex"/>
+  <node name="Is response" length="1byte" displaytype="numberdec"/>
+  <node name="Node A" length="1byte" displaytype="numberdec"/>
+  <node name="Node B" length="1byte" displaytype="numberdec"/>
+  <node name="Node pair" value="{Node A} + {Node B}"/>
+  <node name="Quantity" length="1byte" displaytype="numberdec">
+    <when field="../node[@name='Is response']" in="0"/>
+  </node>
+  <node name="Asked" value="request{Quantity}">
+    <when field="../node[@name='Is response']" in="1"/>
+  </node>
+</root>
+"""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("computed_key.xml", cls.RULES, "ckey")
+
+    def test_a_response_reads_its_request_by_a_computed_key(self):
+        # (transaction, is response, node A, node B, quantity): requests of two node pairs with
+        # the same transaction, answered in the other order; a response of a third pair: no request
+        messages = [(7, 0, 1, 10, 5), (7, 0, 2, 30, 9), (7, 1, 30, 2, None), (7, 1, 10, 1, None),
+                    (7, 1, 4, 4, None)]
+        frames = []
+        for t, is_response, a, b, quantity in messages:
+            payload = bytes([t, is_response, a, b] + ([] if quantity is None else [quantity]))
+            client, server = (40000, (10, 0, 0, 10)), (47600, (10, 0, 0, 1))
+            (sport, src), (dport, dst) = (server, client) if is_response else (client, server)
+            frames.append(udp(sport, dport, payload, src, dst))
+        path = self.env.add_file("computed_key.pcap", pcapgen.raw_pcap_bytes(frames))
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = self.env.field_rows(path, ["frame.number", "ckey.request_in", "ckey.asked",
+                                                  "ckey.expert.no_request_context"], two_pass=two_pass)
+                got = {n: (r["ckey.request_in"], r["ckey.asked"], bool(r["ckey.expert.no_request_context"]))
+                       for n, r in rows.items() if n >= 3}
+                want = {3: (["2"], ["9"], False), 4: (["1"], ["5"], False), 5: ([], [], True)}
+                check(got == want, "%s: %s, expected %s" % ("-2" if two_pass else "one pass", got, want))
 
 
 if __name__ == "__main__":
