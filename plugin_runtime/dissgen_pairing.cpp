@@ -103,6 +103,7 @@ struct key_entry {
     nstime_t last_time;
     guint8 last_role;            /* dg_role */
     kept *last_record;           /* its record (adopt_orphan) */
+    const dg_request_values *last_answered; /* a response: what the request it answered kept */
     address last_src;
     guint8 last_src_bytes[16];
     guint8 *last_bytes;          /* and, with an analysis, its view (kept_view) */
@@ -929,6 +930,7 @@ dg_transaction *first_pass(capture_state *c, kept *k, tvbuff_t *tvb, packet_info
     gboolean orphan;
     dg_transaction *t = NULL;
     pending *q = classify(c, e, tvb, pinfo, length, direction, unchanged, &orphan);
+    e->last_answered = q ? q->txn->values : NULL;
     if (q)
         answer(c, q, k, tvb, pinfo);
     else if (orphan && transport_direction == DG_DIR_ANY && adopt_orphan(c, e, k, tvb, pinfo))
@@ -1193,8 +1195,8 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *, tvbuff_t *tvb, p
     return fp;
 }
 
-const dg_transaction *dg_pairing_waiting(const guint64 *keys, guint key_count, const packet_info *pinfo,
-                                        guint8 direction)
+const dg_request_values *dg_pairing_request_of(const guint64 *keys, guint key_count, tvbuff_t *tvb,
+                                               const packet_info *pinfo, guint8 direction)
 {
     if (!capture || key_count == 0) return NULL;
     keys = with_client(keys, &key_count, pinfo, direction);
@@ -1202,8 +1204,13 @@ const dg_transaction *dg_pairing_waiting(const guint64 *keys, guint key_count, c
     const key_entry *e = (const key_entry *)wmem_map_lookup(capture->keys, &probe);
     if (!e) return NULL;
     for (const pending *q = e->waiting.head; q; q = q->next)
-        if (!q->done && !given_up(capture, q, pinfo, protocol->pairing->timeout)) return q->txn;
-    return NULL;
+        if (!q->done && !given_up(capture, q, pinfo, protocol->pairing->timeout)) return q->txn->values;
+    /* a copy of the key's last response (same_again, its length not known yet) */
+    if (!e->last_answered || e->last_role != DG_ROLE_RESPONSE || !addresses_equal(&e->last_src, &pinfo->src) ||
+        !within_copy_window(e, &e->last_time, pinfo) || tvb_captured_length(tvb) < e->last_length ||
+        tvb_memeql(tvb, 0, e->last_bytes, e->last_length) != 0)
+        return NULL;
+    return e->last_answered;
 }
 
 void dg_pairing_stats_init(const dg_protocol *, stats_tree *st)

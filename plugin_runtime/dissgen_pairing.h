@@ -206,12 +206,14 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *p, tvbuff_t *tvb, 
                                            const guint64 *keys, guint key_count, const dg_view *view, gint length,
                                            guint message, guint8 direction);
 
-/* First pass, before a message is decoded: the transaction of the request
- * with these key values that the message would answer (its key's oldest
- * request still waiting), or NULL; `direction` as dg_pairing_dissect()'s
- * (over TCP or UDP, the client is a key too). Changes nothing. */
-const dg_transaction *dg_pairing_waiting(const guint64 *keys, guint key_count, const packet_info *pinfo,
-                                        guint8 direction);
+/* First pass, before a message is decoded: what the request with these key
+ * values that the message would answer kept (its key's oldest request still
+ * waiting; for a duplicate of the key's last response, the request that one
+ * answered, so that a copy decodes as its original), or NULL; `direction` as
+ * dg_pairing_dissect()'s (over TCP or UDP, the client is a key too). Changes
+ * nothing. */
+const dg_request_values *dg_pairing_request_of(const guint64 *keys, guint key_count, tvbuff_t *tvb,
+                                               const packet_info *pinfo, guint8 direction);
 
 /* At registration (dg_pairing_register): request{...}'s expert info. */
 void dg_request_register(const dg_protocol *p, expert_module_t *experts);

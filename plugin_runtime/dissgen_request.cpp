@@ -72,8 +72,7 @@ const dg_request_values *find_request(const dg_state *st)
     const dg_request_context *rc = st->p->request_context;
     guint64 *keys = wmem_alloc_array(st->pinfo->pool, guint64, rc->key_count);
     if (!read_keys(st, keys)) return NULL;
-    const dg_transaction *t = dg_pairing_waiting(keys, rc->key_count, st->pinfo, answer_direction(st));
-    return t ? t->values : NULL;
+    return dg_pairing_request_of(keys, rc->key_count, st->tvb, st->pinfo, answer_direction(st));
 }
 
 /* Saves what the first pass found for the message, for every later pass. */
@@ -88,9 +87,9 @@ void save(const dg_state *st, const dg_request_values *v)
 void find_from_walk(const dg_state *st)
 {
     st->request_pending = FALSE;
-    const dg_transaction *t =
-        st->key_count ? dg_pairing_waiting(st->keys, st->key_count, st->pinfo, answer_direction(st)) : NULL;
-    st->request = t ? t->values : NULL;
+    st->request = st->key_count ? dg_pairing_request_of(st->keys, st->key_count, st->tvb, st->pinfo,
+                                                        answer_direction(st))
+                                : NULL;
     save(st, st->request);
 }
 

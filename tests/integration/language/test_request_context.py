@@ -496,7 +496,8 @@ class TestRequestByPosition(TsharkTestCase, unittest.TestCase):
 class TestComputedKey(TsharkTestCase, unittest.TestCase):
     """A computed value as a pairing key ({Node A} + {Node B}: the same for a request and
     its response, whose nodes are swapped): it has no bytes at a fixed offset, so a response
-    finds its request with the value its walk computed, and request{Quantity} reads it."""
+    finds its request with the value its walk computed, and request{Quantity} reads it. A
+    response captured twice is a duplicate, not paired, and its copy reads the same request."""
 
     RULES = """<root name="Computed key test" abbreviation="CKEY" byteorder="big">
   <hook table="udp.port" value="47600"/>
@@ -534,6 +535,7 @@ class TestComputedKey(TsharkTestCase, unittest.TestCase):
             client, server = (40000, (10, 0, 0, 10)), (47600, (10, 0, 0, 1))
             (sport, src), (dport, dst) = (server, client) if is_response else (client, server)
             frames.append(udp(sport, dport, payload, src, dst))
+        frames.append(frames[3])  # 6: frame 4 captured twice: a duplicate, not paired, decoded as frame 4
         path = self.env.add_file("computed_key.pcap", pcapgen.raw_pcap_bytes(frames))
         with self.checks() as check:
             for two_pass in (False, True):
@@ -541,7 +543,8 @@ class TestComputedKey(TsharkTestCase, unittest.TestCase):
                                                   "ckey.expert.no_request_context"], two_pass=two_pass)
                 got = {n: (r["ckey.request_in"], r["ckey.asked"], bool(r["ckey.expert.no_request_context"]))
                        for n, r in rows.items() if n >= 3}
-                want = {3: (["2"], ["9"], False), 4: (["1"], ["5"], False), 5: ([], [], True)}
+                want = {3: (["2"], ["9"], False), 4: (["1"], ["5"], False), 5: ([], [], True),
+                        6: ([], ["5"], False)}
                 check(got == want, "%s: %s, expected %s" % ("-2" if two_pass else "one pass", got, want))
 
 
