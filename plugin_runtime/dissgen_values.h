@@ -46,22 +46,26 @@ static inline gboolean in_ranges(const dg_range *ranges, guint16 first, guint16 
     return FALSE;
 }
 
-/* A referenced field's value with the reference's arithmetic applied. Values
- * beyond 2^31 are past any packet's end anyway; clamping there keeps even
- * "* 999999999" (the largest operand the generator accepts) in range. */
+/* A referenced field's value with the reference's arithmetic applied,
+ * exact up to 2^62 either way (a 4-byte length of 4294967295 is reported as
+ * that), saturated beyond: any such value is past any packet's end. */
 static inline gint64 ref_arith(guint64 value, const dg_ref *ref)
 {
-    const gint64 limit = G_GINT64_CONSTANT(1) << 31;
-    gint64 v = ref->is_signed && (gint64)value < 0 ? MAX((gint64)value, -limit)
-               : value > (guint64)limit          ? limit
-                                                 : (gint64)value;
+    const gint64 limit = G_GINT64_CONSTANT(1) << 62;
+    const gint64 base = ref->is_signed && (gint64)value < 0 ? MAX((gint64)value, -limit)
+                        : value > (guint64)limit          ? limit
+                                                          : (gint64)value;
+    const gint64 operand = ref->operand;
+    gint64 v = base;
     switch (ref->op) {
-    case '+': v += ref->operand; break;
-    case '-': v -= ref->operand; break;
-    case '*': v *= ref->operand; break;
+    case '+': v = base + operand; break; /* |base| <= 2^62, |operand| < 2^30: no overflow */
+    case '-': v = base - operand; break;
+    case '*':
+        if (__builtin_mul_overflow(base, operand, &v)) return (base < 0) != (operand < 0) ? -limit : limit;
+        break;
     default: break;
     }
-    return v;
+    return CLAMP(v, -limit, limit);
 }
 
 /* A time leaf's count of units as an nstime. */

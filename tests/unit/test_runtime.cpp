@@ -240,24 +240,29 @@ TEST(RuntimeRefs, Arithmetic) {
     EXPECT_EQ(ref_arith(7, &times), 35);
 }
 
-TEST(RuntimeRefs, LargeValuesClampAtTwoToThe31) {
-    const gint64 limit = G_GINT64_CONSTANT(1) << 31;
+TEST(RuntimeRefs, LargeValuesExactUpToTwoToThe62) {
+    const gint64 limit = G_GINT64_CONSTANT(1) << 62;
     dg_ref none = {0, 0, 0, 0}, times = {0, '*', 0, 999999999}, minus = {0, '-', 0, 1};
-    EXPECT_EQ(ref_arith(G_GUINT64_CONSTANT(1) << 31, &none), limit);
-    EXPECT_EQ(ref_arith((G_GUINT64_CONSTANT(1) << 31) + 1, &none), limit);
+    EXPECT_EQ(ref_arith(G_GUINT64_CONSTANT(4294967295), &none), G_GINT64_CONSTANT(4294967295))
+        << "a 4-byte length is reported as the field holds it";
+    EXPECT_EQ(ref_arith(G_GUINT64_CONSTANT(4294967295), &times), G_GINT64_CONSTANT(4294967295) * 999999999);
+    EXPECT_EQ(ref_arith(G_GUINT64_CONSTANT(1) << 62, &none), limit);
+    EXPECT_EQ(ref_arith((G_GUINT64_CONSTANT(1) << 62) + 1, &none), limit);
     EXPECT_EQ(ref_arith(G_MAXUINT64, &none), limit);
     EXPECT_EQ(ref_arith(G_MAXUINT64, &minus), limit - 1);
-    EXPECT_EQ(ref_arith(G_MAXUINT64, &times), limit * 999999999) << "no overflow";
+    EXPECT_EQ(ref_arith(G_MAXUINT64, &times), limit) << "saturated, no overflow";
 }
 
 // A signed field's (an int's, a computed value's) negative value stays negative, so that
 // a length or count from it is reported negative; an unsigned one's top values clamp.
 TEST(RuntimeRefs, SignedValuesStayNegative) {
-    const gint64 limit = G_GINT64_CONSTANT(1) << 31;
-    dg_ref signed_none = {0, 0, 1, 0}, signed_minus = {0, '-', 1, 8}, unsigned_none = {0, 0, 0, 0};
+    const gint64 limit = G_GINT64_CONSTANT(1) << 62;
+    dg_ref signed_none = {0, 0, 1, 0}, signed_minus = {0, '-', 1, 8}, unsigned_none = {0, 0, 0, 0},
+           signed_times = {0, '*', 1, 999999999};
     EXPECT_EQ(ref_arith((guint64)G_GINT64_CONSTANT(-3), &signed_none), -3);
     EXPECT_EQ(ref_arith(5, &signed_minus), -3);
     EXPECT_EQ(ref_arith((guint64)G_MININT64, &signed_none), -limit) << "no overflow";
+    EXPECT_EQ(ref_arith((guint64)G_MININT64, &signed_times), -limit) << "saturated negative, no overflow";
     EXPECT_EQ(ref_arith((guint64)G_GINT64_CONSTANT(-3), &unsigned_none), limit);
     EXPECT_EQ(ref_arith(G_MAXUINT64 >> 1, &signed_none), limit) << "a large positive one still clamps";
 }

@@ -139,5 +139,28 @@ class TestMessageEdges(TsharkTestCase, unittest.TestCase):
                       (" ".join(extra) or "one pass", out))
 
 
+class TestHugeLengths(TsharkTestCase, unittest.TestCase):
+    """A 4-byte length field of 2^31 or more points past the end: the message quotes the
+    length the field holds (it was capped at 2147483648)."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("huge_lengths.xml", """<root name="Huge lengths" abbreviation="HUGE" ethertype="0x88b5">
+  <node name="Len" length="4byte" displaytype="numberdec"/>
+  <node name="Body" length="../node[@name='Len']" displaytype="origin"/>
+</root>
+""", "huge")
+
+    def test_past_the_end_quotes_the_field(self):
+        lengths = [0x7FFFFFFF, 0x80000000, 0xFFFFFFFF, 0x100]
+        frames = [b"\x02" + bytes(5) + b"\x02" + bytes(4) + b"\x01\x88\xb5" + struct.pack(">I", n) + bytes(60)
+                  for n in lengths]
+        path = self.env.add_file("huge_lengths.pcap", pcap(frames))
+        rows = self.env.field_rows(path, ["frame.number", "_ws.expert.message"], aggregator="|")
+        got = [rows[n + 1]["_ws.expert.message"] for n in range(len(lengths))]
+        want = [["'Body' has length %d, past the end of its data (60 bytes left)" % n] for n in lengths]
+        self.assertEqual(got, want)
+
+
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])
