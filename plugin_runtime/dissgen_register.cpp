@@ -151,12 +151,23 @@ tap_packet_status stats_packet(stats_tree *st, packet_info *pinfo, epan_dissect_
     const dg_protocol *p = stats_protocol;
     tick_stat_node(st, "Messages", 0, FALSE);
     char buf[64];
+    /* A repeated node inside another repeat is recorded once per instance of
+     * the outer one: its instances per message are the sum of its records. */
+    guint64 *per_message = wmem_alloc0_array(pinfo->pool, guint64, p->node_count);
+    gboolean *seen = wmem_alloc0_array(pinfo->pool, gboolean, p->node_count);
+    for (guint i = 0; i < t->count; i++)
+        if (is_repeated(&p->nodes[t->records[i].node])) per_message[t->records[i].node] += t->records[i].value;
     for (guint i = 0; i < t->count; i++) {
         const dg_tap_record *r = &t->records[i];
         const dg_node *n = &p->nodes[r->node];
         if (!stats_node_names[r->node]) continue;
         const char *label = NULL;
-        if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM && !is_repeated(n)) {
+        if (is_repeated(n)) {
+            if (seen[r->node]) continue; /* ticked at its first record, with the sum */
+            seen[r->node] = TRUE;
+            g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "u", per_message[r->node]);
+            label = buf;
+        } else if (n->kind == DG_LEAF && n->show == DG_SHOW_ENUM) {
             header_field_info *hfi = proto_registrar_get_nth(*n->hf);
             label = enum_name(hfi, r->value);
             if (!label) {

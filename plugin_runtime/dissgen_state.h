@@ -365,7 +365,8 @@ static inline void tap_record(dg_state *st, const dg_node *n, guint64 value)
 static inline __attribute__((always_inline)) void store(dg_state *st, const dg_node *n, guint64 value, gint offset,
                                                         gint length)
 {
-    if (st->tap && n->show == DG_SHOW_ENUM) tap_record(st, n, value);
+    /* a repeated enum leaf is counted per message, by its instances (dissect_repeated) */
+    if (st->tap && n->show == DG_SHOW_ENUM && !is_repeated(n)) tap_record(st, n, value);
     if (n->flags & DG_KEY) key_append(st, value);
     if (is_view_input(st, n)) view_append(st, n, value, offset, length);
     if (is_cycle_input(st, n)) cycle_record(st, n, value, offset, length);

@@ -1073,33 +1073,55 @@ class Everything(TsharkTestCase, unittest.TestCase):
 
     def test_statistics_tree_of_a_rule_file_ending_in_a_counted_node(self):
         """The tree's rows are kept per node: the last node of the file counted too (an enum
-        after a repeated node), each value and each number of instances as often as sent.
-        A '/' in a node's name shows as U+2215 (the tree would show only what follows it)."""
+        after a repeated node), each value and each number of instances as often as sent; a
+        repeat inside a repeat counts its instances in the whole message (each Item's Subs
+        added up). A '/' in a node's name shows as U+2215 (the tree would show only what
+        follows it)."""
         rules = ('<root name="Counted last" abbreviation="CLAST" filter="clast" byteorder="big">\n'
                  '  <hook table="udp.port" value="%d"/>\n'
                  '  <node name="Count" length="1byte" displaytype="numberdec"/>\n'
                  '  <node name="Item" count="../node[@name=\'Count\']">\n'
                  '    <node name="Value" length="1byte" displaytype="numberhex"/>\n'
+                 '    <node name="Subs" length="1byte" displaytype="numberdec"/>\n'
+                 '    <node name="Sub" count="../node[@name=\'Subs\']" length="1byte" displaytype="numberhex"/>\n'
                  '  </node>\n'
                  '  <node name="Kind/mode" length="1byte" displaytype="enum">'
                  '<enum value="1" name="One"/><enum value="2" name="Two"/></node>\n'
                  '</root>\n' % UDP_PORT)
         rng = random.Random(7)
         sent = [(rng.randrange(1, 4), rng.choice([1, 1, 2])) for _ in range(40)]
+        subs = [[rng.randrange(0, 3) for _ in range(n)] for n, _k in sent]  # per message, per Item
+
+        def body(n, kind, item_subs):
+            return bytes([n]) + b"".join(bytes([0xAA, k] + [0x55] * k) for k in item_subs) + bytes([kind])
         with TsharkEnv() as env:
             path = os.path.join(env.home, "counted_last.xml")
             with open(path, "w", encoding="utf-8") as fh:
                 fh.write(rules)
             env.install_plugin(ARGS.dissgen, path)
-            frames = [(f, len(f)) for f in (eth_frame(bytes([n] + [0xAA] * n + [kind]), udp=True) for n, kind in sent)]
+            frames = [(f, len(f)) for f in (eth_frame(body(n, kind, item_subs), udp=True)
+                                            for (n, kind), item_subs in zip(sent, subs))]
             cap = env.add_file("counted_last.pcap", pcap(frames))
             out = env.tshark(["-r", cap, "-q", "-z", "clast,tree"]).stdout
         rows = {m.group(1).strip(): int(m.group(2)) for m in re.finditer(r"^(\S.*?|\s\S.*?)\s{2,}(\d+)\s", out, re.M)}
         want = {"Messages": len(sent), "Kind\u2215mode (clast.kind_mode)": len(sent),
                 "One": sum(k == 1 for _n, k in sent), "Two": sum(k == 2 for _n, k in sent),
-                "Item per message (clast.item)": len(sent)}
-        want.update({str(c): sum(n == c for n, _k in sent) for c in (1, 2, 3)})
+                "Item per message (clast.item)": len(sent), "Sub per message (clast.item.sub)": len(sent)}
         self.assertEqual({k: rows.get(k) for k in want}, want, out)
+        # each per-message row's values, in the order the tree lists them
+        children, current = {}, None
+        for line in out.splitlines():
+            top = re.match(r"^(\S.*?)\s{2,}\d+\s", line)
+            child = re.match(r"^ (\S.*?)\s{2,}(\d+)\s", line)
+            if top:
+                current = children.setdefault(top.group(1), {})
+            elif child and current is not None and child.group(1).isdigit():
+                current[int(child.group(1))] = int(child.group(2))
+        totals = [sum(item_subs) for item_subs in subs]
+        self.assertEqual(children.get("Item per message (clast.item)"),
+                         {c: sum(n == c for n, _k in sent) for c in {n for n, _k in sent}}, out)
+        self.assertEqual(children.get("Sub per message (clast.item.sub)"),
+                         {t: totals.count(t) for t in set(totals)}, out)
 
     def test_hooks(self):
         p = self.env.tshark(["-G", "decodes"])
