@@ -292,9 +292,15 @@ void Validator::check_root() {
                          (proto_.filter_given ? "" : " (the abbreviation lowercased)") +
                          " is not valid: it must match [a-z][a-z0-9_]*" +
                          (proto_.filter_given ? "" : "; set a 'filter' attribute on <root>"));
+    std::map<std::pair<std::string, uint64_t>, int> hooked;  // table and value -> the line that hooks it first
+    if (proto_.ethertype) hooked[{"ethertype", *proto_.ethertype}] = proto_.line;
     for (const Hook& h : proto_.hooks) {
         if (!is_table_name(h.table) && !h.table.empty())
             diags_.error(h.line, "bad hook table '" + h.table + "': expected a Wireshark dissector table such as udp.port");
+        auto [first, added] = hooked.emplace(std::make_pair(h.table, h.value), h.line);
+        if (!added)
+            diags_.warning(h.line, "<hook table=\"" + h.table + "\" value=\"" + std::to_string(h.value) +
+                                       "\"> repeats line " + std::to_string(first->second) + ": one hook is enough");
     }
     for (const Heuristic& h : proto_.heuristics) {
         const bool port = h.table.size() > 5 && h.table.compare(h.table.size() - 5, 5, ".port") == 0;

@@ -37,6 +37,14 @@ struct dg_claim {
 
 GArray *claims; /* of dg_claim: table entries this plugin must own */
 
+/* The other registrant of a value, or NULL when there is none or it is this
+ * protocol itself (a value hooked twice, or its TCP stream entry beside its
+ * plain one): a refused message must never come back to us. */
+dissector_handle_t other_than(dissector_handle_t h, int proto)
+{
+    return h && dissector_handle_get_protocol_index(h) != proto ? h : NULL;
+}
+
 /* Runs after every plugin's handoff and before Decode As choices (-d, the
  * profile's decode_as_entries) are applied: whatever the plugin load order,
  * our handle becomes the default for our values, and the other registrant
@@ -47,7 +55,7 @@ void claim_tables(void)
         dg_claim *c = &g_array_index(claims, dg_claim, i);
         dissector_handle_t now = dissector_get_uint_handle(find_dissector_table(c->table), c->value);
         if (now != c->handle) {
-            if (now) c->displaced = now;
+            if (other_than(now, c->proto)) c->displaced = now;
             dissector_add_uint(c->table, c->value, c->handle);
         }
         c->placed = c->handle;
@@ -285,7 +293,8 @@ void dg_handoff(const dg_protocol *p)
          * values before any plugin's handoff: recorded now, before ours
          * replaces them, so that disabling ours gives the value back. Later
          * plugins' entries are recorded by claim_tables. */
-        dissector_handle_t builtin = dissector_get_uint_handle(find_dissector_table(h->table), h->value);
+        dissector_handle_t builtin =
+            other_than(dissector_get_uint_handle(find_dissector_table(h->table), h->value), *p->proto);
         dissector_add_uint(h->table, h->value, h_handle);
         dg_claim c = {h->table, h->value, h_handle, *p->proto, builtin, NULL};
         g_array_append_val(claims, c);

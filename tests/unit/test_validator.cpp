@@ -664,6 +664,19 @@ TEST(Root, NeedsEthertypeOrHook) {
     EXPECT_TRUE(contains(empty.messages(), "rules.xml:1: warning: <root> has no <node>")) << empty.messages();
 }
 
+TEST(Root, AValueHookedTwiceIsAWarning) {
+    Front f = front_end("<root name=\"X\" abbreviation=\"X\" ethertype=\"0x88b5\">\n"
+                        "  <hook table=\"ethertype\" value=\"0x88b5\"/>\n"
+                        "  <hook table=\"udp.port\" value=\"9600\"/>\n  <hook table=\"udp.port\" value=\"9600\"/>\n"
+                        "  <hook table=\"tcp.port\" value=\"9600\"/>\n  <node name=\"a\" length=\"1byte\"/>\n</root>\n");
+    EXPECT_TRUE(f.ok()) << f.messages();
+    EXPECT_TRUE(contains(f.messages(), "rules.xml:2: warning: <hook table=\"ethertype\" value=\"34997\"> repeats line 1"))
+        << f.messages();
+    EXPECT_TRUE(contains(f.messages(), "rules.xml:4: warning: <hook table=\"udp.port\" value=\"9600\"> repeats line 3"))
+        << f.messages();
+    EXPECT_FALSE(contains(f.messages(), "rules.xml:5:")) << "another table is another hook: " << f.messages();
+}
+
 TEST(Root, HookTable) {
     Front f = front_end("<root name=\"X\" abbreviation=\"X\">\n  <hook table=\"UDP port\" value=\"1\"/>\n</root>\n");
     EXPECT_TRUE(contains(f.messages(), "rules.xml:2: error: bad hook table 'UDP port'")) << f.messages();

@@ -293,6 +293,7 @@ GATE = """<root name="Gate" abbreviation="GATE" filter="gate"
       pdulength="node[@name='Length']" pdulengthadd="2">
   <hook table="udp.port" value="3671"/>
   <hook table="tcp.port" value="502"/>
+  <hook table="udp.port" value="3671"/>
   <node name="Magic" length="1byte" displaytype="numberhex" valid="0x42"/>
   <node name="Length" length="1byte" displaytype="numberdec"/>
   <node name="Body" length="rest" displaytype="origin"/>
@@ -304,7 +305,8 @@ MODBUS_READ = bytes.fromhex("000100000006" "0103" "00000001")
 
 class DisplacedDissector(TsharkTestCase, unittest.TestCase):
     """A message the valid fields refuse on a hooked value goes to the dissector the hook
-    displaced there (Wireshark's kip on UDP 3671, mbtcp on TCP 502), one pass and -2."""
+    displaced there (Wireshark's kip on UDP 3671, mbtcp on TCP 502), one pass and -2; a value
+    hooked twice (a warning) never hands a refused message back to the protocol itself."""
 
     @classmethod
     def prepare(cls):
