@@ -188,19 +188,26 @@ TEST(ReportCyclesModel, EveryMessageOfAFrameInItsCycle) {
            {"enipr.cycle.lost", "1"}});
     r.add({{"frame.number", "3"}, {"frame.time_epoch", "100.020000000"}, {"enipr.cycle", "2,2"},
            {"enipr.cycle.period", "0.004000000,0.000001000"}, {"enipr.cycle.lost", "2"}});
+    // a message and its duplicate (no period), each after a loss
+    r.add({{"frame.number", "4"}, {"frame.time_epoch", "100.030000000"}, {"enipr.cycle", "2,2"},
+           {"enipr.cycle.period", "0.004000000"}, {"enipr.cycle.lost", "1,1"}, {"enipr.cycle.duplicate", "4"}});
     CyclesModel m;
     r.feed(m);
     ASSERT_EQ(m.cycles.size(), 2u);
     EXPECT_EQ(m.cycles.at(1).period.size(), 2u);
-    EXPECT_EQ(m.cycles.at(2).period.size(), 4u);
+    ASSERT_EQ(m.cycles.at(2).period.size(), 5u) << "a duplicate's missing period drops no other";
     EXPECT_EQ(m.cycles.at(2).period[0].ns, 4000000);
     EXPECT_EQ(m.cycles.at(2).period[3].ns, 1000);
+    EXPECT_EQ(m.cycles.at(2).period[4].ns, 4000000);
     ASSERT_EQ(m.cycles.at(1).jitter.size(), 1u) << "frame 2's one jitter belongs to one of two messages: not shown";
     EXPECT_EQ(m.cycles.at(1).jitter[0].ns, 100);
     EXPECT_EQ(m.cycles.at(2).jitter[0].ns, -200);
-    ASSERT_EQ(m.lost.size(), 2u);
+    ASSERT_EQ(m.lost.size(), 4u);
     EXPECT_EQ(m.lost[0].cycle, 0u) << "a loss in a frame of two cycles: which one is not known";
     EXPECT_EQ(m.lost[1].cycle, 2u);
+    EXPECT_EQ(m.messages_lost(), 5u) << "every message's loss counts";
+    ASSERT_EQ(m.duplicates.size(), 1u);
+    EXPECT_EQ(m.duplicates[0].cycle, 2u);
 }
 
 TEST(ReportCyclesPage, TableAsPrintedChartsPerCycleEscaped) {

@@ -131,22 +131,38 @@ void CyclesModelBuilder::add(const FieldRow& row) {
     frame_times_[frame] = t;
     // A message of no cycle (yet) has no P.cycle but may still show losses.
     // A frame of several messages (a TCP segment) has a P.cycle for each one
-    // in a cycle, and as many periods; its losses and repeats go to its cycle
+    // in a cycle; its periods, jitters, losses and repeats go to its cycle
     // when all its messages are of one.
     const std::vector<std::string_view> cycles = split_values(value(row, runtime_field::stream_cycle));
-    for (size_t i = 0; i < cycles.size(); ++i)
-        if (parse_uint(cycles[i], cycle) && cycle > 0)
-            add_cycle_message(row, t, static_cast<unsigned>(cycle), i, cycles.size());
     auto same = [&](std::string_view c) { return c == cycles[0]; };
     const bool one_cycle = !cycles.empty() && std::all_of(cycles.begin(), cycles.end(), same);
+    if (one_cycle && parse_uint(cycles[0], cycle) && cycle > 0) {
+        add_cycle_messages(row, t, static_cast<unsigned>(cycle));
+    } else {
+        for (size_t i = 0; i < cycles.size(); ++i)
+            if (parse_uint(cycles[i], cycle) && cycle > 0)
+                add_cycle_message(row, t, static_cast<unsigned>(cycle), i, cycles.size());
+    }
     if (!one_cycle || !parse_uint(cycles[0], cycle)) cycle = 0;
     add_stream_marks(row, t, static_cast<uint32_t>(frame), static_cast<unsigned>(cycle));
     add_pairing(row, t);
 }
 
-// Message `index` of the `count` in the frame that are in a cycle: each has
-// a period; only regular ones have a jitter, so a frame's jitters are
-// matched to its messages only when every one has one.
+// Every period and jitter of a frame whose messages are all of cycle `number`.
+void CyclesModelBuilder::add_cycle_messages(const FieldRow& row, double t, unsigned number) {
+    StreamCycle& c = model_.cycles[number];
+    c.number = number;
+    int64_t ns = 0;
+    for (std::string_view shown : split_values(value(row, runtime_field::stream_period)))
+        if (parse_seconds_ns(shown, ns)) c.period.push_back({t, ns});
+    for (std::string_view shown : split_values(value(row, runtime_field::stream_jitter)))
+        if (parse_seconds_ns(shown, ns)) c.jitter.push_back({t, ns});
+}
+
+// Message `index` of the `count` in the frame that are in a cycle, in a
+// frame of several cycles: a duplicate has no period and only regular
+// messages have a jitter, so the frame's periods (jitters) are matched to
+// its messages only when every one has one.
 void CyclesModelBuilder::add_cycle_message(const FieldRow& row, double t, unsigned number, size_t index, size_t count) {
     StreamCycle& c = model_.cycles[number];
     c.number = number;
@@ -157,11 +173,15 @@ void CyclesModelBuilder::add_cycle_message(const FieldRow& row, double t, unsign
     if (jitters.size() == count && parse_seconds_ns(jitters[index], jitter)) c.jitter.push_back({t, jitter});
 }
 
+// Each message's loss and repeat: a frame of several messages has a value of
+// each for every message that shows one.
 void CyclesModelBuilder::add_stream_marks(const FieldRow& row, double t, uint32_t frame, unsigned cycle) {
-    uint64_t lost = 0;
-    if (parse_uint(value(row, runtime_field::stream_lost), lost, 10) && lost > 0)
-        model_.lost.push_back({t, frame, cycle, lost});
-    if (!value(row, runtime_field::stream_duplicate).empty()) model_.duplicates.push_back({t, frame, cycle, 1});
+    for (std::string_view shown : split_values(value(row, runtime_field::stream_lost))) {
+        uint64_t lost = 0;
+        if (parse_uint(shown, lost, 10) && lost > 0) model_.lost.push_back({t, frame, cycle, lost});
+    }
+    for (size_t i = 0; i < split_values(value(row, runtime_field::stream_duplicate)).size(); ++i)
+        model_.duplicates.push_back({t, frame, cycle, 1});
 }
 
 void CyclesModelBuilder::add_pairing(const FieldRow& row, double t) {

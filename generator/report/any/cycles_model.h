@@ -88,6 +88,7 @@ public:
 
 private:
     std::string_view value(const FieldRow& row, const char* runtime_name) const;
+    void add_cycle_messages(const FieldRow& row, double t, unsigned cycle);
     void add_cycle_message(const FieldRow& row, double t, unsigned cycle, size_t index, size_t count);
     void add_stream_marks(const FieldRow& row, double t, uint32_t frame, unsigned cycle);
     void add_pairing(const FieldRow& row, double t);
