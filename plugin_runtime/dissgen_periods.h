@@ -233,7 +233,8 @@ inline st_time_unit st_unit_for(guint64 largest_ns)
 {
     static const st_time_unit units[] = {{"ns", 1}, {"us", 1000}, {"ms", 1000000}, {"s", 1000000000}};
     guint i = 0;
-    while (i + 1 < G_N_ELEMENTS(units) && largest_ns / units[i].ns > (guint64)G_MAXINT) i++;
+    /* rounded as st_time_row() shows it */
+    while (i + 1 < G_N_ELEMENTS(units) && (largest_ns + units[i].ns / 2) / units[i].ns > (guint64)G_MAXINT) i++;
     return units[i];
 }
 

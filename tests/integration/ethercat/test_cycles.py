@@ -30,6 +30,7 @@ import unittest
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
 import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
 from tshark_env import TsharkTestCase, corpus_captures, relative_time_ns, run_unittests  # noqa: E402
+from cyclemodel import tree_unit, tree_value  # noqa: E402
 import pcaprewrite as pr  # noqa: E402
 from test_losses import ecat_frame, generated as write_pcap, returned  # noqa: E402
 
@@ -308,13 +309,16 @@ def parse_tree(text):
 
 def tree_rows(number, stats):
     """What the statistics tree shows for a cycle of -z ecatr,cycles."""
-    rows = {(number, "frames"): stats["frames"], (number, "nominal period (ns)"): stats["nominal period"],
-            (number, "jitter std dev (ns)"): int(stats["jitter std dev"] + 0.5),
+    largest = max([stats["nominal period"]] + [max(stats.get(w) or (0,)) for w in ("period", "round trip")])
+    unit, scale = tree_unit(largest)
+    rows = {(number, "frames"): stats["frames"],
+            (number, "nominal period (%s)" % unit): tree_value(stats["nominal period"], scale),
+            (number, "jitter std dev (%s)" % unit): tree_value(int(stats["jitter std dev"] + 0.5), scale),
             (number, "frames returned"): stats["frames returned"], (number, "frames lost"): stats["frames lost"],
             (number, "working counter errors"): stats["working counter errors"]}
     for what in ("period", "round trip"):
         for name, value in zip(("min", "median", "p99", "max"), stats.get(what) or ()):
-            rows[(number, "%s %s (ns)" % (what, name))] = min(value, 2**31 - 1)
+            rows[(number, "%s %s (%s)" % (what, name, unit))] = tree_value(value, scale)
     return rows
 
 

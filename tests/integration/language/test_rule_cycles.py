@@ -31,6 +31,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests share captures)
 from pcapgen import ip_checksum  # noqa: E402
 from cyclemodel import figures, mark_fields, mark_of, model, parse_report, pcap_ns, read_pcap  # noqa: E402
+from cyclemodel import tree_unit, tree_value  # noqa: E402
 from tshark_env import TsharkTestCase, run_unittests  # noqa: E402
 
 ARGS = None
@@ -159,11 +160,12 @@ class TestRuleCycles(TsharkTestCase, unittest.TestCase):
         want = {}
         for c in cycles:
             f, n = figures(c), c["number"]
+            unit, scale = tree_unit(max([f["nominal"]] + list(f["period"] or ())))
             want[(n, "messages")] = f["messages"]
-            want[(n, "nominal period (ns)")] = f["nominal"]
+            want[(n, "nominal period (%s)" % unit)] = tree_value(f["nominal"], scale)
             for name, value in zip(("min", "median", "p99", "max"), f["period"] or ()):
-                want[(n, "period %s (ns)" % name)] = min(value, 2**31 - 1)
-            want[(n, "jitter std dev (ns)")] = int(float(f["jitter sd"]) + 0.5)
+                want[(n, "period %s (%s)" % (name, unit))] = tree_value(value, scale)
+            want[(n, "jitter std dev (%s)" % unit)] = tree_value(int(float(f["jitter sd"]) + 0.5), scale)
             want[(n, "messages lost")] = f["lost"]
             want[(n, "duplicates")] = f["duplicates"]
         differ = sorted(k for k in set(have) | set(want) if k not in have or k not in want or
@@ -490,14 +492,13 @@ class TestLongPeriods(TsharkTestCase, unittest.TestCase):
         want = {}
         for c in cycles:
             f, n = figures(c), c["number"]
-            unit, scale = next((u, k) for u, k in (("ns", 1), ("us", 10**3), ("ms", 10**6), ("s", 10**9))
-                               if max(f["nominal"], f["period"][3]) // k <= 2**31 - 1)
+            unit, scale = tree_unit(max(f["nominal"], f["period"][3]))
             want[(n, "messages")] = f["messages"]
             want[(n, "messages lost")] = f["lost"]
-            want[(n, "nominal period (%s)" % unit)] = (f["nominal"] + scale // 2) // scale
+            want[(n, "nominal period (%s)" % unit)] = tree_value(f["nominal"], scale)
             for name, value in zip(("min", "median", "p99", "max"), f["period"]):
-                want[(n, "period %s (%s)" % (name, unit))] = (value + scale // 2) // scale
-            want[(n, "jitter std dev (%s)" % unit)] = (int(float(f["jitter sd"]) + 0.5) + scale // 2) // scale
+                want[(n, "period %s (%s)" % (name, unit))] = tree_value(value, scale)
+            want[(n, "jitter std dev (%s)" % unit)] = tree_value(int(float(f["jitter sd"]) + 0.5), scale)
         units = sorted({k[1].split("(")[1] for k in want if "(" in k[1]})
         check(units == ["ns)", "us)"], "the model: rows in ns and in us (%s)" % units)
         check(have == want, "-2 -z beat.cycles,tree: %s, expected %s" % (

@@ -100,6 +100,20 @@ def model(messages, window, bits, step=1, lost_by_period=False, wrap=None, irreg
     return marks, cycles
 
 
+def tree_unit(largest_ns):
+    """The unit of a cycle's time rows in the statistics tree, whose rows hold up to 2^31 - 1:
+    (name, ns per unit), the first of ns, us, ms, s that holds the cycle's longest time rounded."""
+    for name, scale in (("ns", 1), ("us", 10**3), ("ms", 10**6)):
+        if (largest_ns + scale // 2) // scale <= 2**31 - 1:
+            return name, scale
+    return "s", 10**9
+
+
+def tree_value(ns, scale):
+    """A time in ns as its tree row shows it: rounded to the unit."""
+    return (ns + scale // 2) // scale
+
+
 def quantiles(values):
     """Minimum, lower median, nearest-rank 99th percentile and maximum; None for none."""
     v = sorted(values)
