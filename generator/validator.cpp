@@ -647,6 +647,12 @@ void Validator::check_pdulength() {
         diags_.error(proto_.line, "pdulength field " + quote(*t) + at_line(*t) + " is not numeric");
         return;
     }
+    if (t->is_computed()) {
+        diags_.error(proto_.line, "pdulength field " + quote(*t) + at_line(*t) +
+                                      " is a computed value: a message's length is read from its bytes before it is "
+                                      "decoded; name the length field itself (pdulengthadd adds a constant)");
+        return;
+    }
     uint64_t offset = 0;
     const Node* blocker = nullptr;
     offset_of(t, offset, blocker);
