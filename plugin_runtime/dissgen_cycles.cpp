@@ -56,6 +56,7 @@
 #include "dissgen_values.h"
 
 #include <epan/addr_resolv.h>
+#include <epan/charsets.h>
 #include <epan/expert.h>
 #include <epan/to_str.h>
 #include <epan/proto_data.h>
@@ -483,10 +484,14 @@ void append_bytes(GString *t, const dg_node *n, const guint8 *b, guint32 length)
 {
     if (n->show == DG_SHOW_STRING || n->show == DG_SHOW_STRINGZ) {
         const guint8 *nul = (const guint8 *)memchr(b, 0, length); /* the text ends there, as its item shows it */
-        const guint32 text = nul ? (guint32)(nul - b) : length;
-        char *shown = dg_format_text(NULL, b, text);
+        guint32 text = nul ? (guint32)(nul - b) : length;
+        /* ISO-8859-1 text in UTF-8 first, as its item shows it */
+        guint8 *utf8 = n->extra && n->extra->encoding == ENC_ISO_8859_1 ? get_8859_1_string(NULL, b, (gint)text) : NULL;
+        if (utf8) text = (guint32)strlen((const char *)utf8);
+        char *shown = dg_format_text(NULL, utf8 ? utf8 : b, text);
         g_string_append_printf(t, "%s \"%s\"", n->name, shown);
         wmem_free(NULL, shown);
+        wmem_free(NULL, utf8);
         return;
     }
     g_string_append_printf(t, "%s ", n->name);

@@ -210,6 +210,9 @@ class DatesGuidsSharedNames(TsharkTestCase, unittest.TestCase):
 
 LATIN1_RULES = """<root name="Latin text" abbreviation="LATT" byteorder="big">
   <hook table="udp.port" value="47490"/>
+  <cycles window="1">
+    <signature field="node[@name='Label']"/>
+  </cycles>
   <node name="Station" summary="{Name}">
     <node name="Name" length="8byte" displaytype="string" encoding="latin-1"/>
   </node>
@@ -228,7 +231,7 @@ class Latin1Text(TsharkTestCase, unittest.TestCase):
     def prepare(cls):
         cls.install_text("latin1.xml", LATIN1_RULES, "latt")
         payload = cls.NAME.encode("latin-1") + cls.LABEL.encode("latin-1") + b"\0" + cls.NAME.encode("latin-1")
-        cls.capture = cls.env.add_file("latin1.pcap", pcap([udp(50000, 47490, payload)]))
+        cls.capture = cls.env.add_file("latin1.pcap", pcap([udp(50000, 47490, payload)] * 3))
 
     def test_latin1_text_from_the_bytes(self):
         with self.checks() as check:
@@ -242,6 +245,9 @@ class Latin1Text(TsharkTestCase, unittest.TestCase):
                 check(self.NAME in r["_ws.col.Info"][0], "the summary shows the name: %s" % r["_ws.col.Info"])
             filtered = self.env.tshark(["-r", self.capture, "-Y", 'latt.station.name == "%s"' % self.NAME]).stdout
             check(filtered.strip() != "", "a filter compares the text")
+            report = self.env.tshark(["-r", self.capture, "-q", "-z", "latt,cycles"]).stdout
+            check('Cycle 1: Label "%s"' % self.LABEL in report, "-z latt,cycles names the stream by its text: %s"
+                  % report)
 
 
 if __name__ == "__main__":
