@@ -108,6 +108,7 @@ struct key_entry {
     guint8 last_src_bytes[16];
     guint8 *last_bytes;          /* and, with an analysis, its view (kept_view) */
     guint last_length;
+    guint last_captured;         /* the bytes its tvb held (its copy's tvb holds as many) */
     guint last_view_count;
     guint last_capacity;         /* of last_bytes, which each message of the key fills again */
     nstime_t last_request_time;  /* this key's last request */
@@ -388,15 +389,21 @@ gboolean within_copy_window(const key_entry *e, const nstime_t *then, const pack
     return dg_periods::ns_of(&gap) <= window;
 }
 
+/* The last message of this key again: its bytes from the same source, soon
+ * after it (within_copy_window). */
+gboolean repeats_last(const key_entry *e, tvbuff_t *tvb, const packet_info *pinfo)
+{
+    return e->last_frame && addresses_equal(&e->last_src, &pinfo->src) && within_copy_window(e, &e->last_time, pinfo) &&
+           tvb_memeql(tvb, 0, e->last_bytes, e->last_length) == 0;
+}
+
 /* The same bytes from the same source as the last message of this key, soon
- * after it (within_copy_window), and that message a response or the one just
- * before. */
+ * after it, and that message a response or the one just before. */
 gboolean same_again(const capture_state *c, const key_entry *e, tvbuff_t *tvb, packet_info *pinfo, guint length)
 {
-    if (!e->last_frame || e->last_length != length || !addresses_equal(&e->last_src, &pinfo->src)) return FALSE;
+    if (e->last_length != length) return FALSE;
     if (e->last_role != DG_ROLE_RESPONSE && e->last_frame != c->last_frame) return FALSE;
-    if (!within_copy_window(e, &e->last_time, pinfo)) return FALSE;
-    return tvb_memeql(tvb, 0, e->last_bytes, length) == 0;
+    return repeats_last(e, tvb, pinfo);
 }
 
 /* A message the same as the last one (same_again) is a frame that came back
@@ -470,6 +477,7 @@ void remember_last(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *p
     }
     fill_buffer(&e->last_bytes, &e->last_capacity, tvb, length, c->view);
     e->last_length = length;
+    e->last_captured = tvb_captured_length(tvb);
     e->last_view_count = c->view ? c->view->count : 0;
 }
 
@@ -1205,12 +1213,11 @@ const dg_request_values *dg_pairing_request_of(const guint64 *keys, guint key_co
     if (!e) return NULL;
     for (const pending *q = e->waiting.head; q; q = q->next)
         if (!q->done && !given_up(capture, q, pinfo, protocol->pairing->timeout)) return q->txn->values;
-    /* a copy of the key's last response (same_again, its length not known yet) */
-    if (!e->last_answered || e->last_role != DG_ROLE_RESPONSE || !addresses_equal(&e->last_src, &pinfo->src) ||
-        !within_copy_window(e, &e->last_time, pinfo) || tvb_captured_length(tvb) < e->last_length ||
-        tvb_memeql(tvb, 0, e->last_bytes, e->last_length) != 0)
-        return NULL;
-    return e->last_answered;
+    /* a copy of the key's last response (same_again; the message's own length
+     * is not known before its walk, its tvb's is) */
+    const gboolean copy = e->last_answered && e->last_role == DG_ROLE_RESPONSE &&
+                          tvb_captured_length(tvb) == e->last_captured && repeats_last(e, tvb, pinfo);
+    return copy ? e->last_answered : NULL;
 }
 
 void dg_pairing_stats_init(const dg_protocol *, stats_tree *st)

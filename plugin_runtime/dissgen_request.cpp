@@ -11,14 +11,16 @@
  *    the walk's key values (DG_KEY) are taken when a value first reads the
  *    request (the validator puts every key field before such values), or at
  *    the end of the walk when none did. The request it would answer (its
- *    key's oldest one still waiting) is looked up, always before the message
+ *    key's oldest one still waiting, or for a copy of the key's last response
+ *    the one that response answered) is looked up, always before the message
  *    itself is paired; what that request kept (or that there is none) is
  *    saved for the frame (p_add_proto_data), and later passes (tshark -2,
  *    the GUI in any order) read only that: every pass decodes the message
  *    alike.
  * A message whose values read a request that is not known (not captured, a
  * request of its own, too short to hold its keys) shows them undefined and
- * says so once (P.expert.no_request_context).
+ * says so once (P.expert.no_request_context); one that expects no response
+ * (<unanswered>) has no request: its values are undefined, with no note.
  */
 #include "dissgen_state.h"
 
@@ -157,6 +159,7 @@ void request_end(dg_state *st, const dg_frame_pairing *fp, proto_tree *tree)
 gboolean read_request(const void *context, gint16 index, guint64 *value)
 {
     const dg_state *st = (const dg_state *)context;
+    if (!takes_part_in_pairing(st, st->p->pairing->unanswered)) return FALSE; /* no request, and none missing */
     if (st->request_pending) find_from_walk(st);
     if (!st->request) {
         st->request_missed = TRUE;

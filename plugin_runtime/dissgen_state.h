@@ -360,6 +360,20 @@ static inline void tap_record(dg_state *st, const dg_node *n, guint64 value)
     t->count++;
 }
 
+/* Whether the message decoded the field of r (<request>, <unanswered>) with
+ * a value in its ranges. */
+static inline gboolean role_holds(const dg_state *st, const dg_request_role *r)
+{
+    return in_ranges(r->ranges, 0, r->range_count, st->slots[r->slot].value);
+}
+
+/* <unanswered>: a message that expects no response (a notification) asks
+ * nothing, answers nothing and reads no request. */
+static inline gboolean takes_part_in_pairing(const dg_state *st, const dg_request_role *unanswered)
+{
+    return !unanswered || !st->present[unanswered->slot] || !role_holds(st, unanswered);
+}
+
 /* Keeps a decoded leaf's value where later nodes, the stats tree and the
  * pairing find it. */
 static inline __attribute__((always_inline)) void store(dg_state *st, const dg_node *n, guint64 value, gint offset,

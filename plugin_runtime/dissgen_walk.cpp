@@ -748,25 +748,12 @@ guint8 direction_of(const packet_info *pinfo)
     return DG_DIR_ANY;
 }
 
-/* Whether the message decoded the field of r with a value in its ranges. */
-gboolean role_holds(const dg_state *st, const dg_request_role *r)
-{
-    return in_ranges(r->ranges, 0, r->range_count, st->slots[r->slot].value);
-}
-
 /* Request or response, as the pairing takes the message: what its <request>
  * field says when it was decoded, else the transport's direction. */
 guint8 message_role(const dg_state *st, const dg_request_role *r)
 {
     if (!r || !st->present[r->slot]) return st->direction;
     return role_holds(st, r) ? DG_DIR_REQUEST : DG_DIR_RESPONSE;
-}
-
-/* <unanswered>: a message that expects no response (a notification) asks
- * nothing and answers nothing. */
-gboolean takes_part_in_pairing(const dg_state *st, const dg_request_role *unanswered)
-{
-    return !unanswered || !st->present[unanswered->slot] || !role_holds(st, unanswered);
 }
 
 /* Whether the protocol below this message is Ethernet's type field. Asked

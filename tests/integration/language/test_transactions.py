@@ -406,6 +406,9 @@ class TestUnanswered(TsharkTestCase, unittest.TestCase):
   <node name="Unit" length="1byte" displaytype="numberdec"/>
   <node name="Function" length="1byte" displaytype="numberdec"/>
   <node name="Data" length="4byte" displaytype="numberhex"/>
+  <node name="Answer" direction="response">
+    <node name="Asked" value="request{Data}" displaytype="numberdec"/>
+  </node>
 </root>
 """ % PORT
     # (ms, direction, transaction, function)
@@ -416,8 +419,11 @@ class TestUnanswered(TsharkTestCase, unittest.TestCase):
                (30, "request", 3, 3),     # 5: lost: the capture goes on past its timeout
                (40, "response", 2, 8),    # 6: a notification the other way: answers nothing
                (1500, "request", 4, 3),   # 7
-               (1501, "response", 4, 3)]  # 8: answers 7, and (in one pass) tells that 5 is lost
-    PAIRS, LOST = {2: 1, 8: 7}, {5: 8}
+               (1501, "response", 4, 3),  # 8: answers 7, and (in one pass) tells that 5 is lost
+               (1600, "request", 9, 3),   # 9
+               (1601, "response", 9, 8),  # 10: a notification with 9's key: answers nothing, reads no request
+               (1602, "response", 9, 3)]  # 11: answers 9
+    PAIRS, LOST = {2: 1, 8: 7, 11: 9}, {5: 8}
 
     @classmethod
     def prepare(cls):
@@ -432,7 +438,8 @@ class TestUnanswered(TsharkTestCase, unittest.TestCase):
         with self.checks() as check:
             for two_pass in (True, False):
                 mode = "-2" if two_pass else "one pass"
-                rows = decode(self.env, path, two_pass, ["txnp.function"])
+                rows = decode(self.env, path, two_pass, ["txnp.function", "txnp.answer.asked",
+                                                         "txnp.expert.no_request_context"])
                 functions = [rows[n]["txnp.function"] for n in sorted(rows)]
                 check(functions == [str(m[3]) for m in self.CAPTURE], "%s: functions %s" % (mode, functions))
                 pairs = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
@@ -440,6 +447,11 @@ class TestUnanswered(TsharkTestCase, unittest.TestCase):
                 flagged = {n for n, r in rows.items() if r["txnp.expert.no_response"]}
                 want = set(self.LOST) if two_pass else set(self.LOST.values())
                 check(flagged == want, "%s: no_response on %s only (%s)" % (mode, sorted(want), sorted(flagged)))
+                asked = {n: r["txnp.answer.asked"] for n, r in rows.items() if r["txnp.answer.asked"]}
+                check(asked == {n: str(m) for n, m in self.PAIRS.items()},
+                      "%s: each response reads its request's Data, the notifications none (%s)" % (mode, asked))
+                noted = sorted(n for n, r in rows.items() if r["txnp.expert.no_request_context"])
+                check(not noted, "%s: no 'request not known' note, on the notifications either (%s)" % (mode, noted))
 
 
 if __name__ == "__main__":
