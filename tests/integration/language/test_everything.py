@@ -340,13 +340,18 @@ class Expected:
         return ", ".join(self.info) if self.info else PROTO_NAME
 
     # -- decoding --------------------------------------------------------------
+    def cut_by_capture(self, data_end, needed):
+        """Data that ran out at data_end where a node needed it up to `needed` only because the
+        capture kept less of the frame than was on the wire (a snapshot length)."""
+        return (data_end is not None and self.on_wire is not None and data_end >= len(self.buf) and
+                len(self.buf) < self.on_wire and needed <= self.on_wire)
+
     def expert(self, parent, kind, text, stop=True, data_end=None, needed=None):
         """An expert info of ours; data_end, needed: where the data ran out and how far the
         node needed it, for a shortfall: in a frame the capture kept only in part (a snapshot
         length), one that the frame on the wire covers is Wireshark's "[Packet size limited
         during capture]" item (once), no expert info (docs/manual.md, "Malformed packets")."""
-        if (data_end is not None and self.on_wire is not None and data_end >= len(self.buf) and
-                len(self.buf) < self.on_wire and needed <= self.on_wire):
+        if self.cut_by_capture(data_end, needed):
             if not self.cut_shown:
                 parent.children.append(Item("[Packet size limited during capture: %s truncated]" % PROTO.upper(),
                                             "_ws.short"))
@@ -405,7 +410,8 @@ class Expected:
         length = end - offset if n.lenkind == "rest" else n.length
         left = end - offset
         if length > left:
-            if left > 0:
+            # the bytes there, in a message really that short; none of a leaf the capture cut
+            if left > 0 and not self.cut_by_capture(end, offset + length):
                 parent.children.append(self.blob_item(n, self.buf[offset:end]))
             if n.lenkind == "field":
                 self.expert(parent, "past_end", "'%s' has length %d, past the end of its data (%d bytes left)"
