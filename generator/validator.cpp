@@ -681,9 +681,6 @@ std::string valid_blocker(const Node& blocker, const Node& t) {
     return self + " is decoded only under a condition ('if', <when>, direction or otherwise)";
 }
 
-// valid="LIST": tested before anything is added to the tree, so each such
-// field sits at a fixed offset and is decoded in every message; an 'ifhook'
-// on it or a container only limits the messages it is tested in.
 // What keeps n from being at a fixed offset from the start of every message
 // (n computed, so in no bytes; a field before it of no fixed length; n or a
 // container of it repeated, conditional, placed in a window or cut short by
@@ -703,6 +700,9 @@ const Node* Validator::fixed_offset_blocker(const Node& n, uint64_t& offset) con
     return blocker;
 }
 
+// valid="LIST": tested before anything is added to the tree, so each such
+// field sits at a fixed offset and is decoded in every message; an 'ifhook'
+// on it or a container only limits the messages it is tested in.
 void Validator::check_validity() {
     bool unhooked = false;  // a valid field tested in every message, whatever the hook
     for_each_node(proto_.nodes, [&](Node& n) {
