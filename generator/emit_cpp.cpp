@@ -783,7 +783,7 @@ void Emitter::protocol_struct() {
            << (analysis ? "&" + analysis->symbol : std::string("NULL")) << ", " << (p_.pairing->ordered ? 1 : 0)
            << ", " << (places ? f + "_input_places" : std::string("NULL")) << ", " << places
            << ", " << (request ? "&" + f + "_request_role" : std::string("NULL"))
-           << (unanswered ? ", &" + f + "_unanswered" : std::string()) << " };\n";
+           << ", " << (unanswered ? "&" + f + "_unanswered" : std::string("NULL")) << " };\n";
         if (!p_.request_fields.empty()) request_context();
     }
     if (p_.cycles) cycles_tables();

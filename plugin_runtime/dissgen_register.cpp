@@ -133,6 +133,10 @@ const char *stats_node_name(const dg_node *n, const char *what)
 
 char **stats_node_names;   /* per node: that node's name, or NULL (no statistics) */
 int stats_frames_id;
+/* per node: a repeated node's instances in the message being counted, and
+ * whether its row was ticked; back to 0 after each message */
+guint64 *stats_instances;
+gboolean *stats_ticked;
 
 void stats_init(stats_tree *st)
 {
@@ -140,6 +144,10 @@ void stats_init(stats_tree *st)
     guint n_nodes = p->node_count;
     if (stats_node_names) g_strfreev(stats_node_names);
     stats_node_names = g_new0(char *, n_nodes + 1);
+    g_free(stats_instances);
+    g_free(stats_ticked);
+    stats_instances = g_new0(guint64, n_nodes);
+    stats_ticked = g_new0(gboolean, n_nodes);
     stats_frames_id = stats_tree_create_node(st, "Messages", 0, STAT_DT_INT, FALSE);
     for (guint i = 0; i < n_nodes; i++) {
         const dg_node *n = &p->nodes[i];
@@ -161,8 +169,8 @@ tap_packet_status stats_packet(stats_tree *st, packet_info *pinfo, epan_dissect_
     char buf[64];
     /* A repeated node inside another repeat is recorded once per instance of
      * the outer one: its instances per message are the sum of its records. */
-    guint64 *per_message = wmem_alloc0_array(pinfo->pool, guint64, p->node_count);
-    gboolean *seen = wmem_alloc0_array(pinfo->pool, gboolean, p->node_count);
+    guint64 *per_message = stats_instances;
+    gboolean *seen = stats_ticked;
     for (guint i = 0; i < t->count; i++)
         if (is_repeated(&p->nodes[t->records[i].node])) per_message[t->records[i].node] += t->records[i].value;
     for (guint i = 0; i < t->count; i++) {
@@ -189,6 +197,10 @@ tap_packet_status stats_packet(stats_tree *st, packet_info *pinfo, epan_dissect_
         }
         int id = tick_stat_node(st, stats_node_names[r->node], 0, TRUE);
         tick_stat_node(st, label, id, FALSE);
+    }
+    for (guint i = 0; i < t->count; i++) {
+        per_message[t->records[i].node] = 0;
+        seen[t->records[i].node] = FALSE;
     }
     if (p->pairing) dg_pairing_stats_packet(p, st, pinfo, t->pairing);
     return TAP_PACKET_REDRAW;

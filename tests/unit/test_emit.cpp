@@ -144,7 +144,20 @@ TEST(Emit, RequestRoleFromTheMessage) {
     EXPECT_TRUE(contains(code, "static const dg_range t_request_ranges[] = {\n    { 0x1, 0x1 },\n    { 0x3, 0x4 },\n};"))
         << code;
     EXPECT_TRUE(contains(code, "static const dg_request_role t_request_role = { 0, 2, t_request_ranges };")) << code;
-    EXPECT_TRUE(contains(code, ", 0, &t_request_role };")) << code;
+    EXPECT_TRUE(contains(code, ", 0, &t_request_role, NULL };")) << code;
+}
+
+TEST(Emit, UnansweredFromTheMessage) {
+    Front f = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n"
+                        "  <pairing><key field=\"node[@name='Transaction']\"/>\n"
+                        "    <unanswered field=\"node[@name='Command']\" in=\"8\"/></pairing>\n"
+                        "  <node name=\"Transaction\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
+                        "  <node name=\"Command\" length=\"1byte\" displaytype=\"numberdec\"/>\n</root>\n");
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const std::string code = emit_cpp(*f.proto, "rules.xml");
+    EXPECT_TRUE(contains(code, "static const dg_range t_unanswered_ranges[] = {\n    { 0x8, 0x8 },\n};")) << code;
+    EXPECT_TRUE(contains(code, "static const dg_request_role t_unanswered = { 0, 1, t_unanswered_ranges };")) << code;
+    EXPECT_TRUE(contains(code, ", 0, NULL, &t_unanswered };")) << code;
 }
 
 TEST(FieldType, EveryDisplayTypeOnWholeBytes) {
@@ -632,7 +645,7 @@ TEST(Pairing, InputsAreNumberedInTheirExtraAndNeverQuiet) {
     }
     EXPECT_TRUE(registers > 0) << "the analysis reads registers";
     EXPECT_TRUE(contains(code, "static const dg_pairing tst_pairing = { 1, &dg_ethercat_esc, 1, tst_input_places, " +
-                                   std::to_string(registers) + ", NULL };"))
+                                   std::to_string(registers) + ", NULL, NULL };"))
         << code;
 }
 
@@ -648,14 +661,14 @@ TEST(Pairing, DefaultTimeoutIsOneSecondAndNoAnalysis) {
     Front f = front_end(rules("  <pairing><key field=\"node[@name='Id']\"/></pairing>\n"
                               "  <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
-    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 1, NULL, 0, NULL };"));
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 1, NULL, 0, NULL, NULL };"));
 }
 
 TEST(Pairing, ResponsesInAnyOrder) {
     Front f = front_end(rules("  <pairing order=\"any\"><key field=\"node[@name='Id']\"/></pairing>\n"
                               "  <node name=\"Id\" length=\"1byte\" displaytype=\"numberhex\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
-    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 0, NULL, 0, NULL };"));
+    EXPECT_TRUE(contains(emit_cpp(*f.proto, "t.xml"), "static const dg_pairing tst_pairing = { 1, NULL, 0, NULL, 0, NULL, NULL };"));
 }
 
 // The analyses' table of EtherCAT commands (ethercat_commands.h) names each
