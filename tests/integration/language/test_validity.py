@@ -294,6 +294,8 @@ GATE = """<root name="Gate" abbreviation="GATE" filter="gate"
   <hook table="udp.port" value="3671"/>
   <hook table="tcp.port" value="502"/>
   <hook table="udp.port" value="3671"/>
+  <hook table="udp.port" value="47001"/>
+  <hook table="udp.port" value="47001"/>
   <node name="Magic" length="1byte" displaytype="numberhex" valid="0x42"/>
   <node name="Length" length="1byte" displaytype="numberdec"/>
   <node name="Body" length="rest" displaytype="origin"/>
@@ -314,13 +316,15 @@ class DisplacedDissector(TsharkTestCase, unittest.TestCase):
         udp = lambda p: pcapgen.udp_ethernet_frame(p, 3671)
         ours = b"\x42\x03abc"
         frames = [udp(ours), udp(KNX_SEARCH), udp(b"\x07")]
+        # a port nobody else has, hooked twice: a refused message is UDP's data, not ours again
+        frames.append(pcapgen.udp_ethernet_frame(b"\x07\x07", 47001))
         seq = 1000
         for payload in (MODBUS_READ, ours, MODBUS_READ):
             frames.append(pcapgen.tcp_ethernet_frame(payload, 41000, 502, seq))
             seq += len(payload)
         cls.capture = cls.env.add_file("displaced.pcap", pcapgen.raw_pcap_bytes(frames))
         # the last protocol of each frame, as Wireshark's own dissectors decode them
-        cls.want = ["gate", "kip", "kip", "mbtcp", "gate", "mbtcp"]
+        cls.want = ["gate", "kip", "kip", "data", "mbtcp", "gate", "mbtcp"]
 
     def last_layers(self, extra):
         out = self.env.tshark(["-r", self.capture, "-T", "fields", "-e", "frame.protocols"] + extra).stdout
@@ -333,7 +337,7 @@ class DisplacedDissector(TsharkTestCase, unittest.TestCase):
                 got = self.last_layers(extra)
                 check(got == self.want, "%s: %s, expected %s" % (extra or "one pass", got, self.want))
             gone = self.last_layers(["--disable-protocol", "gate"])
-            check(gone[:4] == ["kip", "kip", "kip", "mbtcp"],
+            check(gone[:5] == ["kip", "kip", "kip", "data", "mbtcp"],
                   "gate disabled: the displaced dissectors take everything: %s" % gone)
 
 
