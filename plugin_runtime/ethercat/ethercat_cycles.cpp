@@ -302,8 +302,7 @@ void cycles_returned(cycle_model *m, const datagram *s, const datagram *b, guint
     }
     cycle *c = sig->cyc;
     if (!c || txn->request_frame < c->first_frame) return;
-    gint64 rtt = ns_of(&txn->round_trip);
-    c->rtts.push(rtt < 0 ? 0 : rtt > (gint64)G_MAXUINT32 ? G_MAXUINT32 : (guint32)rtt);
+    c->rtts.push(clamp_period(ns_of(&txn->round_trip)));
     c->answered++;
     if (txn->request_frame > c->latest_answered) {
         c->latest_answered = txn->request_frame;
