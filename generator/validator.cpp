@@ -96,6 +96,7 @@ private:
     bool check_expr(Node& n, Expr& e, const ExprSite& at);
     const Node* find_before(int reach, const std::string& name);
     const Node* find_readable_before(int reach, const std::string& name, const Node& reader);
+    void warn_if_alternative(const Node& field, const Node& reader, int line, const std::string& what);
     std::vector<std::string> names_before(int reach) const;
     // Every node of each name, in document order: names are looked up once
     // per expression operand, and a <group> used many times makes the tree
@@ -593,6 +594,7 @@ void Validator::check_reference(Node& n, const FieldRef& ref, const std::string&
                                  "; use a field of the same instance or one outside every repeat");
         return;
     }
+    warn_if_alternative(*t, n, n.line, what + " field");
     mark_slot(const_cast<Node*>(t));
 }
 
@@ -1025,7 +1027,8 @@ void Validator::check_cycles_of_ethercat(const Cycles& c) {
         diags_.error(c.line, std::string("lost=\"") + (c.lost_by_period ? "period" : "sequence") + "\"" + with +
                                  "a frame not returned is counted lost by the analysis (remove it)");
     if (c.by_sender)
-        diags_.error(c.line, "sender=\"yes\"" + with + "every frame is the master's (remove it)");
+        diags_.error(c.line, std::string("sender=\"") + (c.by_connection ? "connection" : "yes") + "\"" + with +
+                                 "every frame is the master's (remove it)");
     if (c.requests_only)
         diags_.error(c.line, "requests=\"yes\"" + with + "only frames as sent are timed already (remove it)");
 }
@@ -1104,15 +1107,26 @@ const Node* Validator::find_before(int reach, const std::string& name) {
 }
 
 // The closest node named `name` before `reach` that `reader` sees one value
-// of (a Tag outside a repeat, not the one inside a repeat decoded since);
-// when none, the closest of any kind, for the error to name.
+// of (a Tag outside a repeat, not the one inside a repeat decoded since; not
+// one in an alternative to the reader, never decoded with it); when none, the
+// closest of any kind, for the error or warning to name.
 const Node* Validator::find_readable_before(int reach, const std::string& name, const Node& reader) {
     const Node* closest = find_before(reach, name);
-    if (!closest || !repeat_outside(closest, reader)) return closest;
+    auto readable = [&](const Node* c) { return !repeat_outside(c, reader) && !are_alternatives(proto_, *c, reader); };
+    if (!closest || readable(closest)) return closest;
     const std::vector<const Node*>& named = nodes_by_name_.find(name)->second;
     for (auto it = std::find(named.rbegin(), named.rend(), closest); it != named.rend(); ++it)
-        if (!repeat_outside(*it, reader)) return *it;
+        if (readable(*it)) return *it;
     return closest;
+}
+
+// A reference whose field is in an alternative to its reader (an earlier
+// member of the reader's chain, or a sibling whose condition excludes the
+// reader's) reads a value that is never there.
+void Validator::warn_if_alternative(const Node& field, const Node& reader, int line, const std::string& what) {
+    if (!are_alternatives(proto_, field, reader)) return;
+    diags_.warning(line, what + " is " + quote(field) + at_line(field) + ", an alternative to " + quote(reader) +
+                             ": never decoded together with it, so its value is never there");
 }
 
 // The names of the nodes among the first reach - 1, each once, in document
@@ -1227,6 +1241,7 @@ bool Validator::check_expr(Node& n, Expr& e, const ExprSite& at) {
                                      "; use a field of the same instance or one outside every repeat");
             return false;
         }
+        if (!at.at_reader) warn_if_alternative(*t, n, at.line, "{" + e.name + "}" + in);
         e.target = const_cast<Node*>(t);
         e.is_float = t->display == Display::Float;
         mark_slot(e.target);

@@ -259,6 +259,38 @@ TEST(Computed, SkipsANameInsideARepeatDecodedSinceForTheOneItSees) {
         << none.messages();
 }
 
+
+TEST(Computed, SkipsANameInAnAlternativeToTheReaderAndWarnsWhenNoneIsLeft) {
+    // Short's Count is closest, but Long is the other member of Short's
+    // chain: only one is decoded, so Long reads the header's Count
+    const std::string header = "  <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\"/>\n";
+    const std::string chain = "  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"Short\" if=\"../node[@name='Kind']\" in=\"1\">\n"
+                              "    <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  </node>\n"
+                              "  <node name=\"Long\" otherwise=\"true\">\n"
+                              "    <node name=\"Items\" value=\"{Count} * 2\"/>\n"
+                              "  </node>\n";
+    Front f = front_end(rules(header + chain));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    EXPECT_EQ(f.proto->nodes[3]->children[0]->value->args[0].target, f.proto->nodes[0].get());
+    EXPECT_FALSE(contains(f.messages(), "warning")) << f.messages();
+    // without the header's Count, the only one is never there: a warning on the reader's line
+    Front alone = front_end(rules(chain));
+    ASSERT_TRUE(alone.ok()) << alone.messages();
+    EXPECT_TRUE(contains(alone.messages(), "rules.xml:7: warning: {Count} in the value of 'Items' is 'Count' (line 4), "
+                                           "an alternative to 'Items': never decoded together with it"))
+        << alone.messages();
+    // siblings whose conditions on one field exclude each other are alternatives too, for a length as well
+    Front sized = front_end(rules("  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                                  "  <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\" "
+                                  "if=\"../node[@name='Kind']\" in=\"1\"/>\n"
+                                  "  <node name=\"Data\" length=\"../node[@name='Count']\" if=\"../node[@name='Kind']\" "
+                                  "in=\"2\"/>\n"));
+    EXPECT_TRUE(contains(sized.messages(), "rules.xml:4: warning: length field is 'Count' (line 3), an alternative to "
+                                           "'Data'"))
+        << sized.messages();
+}
 TEST(Computed, Mistakes) {
     Front f = front_end(rules(std::string(kHead) +
                               "  <node name=\"Registers\" count=\"../node[@name='Count']\">\n"
