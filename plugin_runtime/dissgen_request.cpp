@@ -17,10 +17,11 @@
  *    saved for the frame (p_add_proto_data), and later passes (tshark -2,
  *    the GUI in any order) read only that: every pass decodes the message
  *    alike.
- * A message whose values read a request that is not known (not captured, a
- * request of its own, too short to hold its keys) shows them undefined and
- * says so once (P.expert.no_request_context); one that expects no response
- * (<unanswered>) has no request: its values are undefined, with no note.
+ * A message whose values read a request that is not known (not captured,
+ * too short to hold its keys) shows them undefined and says so once
+ * (P.expert.no_request_context); a request itself, or one that expects no
+ * response (<unanswered>), has no request: its values are undefined, with
+ * no note.
  */
 #include "dissgen_state.h"
 
@@ -58,6 +59,16 @@ gboolean read_keys(const dg_state *st, guint64 *keys)
 gboolean may_answer(const dg_state *st)
 {
     return st->direction != DG_DIR_REQUEST || st->p->pairing->request;
+}
+
+/* Whether the message is known to be a request where a value reads its
+ * request: by the transport, or by the pairing's <request> field decoded
+ * before the value (not decoded yet: it may still be a response). */
+gboolean is_request(const dg_state *st)
+{
+    const dg_request_role *r = st->p->pairing->request;
+    if (!r) return st->direction == DG_DIR_REQUEST;
+    return st->present[r->slot] && role_holds(st, r);
 }
 
 /* The direction the pairing will give the message if it answers a request:
@@ -160,6 +171,7 @@ gboolean read_request(const void *context, gint16 index, guint64 *value)
 {
     const dg_state *st = (const dg_state *)context;
     if (!takes_part_in_pairing(st, st->p->pairing->unanswered)) return FALSE; /* no request, and none missing */
+    if (is_request(st)) return FALSE; /* a request answers none: none is missing */
     if (st->request_pending) find_from_walk(st);
     if (!st->request) {
         st->request_missed = TRUE;

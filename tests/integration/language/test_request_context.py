@@ -548,5 +548,54 @@ class TestComputedKey(TsharkTestCase, unittest.TestCase):
                 check(got == want, "%s: %s, expected %s" % ("-2" if two_pass else "one pass", got, want))
 
 
+
+class TestRequestsReadNoRequest(TsharkTestCase, unittest.TestCase):
+    """A layout shared by requests and responses, its request{...} value without an `if`: a
+    request (by the <request> field decoded before the value, or by the port it goes to)
+    answers none, so it shows no value and no no_request_context note, even when its key
+    repeats a request still waiting (a retransmission); a response reads its request, and
+    one whose request was not captured gets the note."""
+
+    RULES = """<root name="Shared layout {how}" abbreviation="{abbreviation}" byteorder="big">
+  <hook table="udp.port" value="{port}"/>
+  <pairing>
+    <key field="node[@name='Sequence']"/>
+    {request}
+  </pairing>
+  <node name="Type" length="1byte" displaytype="numberdec"/>
+  <node name="Sequence" length="2byte" displaytype="numberdec"/>
+  <node name="Command" length="1byte" displaytype="numberdec"/>
+  <node name="Asked" value="request{{Command}}"/>
+</root>
+"""
+    KINDS = (("by field", "SHRF", 47610, '<request field="node[@name=\'Type\']" in="0"/>'),
+             ("by port", "SHRP", 47611, ""))
+
+    @classmethod
+    def prepare(cls):
+        for how, abbreviation, port, request in cls.KINDS:
+            cls.install_text(abbreviation.lower() + ".xml", cls.RULES.format(
+                how=how, abbreviation=abbreviation, port=port, request=request), abbreviation.lower())
+
+    def test_requests_are_quiet_and_responses_read_theirs(self):
+        # (type, sequence, command): a request, sent again; its response; a response whose
+        # request was not captured
+        messages = [(0, 5, 3), (0, 5, 3), (1, 5, 3), (1, 9, 1)]
+        with self.checks() as check:
+            for how, abbreviation, port, _ in self.KINDS:
+                frames = []
+                for kind, sequence, command in messages:
+                    client, server = (40000, (10, 0, 0, 10)), (port, (10, 0, 0, 1))
+                    (sport, src), (dport, dst) = (server, client) if kind else (client, server)
+                    frames.append(udp(sport, dport, struct.pack("!BHB", kind, sequence, command), src, dst))
+                path = self.env.add_file("shared_layout_%d.pcap" % port, pcapgen.raw_pcap_bytes(frames))
+                p = abbreviation.lower()
+                for two_pass in (False, True):
+                    rows = self.env.field_rows(path, ["frame.number", p + ".asked", p + ".expert.no_request_context"],
+                                               two_pass=two_pass)
+                    got = {n: (r[p + ".asked"], bool(r[p + ".expert.no_request_context"])) for n, r in rows.items()}
+                    want = {1: ([], False), 2: ([], False), 3: (["3"], False), 4: ([], True)}
+                    check(got == want, "%s, %s: %s, expected %s" % (how, "-2" if two_pass else "one pass", got, want))
+
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])
