@@ -623,8 +623,14 @@ void Parser::parse_cycles(xmlNode* el, Protocol& proto) {
         else
             cycles.window = static_cast<unsigned>(w);
     }
-    parse_yes_no(attrs, "sender", line, "", "the sender's address and port are part of the signature",
-                 cycles.by_sender);
+    if (attrs.count("sender") && trim(attrs["sender"]) == "connection")
+        cycles.by_sender = cycles.by_connection = true;
+    else if (attrs.count("sender") && trim(attrs["sender"]) != "yes" && trim(attrs["sender"]) != "no")
+        diags_.error(line, "bad sender '" + attrs["sender"] +
+                               "': expected yes (the sender's address and port are part of the signature), "
+                               "connection (the receiver's too: each side of each connection its own stream) or no");
+    else
+        parse_yes_no(attrs, "sender", line, "", "", cycles.by_sender);
     parse_yes_no(attrs, "requests", line, "", "only the <pairing>'s requests are timed, with their round trips",
                  cycles.requests_only);
     if (attrs.count("lost")) {
@@ -1351,7 +1357,8 @@ std::unique_ptr<Protocol> parse_rules(const std::string& text, Diagnostics& diag
     std::unique_ptr<Protocol> proto;
     if (!root || element_name(root) != "root") {
         diags.error(root ? line_of(root) : 0,
-                    "the document element must be <root>, not <" + (root ? element_name(root) : "") + ">");
+                    "unknown element <" + (root ? element_name(root) : "") +
+                        "> as the document element; the document element must be <root>");
     } else if (GroupUses uses; expand_node_groups(root, diags, uses)) {
         proto = Parser(doc, diags, uses).parse_root(root);
     }
