@@ -384,6 +384,7 @@ struct Cycles {
     int line = 0;
     unsigned window = 8;                   // regular periods in a row that make a cycle
     bool by_sender = false;                // sender="yes": the sender is part of the signature
+    bool by_connection = false;            // sender="connection": its receiver too (a stream per connection side)
     std::vector<CycleField> signature;     // one or more
     std::optional<CycleField> sequence;    // the sequence count, if any
     unsigned sequence_bits = 0;            // its width (bits="..."; default: the field's)

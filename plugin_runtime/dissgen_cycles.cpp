@@ -5,7 +5,8 @@
  *  - A message belongs to a stream when it holds a value of the signature
  *    fields, every <only> test held and no <never> test did. Its stream is
  *    the signature's values in decoding order (and, with sender="yes", the
- *    sender's address and port); a field of text, an address or bytes is
+ *    sender's address and port; with sender="connection", the receiver's
+ *    too: each side of each TCP connection its own count); a field of text, an address or bytes is
  *    compared by its bytes, which the stream keeps (its value is their hash).
  *  - With a sequence count of range R (2^bits, or wrap="R": 0 .. R - 1),
  *    from the stream's second message on, the step d = (count - previous
@@ -52,6 +53,7 @@
 
 #include "dissgen_compat.h"
 #include "dissgen_pairing.h"
+#include "dissgen_state.h"
 #include "dissgen_periods.h"
 #include "dissgen_values.h"
 
@@ -98,6 +100,8 @@ struct stream {
     guint32 *lengths;
     address src;            /* sender="yes": the sender's address and port; AT_NONE otherwise */
     guint32 port;
+    address dst;            /* sender="connection": the receiver's address and port too */
+    guint32 dst_port;
     guint32 last_frame;     /* the stream's latest message that was not a duplicate; 0: none yet */
     nstime_t last_time;
     guint64 last_sequence;
@@ -167,7 +171,7 @@ gboolean same_stream(gconstpointer a, gconstpointer b)
 {
     const stream *x = (const stream *)a, *y = (const stream *)b;
     if (x->hash != y->hash || x->count != y->count || x->port != y->port || !addresses_equal(&x->src, &y->src) ||
-        memcmp(x->values, y->values, x->count * sizeof(guint64)) ||
+        x->dst_port != y->dst_port || !addresses_equal(&x->dst, &y->dst) || memcmp(x->values, y->values, x->count * sizeof(guint64)) ||
         memcmp(x->nodes, y->nodes, x->count * sizeof(guint16)))
         return FALSE;
     for (guint i = 0; i < x->count; i++)
@@ -195,13 +199,19 @@ stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info 
     probe.bytes = in->bytes;
     probe.lengths = in->lengths;
     clear_address(&probe.src);
-    probe.port = 0;
+    clear_address(&probe.dst);
+    probe.port = probe.dst_port = 0;
     if (protocol->cycles->by_sender) {
         probe.src = pinfo->src; /* shallow: copied below if the stream is new */
         probe.port = pinfo->srcport;
     }
+    if (protocol->cycles->by_sender == 2) {
+        probe.dst = pinfo->dst;
+        probe.dst_port = pinfo->destport;
+    }
     guint32 h = dg_rt::hash_mix(dg_cycle_input_hash(in), probe.port);
     if (probe.src.type != AT_NONE) h = add_address_to_hash(h, &probe.src);
+    if (protocol->cycles->by_sender == 2) h = add_address_to_hash(dg_rt::hash_mix(h, probe.dst_port), &probe.dst);
     probe.hash = h;
     stream *s = (stream *)wmem_map_lookup(c->streams, &probe);
     if (s) return s;
@@ -221,6 +231,8 @@ stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info 
     }
     copy_address_wmem(wmem_file_scope(), &s->src, &probe.src);
     s->port = probe.port;
+    copy_address_wmem(wmem_file_scope(), &s->dst, &probe.dst);
+    s->dst_port = probe.dst_port;
     wmem_map_insert(c->streams, s, s);
     return s;
 }
@@ -503,6 +515,22 @@ void append_bytes(GString *t, const dg_node *n, const guint8 *b, guint32 length)
     for (guint32 i = 0; i < length; i++) g_string_append_printf(t, i ? ":%02x" : "%02x", b[i]);
 }
 
+/* The name an enum signature field's <enum> gives its value, or NULL. */
+const char *stream_enum_name(const dg_node *n, guint64 value)
+{
+    const header_field_info *hfi = n->hf && *n->hf > 0 ? proto_registrar_get_nth(*n->hf) : NULL;
+    return hfi && hfi->strings ? dg_rt::enum_name(hfi, value) : NULL;
+}
+
+/* ", sender 192.168.1.10:2222" (no port when the transport has none) */
+void append_end(GString *t, const char *which, const address *a, guint32 port)
+{
+    if (a->type == AT_NONE) return;
+    char *addr = address_to_str(NULL, a);
+    g_string_append_printf(t, port ? ", %s %s:%u" : ", %s %s", which, addr, port);
+    wmem_free(NULL, addr);
+}
+
 /* "Connection ID 0x00ff0001, sender 192.168.1.10:2222": each signature field
  * by its node's name and value as the stream first had them. */
 char *stream_text(const stream *s)
@@ -511,18 +539,18 @@ char *stream_text(const stream *s)
     for (guint i = 0; i < s->count; i++) {
         const dg_node *n = &protocol->nodes[s->nodes[i]];
         if (i) g_string_append(t, ", ");
+        const char *name = n->show == DG_SHOW_ENUM && !s->bytes[i] ? stream_enum_name(n, s->values[i]) : NULL;
         if (s->bytes[i])
             append_bytes(t, n, s->bytes[i], s->lengths[i]);
+        else if (name) /* "MessageType PReq (0x3)", as the tree shows an enum */
+            g_string_append_printf(t, "%s %s (0x%" G_GINT64_MODIFIER "x)", n->name, name, s->values[i]);
         else if (n->show == DG_SHOW_DEC || n->show == DG_SHOW_INT)
             g_string_append_printf(t, "%s %" G_GUINT64_FORMAT, n->name, s->values[i]);
         else
             g_string_append_printf(t, "%s 0x%" G_GINT64_MODIFIER "x", n->name, s->values[i]);
     }
-    if (s->src.type != AT_NONE) {
-        char *addr = address_to_str(NULL, &s->src);
-        g_string_append_printf(t, s->port ? ", sender %s:%u" : ", sender %s", addr, s->port);
-        wmem_free(NULL, addr);
-    }
+    append_end(t, "sender", &s->src, s->port);
+    append_end(t, "receiver", &s->dst, s->dst_port);
     return g_string_free(t, FALSE);
 }
 

@@ -317,7 +317,7 @@ typedef struct dg_cycle_test {
 typedef struct dg_cycles {
     guint8 window;         /* regular periods in a row that make a stream a cycle */
     guint8 sequence_bits;  /* the sequence count's width; 0: none */
-    guint8 by_sender;      /* the sender's address and port are part of the signature */
+    guint8 by_sender;      /* 1: the sender's address and port are part of the signature; 2: the receiver's too */
     guint8 only_count;     /* the <only> tests, numbered 0 .. only_count - 1, before the <never> ones */
     const dg_cycle_test *tests;
     const dg_range *ranges;

@@ -428,6 +428,87 @@ class TestSmallCount(TsharkTestCase, unittest.TestCase):
             follows_the_model(self.env, check, self.capture, "smallc", marks, cycles)
 
 
+# --- one stream per side of each connection ---------------------------------------------
+
+CONNECTION_RULES = """<root name="Telecontrol {kind}" abbreviation="{abbreviation}" byteorder="little">
+  <hook table="udp.port" value="{port}"/>
+  <cycles window="4" sender="{sender}">
+    <signature field="node[@name='Kind']"/>
+    <sequence field="node[@name='Send number']" bits="15"/>
+  </cycles>
+  <node name="Kind" length="1byte" displaytype="numberdec"/>
+  <node name="Send number" length="2byte" displaytype="numberdec"/>
+</root>
+"""
+SERVER = (10, 0, 0, 100)
+CLIENTS = (((10, 0, 0, 1), 50001), ((10, 0, 0, 2), 50002))
+
+
+def connection_capture(server_port):
+    """A server sending to two clients, each connection counting its own send numbers from
+    0 every 10 ms (+-50 us), the second client's from 30 ms on and without its number 6
+    (one lost); each client answering with kind 2, counted from 0 too (and without its 6)."""
+    rng = random.Random(104)
+    packets = []
+    for c, (address, port) in enumerate(CLIENTS):
+        for i in range(16 - 3 * c):
+            if c == 1 and i == 6:
+                continue
+            t = 10**9 + (i + 3 * c) * 10_000_000 + c * 1_000_000 + rng.randint(-50_000, 50_000)
+            packets.append((t, udp_frame(struct.pack("<BH", 1, i), SERVER, address, server_port, port)))
+            packets.append((t + 200_000, udp_frame(struct.pack("<BH", 2, i), address, SERVER, port, server_port)))
+    packets.sort(key=lambda p: p[0])
+    return packets
+
+
+def connection_messages(packets, by_connection):
+    """(frame, time ns, stream key, send number) of each message, the key the sender's
+    address and port, and with by_connection the receiver's too."""
+    out = []
+    for frame, (t, f) in enumerate(packets, 1):
+        sport, dport = struct.unpack("!HH", f[34:38])
+        key = (f[42], bytes(f[26:30]), sport) + ((bytes(f[30:34]), dport) if by_connection else ())
+        out.append((frame, t, key, struct.unpack("<H", f[43:45])[0]))
+    return out
+
+
+class TestStreamsPerConnection(TsharkTestCase, unittest.TestCase):
+    """sender="connection": a server's messages to each client are a stream of their own,
+    so two connections counting from 0 are two clean cycles (one loss, where it is); with
+    sender="yes" the same server's two counts are one stream, its count jumping back and
+    forth (losses that are not there)."""
+
+    @classmethod
+    def prepare(cls):
+        cls.packets, cls.captures = {}, {}
+        for sender, abbreviation, port in (("connection", "CONN", 2404), ("yes", "CSND", 2405)):
+            cls.install_text(abbreviation.lower() + ".xml", CONNECTION_RULES.format(
+                kind=sender, abbreviation=abbreviation, sender=sender, port=port), abbreviation.lower())
+            cls.packets[sender] = connection_capture(port)
+            cls.captures[sender] = cls.env.add_file("two_connections_%d.pcap" % port, pcap_ns(cls.packets[sender]))
+
+    def test_each_side_of_each_connection_is_a_stream(self):
+        marks, cycles = model(connection_messages(self.packets["connection"], True), window=4, bits=15)
+        with self.checks() as check:
+            lost = {f: m["lost"] for f, m in marks.items() if "lost" in m}
+            check(list(lost.values()) == [1, 1] and len(cycles) == 4 and
+                  not any("duplicate" in m for m in marks.values()),
+                  "the model: four cycles, one lost each way, no repeats: %s, %d cycles" % (lost, len(cycles)))
+            names = ["Kind %d, sender %s:%d, receiver %s:%d" % (c["stream"]["key"][0],
+                                                                 ".".join(map(str, c["stream"]["key"][1])),
+                                                                 c["stream"]["key"][2],
+                                                                 ".".join(map(str, c["stream"]["key"][3])),
+                                                                 c["stream"]["key"][4]) for c in cycles]
+            follows_the_model(self.env, check, self.captures["connection"], "conn", marks, cycles, names=names)
+
+    def test_by_sender_alone_the_server_repeats_itself(self):
+        marks, cycles = model(connection_messages(self.packets["yes"], False), window=4, bits=15)
+        with self.checks() as check:
+            lost = [m["lost"] for m in marks.values() if "lost" in m]
+            check(len(lost) > 1, "the model sees the server's two counts as losses: %s" % lost)
+            follows_the_model(self.env, check, self.captures["yes"], "csnd", marks, cycles)
+
+
 # --- periods of seconds and minutes -----------------------------------------------------
 
 LONG_PERIOD_RULES = """<root name="Heartbeats" abbreviation="BEAT" ethertype="0x88b5">

@@ -34,6 +34,10 @@ FEATURES = ["isochronous", "sdo_udp", "sdo_asnd", "sdo_pdo", "nmt_info", "ext_nm
             "nmt_udp", "configuration_manager", "multiplexed_access", "node_id_by_sw", "mn_basic_ethernet",
             "routing_type1", "routing_type2", "sdo_rw_all", "sdo_rw_multiple", "multiple_asnd", "ring_redundancy",
             "pres_chaining", "multiple_preq_pres", "dynamic_node_allocation", "modular_device"]
+# The <enum> names of rules/powerlink.xml's MessageType, a <cycles> signature field.
+MESSAGE_TYPES = {0x01: "Start of Cycle (SoC)", 0x03: "PollRequest (PReq)", 0x04: "PollResponse (PRes)",
+                 0x05: "Start of Asynchronous (SoA)", 0x06: "Asynchronous Send (ASnd)",
+                 0x07: "Active Managing Node Indication (AMNI)", 0x0D: "Asynchronous Invite (AInv)"}
 # epl names the feature bits by their number in hex up to 0x14, then "bit21" for bit 21.
 FEATURE_BITS = ["%X" % n for n in range(21)] + ["21"]
 
@@ -484,7 +488,8 @@ class CyclesOfTheIsochronousPhase(TsharkTestCase, unittest.TestCase):
                 check(len(got) == len(cycles), "-z eplr,cycles lists %d cycles" % len(got))
                 for c, g in zip(cycles, got):
                     mtyp, source = c["stream"]["key"]
-                    name = "MessageType 0x%x, Source %d" % (mtyp, source)
+                    # an enum signature field by its name, as the tree shows it
+                    name = "MessageType %s (0x%x), Source %d" % (MESSAGE_TYPES[mtyp], mtyp, source)
                     check(g["name"] == name, "cycle %d is %r, expected %r" % (c["number"], g["name"], name))
                     want = cyclemodel.figures(c)
                     del want["duplicates"]  # no sequence count: not printed
