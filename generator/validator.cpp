@@ -816,11 +816,19 @@ void Validator::parse_summary(Node& n) {
         // has a summary; a container without one only explains a failure.
         Node* found = nullptr;
         Node* container = nullptr;
+        const Node* passed_over = nullptr;  // a later one, decoded only when the first is not
         for_each_node(n.children, [&](Node& d) {
             if (d.name != name) return;
+            if (found && !passed_over && (d.is_leaf() || d.summary) && are_alternatives(proto_, *found, d))
+                passed_over = &d;
             if (!found && (d.is_leaf() || d.summary)) found = &d;
             if (!container && d.is_container() && !d.summary) container = &d;
         });
+        if (passed_over)
+            diags_.warning(n.line, "summary of " + quote(n) + " shows {" + name + "} from " + quote(*found) +
+                                       at_line(*found) + " only; " + quote(*passed_over) + at_line(*passed_over) +
+                                       ", an alternative to it, never shows there: rename it and show it in an "
+                                       "optional part of its own ({?...}), or give each alternative a summary");
         if (!found && container) {
             diags_.error(n.line, "summary of " + quote(n) + " refers to {" + name + "}, a container without a summary: "
                                      "give " + quote(*container) + " a summary or name a leaf");
