@@ -1010,6 +1010,8 @@ void Parser::parse_length(const std::string& raw, int line, Node& node, xmlNode*
         }
         node.length_kind = bytes ? LengthKind::Bytes : LengthKind::Bits;
         node.fixed_bits = bytes ? n * 8 : n;
+    } else if (text[0] == '-' && split_fixed_length(trim(text.substr(1)), true, digits, unit)) {
+        diags_.error(line, "bad length '" + raw + "': a fixed length must be from 1 to 1048576");
     } else if (std::isdigit(static_cast<unsigned char>(text[0]))) {
         std::string msg = "bad length '" + raw + "': expected 'Nbyte', 'Nbit', an XPath, 'rest' or nothing";
         if (split_fixed_length(text, true, digits, unit)) msg += " (did you mean '" + digits + unit + "'?)";
@@ -1267,7 +1269,13 @@ Node* Parser::resolve(const PendingRef& p) {
                                       ? "; a length is 'Nbyte', 'Nbit', an XPath, 'rest' or nothing"
                                       : ""));
     } else if (obj->type != XPATH_NODESET) {
-        diags_.error(p.line, where + " gives a value, not a node; it must select one <node>");
+        // "X * 2 + 1": the last '+ 1' was split off, the rest is arithmetic XPath evaluates
+        const bool arithmetic = obj->type == XPATH_NUMBER && p.ref->op;
+        diags_.error(p.line, where + " gives a value, not a node; it must select one <node>" +
+                                 (arithmetic ? " (one '+', '-' or '*' and a whole number may follow the path; for "
+                                               "more, compute it in a computed value, <node name=\"Size\" "
+                                               "value=\"{N} * 2 + 1\"/>, and select that)"
+                                             : ""));
     } else {
         int count = obj->nodesetval ? obj->nodesetval->nodeNr : 0;
         if (count == 0) {
