@@ -42,6 +42,13 @@ const Node* repeat_outside(const Node* t, const Node& reader) {
     return nullptr;
 }
 
+// The closest container around `a` that holds `b` too (nullptr: the message).
+const Node* common_container(const Node* a, const Node& b) {
+    for (const Node* c = a->parent; c; c = c->parent)
+        if (is_ancestor_or_self(c, &b)) return c;
+    return nullptr;
+}
+
 // Whether n or a node around it is repeated: `index` has an instance to count.
 bool inside_repeat(const Node& n) {
     for (const Node* r = &n; r; r = r->parent)
@@ -1122,9 +1129,20 @@ const Node* Validator::find_readable_before(int reach, const std::string& name, 
     const Node* closest = find_before(reach, name);
     auto readable = [&](const Node* c) { return !repeat_outside(c, reader) && !are_alternatives(proto_, *c, reader); };
     if (!closest || readable(closest)) return closest;
+    // A node passed over as an alternative stands for the reader's own copy of
+    // the field: an earlier one must be inside the container holding both (a
+    // header before the chain), not in another copy of a <group> or another
+    // container that has the same chain.
+    bool scoped = false;
+    const Node* scope = nullptr;  // nullptr: the whole message
     const std::vector<const Node*>& named = nodes_by_name_.find(name)->second;
-    for (auto it = std::find(named.rbegin(), named.rend(), closest); it != named.rend(); ++it)
-        if (readable(*it)) return *it;
+    for (auto it = std::find(named.rbegin(), named.rend(), closest); it != named.rend(); ++it) {
+        if (!scoped && are_alternatives(proto_, **it, reader)) {
+            scoped = true;
+            scope = common_container(*it, reader);
+        }
+        if (readable(*it) && (!scope || is_ancestor_or_self(scope, *it))) return *it;
+    }
     return closest;
 }
 

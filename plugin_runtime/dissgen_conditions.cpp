@@ -33,8 +33,9 @@ gboolean ref_value(dg_state *st, const dg_ref *ref, const dg_node *n, const char
 {
     const dg_slot *s = &st->slots[ref->slot];
     if (!st->present[ref->slot]) {
-        if (st->request_missed) {
-            /* For want of the request (its expert info says so once): not
+        if (st->request_missed || st->request_none) {
+            /* For want of the request (its expert info says so once), or a
+             * request's values read from the request it does not have: not
              * malformed, but nothing after it can be placed. */
             st->stopped = TRUE;
             return FALSE;

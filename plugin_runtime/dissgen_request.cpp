@@ -171,7 +171,10 @@ gboolean read_request(const void *context, gint16 index, guint64 *value)
 {
     const dg_state *st = (const dg_state *)context;
     if (!takes_part_in_pairing(st, st->p->pairing->unanswered)) return FALSE; /* no request, and none missing */
-    if (is_request(st)) return FALSE; /* a request answers none: none is missing */
+    if (is_request(st)) { /* a request answers none: none is missing */
+        st->request_none = TRUE;
+        return FALSE;
+    }
     if (st->request_pending) find_from_walk(st);
     if (!st->request) {
         st->request_missed = TRUE;

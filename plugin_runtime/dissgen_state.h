@@ -106,6 +106,7 @@ struct dg_state {
     /* request{...}: what the paired request kept, NULL when it is not known */
     mutable const dg_request_values *request;
     mutable gboolean request_missed; /* a value read the request, and it is not known */
+    mutable gboolean request_none;   /* a value read the request of a request: there is none (no note) */
     /* keys from the walk (dg_request_context.key_count 0), first pass: the
      * request is looked up when a value first reads it, with the keys decoded so far */
     mutable gboolean request_pending;

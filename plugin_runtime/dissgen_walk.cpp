@@ -241,7 +241,8 @@ gboolean read_offset(const void *context, guint64 *value)
  * has found the request missing yet. */
 gboolean would_miss_request(const dg_state *st, const dg_extra *x)
 {
-    if (!st->p->request_context || st->request_missed || (st->request && !st->request_pending)) return FALSE;
+    if (!st->p->request_context || st->request_missed || st->request_none || (st->request && !st->request_pending))
+        return FALSE;
     for (guint i = 0; i < x->expr_count; i++) {
         const guint8 code = st->p->exprs[x->expr_first + i].code;
         if (code == DG_OP_REQUEST_FIELD || code == DG_OP_REQUEST_FIELD_SIGNED || code == DG_OP_REQUEST_FIELD_FLOAT)

@@ -281,6 +281,15 @@ TEST(Computed, SkipsANameInAnAlternativeToTheReaderAndWarnsWhenNoneIsLeft) {
     EXPECT_TRUE(contains(alone.messages(), "rules.xml:7: warning: {Count} in the value of 'Items' is 'Count' (line 4), "
                                            "an alternative to 'Items': never decoded together with it"))
         << alone.messages();
+    // two containers with the same chain: the second's reader keeps to its own copy (and
+    // is warned), never the first container's Count
+    const std::string wrapped = "  <node name=\"A\">\n" + chain + "  </node>\n";
+    Front twice = front_end(rules(wrapped + std::string(wrapped).replace(wrapped.find("\"A\""), 3, "\"B\"")));
+    ASSERT_TRUE(twice.ok()) << twice.messages();
+    const Node& b = *twice.proto->nodes[1];
+    EXPECT_EQ(b.children[2]->children[0]->value->args[0].target, b.children[1]->children[0].get());
+    EXPECT_TRUE(contains(twice.messages(), "rules.xml:17: warning: {Count} in the value of 'Items' is 'Count' (line 14)"))
+        << twice.messages();
     // siblings whose conditions on one field exclude each other are alternatives too, for a length as well
     Front sized = front_end(rules("  <node name=\"Kind\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
                                   "  <node name=\"Count\" length=\"1byte\" displaytype=\"numberdec\" "

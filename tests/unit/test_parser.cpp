@@ -173,7 +173,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadLength{"12", "bad length '12'"},
                       BadLength{"1.5byte", "bad length '1.5byte'"},
                       BadLength{"abc!", "invalid XPath 'abc!' in 'length'"},
-                      BadLength{"-3byte", "invalid XPath '-3byte' in 'length'"},
+                      BadLength{"-3byte", "bad length '-3byte': a fixed length must be from 1 to 1048576"},
                       BadLength{"Rest", "XPath 'Rest' in 'length' selects no node"}),
     [](const ::testing::TestParamInfo<BadLength>& info) { return "case" + std::to_string(info.index); });
 

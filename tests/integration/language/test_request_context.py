@@ -553,8 +553,9 @@ class TestRequestsReadNoRequest(TsharkTestCase, unittest.TestCase):
     """A layout shared by requests and responses, its request{...} value without an `if`: a
     request (by the <request> field decoded before the value, or by the port it goes to)
     answers none, so it shows no value and no no_request_context note, even when its key
-    repeats a request still waiting (a retransmission); a response reads its request, and
-    one whose request was not captured gets the note."""
+    repeats a request still waiting (a retransmission), and a count from that value ends its
+    decoding quietly (not malformed); a response reads its request, and one whose request was
+    not captured gets the note."""
 
     RULES = """<root name="Shared layout {how}" abbreviation="{abbreviation}" byteorder="big">
   <hook table="udp.port" value="{port}"/>
@@ -566,6 +567,9 @@ class TestRequestsReadNoRequest(TsharkTestCase, unittest.TestCase):
   <node name="Sequence" length="2byte" displaytype="numberdec"/>
   <node name="Command" length="1byte" displaytype="numberdec"/>
   <node name="Asked" value="request{{Command}}"/>
+  <node name="Items" count="../node[@name='Asked']">
+    <node name="Item" length="1byte" displaytype="numberdec"/>
+  </node>
 </root>
 """
     KINDS = (("by field", "SHRF", 47610, '<request field="node[@name=\'Type\']" in="0"/>'),
@@ -587,14 +591,19 @@ class TestRequestsReadNoRequest(TsharkTestCase, unittest.TestCase):
                 for kind, sequence, command in messages:
                     client, server = (40000, (10, 0, 0, 10)), (port, (10, 0, 0, 1))
                     (sport, src), (dport, dst) = (server, client) if kind else (client, server)
-                    frames.append(udp(sport, dport, struct.pack("!BHB", kind, sequence, command), src, dst))
+                    items = bytes(range(command)) if kind and sequence == 5 else b""  # the answer's items
+                    frames.append(udp(sport, dport, struct.pack("!BHB", kind, sequence, command) + items, src, dst))
                 path = self.env.add_file("shared_layout_%d.pcap" % port, pcapgen.raw_pcap_bytes(frames))
                 p = abbreviation.lower()
                 for two_pass in (False, True):
-                    rows = self.env.field_rows(path, ["frame.number", p + ".asked", p + ".expert.no_request_context"],
+                    rows = self.env.field_rows(path, ["frame.number", p + ".asked", p + ".items.item",
+                                                      p + ".expert.no_request_context", "_ws.expert.severity"],
                                                two_pass=two_pass)
-                    got = {n: (r[p + ".asked"], bool(r[p + ".expert.no_request_context"])) for n, r in rows.items()}
-                    want = {1: ([], False), 2: ([], False), 3: (["3"], False), 4: ([], True)}
+                    got = {n: (r[p + ".asked"], r[p + ".items.item"], bool(r[p + ".expert.no_request_context"]),
+                               r["_ws.expert.severity"]) for n, r in rows.items()}
+                    note = ["4194304"]  # PI_NOTE, and nothing more serious (2: the pairing's duplicate)
+                    want = {1: ([], [], False, []), 2: ([], [], False, note), 3: (["3"], ["0", "1", "2"], False, []),
+                            4: ([], [], True, note)}
                     check(got == want, "%s, %s: %s, expected %s" % (how, "-2" if two_pass else "one pass", got, want))
 
 if __name__ == "__main__":
