@@ -524,6 +524,12 @@ def corpus_missing(mutants, source_dir, corpus=None):
     return sorted({t for m in mutants for t in m.tests if needs_corpus(t, source_dir)})
 
 
+def decidable_without_corpus(mutants, source_dir, missing):
+    """The mutants none of whose tests is in `missing` (those that read the absent corpus
+    would skip a part of their cases, so a mutant only they kill would seem to survive)."""
+    return [m for m in mutants if not set(m.tests) & set(missing)]
+
+
 def changed_lines(original, mutated):
     """(first, last) line numbers of original that mutated changes."""
     p = 0
@@ -691,10 +697,17 @@ def main(argv=None):
         return SKIP_CODE
     without_corpus = corpus_missing(mutants + extra, args.source_dir)
     if without_corpus:
-        print("no corpus at %s: the mutants' tests %s read it and would skip, deciding nothing; "
-              "put the corpus there, or choose (--only) mutants whose tests do not read it" % (
-                  corpus_dir(args.source_dir), " ".join(without_corpus)))
-        return 1
+        # A checkout without ../shared (a clone on its own): the mutants that tests of the
+        # corpus decide are left out, with a clear message, and the others run.
+        kept = decidable_without_corpus(mutants, args.source_dir, without_corpus)
+        extra = decidable_without_corpus(extra, args.source_dir, without_corpus)
+        print("no corpus at %s: %d of %d mutants are left out, for their tests (%s) read it and "
+              "would skip cases; put the corpus there to run them" % (
+                  corpus_dir(args.source_dir), len(mutants) - len(kept), len(mutants), " ".join(without_corpus)))
+        mutants = kept
+        if not mutants and not extra:
+            print("SKIPPED: every chosen mutant's tests read the corpus")
+            return SKIP_CODE
 
     t0 = time.monotonic()
     work = os.path.abspath(args.work) if args.work else tempfile.mkdtemp(prefix="dissgen-mutation-")

@@ -243,6 +243,14 @@ class Corpus(unittest.TestCase):
         self.assertEqual(rm.corpus_missing([M()], SOURCE_DIR, absent), ["pairing"])
         self.assertEqual(rm.corpus_missing([M()], SOURCE_DIR, SOURCE_DIR), [])
 
+    def test_without_corpus_only_the_mutants_it_cannot_decide_are_left_out(self):
+        class M:
+            def __init__(self, *tests):
+                self.tests = list(tests)
+        plain, reads, both = M("widths"), M("pairing"), M("widths", "pairing")
+        self.assertEqual(rm.decidable_without_corpus([plain, reads, both], SOURCE_DIR, ["pairing"]), [plain])
+        self.assertEqual(rm.decidable_without_corpus([plain, reads], SOURCE_DIR, []), [plain, reads])
+
 
 if __name__ == "__main__":
     unittest.main()
