@@ -108,12 +108,8 @@ int dg_displaced_dissect(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, vo
     for (int port_tables = 1; port_tables >= 0; port_tables--)
         for (guint i = 0; claims && i < claims->len; i++) {
             const dg_claim *c = &g_array_index(claims, dg_claim, i);
-            if (c->displaced && c->value == pinfo->match_uint && came_through(c->table, pinfo->ptype, port_tables)) {
-                /* As a proxy does (packet_info.h): the displaced dissector may
-                 * ask TCP for the rest of its message, as when TCP calls it. */
-                if (pinfo->ptype == PT_TCP) pinfo->can_desegment = pinfo->saved_can_desegment;
+            if (c->displaced && c->value == pinfo->match_uint && came_through(c->table, pinfo->ptype, port_tables))
                 return call_dissector_only(c->displaced, tvb, pinfo, tree, data);
-            }
         }
     return 0;
 }
