@@ -873,7 +873,8 @@ void Emitter::cycles_tables() {
         o_ << c_array("static const dg_cycle_test " + f + "_cycle_tests", tests)
            << c_array("static const dg_range " + f + "_cycle_ranges", ranges);
     o_ << "static const dg_cycles " << f << "_cycles = { " << c.window << ", " << c.sequence_bits << ", "
-       << (c.by_connection ? 2 : c.by_sender ? 1 : 0) << ", " << c.only.size() << ", "
+       << (c.by_connection ? "DG_STREAM_ENDS_CONNECTION" : c.by_sender ? "DG_STREAM_ENDS_SENDER" : "DG_STREAM_ENDS_NONE")
+       << ", " << c.only.size() << ", "
        << (tests.empty() ? std::string("NULL") : f + "_cycle_tests") << ", "
        << (tests.empty() ? std::string("NULL") : f + "_cycle_ranges") << ", " << c.sequence_step << "u, "
        << (c.lost_by_period ? 1 : 0) << ", " << c.sequence_wrap << "u, " << (c.requests_only ? 1 : 0) << " };\n";

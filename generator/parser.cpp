@@ -623,14 +623,18 @@ void Parser::parse_cycles(xmlNode* el, Protocol& proto) {
         else
             cycles.window = static_cast<unsigned>(w);
     }
-    if (attrs.count("sender") && trim(attrs["sender"]) == "connection")
-        cycles.by_sender = cycles.by_connection = true;
-    else if (attrs.count("sender") && trim(attrs["sender"]) != "yes" && trim(attrs["sender"]) != "no")
-        diags_.error(line, "bad sender '" + attrs["sender"] +
-                               "': expected yes (the sender's address and port are part of the signature), "
-                               "connection (the receiver's too: each side of each connection its own stream) or no");
-    else
-        parse_yes_no(attrs, "sender", line, "", "", cycles.by_sender);
+    if (attrs.count("sender")) {
+        const std::string sender = trim(attrs["sender"]);
+        if (sender == "yes" || sender == "connection" || sender == "no") {
+            cycles.by_sender = sender != "no";
+            cycles.by_connection = sender == "connection";
+        } else {
+            diags_.error(line, "bad sender '" + attrs["sender"] +
+                                   "': expected yes (the sender's address and port are part of the signature), "
+                                   "connection (the receiver's too: each side of each connection its own stream) "
+                                   "or no");
+        }
+    }
     parse_yes_no(attrs, "requests", line, "", "only the <pairing>'s requests are timed, with their round trips",
                  cycles.requests_only);
     if (attrs.count("lost")) {

@@ -6,8 +6,9 @@
  *    fields, every <only> test held and no <never> test did. Its stream is
  *    the signature's values in decoding order (and, with sender="yes", the
  *    sender's address and port; with sender="connection", the receiver's
- *    too: each side of each TCP connection its own count); a field of text, an address or bytes is
- *    compared by its bytes, which the stream keeps (its value is their hash).
+ *    too: each side of each connection its own count); a field of text, an
+ *    address or bytes is compared by its bytes, which the stream keeps (its
+ *    value is their hash).
  *  - With a sequence count of range R (2^bits, or wrap="R": 0 .. R - 1),
  *    from the stream's second message on, the step d = (count - previous
  *    count) mod R says: d = 0, the previous message again (a duplicate:
@@ -171,7 +172,8 @@ gboolean same_stream(gconstpointer a, gconstpointer b)
 {
     const stream *x = (const stream *)a, *y = (const stream *)b;
     if (x->hash != y->hash || x->count != y->count || x->port != y->port || !addresses_equal(&x->src, &y->src) ||
-        x->dst_port != y->dst_port || !addresses_equal(&x->dst, &y->dst) || memcmp(x->values, y->values, x->count * sizeof(guint64)) ||
+        x->dst_port != y->dst_port || !addresses_equal(&x->dst, &y->dst) ||
+        memcmp(x->values, y->values, x->count * sizeof(guint64)) ||
         memcmp(x->nodes, y->nodes, x->count * sizeof(guint16)))
         return FALSE;
     for (guint i = 0; i < x->count; i++)
@@ -201,17 +203,17 @@ stream *stream_of(capture_state *c, const dg_cycle_input *in, const packet_info 
     clear_address(&probe.src);
     clear_address(&probe.dst);
     probe.port = probe.dst_port = 0;
-    if (protocol->cycles->by_sender) {
+    if (protocol->cycles->by_sender != DG_STREAM_ENDS_NONE) {
         probe.src = pinfo->src; /* shallow: copied below if the stream is new */
         probe.port = pinfo->srcport;
     }
-    if (protocol->cycles->by_sender == 2) {
+    if (protocol->cycles->by_sender == DG_STREAM_ENDS_CONNECTION) {
         probe.dst = pinfo->dst;
         probe.dst_port = pinfo->destport;
     }
     guint32 h = dg_rt::hash_mix(dg_cycle_input_hash(in), probe.port);
     if (probe.src.type != AT_NONE) h = add_address_to_hash(h, &probe.src);
-    if (protocol->cycles->by_sender == 2) h = add_address_to_hash(dg_rt::hash_mix(h, probe.dst_port), &probe.dst);
+    if (probe.dst.type != AT_NONE) h = add_address_to_hash(dg_rt::hash_mix(h, probe.dst_port), &probe.dst);
     probe.hash = h;
     stream *s = (stream *)wmem_map_lookup(c->streams, &probe);
     if (s) return s;

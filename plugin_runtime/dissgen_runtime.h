@@ -314,10 +314,13 @@ typedef struct dg_cycle_test {
     guint16 range_first, range_count;
 } dg_cycle_test;
 
+/* dg_cycles.by_sender: the transport's ends that are part of a stream's signature. */
+enum dg_stream_ends { DG_STREAM_ENDS_NONE = 0, DG_STREAM_ENDS_SENDER = 1, DG_STREAM_ENDS_CONNECTION = 2 };
+
 typedef struct dg_cycles {
     guint8 window;         /* regular periods in a row that make a stream a cycle */
     guint8 sequence_bits;  /* the sequence count's width; 0: none */
-    guint8 by_sender;      /* 1: the sender's address and port are part of the signature; 2: the receiver's too */
+    guint8 by_sender;      /* what of the transport is part of the signature: dg_stream_ends */
     guint8 only_count;     /* the <only> tests, numbered 0 .. only_count - 1, before the <never> ones */
     const dg_cycle_test *tests;
     const dg_range *ranges;

@@ -55,7 +55,8 @@ TEST(Emit, CyclesGiveEachFieldItsRoleAndTheTestsTheirRanges) {
     Front without = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n" + nodes);
     ASSERT_TRUE(with.ok() && without.ok()) << with.messages() << without.messages();
     const std::string code = emit_cpp(*with.proto, "rules.xml");
-    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 5, 16, 1, 1, t_cycle_tests, t_cycle_ranges, 1u, "
+    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 5, 16, DG_STREAM_ENDS_SENDER, 1, t_cycle_tests, "
+                                   "t_cycle_ranges, 1u, "
                                "0, 0u, 0 };"))
         << code;
     EXPECT_TRUE(contains(code, "{ 0x1, 0x1 }") && contains(code, "{ 0x3, 0x4 }") &&
@@ -85,7 +86,8 @@ TEST(Emit, CyclesSequenceWidthsAtTheEnds) {
             code_with_sequence("<sequence field=\"node[@name='Count']\" bits=\"" + width + "\"/>",
                                "  <node name=\"Count\" length=\"8byte\" displaytype=\"numberdec\"/>\n");
         EXPECT_TRUE(
-            contains(code, "static const dg_cycles t_cycles = { 8, " + width + ", 0, 0, NULL, NULL, 1u, 0, 0u, 0 };"))
+            contains(code, "static const dg_cycles t_cycles = { 8, " + width +
+                                 ", DG_STREAM_ENDS_NONE, 0, NULL, NULL, 1u, 0, 0u, 0 };"))
             << width;
     }
 }
@@ -95,7 +97,8 @@ TEST(Emit, CyclesSequenceWidthsAtTheEnds) {
 TEST(Emit, CyclesSequenceWrap) {
     const std::string code = code_with_sequence("<sequence field=\"node[@name='Count']\" wrap=\"4000\"/>",
                                                 "  <node name=\"Count\" length=\"2byte\" displaytype=\"numberdec\"/>\n");
-    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 8, 16, 0, 0, NULL, NULL, 1u, 0, 4000u, 0 };"))
+    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 8, 16, DG_STREAM_ENDS_NONE, 0, NULL, NULL, "
+                             "1u, 0, 4000u, 0 };"))
         << code;
 }
 
@@ -106,7 +109,8 @@ TEST(Emit, CyclesSequenceOfFieldLength) {
         code_with_sequence("<sequence field=\"node[@name='Count']\"/>",
                            "  <node name=\"Size\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
                            "  <node name=\"Count\" length=\"../node[@name='Size']\" displaytype=\"numberdec\"/>\n");
-    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 8, 64, 0, 0, NULL, NULL, 1u, 0, 0u, 0 };")) << code;
+    EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 8, 64, DG_STREAM_ENDS_NONE, 0, NULL, NULL, "
+                             "1u, 0, 0u, 0 };")) << code;
 }
 
 // lost="period": the table's last flag.
@@ -116,7 +120,7 @@ TEST(Emit, CyclesLostByPeriod) {
                         "  <cycles lost=\"period\"><signature field=\"node[@name='Stream']\"/></cycles>\n" + nodes);
     ASSERT_TRUE(f.ok()) << f.messages();
     EXPECT_TRUE(contains(emit_cpp(*f.proto, "rules.xml"),
-                         "static const dg_cycles t_cycles = { 8, 0, 0, 0, NULL, NULL, 1u, 1, 0u, 0 };"))
+                         "static const dg_cycles t_cycles = { 8, 0, DG_STREAM_ENDS_NONE, 0, NULL, NULL, 1u, 1, 0u, 0 };"))
         << emit_cpp(*f.proto, "rules.xml");
 }
 
@@ -129,7 +133,7 @@ TEST(Emit, CyclesOfRequestsOnly) {
                         "  <node name=\"Stream\" length=\"2byte\" displaytype=\"numberhex\"/>\n</root>\n");
     ASSERT_TRUE(f.ok()) << f.messages();
     EXPECT_TRUE(contains(emit_cpp(*f.proto, "rules.xml"),
-                         "static const dg_cycles t_cycles = { 8, 0, 0, 0, NULL, NULL, 1u, 0, 0u, 1 };"))
+                         "static const dg_cycles t_cycles = { 8, 0, DG_STREAM_ENDS_NONE, 0, NULL, NULL, 1u, 0, 0u, 1 };"))
         << emit_cpp(*f.proto, "rules.xml");
 }
 
