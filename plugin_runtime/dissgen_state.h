@@ -73,6 +73,7 @@ struct dg_state {
     guint8 *present;      /* per slot: decoded in this message (instance) */
     dg_table *tables;     /* offset tables: per slot, allocated at the first offset leaf */
     gint packet_end;      /* captured bytes */
+    gint cut_end;         /* where the innermost container the capture cut short ends on the wire; 0: none */
     gboolean stopped;     /* a malformed spot was reported: decode nothing more */
     gboolean faulted;     /* a malformed spot was reported in this message, even if decoding went on */
     gboolean cut_shown;   /* the capture kept less than the frame had: shown once (capture_cut) */

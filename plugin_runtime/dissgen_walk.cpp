@@ -96,10 +96,16 @@ gint64 stringz_length(const dg_state *st, gint offset, gint end)
  * fewer than N are left. */
 static gboolean rest_length(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint end, gint64 *out)
 {
-    /* The trailer ends where the frame ends on the wire: in a frame the
-     * capture cut short, the node runs past the captured bytes (reported as
-     * truncated) rather than taking its last captured bytes as the trailer. */
-    if (n->length > 0 && end == st->packet_end) end = (gint)tvb_reported_length(st->tvb);
+    /* In a frame the capture cut short, the bytes left end where the
+     * container ends on the wire: the node runs past the captured bytes (not
+     * shown, as any field cut so) rather than taking the captured ones as
+     * all there is. The trailer of `rest - N` ends where the frame ends. */
+    if (end == st->packet_end) {
+        if (st->cut_end > end)
+            end = st->cut_end;
+        else if (n->length > 0)
+            end = (gint)tvb_reported_length(st->tvb);
+    }
     gint64 v = (gint64)(end - offset) - (gint64)n->length;
     if (v < 0) {
         report(st, tree, &st->p->ei->bad_length, offset, 0,
@@ -453,6 +459,8 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     /* Decode what is there even when the length overruns. */
     gboolean was_stopped = st->stopped;
     st->stopped = FALSE;
+    const gint outer_cut_end = st->cut_end;
+    if (past_end && cut_by_capture(st, end, start + length)) st->cut_end = (gint)(start + length);
     if (n->window >= 0) /* a window: children at addresses, not one after another */
         dissect_window(st, n, subtree, offset, inner_end, in_summary || n->summary_count > 0);
     else
@@ -464,6 +472,7 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
         report_missing(st, subtree, &st->p->ei->truncated, end, start + length, start, end - start,
                        "Truncated: '%s' needs %" G_GINT64_MODIFIER "d bytes, only %d left", n->name, length,
                        end - start);
+    st->cut_end = outer_cut_end;
     st->stopped = st->stopped || was_stopped;
     if (!st->stopped && length >= 0 && *offset < inner_end &&
         (n->length_kind == DG_LEN_FIXED || n->length_kind == DG_LEN_FIELD)) {

@@ -11,7 +11,9 @@ Other (which one holds lies in the bytes not kept). The control: the same bytes 
 length) are malformed (an expert info, no _ws.short); and a Length that runs past even the
 frame's length on the wire stays an error in a cut frame. A leaf the capture cut inside (an
 address, a text, bytes) shows none of its bytes (its value is not known; a part would match
-filters), while one really that short on the wire shows the bytes it has. One pass and -2.
+filters), while one really that short on the wire shows the bytes it has. So does a `rest` leaf
+in a container whose length field says more than the capture kept: the bytes it has to take are
+the container's on the wire, not the captured ones. One pass and -2.
 
     test_snapshot_length.py --dissgen build/bin/dissgen --source-dir .
 """
@@ -137,6 +139,50 @@ class SnapshotInsideALeaf(TsharkTestCase, unittest.TestCase):
                               how, n, caplen, shown, kept, r["_ws.short"], r["_ws.expert.message"]))
                 short = rows[len(self.cuts) + 1]
                 check(short["cutl.station"] == ["c0:a8"] and short["_ws.expert.message"] and not short["_ws.short"],
+                      "%s: really short on the wire, the bytes there and an expert: %s" % (how, short))
+
+
+CONTAINER_RULES = """<root name="Cut in container" abbreviation="CUTC" ethertype="0x88b5">
+  <node name="Length" length="1byte" displaytype="numberdec"/>
+  <node name="Block" length="../node[@name='Length']">
+    <node name="Kind" length="1byte" displaytype="numberdec"/>
+    <node name="Inner" length="rest" displaytype="string"/>
+  </node>
+  <node name="Tail" length="rest" displaytype="origin"/>
+</root>
+"""
+
+
+class SnapshotInsideAContainer(TsharkTestCase, unittest.TestCase):
+    """A `rest` leaf runs to its container's end on the wire: cut by the capture, it is not shown
+    (as a leaf whose length field says more); really short on the wire, it shows what is there."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("cut_container.xml", CONTAINER_RULES, "cutc")
+        cls.whole = b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01\x88\xb5" + b"\x0b" + b"\x07" + b"abcdefghij" + b"\x01\x02"
+        cls.cuts = list(range(HEADER + 3, HEADER + 12))  # inside Inner
+        short = cls.whole[:HEADER + 6]
+        records = [(c, cls.whole) for c in cls.cuts] + [(len(cls.whole), cls.whole), (len(short), short)]
+        cls.capture = cls.env.add_file("cut_container.pcap", pcap(records))
+
+    def test_rest_in_a_cut_container(self):
+        fields = ["frame.number", "_ws.short", "_ws.expert.message", "cutc.block.kind", "cutc.block.inner", "cutc.tail"]
+        with self.checks() as check:
+            for two_pass in (False, True):
+                how = "-2" if two_pass else "one pass"
+                rows = self.env.field_rows(self.capture, fields, two_pass=two_pass, aggregator="|")
+                for n, caplen in enumerate(self.cuts, 1):
+                    r = rows[n]
+                    check(r["cutc.block.kind"] == ["7"] and not r["cutc.block.inner"] and not r["cutc.tail"] and
+                          len(r["_ws.short"]) == 1 and not r["_ws.expert.message"],
+                          "%s frame %d (kept %d bytes): Inner cut by the capture is not shown: %s" % (
+                              how, n, caplen, r))
+                whole = rows[len(self.cuts) + 1]
+                check(whole["cutc.block.inner"] == ["abcdefghij"] and whole["cutc.tail"] == ["01 02"] and
+                      not whole["_ws.expert.message"], "%s: the whole frame: %s" % (how, whole))
+                short = rows[len(self.cuts) + 2]
+                check(short["cutc.block.inner"] == ["abcd"] and short["_ws.expert.message"] and not short["_ws.short"],
                       "%s: really short on the wire, the bytes there and an expert: %s" % (how, short))
 
 
