@@ -142,7 +142,7 @@ class TestRuleCycles(TsharkTestCase, unittest.TestCase):
             check(len(got) == len(cycles), "-z enipr,cycles lists %d cycles, expected %d" % (len(got), len(cycles)))
             for c, g in zip(cycles, got):
                 connection, address, port = c["stream"]["key"]
-                name = "Connection ID 0x%x, sender %s:%d" % (connection, ".".join(map(str, address)), port)
+                name = "Connection ID 0x%08x, sender %s:%d" % (connection, ".".join(map(str, address)), port)
                 check(g["name"] == name, "cycle %d is %r, expected %r" % (c["number"], g["name"], name))
                 want = figures(c)
                 check(g["figures"] == want, "cycle %d figures %s, expected %s" % (c["number"], g["figures"], want))

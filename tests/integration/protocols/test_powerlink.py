@@ -489,7 +489,7 @@ class CyclesOfTheIsochronousPhase(TsharkTestCase, unittest.TestCase):
                 for c, g in zip(cycles, got):
                     mtyp, source = c["stream"]["key"]
                     # an enum signature field by its name, as the tree shows it
-                    name = "MessageType %s (0x%x), Source %d" % (MESSAGE_TYPES[mtyp], mtyp, source)
+                    name = "MessageType %s (0x%02x), Source %d" % (MESSAGE_TYPES[mtyp], mtyp, source)
                     check(g["name"] == name, "cycle %d is %r, expected %r" % (c["number"], g["name"], name))
                     want = cyclemodel.figures(c)
                     del want["duplicates"]  # no sequence count: not printed

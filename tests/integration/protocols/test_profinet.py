@@ -451,7 +451,7 @@ class CyclesOfCyclicData(TsharkTestCase, unittest.TestCase):
                 check(len(got) == len(cycles), "-z pnr,cycles lists %d cycles" % len(got))
                 for c, g in zip(cycles, got):
                     frame_id, mac = c["stream"]["key"]
-                    name = "FrameID 0x%x, sender %s" % (frame_id, ":".join("%02x" % b for b in mac))
+                    name = "FrameID 0x%04x, sender %s" % (frame_id, ":".join("%02x" % b for b in mac))
                     check(g["name"] == name, "cycle %d is %r, expected %r" % (c["number"], g["name"], name))
                     want = cyclemodel.figures(c)
                     check(g["figures"] == want, "cycle %d: %s, expected %s" % (c["number"], g["figures"], want))
