@@ -42,17 +42,6 @@ std::vector<Test> tests_of(const Node& n) {
     return out;
 }
 
-// Siblings whose own conditions cannot both hold: one field (decoded once,
-// before both) tested against disjoint lists, disjoint hook lists, or
-// opposite directions.
-bool conditions_exclude(const Node& x, const Node& y) {
-    for (const Test& a : tests_of(x))
-        for (const Test& b : tests_of(y))
-            if (a.field == b.field && disjoint(*a.list, *b.list)) return true;
-    if (x.has_hook && y.has_hook && disjoint(x.hook_list, y.hook_list)) return true;
-    return x.direction != Direction::Any && y.direction != Direction::Any && x.direction != y.direction;
-}
-
 // x before y among the same siblings: one chain when y and every sibling
 // between them are otherwise="true" (only the first member that holds is decoded).
 bool same_chain(const Protocol& proto, const Node& x, const Node& y) {
@@ -78,6 +67,17 @@ bool same_enums(const Node& a, const Node& b) {
 }
 
 }  // namespace
+
+// Siblings whose own conditions cannot both hold: one field (decoded once,
+// before both) tested against disjoint lists, disjoint hook lists, or
+// opposite directions.
+bool conditions_exclude(const Node& x, const Node& y) {
+    for (const Test& a : tests_of(x))
+        for (const Test& b : tests_of(y))
+            if (a.field == b.field && disjoint(*a.list, *b.list)) return true;
+    if (x.has_hook && y.has_hook && disjoint(x.hook_list, y.hook_list)) return true;
+    return x.direction != Direction::Any && y.direction != Direction::Any && x.direction != y.direction;
+}
 
 bool are_alternatives(const Protocol& proto, const Node& a, const Node& b) {
     // The ancestors (or selves) of a and b that are siblings: their common container's children.

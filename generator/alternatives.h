@@ -15,6 +15,10 @@ namespace dissgen {
 // closest common container.
 bool are_alternatives(const Protocol& proto, const Node& a, const Node& b);
 
+// Whether the own conditions of x and y (if/in and <when> on one field,
+// hooks, directions) can never hold together, whatever comes between them.
+bool conditions_exclude(const Node& x, const Node& y);
+
 // Why a and b cannot be one Wireshark field ("" when they can): their
 // types, display bases, bit masks, value names or unit labels differ.
 std::string shared_field_mismatch(const Node& a, const Node& b);

@@ -104,6 +104,7 @@ private:
     const Node* find_before(int reach, const std::string& name);
     const Node* find_readable_before(int reach, const std::string& name, const Node& reader);
     void warn_if_alternative(const Node& field, const Node& reader, int line, const std::string& what);
+    void warn_if_default_beside_a_rival(const Node& n);
     std::vector<std::string> names_before(int reach) const;
     // Every node of each name, in document order: names are looked up once
     // per expression operand, and a <group> used many times makes the tree
@@ -728,6 +729,9 @@ void Validator::check_validity() {
         }
         uint64_t offset = 0;
         const Node* blocker = fixed_offset_blocker(n, offset);
+        // (an overlay around it says more than a field of no fixed length before it)
+        for (const Node* a = n.parent; blocker && a; a = a->parent)
+            if (a->is_overlay()) blocker = a;
         bool hooked = false;
         for (const Node* a = &n; a; a = a->parent) hooked = hooked || a->has_hook;
         if (blocker) {
@@ -1697,6 +1701,25 @@ const Node* previous_sibling(const Protocol& proto, const Node& n) {
     return nullptr;
 }
 
+// A chain's default (otherwise="true" without conditions of its own) is the
+// alternative of its chain's members only. When the chain opens right after a
+// sibling whose condition excludes the opener's (A if Kind 0, B if Kind 1,
+// Other otherwise), the default decodes beside that sibling too: most likely
+// the author meant one chain, with otherwise="true" on the opener.
+void Validator::warn_if_default_beside_a_rival(const Node& n) {
+    if (n.if_field || !n.whens.empty() || n.has_hook || n.direction != Direction::Any) return;
+    const Node* opener = &n;
+    while (opener && opener->otherwise) opener = previous_sibling(proto_, *opener);
+    if (!opener) return;
+    const Node* rival = previous_sibling(proto_, *opener);
+    // (a computed value beside a chain lays nothing out: no rival)
+    if (!rival || rival->is_computed() || !conditions_exclude(*rival, *opener)) return;
+    diags_.warning(n.line, "otherwise=\"true\" on " + quote(n) + " is the default of the chain that " +
+                               lines_of(*opener) + " opens, so it is decoded also when " + lines_of(*rival) +
+                               " is; to make " + quote(*rival) + " a member of that chain, give " + quote(*opener) +
+                               " otherwise=\"true\"");
+}
+
 void Validator::check_layout(Node& n) {
     for (When& w : n.whens) {
         if (w.peek)
@@ -1722,6 +1745,8 @@ void Validator::check_layout(Node& n) {
             diags_.error(n.line, "otherwise=\"true\" on " + quote(n) + " needs a previous sibling with a condition "
                                  "(if, <when>, ifhook, direction) or otherwise; " + lines_of(*prev) +
                                  " is always decoded");
+        else
+            warn_if_default_beside_a_rival(n);
     }
     if (n.skip_malformed) {
         if (n.is_leaf())
