@@ -1707,9 +1707,13 @@ const Node* previous_sibling(const Protocol& proto, const Node& n) {
 // Other otherwise), the default decodes beside that sibling too: most likely
 // the author meant one chain, with otherwise="true" on the opener.
 void Validator::warn_if_default_beside_a_rival(const Node& n) {
-    if (n.if_field || !n.whens.empty() || n.has_hook || n.direction != Direction::Any) return;
-    const Node* opener = &n;
-    while (opener && opener->otherwise) opener = previous_sibling(proto_, *opener);
+    auto is_default = [](const Node& m) {
+        return m.otherwise && !m.if_field && m.whens.empty() && !m.has_hook && m.direction == Direction::Any;
+    };
+    if (!is_default(n)) return;
+    const Node* opener = previous_sibling(proto_, n);
+    for (; opener && opener->otherwise; opener = previous_sibling(proto_, *opener))
+        if (is_default(*opener)) return;  // (a second default is never decoded at all)
     if (!opener) return;
     const Node* rival = previous_sibling(proto_, *opener);
     // (a computed value beside a chain lays nothing out: no rival)
@@ -1745,7 +1749,7 @@ void Validator::check_layout(Node& n) {
             diags_.error(n.line, "otherwise=\"true\" on " + quote(n) + " needs a previous sibling with a condition "
                                  "(if, <when>, ifhook, direction) or otherwise; " + lines_of(*prev) +
                                  " is always decoded");
-        else
+        else if (!bit_field || n.bit_alternative)  // (a bit field's misplaced otherwise is an error above)
             warn_if_default_beside_a_rival(n);
     }
     if (n.skip_malformed) {

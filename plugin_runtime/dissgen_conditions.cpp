@@ -213,7 +213,10 @@ void dissect_place(dg_state *st, const dg_place *pl, proto_tree *tree, gint star
         gint offset = start + (gint)(a - base);
         proto_node *before = tree ? tree->last_child : NULL;
         clear_slots(st, c);
+        const gint outer_cut_end = st->cut_end; /* a place's size gives its end */
+        st->cut_end = DG_END_KNOWN;
         dissect_instance(st, c, tree, &offset, offset + (gint)pl->size, in_summary, NULL);
+        st->cut_end = outer_cut_end;
         if (pl->stride) label_instance(st, c, tree, before, i);
     }
 }

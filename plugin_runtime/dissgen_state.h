@@ -63,6 +63,8 @@ struct dg_summaries {
     guint count;
 };
 
+#define DG_END_KNOWN (-1) /* dg_state.cut_end of a container the capture kept whole */
+
 #define DG_MAX_LISTS 80 /* nesting is at most 64 levels (parser.h kMaxNesting) */
 
 struct dg_state {
@@ -73,7 +75,8 @@ struct dg_state {
     guint8 *present;      /* per slot: decoded in this message (instance) */
     dg_table *tables;     /* offset tables: per slot, allocated at the first offset leaf */
     gint packet_end;      /* captured bytes */
-    gint cut_end;         /* where the innermost container the capture cut short ends on the wire; 0: none */
+    gint cut_end;         /* where the innermost container ends on the wire when the capture cut it short;
+                           * DG_END_KNOWN: in one that ends where its end says; 0: at the top level */
     gboolean stopped;     /* a malformed spot was reported: decode nothing more */
     gboolean faulted;     /* a malformed spot was reported in this message, even if decoding went on */
     gboolean cut_shown;   /* the capture kept less than the frame had: shown once (capture_cut) */

@@ -99,11 +99,12 @@ static gboolean rest_length(dg_state *st, const dg_node *n, proto_tree *tree, gi
     /* In a frame the capture cut short, the bytes left end where the
      * container ends on the wire: the node runs past the captured bytes (not
      * shown, as any field cut so) rather than taking the captured ones as
-     * all there is. The trailer of `rest - N` ends where the frame ends. */
+     * all there is. At the top level, the trailer of `rest - N` ends where
+     * the frame ends on the wire. */
     if (end == st->packet_end) {
         if (st->cut_end > end)
             end = st->cut_end;
-        else if (n->length > 0)
+        else if (n->length > 0 && st->cut_end != DG_END_KNOWN)
             end = (gint)tvb_reported_length(st->tvb);
     }
     gint64 v = (gint64)(end - offset) - (gint64)n->length;
@@ -459,8 +460,12 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
     /* Decode what is there even when the length overruns. */
     gboolean was_stopped = st->stopped;
     st->stopped = FALSE;
+    /* Where the children's bytes end on the wire, when the capture cut them
+     * short: this container's end when it is cut; an end the capture kept,
+     * none; a length from the children, the enclosing one's. */
     const gint outer_cut_end = st->cut_end;
-    if (past_end && cut_by_capture(st, end, start + length)) st->cut_end = (gint)(start + length);
+    if (length >= 0)
+        st->cut_end = past_end && cut_by_capture(st, end, start + length) ? (gint)(start + length) : DG_END_KNOWN;
     if (n->window >= 0) /* a window: children at addresses, not one after another */
         dissect_window(st, n, subtree, offset, inner_end, in_summary || n->summary_count > 0);
     else
@@ -661,14 +666,17 @@ void dissect_located(dg_state *st, const dg_node *n, proto_tree *tree, gint *off
         if (i == 0 && !entry_ok(st, n, tree, t, 0, base, first, end, first)) break;
         gint64 from = base + (gint64)t->values[i]; /* checked: inside [first, end] */
         gint to = end;
+        const gint outer_cut_end = st->cut_end; /* the last instance ends where the list does */
         if (i + 1 < t->count) {
             if (!entry_ok(st, n, tree, t, i + 1, base, from, end, first)) break;
             to = (gint)(base + (gint64)t->values[i + 1]);
+            st->cut_end = DG_END_KNOWN; /* the next offset gives its end */
         }
         gint at = (gint)from;
         clear_slots(st, n);
         st->instance = i;
         dissect_instance(st, n, tree, &at, to, in_summary, collect ? &summaries : NULL);
+        st->cut_end = outer_cut_end;
         instances++;
         if (!st->stopped) *offset = to;
     }
@@ -713,7 +721,10 @@ void dissect_overlay(dg_state *st, const dg_node *n, proto_tree *tree, gboolean 
     if (!st->present[target]) return;
     const dg_slot *t = &st->slots[target];
     gint at = t->offset;
+    const gint outer_cut_end = st->cut_end; /* the node overlaid was decoded whole: its end is known */
+    st->cut_end = DG_END_KNOWN;
     dissect_container(st, n, tree, &at, t->offset + t->length, in_summary, NULL);
+    st->cut_end = outer_cut_end;
     /* as for any container: one cut short says and teaches nothing */
     if (st->stopped) return;
     if (n->extra->finding_count) raise_findings(st, n, tree, t->offset, at);

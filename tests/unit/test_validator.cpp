@@ -744,5 +744,38 @@ TEST(RestLeaves, AGroupNestedDeeperThanItsDepthSaysToRaiseIt) {
     EXPECT_TRUE(contains(m, "'Trailer' (line 7) finds no bytes after it: raise the group's depth")) << m;
 }
 
+
+TEST(Chains, WarnWhenADefaultAlsoDecodesBesideTheSiblingBeforeItsChain) {
+    const std::string head = "  <node name=\"Tag\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                             "  <node name=\"Q\" length=\"1byte\" displaytype=\"numberdec\" if=\"../node[@name='Tag']\" in=\"2\"/>\n"
+                             "  <node name=\"R\" length=\"1byte\" displaytype=\"numberdec\" if=\"../node[@name='Tag']\" in=\"3\"/>\n";
+    // S is R's default, decoded after Q too; T, a second default, is never decoded: no claim on it.
+    Front f = front_end(rules(head + "  <node name=\"S\" length=\"1byte\" otherwise=\"true\"/>\n"
+                                     "  <node name=\"T\" length=\"1byte\" otherwise=\"true\"/>\n"));
+    const std::string m = f.messages();
+    EXPECT_TRUE(f.ok()) << m;
+    EXPECT_TRUE(contains(m, "rules.xml:5: warning: otherwise=\"true\" on 'S' is the default of the chain that 'R' "
+                            "(line 4) opens, so it is decoded also when 'Q' (line 3) is")) << m;
+    EXPECT_FALSE(contains(m, "on 'T'")) << m;
+    // One chain (otherwise on R), or no default (S an "else if" with conditions of its own): no warning.
+    const std::string q = "  <node name=\"Tag\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                          "  <node name=\"Q\" length=\"1byte\" if=\"../node[@name='Tag']\" in=\"2\"/>\n";
+    for (const std::string& tail :
+         {std::string("  <node name=\"R\" length=\"1byte\" otherwise=\"true\" if=\"../node[@name='Tag']\" in=\"3\"/>\n"
+                      "  <node name=\"S\" length=\"1byte\" otherwise=\"true\"/>\n"),
+          std::string("  <node name=\"R\" length=\"1byte\" if=\"../node[@name='Tag']\" in=\"3\"/>\n"
+                      "  <node name=\"S\" length=\"1byte\" otherwise=\"true\" if=\"../node[@name='Tag']\" in=\"5\"/>\n")}) {
+        Front g = front_end(rules(q + tail));
+        EXPECT_TRUE(g.ok()) << g.messages();
+        EXPECT_FALSE(contains(g.messages(), "is the default of the chain")) << tail << g.messages();
+    }
+    // A bit field's otherwise after no bit alternative is an error, and only that.
+    Front b = front_end(rules("  <node name=\"K\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"A\" length=\"4bit\" displaytype=\"numberhex\" if=\"../node[@name='K']\" in=\"0\"/>\n"
+                              "  <node name=\"B\" length=\"4bit\" displaytype=\"numberhex\" if=\"../node[@name='K']\" in=\"1\"/>\n"
+                              "  <node name=\"C\" length=\"4bit\" displaytype=\"numberhex\" otherwise=\"true\"/>\n"));
+    EXPECT_FALSE(contains(b.messages(), "is the default of the chain")) << b.messages();
+}
+
 }  // namespace
 }  // namespace dissgen::testing

@@ -146,6 +146,9 @@ CONTAINER_RULES = """<root name="Cut in container" abbreviation="CUTC" ethertype
   <node name="Length" length="1byte" displaytype="numberdec"/>
   <node name="Block" length="../node[@name='Length']">
     <node name="Kind" length="1byte" displaytype="numberdec"/>
+    <node name="Name" length="4byte">
+      <node name="Text" length="rest" displaytype="string"/>
+    </node>
     <node name="Inner" length="rest" displaytype="string"/>
   </node>
   <node name="Tail" length="rest" displaytype="origin"/>
@@ -155,34 +158,42 @@ CONTAINER_RULES = """<root name="Cut in container" abbreviation="CUTC" ethertype
 
 class SnapshotInsideAContainer(TsharkTestCase, unittest.TestCase):
     """A `rest` leaf runs to its container's end on the wire: cut by the capture, it is not shown
-    (as a leaf whose length field says more); really short on the wire, it shows what is there."""
+    (as a leaf whose length field says more); really short on the wire, it shows what is there.
+    A container inside the cut one that the capture kept whole (Name, even when it ends right
+    where the capture does) ends where its own length says: its `rest` leaf is shown."""
+    NAME_END = HEADER + 6  # Length, Kind, then the 4 bytes of Name
 
     @classmethod
     def prepare(cls):
         cls.install_text("cut_container.xml", CONTAINER_RULES, "cutc")
-        cls.whole = b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01\x88\xb5" + b"\x0b" + b"\x07" + b"abcdefghij" + b"\x01\x02"
-        cls.cuts = list(range(HEADER + 3, HEADER + 12))  # inside Inner
-        short = cls.whole[:HEADER + 6]
+        cls.whole = (b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01\x88\xb5" + b"\x0b" + b"\x07" + b"wxyz" + b"abcdef" +
+                     b"\x01\x02")
+        cls.cuts = list(range(HEADER + 3, HEADER + 12))  # inside Name, then inside Inner
+        short = cls.whole[:HEADER + 8]
         records = [(c, cls.whole) for c in cls.cuts] + [(len(cls.whole), cls.whole), (len(short), short)]
         cls.capture = cls.env.add_file("cut_container.pcap", pcap(records))
 
     def test_rest_in_a_cut_container(self):
-        fields = ["frame.number", "_ws.short", "_ws.expert.message", "cutc.block.kind", "cutc.block.inner", "cutc.tail"]
+        fields = ["frame.number", "_ws.short", "_ws.expert.message", "cutc.block.kind", "cutc.block.name.text",
+                  "cutc.block.inner", "cutc.tail"]
         with self.checks() as check:
             for two_pass in (False, True):
                 how = "-2" if two_pass else "one pass"
                 rows = self.env.field_rows(self.capture, fields, two_pass=two_pass, aggregator="|")
                 for n, caplen in enumerate(self.cuts, 1):
                     r = rows[n]
-                    check(r["cutc.block.kind"] == ["7"] and not r["cutc.block.inner"] and not r["cutc.tail"] and
+                    text = ["wxyz"] if caplen >= self.NAME_END else []
+                    check(r["cutc.block.kind"] == ["7"] and r["cutc.block.name.text"] == text and
+                          not r["cutc.block.inner"] and not r["cutc.tail"] and
                           len(r["_ws.short"]) == 1 and not r["_ws.expert.message"],
-                          "%s frame %d (kept %d bytes): Inner cut by the capture is not shown: %s" % (
-                              how, n, caplen, r))
+                          "%s frame %d (kept %d bytes): Text %s, Inner cut by the capture not shown: %s" % (
+                              how, n, caplen, text, r))
                 whole = rows[len(self.cuts) + 1]
-                check(whole["cutc.block.inner"] == ["abcdefghij"] and whole["cutc.tail"] == ["01 02"] and
-                      not whole["_ws.expert.message"], "%s: the whole frame: %s" % (how, whole))
+                check(whole["cutc.block.name.text"] == ["wxyz"] and whole["cutc.block.inner"] == ["abcdef"] and
+                      whole["cutc.tail"] == ["01 02"] and not whole["_ws.expert.message"],
+                      "%s: the whole frame: %s" % (how, whole))
                 short = rows[len(self.cuts) + 2]
-                check(short["cutc.block.inner"] == ["abcd"] and short["_ws.expert.message"] and not short["_ws.short"],
+                check(short["cutc.block.inner"] == ["ab"] and short["_ws.expert.message"] and not short["_ws.short"],
                       "%s: really short on the wire, the bytes there and an expert: %s" % (how, short))
 
 
