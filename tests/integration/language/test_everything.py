@@ -40,6 +40,7 @@ ETHERTYPE = 0x88B5
 UDP_PORT = 47474
 RULES = os.path.join("tests", "rules", "everything.xml")
 ELLIPSIS = "\u2026"
+KNOWN_END = -1  # Decoder.cut_end of a box the capture kept whole (DG_END_KNOWN)
 TIMES = "\u00d7"
 
 # --------------------------------------------------------------------------- enums (as in the rules)
@@ -307,6 +308,9 @@ class Expected:
         self.on_wire = on_wire  # the message's length on the wire, when the capture kept less
         self.cut_shown = False
         self.stopped = False
+        # where the innermost box ends on the wire when the capture cut it short; KNOWN_END in
+        # one the capture kept whole; 0 at the top level (a rest blob runs to it)
+        self.cut_end = 0
         self.experts = []       # (field, message) in order
         self.info = []
         self.svals = {}         # id(leaf node) -> value as a summary shows it
@@ -407,7 +411,8 @@ class Expected:
         if n.lenkind == "field" and n.length < 0:
             self.expert(parent, "bad_length", "The length of '%s' is negative (%d)" % (n.name, n.length))
             return offset
-        length = end - offset if n.lenkind == "rest" else n.length
+        rest_end = self.cut_end if end == len(self.buf) and self.cut_end > end else end
+        length = rest_end - offset if n.lenkind == "rest" else n.length
         left = end - offset
         if length > left:
             # the bytes there, in a message really that short; none of a leaf the capture cut
@@ -449,7 +454,11 @@ class Expected:
                         "'%s' has length %d, past the end of its data (%d bytes left)" % (n.name, length, end - start),
                         data_end=end, needed=start + length)
         was_stopped, self.stopped = self.stopped, False
+        outer_cut_end = self.cut_end
+        if length >= 0:
+            self.cut_end = start + length if past_end and self.cut_by_capture(end, start + length) else KNOWN_END
         offset = self.node_list(n.children, item, offset, inner_end, in_summary or bool(n.pieces))
+        self.cut_end = outer_cut_end
         if past_end and n.lenkind != "field" and not self.stopped:  # no child ran out: the box is short
             self.expert(item, "truncated", "Truncated: '%s' needs %d bytes, only %d left" % (n.name, length, end - start),
                         data_end=end, needed=start + length)
