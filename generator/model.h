@@ -292,10 +292,12 @@ struct Node {
     // A counted list of such instances: the walk repeats it `count` times without
     // moving (dg_extra.no_bytes).
     bool is_counted_list_of_no_bytes() const { return count.has_value() && !repeat && !repeat_rest && takes_no_bytes(); }
-    // Decoded only under a condition (if/in or ifhook): may take no bytes.
-    bool is_conditional() const {
-        return if_field.has_value() || has_hook || direction != Direction::Any || !whens.empty() || otherwise;
+    // A condition of its own: if/in, <when>, ifhook or direction (not otherwise).
+    bool has_own_condition() const {
+        return if_field.has_value() || has_hook || direction != Direction::Any || !whens.empty();
     }
+    // Decoded only under a condition (its own, or otherwise): may take no bytes.
+    bool is_conditional() const { return has_own_condition() || otherwise; }
     bool has_fixed_length() const {
         return length_kind == LengthKind::Bits || length_kind == LengthKind::Bytes;
     }

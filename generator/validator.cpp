@@ -1707,9 +1707,7 @@ const Node* previous_sibling(const Protocol& proto, const Node& n) {
 // Other otherwise), the default decodes beside that sibling too: most likely
 // the author meant one chain, with otherwise="true" on the opener.
 void Validator::warn_if_default_beside_a_rival(const Node& n) {
-    auto is_default = [](const Node& m) {
-        return m.otherwise && !m.if_field && m.whens.empty() && !m.has_hook && m.direction == Direction::Any;
-    };
+    auto is_default = [](const Node& m) { return m.otherwise && !m.has_own_condition(); };
     if (!is_default(n)) return;
     const Node* opener = previous_sibling(proto_, n);
     for (; opener && opener->otherwise; opener = previous_sibling(proto_, *opener))

@@ -66,7 +66,6 @@
 #include <epan/stat_tap_ui.h>
 #include <epan/stats_tree.h>
 #include <epan/tap.h>
-#include <wsutil/sign_ext.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -543,20 +542,18 @@ char *stream_text(const stream *s)
         const dg_node *n = &protocol->nodes[s->nodes[i]];
         if (i) g_string_append(t, ", ");
         const char *name = n->show == DG_SHOW_ENUM && !s->bytes[i] ? stream_enum_name(n, s->values[i]) : NULL;
-        /* hex padded to the field's width, as its tree item shows it */
-        const int digits = (int)((MIN(n->bits, 64u) + 3) / 4);
-        if (s->bytes[i])
+        if (s->bytes[i]) {
             append_bytes(t, n, s->bytes[i], s->lengths[i]);
-        else if (name) /* "MessageType PReq (0x03)", as the tree shows an enum */
-            g_string_append_printf(t, "%s %s (0x%0*" G_GINT64_MODIFIER "x)", n->name, name, digits, s->values[i]);
-        else if (n->show == DG_SHOW_DEC)
-            g_string_append_printf(t, "%s %" G_GUINT64_FORMAT, n->name, s->values[i]);
-        else if (n->show == DG_SHOW_INT)
-            g_string_append_printf(t, "%s %" G_GINT64_FORMAT, n->name,
-                                   (gint64)(n->bits > 0 && n->bits < 64 ? ws_sign_ext64(s->values[i], (int)n->bits)
-                                                                        : s->values[i]));
+            continue;
+        }
+        char buf[32]; /* the longest number: "-9223372036854775808" */
+        dg_rt::dg_text number;
+        dg_rt::text_init(&number, NULL, buf, sizeof buf);
+        dg_rt::append_number(&number, n, s->values[i]);
+        if (name) /* "MessageType PReq (0x03)", as the tree shows an enum */
+            g_string_append_printf(t, "%s %s (%s)", n->name, name, number.data);
         else
-            g_string_append_printf(t, "%s 0x%0*" G_GINT64_MODIFIER "x", n->name, digits, s->values[i]);
+            g_string_append_printf(t, "%s %s", n->name, number.data);
     }
     append_end(t, "sender", &s->src, s->port);
     append_end(t, "receiver", &s->dst, s->dst_port);

@@ -25,6 +25,7 @@
  */
 #include "dissgen_pairing.h"
 #include "dissgen_periods.h"
+#include "dissgen_state.h"
 #include "dissgen_values.h"
 
 
@@ -1020,14 +1021,12 @@ gboolean known_lost(const dg_transaction *t)
  * that the note names the request the way its tree does. */
 const char *key_text(packet_info *pinfo, guint64 key)
 {
-    if (key_node && key_node->show == DG_SHOW_DEC)
-        return wmem_strdup_printf(pinfo->pool, "%" G_GINT64_MODIFIER "u", key);
-    guint bits = key_node ? key_node->bits : 64;
-    if (key_node && key_node->show == DG_SHOW_INT) {
-        gint64 value = bits > 0 && bits < 64 && (key >> (bits - 1)) & 1 ? (gint64)(key | (~G_GUINT64_CONSTANT(0) << bits)) : (gint64)key;
-        return wmem_strdup_printf(pinfo->pool, "%" G_GINT64_MODIFIER "d", value);
-    }
-    return wmem_strdup_printf(pinfo->pool, "0x%0*" G_GINT64_MODIFIER "x", (int)((bits + 3) / 4), key);
+    dg_rt::dg_text *text = dg_rt::text_new(pinfo->pool);
+    if (key_node)
+        dg_rt::append_number(text, key_node, key);
+    else
+        dg_rt::append_hex(text, key, 16);
+    return text->data;
 }
 
 /* The requests this message proved lost, each linked. The expert info goes

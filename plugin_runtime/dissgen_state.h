@@ -198,6 +198,10 @@ void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offs
 
 /* The name an enum's value_string, val64_string or range_string gives the value, or NULL. */
 const char *enum_name(const header_field_info *hfi, guint64 value);
+/* A number as its field's tree item shows it, without an enum name or a unit
+ * label: decimal, signed decimal, or hex with as many digits as its bits need
+ * (dissgen_text.cpp). */
+void append_number(dg_text *out, const dg_node *n, guint64 value);
 
 /* The summary of container n, in st->text (valid until the next summary). */
 const char *summary_text(const dg_state *st, const dg_node *n);

@@ -34,6 +34,20 @@ const char *enum_name(const header_field_info *hfi, guint64 value)
     return try_val_to_str((guint32)value, (const value_string *)hfi->strings);
 }
 
+void append_number(dg_text *out, const dg_node *n, guint64 value)
+{
+    if (n->show == DG_SHOW_DEC) {
+        append_dec(out, value);
+    } else if (n->show == DG_SHOW_INT) {
+        char buf[24];
+        const guint64 v = n->bits > 0 && n->bits < 64 ? ws_sign_ext64(value, (int)n->bits) : value;
+        g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "d", (gint64)v);
+        append_str(out, buf);
+    } else {
+        append_hex(out, value, (n->bits + 3) / 4);
+    }
+}
+
 } // namespace dg_rt
 
 using namespace dg_rt;

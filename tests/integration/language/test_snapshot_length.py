@@ -72,9 +72,7 @@ class SnapshotLength(TsharkTestCase, unittest.TestCase):
         fields = ["frame.number", "frame.cap_len", "_ws.short", "_ws.expert.message", "cutt.record.body.word",
                   "cutt.status", "cutt.other"]
         with self.checks() as check:
-            for two_pass in (False, True):
-                how = "-2" if two_pass else "one pass"
-                rows = self.env.field_rows(self.capture, fields, two_pass=two_pass, aggregator="|")
+            for how, rows in self.env.field_rows_each_pass(self.capture, fields, aggregator="|"):
                 check(len(rows) == len(self.cuts) + len(self.short) + 2, "%s: %d frames" % (how, len(rows)))
                 for n, caplen in enumerate(self.cuts, 1):
                     r = rows[n]
@@ -127,9 +125,7 @@ class SnapshotInsideALeaf(TsharkTestCase, unittest.TestCase):
     def test_no_part_of_a_cut_leaf(self):
         fields = ["frame.number", "_ws.short", "_ws.expert.message"] + [f for f, _, _ in self.LEAVES]
         with self.checks() as check:
-            for two_pass in (False, True):
-                how = "-2" if two_pass else "one pass"
-                rows = self.env.field_rows(self.capture, fields, two_pass=two_pass, aggregator="|")
+            for how, rows in self.env.field_rows_each_pass(self.capture, fields, aggregator="|"):
                 for n, caplen in enumerate(self.cuts, 1):
                     r = rows[n]
                     kept = sorted(f for f, at, length in self.LEAVES if HEADER + at + length <= caplen)
@@ -177,9 +173,7 @@ class SnapshotInsideAContainer(TsharkTestCase, unittest.TestCase):
         fields = ["frame.number", "_ws.short", "_ws.expert.message", "cutc.block.kind", "cutc.block.name.text",
                   "cutc.block.inner", "cutc.tail"]
         with self.checks() as check:
-            for two_pass in (False, True):
-                how = "-2" if two_pass else "one pass"
-                rows = self.env.field_rows(self.capture, fields, two_pass=two_pass, aggregator="|")
+            for how, rows in self.env.field_rows_each_pass(self.capture, fields, aggregator="|"):
                 for n, caplen in enumerate(self.cuts, 1):
                     r = rows[n]
                     text = ["wxyz"] if caplen >= self.NAME_END else []

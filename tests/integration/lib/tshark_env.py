@@ -232,6 +232,12 @@ class TsharkEnv:
             rows[int(cols[0])] = {f: (v.split(aggregator) if v else []) for f, v in zip(fields[1:], cols[1:])}
         return (rows, p.stderr) if with_stderr else rows
 
+    def field_rows_each_pass(self, path, fields, **kwargs):
+        """("one pass", rows), then ("-2", rows): field_rows() in one pass and in two, for
+        checks that must hold in both (kwargs as for field_rows)."""
+        for two_pass in (False, True):
+            yield ("-2" if two_pass else "one pass"), self.field_rows(path, fields, two_pass=two_pass, **kwargs)
+
     def tshark(self, args, check=True, stdout=None, timeout=1800, extra_env=None):
         """Run tshark; return CompletedProcess (text stdout/stderr unless stdout is a file).
         extra_env: variables set for this run only (DISSGEN_TABLE_WALK, ...)."""
