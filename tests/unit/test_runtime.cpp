@@ -158,6 +158,29 @@ TEST(RuntimeText, HexWidthStopsAtSixteenDigits) {
     EXPECT_STREQ(t->data, "0x0000000000000001");
 }
 
+// A number as its field shows it, where no item does (cycle stream names, pairing notes):
+// hex padded to the field's width, decimal, signed with the field's sign bit.
+TEST(RuntimeText, NumbersAsTheirFieldShowsThem) {
+    auto shown = [](int show, guint bits, guint64 v) {
+        dg_node n{};
+        n.show = show;
+        n.bits = bits;
+        dg_text* t = text_new(NULL);
+        append_number(t, &n, v);
+        return std::string(t->data, t->len);
+    };
+    EXPECT_EQ(shown(DG_SHOW_HEX, 16, 0xab), "0x00ab");
+    EXPECT_EQ(shown(DG_SHOW_HEX, 12, 0xab), "0x0ab");
+    EXPECT_EQ(shown(DG_SHOW_HEX, 1, 1), "0x1");
+    EXPECT_EQ(shown(DG_SHOW_DEC, 16, 0xffff), "65535");
+    EXPECT_EQ(shown(DG_SHOW_INT, 16, 0xffff), "-1");
+    EXPECT_EQ(shown(DG_SHOW_INT, 16, 0x7fff), "32767");
+    EXPECT_EQ(shown(DG_SHOW_INT, 8, 0x80), "-128");
+    EXPECT_EQ(shown(DG_SHOW_INT, 4, 0x8), "-8");
+    EXPECT_EQ(shown(DG_SHOW_INT, 64, G_MAXUINT64), "-1");
+    EXPECT_EQ(shown(DG_SHOW_INT, 32, 0x80000000u), "-2147483648");
+}
+
 // A caller's buffer of 6 bytes, and 4 after it that no text may write.
 struct GuardedBuffer {
     char buf[6] = {0};
