@@ -166,6 +166,10 @@ struct capture_state {
     /* Transactions answered and requests let go of, for the next requests:
      * most are answered within a few messages, so these stay short. */
     struct recycled *free_transactions, *free_pending;
+    /* Over UDP, the client of the latest request sent to a group address,
+     * by its key values (pair_key -> guint64): a response sent to a group
+     * names no client of its own (with_client). One entry per key values. */
+    wmem_map_t *group_clients;
 };
 
 /* A freed transaction or pending request on a capture_state free list. */
@@ -251,6 +255,7 @@ capture_state *current_capture(void)
         capture->lost_lists = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
         capture->long_trips = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
         capture->unanswered = wmem_array_new(wmem_file_scope(), sizeof(dg_transaction *));
+        capture->group_clients = wmem_map_new(wmem_file_scope(), key_hash, key_equal);
         order_count none = {0, 0};
         wmem_array_append_one(capture->scope_answered, none);
         if (analysis && analysis->capture_new) capture->analysis = analysis->capture_new(protocol);
@@ -1152,6 +1157,41 @@ guint64 endpoint_key(const address *a, guint32 port)
     return value << 16 | (port & 0xffff);
 }
 
+/* Whether a message to `a` goes to a group of stations: an IPv4 multicast
+ * address or the limited broadcast, an IPv6 multicast address. (A subnet's
+ * broadcast address cannot be told from a station's here.) */
+gboolean group_address(const address *a)
+{
+    const guint8 *b = (const guint8 *)a->data;
+    if (a->type == AT_IPv4 && a->len == 4)
+        return (b[0] & 0xf0) == 0xe0 || (b[0] == 0xff && b[1] == 0xff && b[2] == 0xff && b[3] == 0xff);
+    return a->type == AT_IPv6 && a->len == 16 && b[0] == 0xff;
+}
+
+/* Over UDP, a response sent to a group address (PTP's Delay_Resp to
+ * 224.0.1.129) names no client: it goes to the client of the latest request
+ * with the same key values sent to a group, which `learn` (the first pass
+ * pairing a message) records. Returns NULL when no such request was seen. */
+const guint64 *group_client(const guint64 *keys, guint count, const packet_info *pinfo, gboolean request,
+                            guint64 client, gboolean learn)
+{
+    if (!group_address(&pinfo->dst)) return NULL;
+    pair_key probe = {count, (guint64 *)keys};
+    if (!request) return capture ? (const guint64 *)wmem_map_lookup(capture->group_clients, &probe) : NULL;
+    if (!learn) return NULL;
+    wmem_map_t *clients = current_capture()->group_clients;
+    guint64 *known = (guint64 *)wmem_map_lookup(clients, &probe);
+    if (!known) {
+        pair_key *key = wmem_new(wmem_file_scope(), pair_key);
+        key->count = count;
+        key->values = (guint64 *)wmem_memdup(wmem_file_scope(), keys, count * sizeof(guint64));
+        known = wmem_new(wmem_file_scope(), guint64);
+        wmem_map_insert(clients, key, known);
+    }
+    *known = client;
+    return NULL;
+}
+
 /* Over TCP or UDP, when a message's direction is known, its client is one
  * more key value: a request's sender, a response's receiver (its address,
  * and over TCP its port). Over TCP the other end is one more (a request's
@@ -1160,9 +1200,12 @@ guint64 endpoint_key(const address *a, guint32 port)
  * connections stay apart. Two clients using the same key values (Modbus/TCP
  * transaction 1 from two masters) are then paired apart, as Wireshark pairs
  * them by conversation. Over UDP the receiver is left out: a request sent
- * to a broadcast or multicast address is answered from the device's own.
+ * to a broadcast or multicast address is answered from the device's own;
+ * a response sent to a group address goes by group_client. `learn`: the
+ * message is being paired on the first pass (not read for request{...}).
  * Returns the keys to pair by, and their count in *count. */
-const guint64 *with_client(const guint64 *keys, guint *count, const packet_info *pinfo, guint8 direction)
+const guint64 *with_client(const guint64 *keys, guint *count, const packet_info *pinfo, guint8 direction,
+                           gboolean learn)
 {
     if ((pinfo->ptype != PT_TCP && pinfo->ptype != PT_UDP) ||
         (direction != DG_DIR_REQUEST && direction != DG_DIR_RESPONSE))
@@ -1171,8 +1214,13 @@ const guint64 *with_client(const guint64 *keys, guint *count, const packet_info 
     const gboolean tcp = pinfo->ptype == PT_TCP;
     guint64 *out = wmem_alloc_array(pinfo->pool, guint64, *count + 2);
     memcpy(out, keys, *count * sizeof(guint64));
-    out[(*count)++] = endpoint_key(request ? &pinfo->src : &pinfo->dst,
-                                   tcp ? (request ? pinfo->srcport : pinfo->destport) : 0);
+    guint64 client = endpoint_key(request ? &pinfo->src : &pinfo->dst,
+                                  tcp ? (request ? pinfo->srcport : pinfo->destport) : 0);
+    if (!tcp) {
+        const guint64 *group = group_client(keys, *count, pinfo, request, client, learn);
+        if (group) client = *group;
+    }
+    out[(*count)++] = client;
     if (tcp)
         out[(*count)++] = endpoint_key(request ? &pinfo->dst : &pinfo->src, request ? pinfo->destport : pinfo->srcport);
     return out;
@@ -1186,7 +1234,7 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *, tvbuff_t *tvb, p
 {
     /* A message cut short before its first key field answers and asks nothing. */
     if (key_count == 0) return NULL;
-    keys = with_client(keys, &key_count, pinfo, direction);
+    keys = with_client(keys, &key_count, pinfo, direction, !PINFO_FD_VISITED(pinfo));
     kept *k = capture ? record_of(capture, pinfo, message, FALSE) : NULL;
     const dg_transaction *fresh = NULL;
     if (!k || !k->role) {
@@ -1206,7 +1254,7 @@ const dg_request_values *dg_pairing_request_of(const guint64 *keys, guint key_co
                                                const packet_info *pinfo, guint8 direction)
 {
     if (!capture || key_count == 0) return NULL;
-    keys = with_client(keys, &key_count, pinfo, direction);
+    keys = with_client(keys, &key_count, pinfo, direction, FALSE);
     pair_key probe = {key_count, (guint64 *)keys};
     const key_entry *e = (const key_entry *)wmem_map_lookup(capture->keys, &probe);
     if (!e) return NULL;

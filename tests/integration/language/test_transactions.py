@@ -14,7 +14,8 @@ is still in flight. A protocol whose only key is a computed value (its walk read
 still tells a message sent again with other bytes from a duplicate by the message's bytes.
 A request overtaken by the answers to 16 later requests still waits, by 17 it is lost; only
 requests on its own connection count. Over TCP the connection is the client: requests a server
-sends from its own port on two connections, with the same key, are paired apart.
+sends from its own port on two connections, with the same key, are paired apart. Over UDP a
+response sent to a group address answers the latest request with its key sent to a group.
 Needs no corpus.
 """
 
@@ -57,15 +58,19 @@ PAIRS = {3: 2, 6: 5, 9: 8, 10: 7, 14: 13}
 LOST = {4: 5, 15: 17}  # lost request: the frame that proves it
 
 
-def frame(direction, transaction, unit, n, client_port=40000, client=CLIENT):
-    payload = struct.pack(">HBBI", transaction, unit, 3, n)
-    sport, dport = (client_port, PORT) if direction == "request" else (PORT, client_port)
-    src, dst = (client, SERVER) if direction == "request" else (SERVER, client)
+def udp_frame(src, dst, sport, dport, payload):
+    """An Ethernet frame of an IPv4 UDP datagram (the MAC addresses are not read)."""
     u = struct.pack("!HHHH", sport, dport, 8 + len(payload), 0) + payload
     ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src, dst)
     ip = ip[:10] + struct.pack("!H", pcapgen.ip_checksum(ip)) + ip[12:]
-    macs = b"\x02\x00\x00\x00\x00\x02\x02\x00\x00\x00\x00\x01"
-    return macs + b"\x08\x00" + ip + u
+    return b"\x02\x00\x00\x00\x00\x02\x02\x00\x00\x00\x00\x01\x08\x00" + ip + u
+
+
+def frame(direction, transaction, unit, n, client_port=40000, client=CLIENT):
+    payload = struct.pack(">HBBI", transaction, unit, 3, n)
+    if direction == "request":
+        return udp_frame(client, SERVER, client_port, PORT, payload)
+    return udp_frame(SERVER, client, PORT, client_port, payload)
 
 
 def write_frames(path, frames):
@@ -324,12 +329,8 @@ class TestRequestRole(TsharkTestCase, unittest.TestCase):
     @staticmethod
     def message(from_server, sport, dport, transaction, kind, n):
         head = struct.pack(">HB", transaction, 0) if kind is None else struct.pack(">HBB", transaction, 1, kind)
-        payload = head + struct.pack(">I", n)
-        u = struct.pack("!HHHH", sport, dport, 8 + len(payload), 0) + payload
         src, dst = (SERVER, CLIENT) if from_server else (CLIENT, SERVER)
-        ip = struct.pack("!BBHHHBBH4s4s", 0x45, 0, 20 + len(u), 0, 0x4000, 64, 17, 0, src, dst)
-        ip = ip[:10] + struct.pack("!H", pcapgen.ip_checksum(ip)) + ip[12:]
-        return b"\x02\x00\x00\x00\x00\x02\x02\x00\x00\x00\x00\x01\x08\x00" + ip + u
+        return udp_frame(src, dst, sport, dport, head + struct.pack(">I", n))
 
     def test_the_message_says_which_it_is(self):
         path = self.env.path("request_role.pcap")
@@ -349,6 +350,52 @@ class TestRequestRole(TsharkTestCase, unittest.TestCase):
                 check(asked == want, "%s: request{Number} %s, expected %s" % (mode, asked, want))
                 missed = sorted(n for n, r in rows.items() if r["txnp.expert.no_request_context"])
                 check(not missed, "%s: no 'request not known' note (%s)" % (mode, missed))
+
+
+class TestGroupAddressed(TsharkTestCase, unittest.TestCase):
+    """A response sent to a group address (an IPv4 multicast or the limited broadcast) names
+    no client: it answers the latest request with its key values sent to a group, whoever
+    sent it, as PTP's Delay_Resp (to 224.0.1.129) answers a slave's Delay_Req. Two clients
+    asking in turn are each answered; request{Number} reads the request it answers."""
+
+    A, B, MASTER = CLIENT, b"\x0a\x00\x00\x03", SERVER
+    GROUP, BROADCAST = b"\xe0\x00\x01\x81", b"\xff\xff\xff\xff"
+    # (ms, source, destination, transaction, kind): every message on the hooked port both ways
+    CAPTURE = [(0, A, GROUP, 1, 1),          # 1: A asks the group
+               (1, MASTER, GROUP, 1, 2),     # 2: answers 1
+               (10, B, GROUP, 2, 1),         # 3: B asks
+               (11, A, GROUP, 3, 1),         # 4: A asks
+               (12, MASTER, GROUP, 3, 2),    # 5: answers 4
+               (13, MASTER, GROUP, 2, 2),    # 6: answers 3, B's
+               (20, MASTER, GROUP, 9, 2),    # 7: nobody asked: an orphan
+               (30, B, BROADCAST, 5, 1),     # 8: B asks every station
+               (31, MASTER, BROADCAST, 5, 2),  # 9: answers 8, to every station
+               (40, A, GROUP, 6, 1),         # 10: A asks the group
+               (41, MASTER, A, 6, 2)]        # 11: answers 10, to A itself
+    PAIRS = {2: 1, 5: 4, 6: 3, 9: 8, 11: 10}
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("request_role.xml", TestRequestRole.RULES, "txnp")
+
+    @staticmethod
+    def message(src, dst, transaction, kind, n):
+        return udp_frame(src, dst, PORT, PORT, struct.pack(">HBBI", transaction, 1, kind, n))
+
+    def test_a_response_to_a_group_answers_its_requests_sender(self):
+        path = self.env.path("group.pcap")
+        write_frames(path, [(ms, self.message(*m, n)) for n, (ms, *m) in enumerate(self.CAPTURE, 1)])
+        with self.checks() as check:
+            for two_pass in (True, False):
+                mode = "-2" if two_pass else "one pass"
+                rows = decode(self.env, path, two_pass, ["txnp.answer.asked"])
+                pairs = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
+                check(pairs == self.PAIRS, "%s: each response answers its request (%s)" % (mode, pairs))
+                asked = {n: r["txnp.answer.asked"] for n, r in rows.items() if r["txnp.answer.asked"]}
+                want = {n: str(m) for n, m in self.PAIRS.items()}
+                check(asked == want, "%s: request{Number} %s, expected %s" % (mode, asked, want))
+                lost = sorted(n for n, r in rows.items() if r["txnp.expert.no_response"])
+                check(not lost, "%s: no request lost (%s)" % (mode, lost))
 
 
 class TestServerRequestsOnTwoConnections(TsharkTestCase, unittest.TestCase):
