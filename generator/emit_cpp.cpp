@@ -335,6 +335,9 @@ const char* show_of(const Node& n) {
         case Display::Time: return "DG_SHOW_TIME";
         case Display::DateTime: return "DG_SHOW_DATETIME";
         case Display::Guid: return "DG_SHOW_GUID";
+        case Display::IPv6: return "DG_SHOW_IPV6";
+        case Display::Mac: return "DG_SHOW_MAC";
+        case Display::Eui64: return "DG_SHOW_EUI64";
     }
     return "DG_SHOW_HIDDEN";
 }
@@ -1139,7 +1142,7 @@ std::vector<FragmentField> fragment_fields(const Protocol& proto) {
     return out;
 }
 
-// The Wireshark type of string, stringz, ipv4, int, float, time, datetime and guid leaves.
+// The Wireshark type of string, stringz, int, float, time, datetime, guid and address leaves.
 std::optional<FieldType> typed_field_type(const Node& n) {
     unsigned bytes = value_bytes(n);
     switch (n.display) {
@@ -1150,6 +1153,9 @@ std::optional<FieldType> typed_field_type(const Node& n) {
         case Display::Time: return FieldType{"FT_RELATIVE_TIME", "BASE_NONE", 0};
         case Display::DateTime: return FieldType{"FT_ABSOLUTE_TIME", "ABSOLUTE_TIME_UTC", 0};
         case Display::Guid: return FieldType{"FT_GUID", "BASE_NONE", 0};
+        case Display::IPv6: return FieldType{"FT_IPv6", "BASE_NONE", 0};
+        case Display::Mac: return FieldType{"FT_ETHER", "BASE_NONE", 0};
+        case Display::Eui64: return FieldType{"FT_EUI64", "BASE_NONE", 0};
         case Display::Int: {
             return FieldType{"FT_INT" + std::to_string(bytes * 8), "BASE_DEC", group_mask(n)};
         }

@@ -20,6 +20,9 @@ const char* display_name(Display d) {
         case Display::Time: return "time";
         case Display::DateTime: return "datetime";
         case Display::Guid: return "guid";
+        case Display::IPv6: return "ipv6";
+        case Display::Mac: return "mac";
+        case Display::Eui64: return "eui64";
     }
     return "?";
 }
@@ -54,7 +57,8 @@ bool Node::is_compared_by_bytes() const {
     if (!is_leaf() || is_computed() || is_numeric()) return false;
     switch (display) {
         case Display::String: case Display::StringZ: case Display::Origin: case Display::Address:
-        case Display::IPv4: case Display::Guid: case Display::NonDisplay: return true;
+        case Display::IPv4: case Display::Guid: case Display::IPv6: case Display::Mac: case Display::Eui64:
+        case Display::NonDisplay: return true;
         default: return false;
     }
 }

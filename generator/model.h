@@ -22,7 +22,9 @@ enum class Display {
     // values shown as text, addresses, signed and floating-point numbers, times
     String, StringZ, IPv4, Int, Float, Time,
     // absolute dates and times (Wireshark's FT_ABSOLUTE_TIME), GUIDs (FT_GUID)
-    DateTime, Guid
+    DateTime, Guid,
+    // IPv6 addresses (FT_IPv6), MAC addresses (FT_ETHER: the vendor's name shown), EUI-64s (FT_EUI64)
+    IPv6, Mac, Eui64
 };
 
 // direction="request|response" (Any: no such attribute)

@@ -69,7 +69,9 @@ const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberd
                                                 "string",  "stringz",   "ipv4",      "int",
                                                 "float",   "time",
                                                 // absolute dates and times, GUIDs
-                                                "datetime", "guid"};
+                                                "datetime", "guid",
+                                                // addresses of fixed size
+                                                "ipv6", "mac", "eui64"};
 
 int line_of(const xmlNode* el) { return xml_line(el); }  // lines above 65534: use_start_lines
 
@@ -981,7 +983,8 @@ void Parser::parse_display(const std::string& text, int line, Node& node) {
                                       Display::NonDisplay,
                                       Display::String,  Display::StringZ,   Display::IPv4,
                                       Display::Int,     Display::Float,     Display::Time,
-                                      Display::DateTime, Display::Guid};
+                                      Display::DateTime, Display::Guid,
+                                      Display::IPv6,    Display::Mac,       Display::Eui64};
     for (size_t i = 0; i < kDisplayNames.size(); ++i) {
         if (text == kDisplayNames[i]) {
             node.display = kValues[i];

@@ -27,11 +27,21 @@ std::string at_line(const Node& n) {
     return " (line " + std::to_string(n.line) + (n.group_use.empty() ? "" : ", " + n.group_use) + ")";
 }
 
+// The one size of an address display (Wireshark's item of that type takes no other).
+unsigned fixed_display_bytes(Display d) {
+    switch (d) {
+        case Display::IPv4: return 4;
+        case Display::Mac: return 6;
+        case Display::Eui64: return 8;
+        default: return 16;  // guid, ipv6
+    }
+}
+
 // Displays that show whole bytes and never join a bit group.
 bool is_byte_display(Display d) {
     return d == Display::Origin || d == Display::Address || d == Display::String || d == Display::StringZ ||
            d == Display::IPv4 || d == Display::Float || d == Display::Time || d == Display::DateTime ||
-           d == Display::Guid;
+           d == Display::Guid || d == Display::IPv6 || d == Display::Mac || d == Display::Eui64;
 }
 
 // The repeated node around t (t itself included) that does not hold
@@ -1565,10 +1575,13 @@ void Validator::check_string_display(Node& n) {
                 diags_.error(n.line, shown + " display needs whole bytes; " + quote(n) + " is " +
                                          std::to_string(n.fixed_bits) + " bits");
             break;
-        case Display::IPv4:
-            if (!n.has_fixed_length() || n.fixed_bits != 32)
-                diags_.error(n.line, "ipv4 display needs a length of 4byte; " + quote(n) + " has another length");
+        case Display::IPv4: case Display::Guid: case Display::IPv6: case Display::Mac: case Display::Eui64: {
+            const unsigned bytes = fixed_display_bytes(n.display);
+            if (!n.has_fixed_length() || n.fixed_bits != bytes * 8)
+                diags_.error(n.line, shown + " display needs a length of " + std::to_string(bytes) + "byte; " +
+                                         quote(n) + " has another length");
             break;
+        }
         case Display::Float:
             if (!n.has_fixed_length() || (n.fixed_bits != 32 && n.fixed_bits != 64))
                 diags_.error(n.line, "float display needs a length of 4byte or 8byte (IEEE 754 single or double); " +
@@ -1580,10 +1593,6 @@ void Validator::check_string_display(Node& n) {
                                          std::to_string(n.fixed_bits) + " bits");
             break;
         case Display::DateTime: check_datetime_length(n); break;
-        case Display::Guid:
-            if (!n.has_fixed_length() || n.fixed_bits != 128)
-                diags_.error(n.line, "guid display needs a length of 16byte; " + quote(n) + " has another length");
-            break;
         default: break;
     }
 }

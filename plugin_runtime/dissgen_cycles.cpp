@@ -491,9 +491,9 @@ figures figures_of(const cycle *c)
 }
 
 /* A field compared by its bytes: text in quotes up to its first NUL
- * (non-printable characters escaped), an IPv4 address dotted as its item
+ * (non-printable characters escaped), an IPv4 or IPv6 address as its item
  * shows it, other bytes in hex separated by colons, in capture order (a MAC
- * address, a GUID, raw bytes). */
+ * address, an EUI-64, a GUID, raw bytes). */
 void append_bytes(GString *t, const dg_node *n, const guint8 *b, guint32 length)
 {
     if (n->show == DG_SHOW_STRING || n->show == DG_SHOW_STRINGZ) {
@@ -509,6 +509,14 @@ void append_bytes(GString *t, const dg_node *n, const guint8 *b, guint32 length)
         return;
     }
     g_string_append_printf(t, "%s ", n->name);
+    if (n->show == DG_SHOW_IPV6 && length == 16) {
+        address a;
+        set_address(&a, AT_IPv6, 16, b);
+        char *shown = address_to_str(NULL, &a);
+        g_string_append(t, shown);
+        wmem_free(NULL, shown);
+        return;
+    }
     if (n->show == DG_SHOW_IPV4) { /* its item reads it in the node's byte order */
         const gboolean little = (n->flags & DG_LITTLE) != 0;
         for (guint32 i = 0; i < length; i++) g_string_append_printf(t, i ? ".%u" : "%u", b[little ? length - 1 - i : i]);

@@ -619,7 +619,7 @@ static inline guint item_encoding(const dg_node *n)
 {
     switch (n->show) {
     case DG_SHOW_STRING: case DG_SHOW_STRINGZ: return n->extra ? n->extra->encoding : ENC_UTF_8;
-    case DG_SHOW_IPV4: case DG_SHOW_FLOAT: case DG_SHOW_GUID: return encoding_of(n);
+    case DG_SHOW_IPV4: case DG_SHOW_FLOAT: case DG_SHOW_GUID: case DG_SHOW_EUI64: return encoding_of(n);
     case DG_SHOW_DATETIME: return encoding_of(n) | (n->extra ? n->extra->time_encoding : ENC_TIME_SECS_NSECS);
     default: return ENC_NA;
     }

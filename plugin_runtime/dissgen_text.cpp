@@ -77,8 +77,9 @@ nstime_t datetime_at(const dg_state *st, const dg_node *n, gint offset, gint len
     return t;
 }
 
-/* The values of string, stringz, ipv4, int, float, time, datetime and guid
- * leaves, for summaries and the Info column (as the tree item shows them). */
+/* The values of string, stringz, int, float, time, datetime, guid and
+ * address leaves, for summaries and the Info column (as the tree item shows
+ * them; a MAC address without its vendor's name, as tshark's fields). */
 void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
 {
     const dg_node *n = s->node;
@@ -120,6 +121,17 @@ void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
         e_guid_t guid;
         tvb_get_guid(st->tvb, s->offset, &guid, encoding_of(n));
         append_str(out, guid_to_str(st->pinfo->pool, &guid));
+        return;
+    }
+    case DG_SHOW_IPV6: append_str(out, tvb_ip6_to_str(st->pinfo->pool, st->tvb, s->offset)); return;
+    case DG_SHOW_MAC: append_str(out, tvb_ether_to_str(st->pinfo->pool, st->tvb, s->offset)); return;
+    case DG_SHOW_EUI64: {
+        /* its item reads it in the node's byte order */
+        const guint64 v = tvb_get_guint64(st->tvb, s->offset, encoding_of(n));
+        for (int shift = 56; shift >= 0; shift -= 8) {
+            g_snprintf(buf, sizeof buf, shift == 56 ? "%02x" : ":%02x", (unsigned)(v >> shift) & 0xff);
+            append_str(out, buf);
+        }
         return;
     }
     default: return;
@@ -189,7 +201,8 @@ void append_bare_value(const dg_state *st, dg_text *out, const dg_slot *s)
         if (s->length > 0) append_str(out, tvb_bytes_to_str_punct(pool, st->tvb, s->offset, s->length, ' '));
         return;
     case DG_SHOW_STRING: case DG_SHOW_STRINGZ: case DG_SHOW_IPV4: case DG_SHOW_INT: case DG_SHOW_FLOAT:
-    case DG_SHOW_TIME: case DG_SHOW_DATETIME: case DG_SHOW_GUID:
+    case DG_SHOW_TIME: case DG_SHOW_DATETIME: case DG_SHOW_GUID: case DG_SHOW_IPV6: case DG_SHOW_MAC:
+    case DG_SHOW_EUI64:
         append_typed_value(st, out, s);
         return;
     default:

@@ -133,6 +133,7 @@ TESTS = {
     "esi": unit("Esi*:Files/EsiErr.*:Design.*:Eni.*:Files/NetworkErr.*:BusTables.*:ManualBus.*:-*Golden*"),
     "typed_values": integration("test_typed_values.py"),
     "dates_guids_shared_names": integration("test_dates_guids_shared_names.py"),
+    "addresses": integration("test_addresses.py"),
     "info_column": integration("test_info_column.py"),
     "empty_summaries": integration("test_info_column.py", "EmptySummaries.test_nothing_where_nothing_is_summarised"),
     "summary_across_repeats": integration("test_info_column.py", "SummaryAcrossRepeats.test_last_value_of_the_instance"),

@@ -54,12 +54,36 @@ TEST(DatesAndGuids, WrongLengthsAreErrorsOnTheirLine) {
         {"length=\"rest\" displaytype=\"datetime\"", "datetime display with unit 's+ns' needs a length of 8byte"},
         {"length=\"15byte\" displaytype=\"guid\"", "guid display needs a length of 16byte"},
         {"length=\"rest\" displaytype=\"guid\"", "guid display needs a length of 16byte"},
+        {"length=\"4byte\" displaytype=\"ipv6\"", "ipv6 display needs a length of 16byte"},
+        {"length=\"8byte\" displaytype=\"mac\"", "mac display needs a length of 6byte"},
+        {"length=\"rest\" displaytype=\"mac\"", "mac display needs a length of 6byte"},
+        {"length=\"6byte\" displaytype=\"eui64\"", "eui64 display needs a length of 8byte"},
     };
     for (const Case& c : cases) {
         Front f = front_end(rules("  <node name=\"k\" length=\"1byte\"/>\n  <node name=\"v\" " + std::string(c.node) + "/>\n"));
         EXPECT_FALSE(f.ok()) << c.node;
         EXPECT_TRUE(contains(f.messages(), "rules.xml:3: error: " + std::string(c.message))) << f.messages();
     }
+}
+
+// Addresses of one size: Wireshark's address types, no bitmask, compared by their bytes.
+TEST(DatesAndGuids, AddressesAreWiresharksAddressTypes) {
+    Front f = front_end(rules("  <node name=\"v6\" length=\"16byte\" displaytype=\"ipv6\"/>\n"
+                              "  <node name=\"mac\" length=\"6byte\" displaytype=\"mac\"/>\n"
+                              "  <node name=\"eui\" length=\"64bit\" displaytype=\"eui64\" byteorder=\"little\"/>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const Protocol& p = *f.proto;
+    const std::pair<const char*, const char*> types[] = {{"v6", "FT_IPv6"}, {"mac", "FT_ETHER"}, {"eui", "FT_EUI64"}};
+    for (const auto& [name, type] : types) {
+        EXPECT_EQ(field_type(*find(p, name)).type, type) << name;
+        EXPECT_EQ(field_type(*find(p, name)).display, "BASE_NONE") << name;
+        EXPECT_EQ(field_type(*find(p, name)).mask, 0u) << name;
+        EXPECT_FALSE(find(p, name)->is_numeric()) << name;
+        EXPECT_TRUE(find(p, name)->is_compared_by_bytes()) << name;
+    }
+    std::string code = emit_cpp(p, "t.xml");
+    for (const char* show : {"DG_SHOW_IPV6", "DG_SHOW_MAC", "DG_SHOW_EUI64"})
+        EXPECT_EQ(count_of(code, show), 1u) << show << "\n" << code;
 }
 
 TEST(DatesAndGuids, EightByteSecondsAndUnitsOfTimeStayAsTheyWere) {
