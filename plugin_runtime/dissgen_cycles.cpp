@@ -517,6 +517,10 @@ void append_bytes(GString *t, const dg_node *n, const guint8 *b, guint32 length)
         wmem_free(NULL, shown);
         return;
     }
+    if (n->show == DG_SHOW_EUI64 && (n->flags & DG_LITTLE) && length == 8) { /* as its item reads it */
+        for (guint32 i = 0; i < length; i++) g_string_append_printf(t, i ? ":%02x" : "%02x", b[length - 1 - i]);
+        return;
+    }
     if (n->show == DG_SHOW_IPV4) { /* its item reads it in the node's byte order */
         const gboolean little = (n->flags & DG_LITTLE) != 0;
         for (guint32 i = 0; i < length; i++) g_string_append_printf(t, i ? ".%u" : "%u", b[little ? length - 1 - i : i]);

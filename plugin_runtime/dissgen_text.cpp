@@ -127,7 +127,7 @@ void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
     case DG_SHOW_MAC: append_str(out, tvb_ether_to_str(st->pinfo->pool, st->tvb, s->offset)); return;
     case DG_SHOW_EUI64: {
         /* its item reads it in the node's byte order */
-        const guint64 v = tvb_get_guint64(st->tvb, s->offset, encoding_of(n));
+        const guint64 v = read_uint(st->tvb, s->offset, 8, encoding_of(n));
         for (int shift = 56; shift >= 0; shift -= 8) {
             g_snprintf(buf, sizeof buf, shift == 56 ? "%02x" : ":%02x", (unsigned)(v >> shift) & 0xff);
             append_str(out, buf);
