@@ -168,7 +168,8 @@ struct capture_state {
     struct recycled *free_transactions, *free_pending;
     /* Over UDP, the client of the latest request sent to a group address,
      * by its key values (pair_key -> guint64): a response sent to a group
-     * names no client of its own (with_client). One entry per key values. */
+     * names no client of its own (with_client). Kept while that request's
+     * key entry is (forget_group_client). */
     wmem_map_t *group_clients;
 };
 
@@ -681,6 +682,64 @@ void forget_requests(capture_state *c)
     }
 }
 
+/* Whether a message of this transport and direction is paired with its
+ * client as one more key value (with_client): over TCP or UDP, when its
+ * direction is known. */
+gboolean keyed_by_client(const packet_info *pinfo, guint8 direction)
+{
+    return (pinfo->ptype == PT_TCP || pinfo->ptype == PT_UDP) &&
+           (direction == DG_DIR_REQUEST || direction == DG_DIR_RESPONSE);
+}
+
+/* Whether a message to `a` goes to a group of stations: an IPv4 multicast
+ * address or the limited broadcast, an IPv6 multicast address. (A subnet's
+ * broadcast address cannot be told from a station's here.) */
+gboolean group_address(const address *a)
+{
+    const guint8 *b = (const guint8 *)a->data;
+    if (a->type == AT_IPv4 && a->len == 4)
+        return (b[0] & 0xf0) == 0xe0 || (b[0] == 0xff && b[1] == 0xff && b[2] == 0xff && b[3] == 0xff);
+    return a->type == AT_IPv6 && a->len == 16 && b[0] == 0xff;
+}
+
+/* A new request over UDP sent to a group address: its client (its keys'
+ * last value, with_client) becomes the one a response sent to a group with
+ * the same key values goes to (with_client). */
+void remember_group_client(capture_state *c, const packet_info *pinfo, guint8 direction, const guint64 *keys,
+                           guint key_count)
+{
+    if (pinfo->ptype != PT_UDP || !keyed_by_client(pinfo, direction) || !group_address(&pinfo->dst)) return;
+    pair_key probe = {key_count - 1, (guint64 *)keys};
+    guint64 *client = (guint64 *)wmem_map_lookup(c->group_clients, &probe);
+    if (!client) {
+        pair_key *key = wmem_new(wmem_file_scope(), pair_key);
+        key->count = key_count - 1;
+        key->values = (guint64 *)wmem_memdup(wmem_file_scope(), keys, key->count * sizeof(guint64));
+        client = wmem_new(wmem_file_scope(), guint64);
+        wmem_map_insert(c->group_clients, key, client);
+    }
+    *client = keys[key_count - 1];
+}
+
+/* The group client remembered for the key values of `key` (with its client
+ * last) is let go of with the key's entry, unless a later request's client
+ * took its place: the map holds no more than the key entries. */
+void forget_group_client(capture_state *c, const pair_key *key)
+{
+    if (key->count == 0) return;
+    pair_key probe = {key->count - 1, key->values};
+    const void *stored;
+    void *client;
+    if (!wmem_map_lookup_extended(c->group_clients, &probe, &stored, &client) ||
+        *(const guint64 *)client != key->values[key->count - 1])
+        return;
+    wmem_map_remove(c->group_clients, &probe);
+    pair_key *kept_key = (pair_key *)(void *)stored;
+    wmem_free(wmem_file_scope(), kept_key->values);
+    wmem_free(wmem_file_scope(), kept_key);
+    wmem_free(wmem_file_scope(), client);
+}
+
 /* Removes e and what it keeps. Its requests are given up: its last message,
  * and so each of them, is long ago. */
 void forget_key(capture_state *c, key_entry *e)
@@ -691,6 +750,7 @@ void forget_key(capture_state *c, key_entry *e)
         release(c, q);
     }
     unlink_entry(c, e);
+    forget_group_client(c, e->key);
     wmem_map_remove(c->keys, e->key);
     wmem_free(wmem_file_scope(), e->key->values);
     wmem_free(wmem_file_scope(), e->key);
@@ -951,8 +1011,10 @@ dg_transaction *first_pass(capture_state *c, kept *k, tvbuff_t *tvb, packet_info
         ;
     else if (orphan)
         k->role = DG_ROLE_ORPHAN;
-    else
+    else {
         t = new_request(c, e, k, tvb, pinfo, length, keys[0], direction == DG_DIR_ANY);
+        remember_group_client(c, pinfo, transport_direction, keys, key_count);
+    }
     remember_last(c, e, tvb, pinfo, length, k->role);
     e->last_record = k;
     with_lost(c, k);
@@ -1157,41 +1219,6 @@ guint64 endpoint_key(const address *a, guint32 port)
     return value << 16 | (port & 0xffff);
 }
 
-/* Whether a message to `a` goes to a group of stations: an IPv4 multicast
- * address or the limited broadcast, an IPv6 multicast address. (A subnet's
- * broadcast address cannot be told from a station's here.) */
-gboolean group_address(const address *a)
-{
-    const guint8 *b = (const guint8 *)a->data;
-    if (a->type == AT_IPv4 && a->len == 4)
-        return (b[0] & 0xf0) == 0xe0 || (b[0] == 0xff && b[1] == 0xff && b[2] == 0xff && b[3] == 0xff);
-    return a->type == AT_IPv6 && a->len == 16 && b[0] == 0xff;
-}
-
-/* Over UDP, a response sent to a group address (PTP's Delay_Resp to
- * 224.0.1.129) names no client: it goes to the client of the latest request
- * with the same key values sent to a group, which `learn` (the first pass
- * pairing a message) records. Returns NULL when no such request was seen. */
-const guint64 *group_client(const guint64 *keys, guint count, const packet_info *pinfo, gboolean request,
-                            guint64 client, gboolean learn)
-{
-    if (!group_address(&pinfo->dst)) return NULL;
-    pair_key probe = {count, (guint64 *)keys};
-    if (!request) return capture ? (const guint64 *)wmem_map_lookup(capture->group_clients, &probe) : NULL;
-    if (!learn) return NULL;
-    wmem_map_t *clients = current_capture()->group_clients;
-    guint64 *known = (guint64 *)wmem_map_lookup(clients, &probe);
-    if (!known) {
-        pair_key *key = wmem_new(wmem_file_scope(), pair_key);
-        key->count = count;
-        key->values = (guint64 *)wmem_memdup(wmem_file_scope(), keys, count * sizeof(guint64));
-        known = wmem_new(wmem_file_scope(), guint64);
-        wmem_map_insert(clients, key, known);
-    }
-    *known = client;
-    return NULL;
-}
-
 /* Over TCP or UDP, when a message's direction is known, its client is one
  * more key value: a request's sender, a response's receiver (its address,
  * and over TCP its port). Over TCP the other end is one more (a request's
@@ -1201,23 +1228,22 @@ const guint64 *group_client(const guint64 *keys, guint count, const packet_info 
  * transaction 1 from two masters) are then paired apart, as Wireshark pairs
  * them by conversation. Over UDP the receiver is left out: a request sent
  * to a broadcast or multicast address is answered from the device's own;
- * a response sent to a group address goes by group_client. `learn`: the
- * message is being paired on the first pass (not read for request{...}).
+ * a response sent to a group address names no client: it goes to the
+ * client of the latest request with the same key values sent to a group
+ * (remember_group_client; PTP's Delay_Resp to 224.0.1.129).
  * Returns the keys to pair by, and their count in *count. */
-const guint64 *with_client(const guint64 *keys, guint *count, const packet_info *pinfo, guint8 direction,
-                           gboolean learn)
+const guint64 *with_client(const guint64 *keys, guint *count, const packet_info *pinfo, guint8 direction)
 {
-    if ((pinfo->ptype != PT_TCP && pinfo->ptype != PT_UDP) ||
-        (direction != DG_DIR_REQUEST && direction != DG_DIR_RESPONSE))
-        return keys;
+    if (!keyed_by_client(pinfo, direction)) return keys;
     const gboolean request = direction == DG_DIR_REQUEST;
     const gboolean tcp = pinfo->ptype == PT_TCP;
     guint64 *out = wmem_alloc_array(pinfo->pool, guint64, *count + 2);
     memcpy(out, keys, *count * sizeof(guint64));
     guint64 client = endpoint_key(request ? &pinfo->src : &pinfo->dst,
                                   tcp ? (request ? pinfo->srcport : pinfo->destport) : 0);
-    if (!tcp) {
-        const guint64 *group = group_client(keys, *count, pinfo, request, client, learn);
+    if (!tcp && !request && capture && group_address(&pinfo->dst)) {
+        pair_key probe = {*count, (guint64 *)keys};
+        const guint64 *group = (const guint64 *)wmem_map_lookup(capture->group_clients, &probe);
         if (group) client = *group;
     }
     out[(*count)++] = client;
@@ -1234,7 +1260,7 @@ const dg_frame_pairing *dg_pairing_dissect(const dg_protocol *, tvbuff_t *tvb, p
 {
     /* A message cut short before its first key field answers and asks nothing. */
     if (key_count == 0) return NULL;
-    keys = with_client(keys, &key_count, pinfo, direction, !PINFO_FD_VISITED(pinfo));
+    keys = with_client(keys, &key_count, pinfo, direction);
     kept *k = capture ? record_of(capture, pinfo, message, FALSE) : NULL;
     const dg_transaction *fresh = NULL;
     if (!k || !k->role) {
@@ -1254,7 +1280,7 @@ const dg_request_values *dg_pairing_request_of(const guint64 *keys, guint key_co
                                                const packet_info *pinfo, guint8 direction)
 {
     if (!capture || key_count == 0) return NULL;
-    keys = with_client(keys, &key_count, pinfo, direction, FALSE);
+    keys = with_client(keys, &key_count, pinfo, direction);
     pair_key probe = {key_count, (guint64 *)keys};
     const key_entry *e = (const key_entry *)wmem_map_lookup(capture->keys, &probe);
     if (!e) return NULL;

@@ -77,7 +77,7 @@ def write_frames(path, frames):
     """A pcap file of (ms, bytes), readable by the unprivileged tshark."""
     out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
     for ms, data in frames:
-        out.append(struct.pack("<IIII", 1_700_000_000, ms * 1000, len(data), len(data)) + data)
+        out.append(struct.pack("<IIII", 1_700_000_000 + ms // 1000, ms % 1000 * 1000, len(data), len(data)) + data)
     with open(path, "wb") as fh:
         fh.write(b"".join(out))
     os.chmod(path, 0o644)
@@ -374,6 +374,15 @@ class TestGroupAddressed(TsharkTestCase, unittest.TestCase):
                (41, MASTER, A, 6, 2)]        # 11: answers 10, to A itself
     PAIRS = {2: 1, 5: 4, 6: 3, 9: 8, 11: 10}
 
+    # A's request is forgotten (10 timeouts old) after B asked with the same key: B's
+    # client stays the one a group-addressed answer goes to.
+    FORGOTTEN = [(100, A, GROUP, 7, 1),          # 1: A asks; never answered: lost
+                 (10000, B, GROUP, 7, 1),        # 2: B asks with the same key
+                 (10200, A, MASTER, 8, 1),       # 3
+                 (10300, MASTER, A, 8, 2),       # 4: answers 3; A's key (1) is forgotten here
+                 (10400, MASTER, GROUP, 7, 2)]   # 5: answers 2, B's
+    FORGOTTEN_PAIRS = {4: 3, 5: 2}
+
     @classmethod
     def prepare(cls):
         cls.install_text("request_role.xml", TestRequestRole.RULES, "txnp")
@@ -396,6 +405,16 @@ class TestGroupAddressed(TsharkTestCase, unittest.TestCase):
                 check(asked == want, "%s: request{Number} %s, expected %s" % (mode, asked, want))
                 lost = sorted(n for n, r in rows.items() if r["txnp.expert.no_response"])
                 check(not lost, "%s: no request lost (%s)" % (mode, lost))
+
+    def test_a_forgotten_request_leaves_a_later_clients_answer_alone(self):
+        path = self.env.path("group-forgotten.pcap")
+        write_frames(path, [(ms, self.message(*m, n)) for n, (ms, *m) in enumerate(self.FORGOTTEN, 1)])
+        with self.checks() as check:
+            for two_pass in (True, False):
+                rows = decode(self.env, path, two_pass)
+                pairs = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
+                check(pairs == self.FORGOTTEN_PAIRS, "%s: each response answers its request (%s)" % (
+                    "-2" if two_pass else "one pass", pairs))
 
 
 class TestServerRequestsOnTwoConnections(TsharkTestCase, unittest.TestCase):
