@@ -517,16 +517,16 @@ void append_bytes(GString *t, const dg_node *n, const guint8 *b, guint32 length)
         wmem_free(NULL, shown);
         return;
     }
-    if (n->show == DG_SHOW_EUI64 && (n->flags & DG_LITTLE) && length == 8) { /* as its item reads it */
-        for (guint32 i = 0; i < length; i++) g_string_append_printf(t, i ? ":%02x" : "%02x", b[length - 1 - i]);
-        return;
+    /* an IPv4 address or an EUI-64 in the node's byte order, as its item reads it */
+    const gboolean ipv4 = n->show == DG_SHOW_IPV4;
+    const gboolean reversed = (ipv4 || n->show == DG_SHOW_EUI64) && (n->flags & DG_LITTLE);
+    for (guint32 i = 0; i < length; i++) {
+        const guint8 byte = b[reversed ? length - 1 - i : i];
+        if (ipv4)
+            g_string_append_printf(t, i ? ".%u" : "%u", byte);
+        else
+            g_string_append_printf(t, i ? ":%02x" : "%02x", byte);
     }
-    if (n->show == DG_SHOW_IPV4) { /* its item reads it in the node's byte order */
-        const gboolean little = (n->flags & DG_LITTLE) != 0;
-        for (guint32 i = 0; i < length; i++) g_string_append_printf(t, i ? ".%u" : "%u", b[little ? length - 1 - i : i]);
-        return;
-    }
-    for (guint32 i = 0; i < length; i++) g_string_append_printf(t, i ? ":%02x" : "%02x", b[i]);
 }
 
 /* The name an enum signature field's <enum> gives its value, or NULL. */
