@@ -871,7 +871,7 @@ void Emitter::cycles_tables() {
     o_ << "\n/* Periodic traffic (<cycles>, line " << c.line
        << "): each <only>/<never> test's ranges; window, sequence bits, sender in the signature, "
           "<only> tests, sequence step (0: learned), losses told by the period, the count's wrap (0: at 2^bits), "
-          "requests only. */\n";
+          "requests only, the most lost in one gap (0: the default). */\n";
     if (!tests.empty())
         o_ << c_array("static const dg_cycle_test " + f + "_cycle_tests", tests)
            << c_array("static const dg_range " + f + "_cycle_ranges", ranges);
@@ -880,7 +880,7 @@ void Emitter::cycles_tables() {
        << ", " << c.only.size() << ", "
        << (tests.empty() ? std::string("NULL") : f + "_cycle_tests") << ", "
        << (tests.empty() ? std::string("NULL") : f + "_cycle_ranges") << ", " << c.sequence_step << "u, "
-       << (c.lost_by_period ? 1 : 0) << ", " << c.sequence_wrap << "u, " << (c.requests_only ? 1 : 0) << " };\n";
+       << (c.lost_by_period ? 1 : 0) << ", " << c.sequence_wrap << "u, " << (c.requests_only ? 1 : 0) << ", " << c.max_lost << "u };\n";
 }
 
 // <request> (<unanswered>): the field's slot and the values that make a

@@ -382,6 +382,10 @@ struct Pairing {
 
 // --- periodic traffic (<cycles> in <root>) ---
 
+// The runtime counts a gap's lost messages in 32 bits, the top value meaning
+// "the count went back": the largest maxlost="N".
+constexpr uint64_t kMostLostInAGap = 0xfffffffeu;
+
 // Messages with the same signature values (and sender) are a stream; a
 // stream whose messages come at a regular period is a cycle.
 struct Cycles {
@@ -398,6 +402,7 @@ struct Cycles {
     bool lost_by_period = false;           // lost="period": a cycle's gap of n periods is n - 1 lost
     int lost_line = 0;                     // the line of lost="sequence" (0: not given)
     bool requests_only = false;            // requests="yes": only the pairing's requests, with round trips
+    uint64_t max_lost = 0;                 // maxlost="N": a gap of more lost is a restart (0: not given)
 };
 
 struct Protocol {

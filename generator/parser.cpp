@@ -59,7 +59,7 @@ const std::vector<std::string> kLearnKeyAttributes = {"value", "lookup", "span",
 const std::vector<std::string> kPairingAttributes = {"timeout", "analysis", "order"};
 const std::vector<std::string> kKeyAttributes = {"field"};
 const std::vector<std::string> kInputAttributes = {"name", "field"};
-const std::vector<std::string> kCyclesAttributes = {"window", "sender", "lost", "requests"};
+const std::vector<std::string> kCyclesAttributes = {"window", "sender", "lost", "requests", "maxlost"};
 const std::vector<std::string> kCycleFieldAttributes = {"field"};
 const std::vector<std::string> kSequenceAttributes = {"field", "bits", "step", "wrap"};
 const std::vector<std::string> kCycleTestAttributes = {"field", "in"};
@@ -603,7 +603,7 @@ void Parser::parse_pairing(xmlNode* el, Protocol& proto) {
     if (pairing.unanswered) defer(pairing.unanswered->field, el->parent, pairing.unanswered->line, "field");
 }
 
-// Periodic traffic: <cycles window="8" sender="yes" lost="sequence|period" requests="yes"><signature field="XPATH"/>...
+// Periodic traffic: <cycles window="8" sender="yes" lost="sequence|period" requests="yes" maxlost="N"><signature field="XPATH"/>...
 // [<sequence field="XPATH" bits="N"/>] [<only field="XPATH" in="LIST"/>]... [<never .../>]...</cycles>
 void Parser::parse_cycles(xmlNode* el, Protocol& proto) {
     int line = line_of(el);
@@ -649,6 +649,15 @@ void Parser::parse_cycles(xmlNode* el, Protocol& proto) {
             diags_.error(line, "bad lost '" + attrs["lost"] +
                                    "': expected sequence (the <sequence> count tells the messages lost) or period (a "
                                    "cycle's period of about n nominal periods means n - 1 messages lost)");
+    }
+    if (attrs.count("maxlost")) {
+        uint64_t n = 0;
+        if (!parse_number(attrs["maxlost"], n) || n < 1 || n > kMostLostInAGap)
+            diags_.error(line, "bad maxlost '" + attrs["maxlost"] +
+                                   "': expected the most messages counted lost in one gap, 1 to " +
+                                   std::to_string(kMostLostInAGap) + " (a bigger gap is a restart: nothing lost)");
+        else
+            cycles.max_lost = n;
     }
     for (xmlNode* c = el->children; c; c = c->next) {
         if (c->type != XML_ELEMENT_NODE) {

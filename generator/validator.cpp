@@ -1013,6 +1013,10 @@ void Validator::check_cycles() {
         diags_.error(c.line, "lost=\"period\" and the <sequence> count (line " + std::to_string(c.sequence->line) +
                                  ") would both tell the messages lost: a stream with a count is judged by its count; "
                                  "keep one");
+    if (c.max_lost && !c.sequence && !c.lost_by_period)
+        diags_.error(c.line, "maxlost=\"" + std::to_string(c.max_lost) +
+                                 "\" limits the messages counted lost, and nothing counts them here: add a "
+                                 "<sequence field=\"XPATH\"/> or lost=\"period\", or remove it");
     if (c.lost_line && !c.sequence)
         diags_.error(c.lost_line, "lost=\"sequence\" needs a <sequence field=\"XPATH\"/> in <cycles> (or "
                                   "lost=\"period\": losses told by the period)");

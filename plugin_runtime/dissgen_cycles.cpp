@@ -271,16 +271,17 @@ guint32 lost_before(guint64 advance, guint64 step, guint64 top)
 
 /* lost="period": the messages lost in a gap of `period` in a cycle whose
  * nominal period is `nominal`: the period rounded to whole nominal periods,
- * minus one; G_MAXUINT32 for a gap of more than max_gap_periods (a pause: the
- * stream stopped and came back; nothing is counted, as for a count that went
- * back). Further out, a gap in whole periods depends on ppm of clock drift. */
-const guint64 max_gap_periods = 16;
+ * minus one; G_MAXUINT32 for more than `most` lost (a pause: the stream
+ * stopped and came back; nothing is counted, as for a count that went back).
+ * By default at most 15: further out, a gap in whole periods depends on ppm
+ * of clock drift. */
+const guint32 most_lost_by_period = 15;
 
-guint32 lost_in_gap(gint64 period, guint64 nominal)
+guint32 lost_in_gap(gint64 period, guint64 nominal, guint32 most)
 {
     if (period <= 0 || !nominal) return 0;
     const guint64 periods = ((guint64)period + nominal / 2) / nominal;
-    if (periods > max_gap_periods) return G_MAXUINT32;
+    if (periods > (guint64)most + 1) return G_MAXUINT32;
     return periods >= 2 ? (guint32)(periods - 1) : 0;
 }
 
@@ -313,6 +314,8 @@ gboolean sequence_step(stream *s, const dg_cycle_input *in, const dg_cycles *cy,
             s->learned_step = advance;
         const guint64 by = step ? step : s->learned_step;
         *lost = by ? lost_before(advance, by, top) : G_MAXUINT32;
+        if (cy->max_lost && *lost != G_MAXUINT32 && *lost > cy->max_lost)
+            *lost = G_MAXUINT32; /* maxlost="N": a longer gap is a restart (a device reset, a new connection) */
     }
     s->last_sequence = count;
     s->has_sequence = TRUE;
@@ -388,7 +391,8 @@ mark *time_message(capture_state *c, const dg_cycle_input *in, const dg_frame_pa
     }
     const gboolean first = s->last_frame == 0;
     const gint64 period = first ? 0 : ns_of(&pinfo->abs_ts) - ns_of(&s->last_time);
-    if (cy->lost_by_period && s->cyc) lost = lost_in_gap(period, s->cyc->periods.median());
+    if (cy->lost_by_period && s->cyc)
+        lost = lost_in_gap(period, s->cyc->periods.median(), cy->max_lost ? cy->max_lost : most_lost_by_period);
     const gboolean went_back = lost == G_MAXUINT32;
     if (!went_back) {
         m.lost = lost;

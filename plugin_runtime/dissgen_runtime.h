@@ -330,6 +330,8 @@ typedef struct dg_cycles {
     guint8 lost_by_period; /* lost="period": a cycle's period of n nominal ones means n - 1 lost */
     guint64 sequence_wrap; /* wrap="N": the count runs 0 .. N - 1, then 0 again; 0: at 2^sequence_bits */
     guint8 requests_only;  /* requests="yes": only the pairing's requests are timed, with their round trips */
+    guint32 max_lost;      /* maxlost="N": a gap of more messages lost is a restart; 0: half the count's
+                              range (a sequence), 15 (lost="period") */
 } dg_cycles;
 
 /* A register the pairing's analysis reads, where the rule file's register map

@@ -57,7 +57,7 @@ TEST(Emit, CyclesGiveEachFieldItsRoleAndTheTestsTheirRanges) {
     const std::string code = emit_cpp(*with.proto, "rules.xml");
     EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 5, 16, DG_STREAM_ENDS_SENDER, 1, t_cycle_tests, "
                                    "t_cycle_ranges, 1u, "
-                               "0, 0u, 0 };"))
+                               "0, 0u, 0, 0u };"))
         << code;
     EXPECT_TRUE(contains(code, "{ 0x1, 0x1 }") && contains(code, "{ 0x3, 0x4 }") &&
                 contains(code, "{ 0x1, 0xffffffffffffffff }"));
@@ -68,15 +68,21 @@ TEST(Emit, CyclesGiveEachFieldItsRoleAndTheTestsTheirRanges) {
     EXPECT_FALSE(contains(emit_cpp(*without.proto, "rules.xml"), "cycle"));  // costs nothing where absent
 }
 
+// The code of a file with `cycles` (its <cycles> element, or more) before `nodes`.
+std::string code_with_cycles(const std::string& cycles, const std::string& nodes) {
+    Front f = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n  " + cycles + "\n" + nodes +
+                        "</root>\n");
+    EXPECT_TRUE(f.ok()) << cycles << ": " << f.messages();
+    return f.ok() ? emit_cpp(*f.proto, "rules.xml") : "";
+}
+
+const std::string stream_node = "  <node name=\"Stream\" length=\"2byte\" displaytype=\"numberhex\"/>\n";
+
 // The code of a file whose <cycles> counts by `sequence` (a <sequence>
 // element) over a 2-byte Stream and `count_nodes`.
 std::string code_with_sequence(const std::string& sequence, const std::string& count_nodes) {
-    Front f = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n"
-                        "  <cycles><signature field=\"node[@name='Stream']\"/>" + sequence + "</cycles>\n"
-                        "  <node name=\"Stream\" length=\"2byte\" displaytype=\"numberhex\"/>\n" + count_nodes +
-                        "</root>\n");
-    EXPECT_TRUE(f.ok()) << sequence << ": " << f.messages();
-    return f.ok() ? emit_cpp(*f.proto, "rules.xml") : "";
+    return code_with_cycles("<cycles><signature field=\"node[@name='Stream']\"/>" + sequence + "</cycles>",
+                            stream_node + count_nodes);
 }
 
 // bits="1" to bits="64": the range's ends are sequence counts too (a 1-bit toggle).
@@ -87,7 +93,7 @@ TEST(Emit, CyclesSequenceWidthsAtTheEnds) {
                                "  <node name=\"Count\" length=\"8byte\" displaytype=\"numberdec\"/>\n");
         EXPECT_TRUE(
             contains(code, "static const dg_cycles t_cycles = { 8, " + width +
-                                 ", DG_STREAM_ENDS_NONE, 0, NULL, NULL, 1u, 0, 0u, 0 };"))
+                                 ", DG_STREAM_ENDS_NONE, 0, NULL, NULL, 1u, 0, 0u, 0, 0u };"))
             << width;
     }
 }
@@ -98,7 +104,7 @@ TEST(Emit, CyclesSequenceWrap) {
     const std::string code = code_with_sequence("<sequence field=\"node[@name='Count']\" wrap=\"4000\"/>",
                                                 "  <node name=\"Count\" length=\"2byte\" displaytype=\"numberdec\"/>\n");
     EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 8, 16, DG_STREAM_ENDS_NONE, 0, NULL, NULL, "
-                             "1u, 0, 4000u, 0 };"))
+                             "1u, 0, 4000u, 0, 0u };"))
         << code;
 }
 
@@ -110,31 +116,25 @@ TEST(Emit, CyclesSequenceOfFieldLength) {
                            "  <node name=\"Size\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
                            "  <node name=\"Count\" length=\"../node[@name='Size']\" displaytype=\"numberdec\"/>\n");
     EXPECT_TRUE(contains(code, "static const dg_cycles t_cycles = { 8, 64, DG_STREAM_ENDS_NONE, 0, NULL, NULL, "
-                             "1u, 0, 0u, 0 };")) << code;
+                             "1u, 0, 0u, 0, 0u };")) << code;
 }
 
-// lost="period": the table's last flag.
-TEST(Emit, CyclesLostByPeriod) {
-    const std::string nodes = "  <node name=\"Stream\" length=\"2byte\" displaytype=\"numberhex\"/>\n</root>\n";
-    Front f = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n"
-                        "  <cycles lost=\"period\"><signature field=\"node[@name='Stream']\"/></cycles>\n" + nodes);
-    ASSERT_TRUE(f.ok()) << f.messages();
-    EXPECT_TRUE(contains(emit_cpp(*f.proto, "rules.xml"),
-                         "static const dg_cycles t_cycles = { 8, 0, DG_STREAM_ENDS_NONE, 0, NULL, NULL, 1u, 1, 0u, 0 };"))
-        << emit_cpp(*f.proto, "rules.xml");
-}
-
-// requests="yes": the table's last flag.
-TEST(Emit, CyclesOfRequestsOnly) {
-    Front f = front_end("<root name=\"T\" abbreviation=\"T\" ethertype=\"0x88b5\">\n"
-                        "  <pairing><key field=\"node[@name='Transaction']\"/></pairing>\n"
-                        "  <cycles requests=\"yes\"><signature field=\"node[@name='Stream']\"/></cycles>\n"
-                        "  <node name=\"Transaction\" length=\"2byte\" displaytype=\"numberdec\"/>\n"
-                        "  <node name=\"Stream\" length=\"2byte\" displaytype=\"numberhex\"/>\n</root>\n");
-    ASSERT_TRUE(f.ok()) << f.messages();
-    EXPECT_TRUE(contains(emit_cpp(*f.proto, "rules.xml"),
-                         "static const dg_cycles t_cycles = { 8, 0, DG_STREAM_ENDS_NONE, 0, NULL, NULL, 1u, 0, 0u, 1 };"))
-        << emit_cpp(*f.proto, "rules.xml");
+// lost="period", maxlost="N", requests="yes": their members of the table.
+TEST(Emit, CyclesLossesAndRequests) {
+    const std::string signature = "<signature field=\"node[@name='Stream']\"/>";
+    const std::string count = "  <node name=\"Count\" length=\"2byte\" displaytype=\"numberdec\"/>\n";
+    const std::string table = "static const dg_cycles t_cycles = { 8, ";
+    std::string code = code_with_cycles("<cycles lost=\"period\">" + signature + "</cycles>", stream_node);
+    EXPECT_TRUE(contains(code, table + "0, DG_STREAM_ENDS_NONE, 0, NULL, NULL, 1u, 1, 0u, 0, 0u };")) << code;
+    code = code_with_cycles("<cycles maxlost=\"4294967294\">" + signature +
+                                "<sequence field=\"node[@name='Count']\"/></cycles>",
+                            stream_node + count);
+    EXPECT_TRUE(contains(code, table + "16, DG_STREAM_ENDS_NONE, 0, NULL, NULL, 1u, 0, 0u, 0, 4294967294u };"))
+        << code;
+    code = code_with_cycles("<pairing><key field=\"node[@name='Transaction']\"/></pairing>\n"
+                            "  <cycles requests=\"yes\">" + signature + "</cycles>",
+                            "  <node name=\"Transaction\" length=\"2byte\" displaytype=\"numberdec\"/>\n" + stream_node);
+    EXPECT_TRUE(contains(code, table + "0, DG_STREAM_ENDS_NONE, 0, NULL, NULL, 1u, 0, 0u, 1, 0u };")) << code;
 }
 
 TEST(Emit, RequestRoleFromTheMessage) {

@@ -586,5 +586,85 @@ class TestLongPeriods(TsharkTestCase, unittest.TestCase):
             sorted(set(have.items()) ^ set(want.items())), len(want)))
 
 
+# --- the most messages lost in one gap --------------------------------------------------
+
+MOST_LOST_RULES = """<root name="Restarting {kind}" abbreviation="{abbreviation}" ethertype="{ethertype:#06x}">
+  <cycles {losses} maxlost="{most}">
+    <signature field="node[@name='Stream']"/>
+    {sequence}
+  </cycles>
+  <node name="Stream" length="1byte" displaytype="numberdec"/>
+  <node name="Count" length="2byte" displaytype="numberdec"/>
+</root>
+"""
+
+MOST_LOST = 10
+
+
+def restarting_capture(ethertype):
+    """Stream 1 every ms (+-3 us), its 16-bit count jumping by 11 (10 lost: maxlost, still
+    counted), by 12 (11 lost: more, a restart), to 20000 (a device reset); stream 2 every
+    2 ms, silent for 11 periods (10 lost) and then for 12 (11 lost: a pause by the period)."""
+    rng = random.Random(1011)
+    head = b"\x01\x0c\xcd\x04\0\x01\x02\0\0\0\0\x01" + struct.pack(">H", ethertype)
+    counts = list(range(12)) + list(range(22, 34)) + list(range(45, 57)) + list(range(20000, 20012))
+    packets = []
+    for i, count in enumerate(counts):
+        t = 10**9 + i * 1_000_000 + rng.randint(-3_000, 3_000)
+        packets.append((t, head + bytes([1]) + struct.pack(">H", count) + bytes(43)))
+    slot = 0
+    for i in range(36):
+        slot += 1 + (10 if i == 12 else 11 if i == 24 else 0)
+        t = 10**9 + 500_000 + slot * 2_000_000 + rng.randint(-3_000, 3_000)
+        packets.append((t, head + bytes([2]) + struct.pack(">H", i) + bytes(43)))
+    packets.sort(key=lambda p: p[0])
+    return packets
+
+
+class TestMostLostInAGap(TsharkTestCase, unittest.TestCase):
+    """maxlost="10": a gap of up to 10 messages lost is counted, a longer one is a restart
+    of the count (a device reset) or a pause of the stream, with nothing counted lost and no
+    expert info: by the sequence count and by the period (lost="period")."""
+
+    # each kind its own ethertype: one protocol per table entry
+    KINDS = {"restart": ("RESTART", 0x88b5, "", '<sequence field="node[@name=\'Count\']"/>'),
+             "pause": ("PAUSE", 0x88b6, 'lost="period"', "")}
+
+    @classmethod
+    def prepare(cls):
+        cls.packets, cls.captures = {}, {}
+        for kind, (abbreviation, ethertype, losses, sequence) in cls.KINDS.items():
+            cls.install_text(abbreviation.lower() + ".xml", MOST_LOST_RULES.format(
+                kind=kind, abbreviation=abbreviation, ethertype=ethertype, losses=losses, most=MOST_LOST,
+                sequence=sequence), abbreviation.lower())
+            cls.packets[kind] = restarting_capture(ethertype)
+            cls.captures[kind] = cls.env.add_file(kind + ".pcap", pcap_ns(cls.packets[kind]))
+
+    def test_by_the_sequence_count(self):
+        messages = [(frame, t, data[14], struct.unpack(">H", data[15:17])[0])
+                    for frame, (t, data) in enumerate(self.packets["restart"], 1)]
+        marks, cycles = model(messages, window=8, bits=16, max_lost=MOST_LOST)
+        with self.checks() as check:
+            # the model itself: 10 lost once in stream 1; stream 2's count has no gap
+            lost = sorted(m["lost"] for m in marks.values() if "lost" in m)
+            check(lost == [MOST_LOST], "the model: 10 lost once (%s)" % lost)
+            unbounded = sorted(m["lost"] for m in model(messages, window=8, bits=16)[0].values() if "lost" in m)
+            check(unbounded == [10, 11, 19943], "the model without maxlost: %s" % unbounded)
+            follows_the_model(self.env, check, self.captures["restart"], "restart", marks, cycles)
+
+    def test_by_the_period(self):
+        messages = [(frame, t, data[14], None) for frame, (t, data) in enumerate(self.packets["pause"], 1)]
+        marks, cycles = model(messages, window=8, bits=0, lost_by_period=True, max_lost=MOST_LOST)
+        with self.checks() as check:
+            # the model itself: stream 2's 11-period gap is 10 lost, its 12-period one a pause;
+            # stream 1 loses nothing by its period
+            lost = sorted(m["lost"] for m in marks.values() if "lost" in m)
+            check(lost == [MOST_LOST], "the model: 10 lost once (%s)" % lost)
+            unbounded = sorted(m["lost"] for m in model(messages, window=8, bits=0, lost_by_period=True)[0].values()
+                               if "lost" in m)
+            check(unbounded == [10, 11], "the model without maxlost: %s" % unbounded)
+            follows_the_model(self.env, check, self.captures["pause"], "pause", marks, cycles, duplicates=False)
+
+
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])

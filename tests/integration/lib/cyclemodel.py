@@ -21,17 +21,18 @@ def clamp(ns):
     return max(ns, 0)
 
 
-MAX_GAP_PERIODS = 16  # lost="period": a longer gap is a pause, nothing lost
+MOST_LOST_BY_PERIOD = 15  # lost="period": a gap of more lost is a pause, nothing lost
 
 
-def model(messages, window, bits, step=1, lost_by_period=False, wrap=None, irregular=()):
+def model(messages, window, bits, step=1, lost_by_period=False, wrap=None, irregular=(), max_lost=None):
     """messages: (frame, time ns, stream key, sequence count) in capture order; step: how
     much the count advances per message, 0 when learned from the stream (step="learned");
     lost_by_period: lost="period", a cycle's period of n whole nominal periods is n - 1 lost;
     wrap: wrap="N", the count runs 0 .. N - 1 (a count of N or more is no count, and the
     next count is the stream's first again); irregular: frames whose period cannot be regular
     for a reason outside the stream's times and counts (requests="yes": the previous request
-    was not answered before, or this one is a poll).
+    was not answered before, or this one is a poll); max_lost: maxlost="N", a gap of more
+    messages lost is a restart (a sequence) or a pause (lost="period"): nothing lost.
     Returns ({frame: mark}, [cycle]) as the manual describes them."""
     mask = (1 << bits) - 1
     modulus = wrap or (1 << bits)
@@ -58,6 +59,8 @@ def model(messages, window, bits, step=1, lost_by_period=False, wrap=None, irreg
                     s["step"] = advance  # learned: the first advance, or a smaller one dividing it
                 if s["step"] and advance <= half and advance % s["step"] == 0:
                     lost = min(advance // s["step"] - 1, 2**32 - 2)
+                    if max_lost is not None and lost > max_lost:
+                        lost, back = 0, True
                 else:
                     back = True
             s["last_seq"] = seq
@@ -67,7 +70,7 @@ def model(messages, window, bits, step=1, lost_by_period=False, wrap=None, irreg
             periods = sorted(s["cycle"]["periods"])
             nominal = periods[(len(periods) - 1) // 2]
             gap = (period + nominal // 2) // nominal
-            if gap > MAX_GAP_PERIODS:
+            if gap - 1 > (MOST_LOST_BY_PERIOD if max_lost is None else max_lost):
                 back = True
             elif gap >= 2:
                 lost = gap - 1
