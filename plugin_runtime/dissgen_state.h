@@ -80,6 +80,10 @@ struct dg_state {
     gboolean stopped;     /* a malformed spot was reported: decode nothing more */
     gboolean faulted;     /* a malformed spot was reported in this message, even if decoding went on */
     gboolean cut_shown;   /* the capture kept less than the frame had: shown once (capture_cut) */
+    gint64 told_end;      /* where a length reported past the end of its data says its container ends
+                           * (0: none), and where that data ran out: data missing there, needed up to
+                           * no further than told_end, is that fault, not told again */
+    gint told_short_at;
     gboolean peek_cut;    /* a <when peek> read past the kept bytes: which alternative holds is not known */
     gboolean want_text;   /* summaries are shown: a visible tree, or columns */
     gboolean want_info;   /* the Info column is shown (pinfo->cinfo) */
@@ -150,7 +154,9 @@ static inline gboolean cut_by_capture(const dg_state *st, gint64 data_end, gint6
 void capture_cut(dg_state *st, proto_tree *tree);
 
 /* Data that ran out at data_end where a node needed it up to needed_end: the
- * capture's cut (cut_by_capture) or a malformed spot reported as report() does. */
+ * capture's cut (cut_by_capture), the fault of an enclosing length already
+ * reported (st->told_end: decoding stops, nothing more is told), or a
+ * malformed spot reported as report() does. */
 void report_missing(dg_state *st, proto_tree *tree, expert_field *ei, gint64 data_end, gint64 needed_end, gint offset,
                     gint length, const char *format, ...) G_GNUC_PRINTF(8, 9);
 

@@ -54,6 +54,11 @@ void report_missing(dg_state *st, proto_tree *tree, expert_field *ei, gint64 dat
         capture_cut(st, tree);
         return;
     }
+    if (data_end >= st->told_short_at && needed_end <= st->told_end) { /* one cause, one expert info */
+        st->stopped = TRUE;
+        st->faulted = TRUE;
+        return;
+    }
     va_list ap;
     va_start(ap, format);
     report_v(st, tree, ei, offset, length, format, ap);
@@ -453,11 +458,22 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
 
     proto_item *item = NULL;
     proto_tree *subtree = open_container(st, n, tree, start, &item);
-    /* A length field past the end is the fault, where it points. */
-    if (past_end && n->length_kind == DG_LEN_FIELD)
+    /* A length field past the end is the fault, where it points; the
+     * children's lengths that end within it are not faults of their own.
+     * When the capture cut the bytes, that is said after what they hold. */
+    const gint64 outer_told_end = st->told_end;
+    const gint outer_told_short_at = st->told_short_at;
+    const gboolean length_past_end = past_end && n->length_kind == DG_LEN_FIELD;
+    const gboolean cut = past_end && cut_by_capture(st, end, start + length);
+    if (length_past_end && !cut) {
         report_missing(st, subtree, &st->p->ei->past_end, end, start + length, start, end - start,
                        "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)", n->name,
                        length, end - start);
+        if (start + length > st->told_end) {
+            st->told_end = start + length;
+            st->told_short_at = end;
+        }
+    }
     /* Decode what is there even when the length overruns. */
     gboolean was_stopped = st->stopped;
     st->stopped = FALSE;
@@ -466,26 +482,32 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
      * none; a length from the children, the enclosing one's. */
     const gint outer_cut_end = st->cut_end;
     if (length >= 0)
-        st->cut_end = past_end && cut_by_capture(st, end, start + length) ? (gint)(start + length) : DG_END_KNOWN;
+        st->cut_end = cut ? (gint)(start + length) : DG_END_KNOWN;
     if (n->window >= 0) /* a window: children at addresses, not one after another */
         dissect_window(st, n, subtree, offset, inner_end, in_summary || n->summary_count > 0);
     else
         walk_list(st, n->walk, n->first_child, n->child_count, subtree, offset, inner_end,
                   in_summary || n->summary_count > 0);
-    /* A fixed length cut short: the child where the bytes ran out said so;
-     * only when none did (they all fit) is the container itself short. */
-    if (past_end && n->length_kind != DG_LEN_FIELD && !st->stopped)
-        report_missing(st, subtree, &st->p->ei->truncated, end, start + length, start, end - start,
-                       "Truncated: '%s' needs %" G_GINT64_MODIFIER "d bytes, only %d left", n->name, length,
-                       end - start);
+    /* A length cut short: the child where the bytes ran out said so; only
+     * when none did (they all fit) is the container itself short. */
+    if (past_end && !st->stopped) {
+        if (cut)
+            capture_cut(st, subtree);
+        else if (!length_past_end)
+            report_missing(st, subtree, &st->p->ei->truncated, end, start + length, start, end - start,
+                           "Truncated: '%s' needs %" G_GINT64_MODIFIER "d bytes, only %d left", n->name, length,
+                           end - start);
+    }
     st->cut_end = outer_cut_end;
+    st->told_end = outer_told_end;
+    st->told_short_at = outer_told_short_at;
     st->stopped = st->stopped || was_stopped;
     if (!st->stopped && length >= 0 && *offset < inner_end &&
         (n->length_kind == DG_LEN_FIXED || n->length_kind == DG_LEN_FIELD)) {
         show_trailing_bytes(st, n, subtree, start, *offset, inner_end, length);
     }
     if (!st->stopped && length >= 0) *offset = inner_end;
-    if (st->stopped && !was_stopped && (n->flags & DG_SKIP_MALFORMED) && length >= 0) {
+    if (st->stopped && !was_stopped && !length_past_end && (n->flags & DG_SKIP_MALFORMED) && length >= 0) {
         /* malformed="skip": the spot is marked by its expert info; the rest of
          * this container is left undecoded and decoding goes on after it, as
          * for a PDU in a tvb of its own. */

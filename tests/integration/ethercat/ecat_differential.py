@@ -643,6 +643,12 @@ def ours_shows(payload, on_wire=None):
         """The data ran out only because the capture kept less than the wire had."""
         return on_wire is not None and data_end >= size and size < on_wire and needed_end <= on_wire
 
+    told_end = 0  # the header's Length, once reported past the end of the bytes
+
+    def told(data_end, needed_end):
+        """Not reported: the capture's cut, or bytes the header's Length already said are missing."""
+        return cut(data_end, needed_end) or (data_end >= size and needed_end <= told_end)
+
     if size < 2:
         if not cut(size, 2):
             experts.append(("truncated", 0, "Truncated: 'Length' needs 2 bytes, only %d left" % size))
@@ -654,6 +660,8 @@ def ours_shows(payload, on_wire=None):
     if past_end and not cut(size, 2 + length):
         experts.append(("past_end", 2, "'%s' has length %d, past the end of its data (%d bytes left)"
                         % (name, length, size - 2)))
+    if past_end:
+        told_end = 2 + length
     if ftype != 1:
         return 0, "EtherCAT", experts, regions, ""
     end = size if past_end else 2 + length
@@ -662,7 +670,7 @@ def ours_shows(payload, on_wire=None):
     def leaf(what, n):
         nonlocal off, stopped
         if n > end - off:
-            if not cut(end, off + n):
+            if not told(end, off + n):
                 experts.append(("truncated", off, "Truncated: '%s' needs %d bytes, only %d left" % (what, n, end - off)))
             stopped = True
             return None
@@ -706,7 +714,7 @@ def ours_shows(payload, on_wire=None):
                     # bytes the capture did not keep: no alternative is taken, decoding stops
                     stopped = True
                 elif dlen > end - off:
-                    if not cut(end, off + dlen):
+                    if not told(end, off + dlen):
                         experts.append(("past_end", off, "'%s' has length %d, past the end of its data (%d bytes left)"
                                         % (DATA_CONTAINERS[view], dlen, end - off)))
                     regions.append((off, end, DATA_CONTAINERS[view], True))
@@ -722,7 +730,7 @@ def ours_shows(payload, on_wire=None):
         if stopped or not more:
             break
         if off >= end:
-            if not cut(end, end + 1):
+            if not told(end, end + 1):
                 experts.append(("more_no_data", off, "'Datagram': the repeat flag 'More' says another follows, "
                                 "but no data is left"))
             break

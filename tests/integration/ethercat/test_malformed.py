@@ -23,6 +23,7 @@ from tshark_env import TsharkEnv, read_tshark_output, run_unittests  # noqa: E40
 
 ARGS = None
 ETH_HEADER = b"\xff" * 6 + b"\x02\x00\x00\x00\x00\x01" + b"\x88\xa4"
+PI_MALFORMED = 0x07000000  # epan/proto.h: the expert group of a malformed spot
 OUR_EXPERTS = ("ecatr.expert.truncated", "ecatr.expert.past_end", "ecatr.expert.more_no_data",
                "ecatr.expert.count_short", "ecatr.expert.bad_length", "ecatr.expert.unused")
 
@@ -86,7 +87,8 @@ class Malformed(unittest.TestCase):
                 for orig in (len(whole), cut):   # snap-length truncation and a short frame
                     packets.append((whole[:cut], orig))
                     expected_cmds.append(["0x%02x" % d.cmd for d, s in zip(f.datagrams, starts) if s < cut])
-        rows = self.decode(packets, ["ecatr.datagram.cmd", "_ws.expert.message", "_ws.col.Protocol", "_ws.short"])
+        rows = self.decode(packets, ["ecatr.datagram.cmd", "_ws.expert.message", "_ws.col.Protocol", "_ws.short",
+                                     "_ws.expert.group"])
         for (data, orig), row, cmds in zip(packets, rows, expected_cmds):
             self.assertEqual(row[2], "ECATR")
             got = row[0].split("|") if row[0] else []
@@ -94,6 +96,10 @@ class Malformed(unittest.TestCase):
             if len(data) > 14 and orig == len(data):  # that short on the wire: malformed
                 self.assertTrue(any(w in row[1] for w in ("Truncated", "past the end")) and not row[3],
                                 "no expert info for a frame of %d bytes: %r" % (len(data), row[1]))
+                # one cause, one expert info: the header's Length past the end, not again for
+                # each datagram, field or count inside it that the cut leaves short
+                malformed = [g for g in row[4].split("|") if int(g) == PI_MALFORMED]
+                self.assertEqual(len(malformed), 1, "a frame of %d bytes: expert infos %r" % (len(data), row[1]))
             elif len(data) > 14:  # whole on the wire, the capture kept less: not malformed
                 malformed = ("Truncated", "past the end", "no data is left", "should occur")
                 self.assertTrue(row[3] and not any(w in row[1] for w in malformed),

@@ -311,6 +311,9 @@ class Expected:
         # where the innermost box ends on the wire when the capture cut it short; KNOWN_END in
         # one the capture kept whole; 0 at the top level (a rest blob runs to it)
         self.cut_end = 0
+        # where a box whose length was reported past the end of its data says it ends (0: none),
+        # and where its data ran out: data missing there, needed no further, is that fault
+        self.told_end, self.told_short_at = 0, 0
         self.experts = []       # (field, message) in order
         self.info = []
         self.svals = {}         # id(leaf node) -> value as a summary shows it
@@ -360,6 +363,9 @@ class Expected:
                 parent.children.append(Item("[Packet size limited during capture: %s truncated]" % PROTO.upper(),
                                             "_ws.short"))
                 self.cut_shown = True
+            self.stopped = True
+            return
+        if data_end is not None and data_end >= self.told_short_at and needed <= self.told_end:  # told
             self.stopped = True
             return
         severity, group = EXPERTS[kind]
@@ -449,17 +455,22 @@ class Expected:
         inner_end = start + length if length >= 0 and not past_end else end
         item = Item(n.name, n.field, "1" if n.field else None)
         parent.children.append(item)
-        if past_end and n.lenkind == "field":  # the length field is the fault
+        cut = past_end and self.cut_by_capture(end, start + length)  # said after what the kept bytes hold
+        if past_end and n.lenkind == "field" and not cut:  # the length field is the fault
             self.expert(item, "past_end",
                         "'%s' has length %d, past the end of its data (%d bytes left)" % (n.name, length, end - start),
                         data_end=end, needed=start + length)
+        outer_told = self.told_end, self.told_short_at
+        if past_end and n.lenkind == "field" and start + length > self.told_end:
+            self.told_end, self.told_short_at = start + length, end
         was_stopped, self.stopped = self.stopped, False
         outer_cut_end = self.cut_end
         if length >= 0:
-            self.cut_end = start + length if past_end and self.cut_by_capture(end, start + length) else KNOWN_END
+            self.cut_end = start + length if cut else KNOWN_END
         offset = self.node_list(n.children, item, offset, inner_end, in_summary or bool(n.pieces))
         self.cut_end = outer_cut_end
-        if past_end and n.lenkind != "field" and not self.stopped:  # no child ran out: the box is short
+        self.told_end, self.told_short_at = outer_told
+        if past_end and (cut or n.lenkind != "field") and not self.stopped:  # no child ran out: the box is short
             self.expert(item, "truncated", "Truncated: '%s' needs %d bytes, only %d left" % (n.name, length, end - start),
                         data_end=end, needed=start + length)
         self.stopped = self.stopped or was_stopped

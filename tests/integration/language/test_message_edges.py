@@ -11,7 +11,8 @@
 - a stream message whose length (pdulength) is shorter than the bytes up to its length
   field: malformed, and no messages made up from the bytes after it;
 - a response whose request is not in the capture: its note
-  (P.expert.no_request_context) is in `-z expert` also without a tree.
+  (P.expert.no_request_context) is in `-z expert` also without a tree;
+- a frame shorter than nested lengths say: one expert info, the outermost length's.
 
     test_message_edges.py --dissgen build/bin/dissgen --source-dir .
 """
@@ -160,6 +161,104 @@ class TestHugeLengths(TsharkTestCase, unittest.TestCase):
         got = [rows[n + 1]["_ws.expert.message"] for n in range(len(lengths))]
         want = [["'Body' has length %d, past the end of its data (60 bytes left)" % n] for n in lengths]
         self.assertEqual(got, want)
+
+
+NESTED_RULES = """<root name="Nested lengths" abbreviation="NEST" ethertype="0x88b5">
+  <node name="Outer len" length="1byte" displaytype="numberdec"/>
+  <node name="Outer" length="../node[@name='Outer len']">
+    <node name="Inner len" length="1byte" displaytype="numberdec"/>
+    <node name="Inner" length="../node[@name='Inner len']">
+      <node name="Count" length="1byte" displaytype="numberdec"/>
+      <node name="Value" length="2byte" displaytype="numberhex" count="../node[@name='Count']"/>
+    </node>
+    <node name="Tail len" length="1byte" displaytype="numberdec"/>
+    <node name="Tail" length="../node[@name='Tail len']" displaytype="origin"/>
+  </node>
+</root>
+"""
+
+
+# A record whose length runs past the end, in a container skipped as malformed: decoding goes
+# on after that container, and a fault there is its own, however far the record's length said.
+SKIPPED_RULES = """<root name="Skipped record" abbreviation="SKIPREC" ethertype="0x88b6">
+  <node name="Records" length="4byte" malformed="skip">
+    <node name="Length" length="1byte" displaytype="numberdec"/>
+    <node name="Record" length="../node[@name='Length']">
+      <node name="Data" length="2byte" displaytype="numberhex"/>
+    </node>
+  </node>
+  <node name="Trailer" length="4byte" displaytype="numberhex"/>
+</root>
+"""
+
+
+# A box the data holds whole, inside a length past the end: a field its own end cuts short is
+# a fault of its own.
+BOXED_RULES = """<root name="Boxed" abbreviation="BOXED" ethertype="0x88b7">
+  <node name="Outer len" length="1byte" displaytype="numberdec"/>
+  <node name="Outer" length="../node[@name='Outer len']">
+    <node name="Box" length="3byte">
+      <node name="Item len" length="1byte" displaytype="numberdec"/>
+      <node name="Item" length="../node[@name='Item len']" displaytype="origin"/>
+    </node>
+    <node name="Rest" length="4byte" displaytype="numberhex"/>
+  </node>
+</root>
+"""
+
+
+class TestOneCauseOneExpert(TsharkTestCase, unittest.TestCase):
+    """A frame shorter than its outer length says: that length past the end is the one
+    expert info. The lengths and counts inside that end within it are not faults of their
+    own (the data they miss is the data the outer length misses); one that reaches past
+    the outer length's end is, and so is one cut short by the end of a box the data holds
+    whole, or one after a skipped container. What the data holds is decoded."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("nested_lengths.xml", NESTED_RULES, "nest")
+        cls.install_text("skipped_record.xml", SKIPPED_RULES, "skiprec")
+        cls.install_text("boxed.xml", BOXED_RULES, "boxed")
+
+    def assert_experts(self, ethertype, name, message, want):
+        """One frame of `message` bytes on `ethertype`: its expert infos are `want`, one pass and -2."""
+        eth = b"\x02" + bytes(5) + b"\x02" + bytes(4) + b"\x01" + struct.pack(">H", ethertype)
+        path = self.env.add_file(name + ".pcap", pcap([eth + message]))
+        for how, rows in self.env.field_rows_each_pass(path, ["frame.number", "_ws.expert.message"],
+                                                      aggregator="|"):
+            self.assertEqual(rows[1]["_ws.expert.message"], want, how)
+
+    def test_a_box_cut_by_its_own_end_is_its_own_fault(self):
+        self.assert_experts(0x88b7, "boxed", bytes([20, 5, 1, 2, 9]), [
+            "'Outer' has length 20, past the end of its data (4 bytes left)",
+            "'Item' has length 5, past the end of its data (2 bytes left)"])
+
+    def test_a_fault_after_a_skipped_record_is_its_own(self):
+        self.assert_experts(0x88b6, "skipped_record", bytes([200, 1, 2, 3, 0xAA, 0xBB]), [
+            "'Record' has length 200, past the end of its data (3 bytes left)",
+            "Truncated: 'Trailer' needs 4 bytes, only 2 left"])
+
+    def test_inner_lengths_within_the_outer_one_are_not_told_again(self):
+        eth = b"\x02" + bytes(5) + b"\x02" + bytes(4) + b"\x01\x88\xb5"
+        frames = [
+            bytes([10, 7, 3, 1, 2, 3, 4]),           # Outer 10, Inner 7 with 3 values: cut before the 3rd
+            bytes([10, 7, 3, 1, 2, 3, 4, 5, 6, 1]),  # cut in the Tail
+            bytes([10, 7, 3, 1, 2, 3, 4, 5, 6, 30]),  # Tail len 30 reaches past Outer's 10: its own fault
+            bytes([10, 3, 1, 1, 2, 5, 1, 2, 3, 4, 5]),  # whole: nothing to report
+        ]
+        path = self.env.add_file("nested_lengths.pcap", pcap([eth + f for f in frames]))
+        want = [
+            (["'Outer' has length 10, past the end of its data (6 bytes left)"], "0x0102|0x0304"),
+            (["'Outer' has length 10, past the end of its data (9 bytes left)"], "0x0102|0x0304|0x0506"),
+            (["'Outer' has length 10, past the end of its data (9 bytes left)",
+              "'Tail' has length 30, past the end of its data (0 bytes left)"], "0x0102|0x0304|0x0506"),
+            ([], "0x0102"),
+        ]
+        for how, rows in self.env.field_rows_each_pass(path, ["frame.number", "_ws.expert.message",
+                                                             "nest.outer.inner.value"], aggregator="|"):
+            got = [(rows[n]["_ws.expert.message"], "|".join(rows[n]["nest.outer.inner.value"]))
+                   for n in range(1, len(frames) + 1)]
+            self.assertEqual(got, want, how)
 
 
 if __name__ == "__main__":

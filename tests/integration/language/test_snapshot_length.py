@@ -18,6 +18,7 @@ the container's on the wire, not the captured ones. One pass and -2.
     test_snapshot_length.py --dissgen build/bin/dissgen --source-dir .
 """
 import os
+import re
 import struct
 import sys
 import unittest
@@ -98,6 +99,23 @@ class SnapshotLength(TsharkTestCase, unittest.TestCase):
                 lie = rows[len(rows) - 1]["_ws.expert.message"]
                 check(any("'Body' has length 200, past the end" in m for m in lie),
                       "%s: a Length past the frame on the wire is an error in a cut frame: %s" % (how, lie))
+
+    def test_the_cut_is_said_after_what_was_kept(self):
+        """In the tree, "[Packet size limited during capture]" comes after every field the
+        capture kept, also inside a Body whose Length runs past the kept bytes."""
+        with self.checks() as check:
+            for two_pass in (False, True):
+                text = self.env.tshark(["-r", self.capture, "-V", "-O", "cutt"] + (["-2"] if two_pass else [])).stdout
+                frames = re.split(r"^Frame (\d+):", text, flags=re.M)[1:]
+                for number, tree in zip(frames[::2], frames[1::2]):
+                    if int(number) > len(self.cuts):
+                        continue
+                    lines = [line.strip() for line in tree.splitlines()]
+                    said = [i for i, line in enumerate(lines) if line.startswith("[Packet size limited")]
+                    kept = [i for i, line in enumerate(lines) if re.match(r"(Count|Length|Word): ", line)]
+                    check(len(said) == 1 and all(i < said[0] for i in kept),
+                          "%s frame %s: the cut said at line %s, after the fields at %s" % (
+                              "-2" if two_pass else "one pass", number, said, kept))
 
 
 LEAVES_RULES = """<root name="Cut leaves" abbreviation="CUTL" ethertype="0x88b5">
