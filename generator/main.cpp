@@ -158,16 +158,22 @@ int cmd_esi(const std::vector<std::string>& paths) {
 // to load there. Only a warning for check: the rules may target another Wireshark.
 void check_names_against_wireshark(const Protocol& p, Diagnostics& diags, bool as_error) {
     for (const InstalledProtocol& w : installed_protocols()) {
-        if (w.name == p.name && w.short_name == p.abbreviation && w.filter == p.filter)
-            continue;  // this very protocol, from a plugin installed earlier
-        std::string clash;
-        if (w.filter == p.filter) clash = "filter name '" + p.filter + "'";
-        else if (w.short_name == p.abbreviation) clash = "abbreviation '" + p.abbreviation + "'";
-        else if (w.name == p.name) clash = "name '" + p.name + "'";
-        if (clash.empty()) continue;
-        std::string msg = "the protocol " + clash + " is already used by Wireshark's '" + w.name + "' (" +
-                          w.filter + "); the plugin will not load beside it: change it on <root>" +
-                          (p.filter_given || clash.rfind("filter", 0) != 0 ? "" : " (e.g. filter=\"" + p.filter + "_rules\")");
+        const bool same = w.name == p.name && w.short_name == p.abbreviation && w.filter == p.filter;
+        if (same && installed_by_dissgen(w.filter)) continue;  // this very protocol, from a plugin installed earlier
+        std::string msg;
+        if (same) {
+            msg = "the protocol's name, abbreviation and filter name are those of Wireshark's own '" + w.name +
+                  "' (" + w.filter + "); the plugin will not load beside it: change all three on <root>";
+        } else {
+            std::string clash;
+            if (w.filter == p.filter) clash = "filter name '" + p.filter + "'";
+            else if (w.short_name == p.abbreviation) clash = "abbreviation '" + p.abbreviation + "'";
+            else if (w.name == p.name) clash = "name '" + p.name + "'";
+            if (clash.empty()) continue;
+            msg = "the protocol " + clash + " is already used by Wireshark's '" + w.name + "' (" + w.filter +
+                  "); the plugin will not load beside it: change it on <root>" +
+                  (p.filter_given || clash.rfind("filter", 0) != 0 ? "" : " (e.g. filter=\"" + p.filter + "_rules\")");
+        }
         if (as_error) diags.error(p.line, msg);
         else diags.warning(p.line, msg);
         return;

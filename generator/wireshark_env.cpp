@@ -100,4 +100,10 @@ std::vector<InstalledProtocol> installed_protocols() {
     return protocols;
 }
 
+bool installed_by_dissgen(const std::string& filter) {
+    std::string out;
+    if (run_command({"tshark", "-G", "fields"}, &out) != 0) return false;
+    return out.find("\t" + filter + ".expert.truncated\t") != std::string::npos;
+}
+
 }  // namespace dissgen

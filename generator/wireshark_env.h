@@ -33,4 +33,8 @@ struct InstalledProtocol {
 // tshark is not available.
 std::vector<InstalledProtocol> installed_protocols();
 
+// Whether the installed protocol `filter` is a dissgen plugin's: it has the
+// runtime's own expert infos (`tshark -G fields`).
+bool installed_by_dissgen(const std::string& filter);
+
 }  // namespace dissgen

@@ -217,34 +217,53 @@ void register_stats_tree(const dg_protocol *p)
 
 /* --- registration --------------------------------------------------------- */
 
+/* Whether the protocol registered as `filter` is a dissgen plugin's: every one
+ * has the runtime's own expert infos (a dissector of Wireshark's, built in
+ * or a plugin, has not). */
+static gboolean registered_by_dissgen(const char *filter)
+{
+    char *marker = g_strdup_printf("%s.expert.truncated", filter);
+    const gboolean ours = proto_registrar_get_byname(marker) != NULL;
+    g_free(marker);
+    return ours;
+}
+
 gboolean dg_protocol_names_free(const dg_protocol *p)
 {
-    /* The very same protocol from another plugin (a packaged plugin and the
-     * user's own build of the same rules): the first one registered wins, and
-     * this one steps aside without a dialog at every start. */
+    /* The very same protocol from another dissgen plugin (a packaged plugin and
+     * the user's own build of the same rules): the first one registered wins,
+     * and this one steps aside without a dialog at every start. A dissector of
+     * Wireshark's with the same three names is a clash, told below. */
     int same = proto_get_id_by_filter_name(p->filter);
     if (same != -1 && strcmp(proto_get_protocol_name(same), p->name) == 0 &&
-        strcmp(proto_get_protocol_short_name(find_protocol_by_id(same)), p->short_name) == 0) {
+        strcmp(proto_get_protocol_short_name(find_protocol_by_id(same)), p->short_name) == 0 &&
+        registered_by_dissgen(p->filter)) {
         /* ws_log, not ws_info: that macro would compile the source path into the plugin */
         ws_log("dissgen", LOG_LEVEL_INFO, "\"%s\" (%s) is already registered by another plugin; this one steps aside",
                p->name, p->filter);
         return FALSE;
     }
-    const char *what = NULL, *value = NULL;
-    if (proto_get_id_by_filter_name(p->filter) != -1) {
-        what = "filter name";
-        value = p->filter;
-    } else if (proto_get_id_by_short_name(p->short_name) != -1) {
-        what = "abbreviation";
-        value = p->short_name;
-    } else if (proto_name_already_registered(p->name)) {
-        what = "name";
-        value = p->name;
+    /* Every name taken, in one message: Wireshark refuses any one of them. */
+    struct taken {
+        const char *what, *value, *attribute;
+    } clashes[3];
+    guint n = 0;
+    if (proto_get_id_by_filter_name(p->filter) != -1) clashes[n++] = {"filter name", p->filter, "filter"};
+    if (proto_get_id_by_short_name(p->short_name) != -1)
+        clashes[n++] = {"abbreviation", p->short_name, "abbreviation"};
+    if (proto_name_already_registered(p->name)) clashes[n++] = {"name", p->name, "name"};
+    if (n == 0) return TRUE;
+    GString *names = g_string_new(NULL), *attributes = g_string_new(NULL);
+    for (guint i = 0; i < n; i++) {
+        g_string_append_printf(names, "%s%s \"%s\"", i == 0 ? "" : i + 1 == n ? " and the " : ", the ",
+                               clashes[i].what, clashes[i].value);
+        g_string_append_printf(attributes, "%s%s=...", i == 0 ? "" : " ", clashes[i].attribute);
     }
-    if (!what) return TRUE;
-    report_failure("The dissgen plugin for \"%s\" was not loaded: another protocol already has the %s \"%s\". "
-                   "Change it in the rule file (<root %s=...>) and regenerate the plugin.",
-                   p->name, what, value, strcmp(what, "abbreviation") == 0 || strcmp(what, "name") == 0 ? what : "filter");
+    report_failure("The dissgen plugin for \"%s\" was not loaded: another protocol already has the %s. "
+                   "Change %s in the rule file (<root %s>) and regenerate the plugin.",
+                   p->name, names->str, n == 1 ? "it" : "them", attributes->str);
+    g_string_free(names, TRUE);
+    g_string_free(attributes, TRUE);
     return FALSE;
 }
 

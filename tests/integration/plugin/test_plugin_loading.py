@@ -5,8 +5,9 @@
 - `dissgen install` puts a plugin that tshark loads with no warning;
 - ethertype 0x88A4 and UDP 34980 decode with the rules by default, whatever the
   plugin load order, while Wireshark's own EtherCAT plugin stays selectable (-d);
-- a rule file whose names clash with a Wireshark protocol is reported and
-  skipped at load, and tshark keeps running;
+- a rule file whose names clash with a Wireshark protocol (one name, or all three) is
+  reported and skipped at load, and tshark keeps running; two plugins of the same rules
+  load once, without a word;
 - editing the rules and installing again changes the decode;
 - the paper's own example generates a working plugin;
 - as root in CI, `dissgen install --system` serves root's tshark.
@@ -27,6 +28,19 @@ from tshark_env import TsharkEnv, run_unittests  # noqa: E402
 
 ARGS = None
 SYSTEM_ETHERCAT = "/usr/lib/x86_64-linux-gnu/wireshark/plugins/4.0/epan/ethercat.so"
+
+
+# Rules that take LLDP's own three names, and an LLDPDU: Chassis ID, Port ID, TTL, End.
+LLDP_RULES = """<root name="Link Layer Discovery Protocol" abbreviation="LLDP" ethertype="0x88cc">
+  <node name="TLV" repeat="node[@name='Type']">
+    <node name="Type" length="7bit" displaytype="numberdec"/>
+    <node name="Length" length="9bit" displaytype="numberdec"/>
+    <node name="Value" length="../node[@name='Length']" displaytype="origin"/>
+  </node>
+</root>
+"""
+LLDP_FRAME = (b"\x01\x80\xc2\x00\x00\x0e\x00\x1b\x1b\x0a\x0b\x0c\x88\xcc"
+              b"\x02\x07\x04\x00\x1b\x1b\x0a\x0b\x0c" b"\x04\x05\x05eth0" b"\x06\x02\x00\x78" b"\x00\x00")
 
 
 def sample_frames():
@@ -219,15 +233,17 @@ class PluginLoading(unittest.TestCase):
         with open(paper, encoding="utf-8") as fh:
             text = fh.read()
         # Each of the three names clashing in turn (Wireshark's ecat is "EtherCAT datagram(s)", ECAT,
-        # ecat); the message names the attribute to change.
+        # ecat); the message names every name taken, and the attributes to change.
         root = '<root name="EtherCAT" abbreviation="ECAT"'
-        for kind, name, attribute, value, header in (
-                ("filter name", "EtherCAT", "filter", "ecat", root),
-                ("abbreviation", "EtherCAT", "abbreviation", "ECAT", root + ' filter="paperx"'),
-                ("name", "EtherCAT datagram(s)", "name", "EtherCAT datagram(s)",
+        for kind, name, taken, attributes, header in (
+                ("filter name", "EtherCAT", 'the filter name "ecat" and the abbreviation "ECAT". Change them',
+                 "filter=... abbreviation=...", root),
+                ("abbreviation", "EtherCAT", 'the abbreviation "ECAT". Change it', "abbreviation=...",
+                 root + ' filter="paperx"'),
+                ("name", "EtherCAT datagram(s)", 'the name "EtherCAT datagram(s)". Change it', "name=...",
                  '<root name="EtherCAT datagram(s)" abbreviation="PAPX" filter="paperx"')):
             with self.subTest(clash=kind):
-                folder = os.path.join(self.env.home, "clash-" + attribute)
+                folder = os.path.join(self.env.home, "clash-" + kind.replace(" ", "-"))
                 os.makedirs(folder, exist_ok=True)
                 variant = os.path.join(folder, "paper_example.xml")
                 with open(variant, "w", encoding="utf-8") as fh:
@@ -235,10 +251,49 @@ class PluginLoading(unittest.TestCase):
                 self.env.install_plugin(ARGS.dissgen, variant)
                 p = self.env.tshark(["-r", self.capture, "-T", "fields", "-e", "_ws.col.Protocol"], check=False)
                 self.assertEqual(p.returncode, 0, p.stderr)
-                self.assertIn('The dissgen plugin for "%s" was not loaded: another protocol already has the %s "%s". '
-                              'Change it in the rule file (<root %s=...>) and regenerate the plugin.'
-                              % (name, kind, value, attribute), p.stderr)
+                self.assertIn('The dissgen plugin for "%s" was not loaded: another protocol already has %s '
+                              'in the rule file (<root %s>) and regenerate the plugin.'
+                              % (name, taken, attributes), p.stderr)
                 self.assertEqual(p.stdout.split(), ["ECAT", "ECAT", "ECAT"])
+
+    def test_wiresharks_own_three_names_are_a_clash(self):
+        """Rules named exactly as a dissector built into Wireshark (LLDP's name, abbreviation and
+        filter name) are not an earlier dissgen plugin of the same rules: check warns, and at
+        load the plugin names every name it cannot have and steps aside for Wireshark's."""
+        rules = os.path.join(self.env.home, "lldp.xml")
+        with open(rules, "w", encoding="utf-8") as fh:
+            fh.write(LLDP_RULES)
+        check = dissgen("check", rules)
+        self.assertIn("lldp.xml:1: warning: the protocol's name, abbreviation and filter name are those of "
+                      "Wireshark's own 'Link Layer Discovery Protocol' (lldp)", check.stderr)
+        self.env.install_plugin(ARGS.dissgen, rules)
+        capture = self.env.add_file("lldp.pcap", pcapgen.raw_pcap_bytes([LLDP_FRAME]))
+        p = self.env.tshark(["-r", capture, "-T", "fields", "-e", "lldp.tlv.type"], check=False)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn('The dissgen plugin for "Link Layer Discovery Protocol" was not loaded: another protocol '
+                      'already has the filter name "lldp", the abbreviation "LLDP" and the name "Link Layer '
+                      'Discovery Protocol". Change them in the rule file (<root filter=... abbreviation=... '
+                      'name=...>) and regenerate the plugin.', p.stderr)
+        self.assertEqual(p.stdout.split(), ["1,2,3,0"], "Wireshark's lldp decodes the frame")
+
+    def test_the_same_rules_twice_load_once_without_a_word(self):
+        """Two plugins of the same rules (a packaged one and the user's own build): the first
+        registered decodes, the other steps aside with no failure message."""
+        built = self.env.install_plugin(ARGS.dissgen, self.rules)[0]
+        folder = tempfile.mkdtemp(dir=self.env.home)
+        epan = os.path.join(folder, self.env.abi, "epan")
+        os.makedirs(epan)
+        for name in ("dissgen_ethercat.so", "packaged_ethercat.so"):
+            shutil.copy(built, os.path.join(epan, name))
+        subprocess.run(["chmod", "-R", "a+rX", folder], check=True)
+        base_env = self.env.env
+        self.env.env = lambda: dict(base_env(), WIRESHARK_PLUGIN_DIR=folder)
+        try:
+            rows, stderr = fields(self.env, self.capture, ["_ws.col.Protocol", "ecatr.datagram.cmd"])
+        finally:
+            self.env.env = base_env
+        self.assertNotIn("was not loaded", stderr)
+        self.assertEqual(rows, [["ECATR", "0x04,0x0c"], ["ECATR", "0x07"], ["ECATR", "0x0e"]], stderr)
 
     def test_editing_rules_and_installing_again_changes_the_decode(self):
         edited = os.path.join(self.env.home, "ethercat.xml")
