@@ -105,9 +105,11 @@ struct Layout {
     // computed values: each one's operations, in postfix order
     std::map<const Node*, std::pair<int, int>> expr_span;  // first, count
     std::vector<ExprRow> exprs;
-    // <finding>s in document order: their rows, and each node's first
+    // <finding>s in document order: their rows, and each node's first; the
+    // expert infos, one per name (a <group> used twice raises one from each use)
     std::vector<std::string> findings;
     std::map<const Node*, int> finding_first;
+    std::vector<const Finding*> finding_experts;
     // <learn>s in document order (Learn::index): their rows, their keys' rows, each node's first
     std::vector<std::string> learns, learn_keys;
     std::map<const Node*, int> learn_first;
@@ -233,17 +235,20 @@ void layout_learns(Layout& l, const Protocol& proto) {
 // Each <finding>: its expert field, condition (after every computed value's
 // operations) and text (after every summary's pieces).
 void layout_findings(Layout& l, const std::string& filter) {
+    std::map<std::string, size_t> expert_of;  // filter name -> index in finding_experts
     for (const Node* n : l.nodes) {
         if (n->findings.empty()) continue;
         l.finding_first[n] = static_cast<int>(l.findings.size());
         for (const Finding& f : n->findings) {
+            auto [expert, added] = expert_of.emplace(f.filter_name, l.finding_experts.size());
+            if (added) l.finding_experts.push_back(&f);
             std::vector<ExprRow> rows = compile_expression(f.condition, false);
             const size_t expr_first = l.exprs.size(), text_first = l.pieces.size();
             l.exprs.insert(l.exprs.end(), rows.begin(), rows.end());
             for (const SummaryPiece& p : f.text_pieces)
                 l.pieces.push_back({p.text, p.leaf ? p.leaf->slot : -1, 0, -1, p.leaf});
             l.findings.push_back("/* " + f.name + ", line " + std::to_string(f.line) + " */ { &" + filter +
-                                 "_finding_ei[" + std::to_string(l.findings.size()) + "], " +
+                                 "_finding_ei[" + std::to_string(expert->second) + "], " +
                                  std::to_string(expr_first) + ", " + std::to_string(rows.size()) + ", " +
                                  std::to_string(text_first) + ", " + std::to_string(f.text_pieces.size()) + " }");
         }
@@ -594,7 +599,7 @@ void Emitter::condition_and_window_tables() {
     table("dg_expr_op", "exprs", exprs, "Computed values: their operations in postfix order");
     if (l_.findings.empty()) return;
     o_ << "/* <finding>s: expert info, condition (first, count in exprs), text (first, count in summary). */\n"
-       << "static expert_field " << p_.filter << "_finding_ei[" << l_.findings.size() << "];\n";
+       << "static expert_field " << p_.filter << "_finding_ei[" << l_.finding_experts.size() << "];\n";
     o_ << c_array("static const dg_finding " + p_.filter + "_findings", l_.findings);
 }
 
@@ -1005,9 +1010,7 @@ void Emitter::expert_entries() {
 // The rule file's <finding>s, after the runtime's expert infos; the summary
 // is the text as written.
 void Emitter::finding_entries() {
-    std::vector<const Finding*> all;
-    for (const Node* n : l_.nodes)
-        for (const Finding& f : n->findings) all.push_back(&f);
+    const std::vector<const Finding*>& all = l_.finding_experts;
     for (size_t i = 0; i < all.size(); ++i) {
         const Finding& f = *all[i];
         o_ << "        { &" << p_.filter << "_finding_ei[" << i << "], { " << c_string(f.filter_name) << ", "
@@ -1213,9 +1216,11 @@ std::string list_fields(const Protocol& proto) {
         if (n.filter_name.empty() || n.shares_field) return;  // a shared field is listed once
         out << n.filter_name << "\t" << field_type(n).type << "\t" << n.name << "\t" << kRulesSource << "\n";
     });
+    std::set<std::string> findings;  // a <group> used twice raises one from each use
     for_each_node(proto.nodes, [&](const Node& n) {  // <finding>s: expert infos, named by their text
         for (const Finding& f : n.findings)
-            out << f.filter_name << "\tFT_NONE\t" << f.text << "\t" << kRulesSource << "\n";
+            if (findings.insert(f.filter_name).second)
+                out << f.filter_name << "\tFT_NONE\t" << f.text << "\t" << kRulesSource << "\n";
     });
     for (const NameGroup* g : name_groups_of(proto))
         for (const RuntimeName& n : g->names)

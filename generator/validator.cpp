@@ -2221,6 +2221,7 @@ void Validator::name_findings() {
             }
             f.filter_name = proto_.filter + ".finding." + f.name;
             auto [it, inserted] = seen.emplace(f.name, f.line);
+            if (!inserted && it->second == f.line) continue;  // a <group> used again: one expert info, raised by each use
             if (!inserted)
                 diags_.error(f.line, "duplicate finding name '" + f.name + "'" + also_at(it->second, f.line));
             else if (auto owner = filter_owner_.find(f.filter_name); owner != filter_owner_.end())

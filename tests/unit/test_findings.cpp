@@ -147,6 +147,25 @@ TEST(FindingEmit, FieldsListsEachFindingAsWiresharkRegistersIt) {
         << list_fields(*f.proto);
 }
 
+// A <group> used twice copies its <finding>: one expert info registered and
+// listed, raised by each use's own row.
+TEST(FindingEmit, AGroupUsedTwiceRegistersItsFindingOnce) {
+    Front f = front_end(rules("  <group name=\"Point\">\n"
+                              "    <node name=\"X\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "    <finding name=\"x_zero\" severity=\"warning\" condition=\"{X} == 0\" text=\"X is 0\"/>\n"
+                              "  </group>\n"
+                              "  <node name=\"From\"><use group=\"Point\"/></node>\n"
+                              "  <node name=\"To\"><use group=\"Point\"/></node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    const std::string code = emit_cpp(*f.proto, "t.xml");
+    EXPECT_TRUE(contains(code, "static expert_field tst_finding_ei[1];")) << code;
+    EXPECT_TRUE(contains(code, "/* x_zero, line 4 */ { &tst_finding_ei[0], 0, 3, 0, 1 }") &&
+                contains(code, "/* x_zero, line 4 */ { &tst_finding_ei[0], 3, 3, 1, 1 }"))
+        << code;
+    const std::string fields = list_fields(*f.proto);
+    EXPECT_EQ(fields.find("tst.finding.x_zero"), fields.rfind("tst.finding.x_zero")) << fields;
+}
+
 TEST(FindingEmit, NothingOfItWithoutFindings) {
     Front f = front_end(reply_with(""));
     ASSERT_TRUE(f.ok()) << f.messages();

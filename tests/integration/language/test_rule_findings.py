@@ -149,5 +149,53 @@ class TestRuleFindings(TsharkTestCase, unittest.TestCase):
                               r"\s+\[Expert Info \(Warning/Protocol\): Item \d+: value \1 is above 1000\]")
 
 
+# A <finding> in a <group> used twice: one expert info, raised by each use.
+TWO_POINTS_RULES = """<root name="Two points" abbreviation="TWOPT" ethertype="0x88b6">
+  <group name="Point">
+    <node name="X" length="2byte" displaytype="numberdec"/>
+    <node name="Y" length="2byte" displaytype="numberdec"/>
+    <finding name="on_axis" severity="warning" group="protocol" condition="{X} == 0 || {Y} == 0"
+             text="on an axis at {X},{Y}"/>
+  </group>
+  <node name="From"><use group="Point"/></node>
+  <node name="To"><use group="Point"/></node>
+</root>
+"""
+
+
+class TestFindingInAGroupUsedTwice(TsharkTestCase, unittest.TestCase):
+    """One name, one expert info registered: it fires inside each use where its condition
+    holds there, with that use's values, and nowhere else; one pass and -2."""
+
+    POINTS = [((0, 5), (3, 4)), ((3, 4), (7, 0)), ((0, 0), (0, 9)), ((3, 4), (5, 6))]
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("two_points.xml", TWO_POINTS_RULES, "twopt")
+        frames = [b"\x02\0\0\0\0\x02\x02\0\0\0\0\x01\x88\xb6" + struct.pack(">4H", *a, *b) + bytes(38)
+                  for a, b in cls.POINTS]
+        cls.path = cls.env.add_file("two_points.pcap", raw_pcap_bytes(frames))
+
+    def test_each_use_raises_it(self):
+        with self.checks() as check:
+            fields = self.env.tshark(["-G", "fields"]).stdout
+            check(len(re.findall(r"\ttwopt\.finding\.on_axis\t", fields)) == 1, "registered once")
+            for two_pass in (False, True):
+                how = "-2" if two_pass else "one pass"
+                text = self.env.tshark(["-r", self.path, "-V", "-O", "twopt"] + (["-2"] if two_pass else [])).stdout
+                frames = re.split(r"^Frame \d+:", text, flags=re.M)[1:]
+                for tree, points in zip(frames, self.POINTS):
+                    got, use = [], None
+                    for line in tree.splitlines():
+                        if re.match(r"^    (From|To)$", line):
+                            use = line.strip()
+                        elif re.match(r"^\s+\[Expert Info \(Warning/Protocol\): ", line):
+                            got.append((use, line.split("): ", 1)[1].rstrip("]")))
+                    want = [(use, "on an axis at %d,%d" % p) for use, p in zip(("From", "To"), points) if 0 in p]
+                    check(got == want, "%s %s: %s, expected %s" % (how, points, got, want))
+                rows = self.env.field_rows(self.path, ["frame.number"], two_pass, display_filter="twopt.finding.on_axis")
+                check(sorted(rows) == [1, 2, 3], "%s: the filter finds frames %s" % (how, sorted(rows)))
+
+
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])
