@@ -343,6 +343,7 @@ const char* show_of(const Node& n) {
         case Display::IPv6: return "DG_SHOW_IPV6";
         case Display::Mac: return "DG_SHOW_MAC";
         case Display::Eui64: return "DG_SHOW_EUI64";
+        case Display::Oid: return "DG_SHOW_OID";
     }
     return "DG_SHOW_HIDDEN";
 }
@@ -1159,6 +1160,7 @@ std::optional<FieldType> typed_field_type(const Node& n) {
         case Display::IPv6: return FieldType{"FT_IPv6", "BASE_NONE", 0};
         case Display::Mac: return FieldType{"FT_ETHER", "BASE_NONE", 0};
         case Display::Eui64: return FieldType{"FT_EUI64", "BASE_NONE", 0};
+        case Display::Oid: return FieldType{"FT_OID", "BASE_NONE", 0};
         case Display::Int: {
             return FieldType{"FT_INT" + std::to_string(bytes * 8), "BASE_DEC", group_mask(n)};
         }

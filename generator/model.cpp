@@ -23,6 +23,7 @@ const char* display_name(Display d) {
         case Display::IPv6: return "ipv6";
         case Display::Mac: return "mac";
         case Display::Eui64: return "eui64";
+        case Display::Oid: return "oid";
     }
     return "?";
 }
@@ -58,7 +59,7 @@ bool Node::is_compared_by_bytes() const {
     switch (display) {
         case Display::String: case Display::StringZ: case Display::Origin: case Display::Address:
         case Display::IPv4: case Display::Guid: case Display::IPv6: case Display::Mac: case Display::Eui64:
-        case Display::NonDisplay: return true;
+        case Display::Oid: case Display::NonDisplay: return true;
         default: return false;
     }
 }

@@ -24,7 +24,9 @@ enum class Display {
     // absolute dates and times (Wireshark's FT_ABSOLUTE_TIME), GUIDs (FT_GUID)
     DateTime, Guid,
     // IPv6 addresses (FT_IPv6), MAC addresses (FT_ETHER: the vendor's name shown), EUI-64s (FT_EUI64)
-    IPv6, Mac, Eui64
+    IPv6, Mac, Eui64,
+    // object identifiers, BER-encoded without tag and length (FT_OID: shown dotted, 1.3.6.1...)
+    Oid
 };
 
 // direction="request|response" (Any: no such attribute)

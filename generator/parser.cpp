@@ -71,7 +71,9 @@ const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberd
                                                 // absolute dates and times, GUIDs
                                                 "datetime", "guid",
                                                 // addresses of fixed size
-                                                "ipv6", "mac", "eui64"};
+                                                "ipv6", "mac", "eui64",
+                                                // object identifiers
+                                                "oid"};
 
 int line_of(const xmlNode* el) { return xml_line(el); }  // lines above 65534: use_start_lines
 
@@ -993,7 +995,8 @@ void Parser::parse_display(const std::string& text, int line, Node& node) {
                                       Display::String,  Display::StringZ,   Display::IPv4,
                                       Display::Int,     Display::Float,     Display::Time,
                                       Display::DateTime, Display::Guid,
-                                      Display::IPv6,    Display::Mac,       Display::Eui64};
+                                      Display::IPv6,    Display::Mac,       Display::Eui64,
+                                      Display::Oid};
     for (size_t i = 0; i < kDisplayNames.size(); ++i) {
         if (text == kDisplayNames[i]) {
             node.display = kValues[i];

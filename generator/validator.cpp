@@ -41,7 +41,7 @@ unsigned fixed_display_bytes(Display d) {
 bool is_byte_display(Display d) {
     return d == Display::Origin || d == Display::Address || d == Display::String || d == Display::StringZ ||
            d == Display::IPv4 || d == Display::Float || d == Display::Time || d == Display::DateTime ||
-           d == Display::Guid || d == Display::IPv6 || d == Display::Mac || d == Display::Eui64;
+           d == Display::Guid || d == Display::IPv6 || d == Display::Mac || d == Display::Eui64 || d == Display::Oid;
 }
 
 // The repeated node around t (t itself included) that does not hold
@@ -1597,6 +1597,11 @@ void Validator::check_string_display(Node& n) {
                                          std::to_string(n.fixed_bits) + " bits");
             break;
         case Display::DateTime: check_datetime_length(n); break;
+        case Display::Oid:
+            if (n.length_kind == LengthKind::Children)
+                diags_.error(n.line, "oid display needs a length (Nbyte, a length field or 'rest'); " + quote(n) +
+                                         " has none");
+            break;
         default: break;
     }
 }

@@ -30,7 +30,7 @@ enum dg_show {
     DG_SHOW_STRING, DG_SHOW_STRINGZ, DG_SHOW_IPV4, DG_SHOW_INT, DG_SHOW_FLOAT, DG_SHOW_TIME,
     DG_SHOW_DATETIME, DG_SHOW_GUID,
     /* addresses of one size: IPv6, MAC (FT_ETHER), EUI-64 */
-    DG_SHOW_IPV6, DG_SHOW_MAC, DG_SHOW_EUI64
+    DG_SHOW_IPV6, DG_SHOW_MAC, DG_SHOW_EUI64, DG_SHOW_OID
 };
 enum dg_flags {
     DG_LITTLE = 1 << 0,      /* little-endian value */

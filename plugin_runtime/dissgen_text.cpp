@@ -10,6 +10,7 @@
  */
 #include "dissgen_state.h"
 
+#include <epan/oids.h>
 #include <epan/to_str.h>
 #include <wsutil/sign_ext.h>
 
@@ -125,6 +126,13 @@ void append_typed_value(const dg_state *st, dg_text *out, const dg_slot *s)
     }
     case DG_SHOW_IPV6: append_str(out, tvb_ip6_to_str(st->pinfo->pool, st->tvb, s->offset)); return;
     case DG_SHOW_MAC: append_str(out, tvb_ether_to_str(st->pinfo->pool, st->tvb, s->offset)); return;
+    case DG_SHOW_OID: /* dotted, as its item: an empty one shows nothing */
+        if (s->length > 0)
+            append_str(out, oid_encoded2string(st->pinfo->pool,
+                                               (const guint8 *)tvb_memdup(st->pinfo->pool, st->tvb, s->offset,
+                                                                          s->length),
+                                               (guint)s->length));
+        return;
     case DG_SHOW_EUI64: {
         /* its item reads it in the node's byte order */
         const guint64 v = read_uint(st->tvb, s->offset, 8, encoding_of(n));
@@ -202,7 +210,7 @@ void append_bare_value(const dg_state *st, dg_text *out, const dg_slot *s)
         return;
     case DG_SHOW_STRING: case DG_SHOW_STRINGZ: case DG_SHOW_IPV4: case DG_SHOW_INT: case DG_SHOW_FLOAT:
     case DG_SHOW_TIME: case DG_SHOW_DATETIME: case DG_SHOW_GUID: case DG_SHOW_IPV6: case DG_SHOW_MAC:
-    case DG_SHOW_EUI64:
+    case DG_SHOW_EUI64: case DG_SHOW_OID:
         append_typed_value(st, out, s);
         return;
     default:

@@ -151,10 +151,11 @@ gint64 leaf_length(dg_state *st, const dg_node *n, proto_tree *tree, gint offset
 void report_short_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint64 length, gint left)
 {
     const gint64 data_end = (gint64)offset + left, needed_end = (gint64)offset + length;
-    /* An address, a float, a datetime or a GUID has one size only: Wireshark throws on fewer bytes. */
+    /* An address, a float, a datetime or a GUID has one size only: Wireshark throws on fewer bytes;
+     * an OID's first bytes would be another OID. */
     gboolean fixed_size = n->show == DG_SHOW_IPV4 || n->show == DG_SHOW_FLOAT || n->show == DG_SHOW_DATETIME ||
                           n->show == DG_SHOW_GUID || n->show == DG_SHOW_IPV6 || n->show == DG_SHOW_MAC ||
-                          n->show == DG_SHOW_EUI64;
+                          n->show == DG_SHOW_EUI64 || n->show == DG_SHOW_OID;
     if (!(n->flags & DG_NUMERIC) && !fixed_size && left > 0 && tree && !cut_by_capture(st, data_end, needed_end)) {
         proto_item *item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, left, item_encoding(n));
         if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);

@@ -66,14 +66,17 @@ TEST(DatesAndGuids, WrongLengthsAreErrorsOnTheirLine) {
     }
 }
 
-// Addresses of one size: Wireshark's address types, no bitmask, compared by their bytes.
+// Addresses of one size and OIDs of any: Wireshark's types, no bitmask, compared by their bytes.
 TEST(DatesAndGuids, AddressesAreWiresharksAddressTypes) {
     Front f = front_end(rules("  <node name=\"v6\" length=\"16byte\" displaytype=\"ipv6\"/>\n"
                               "  <node name=\"mac\" length=\"6byte\" displaytype=\"mac\"/>\n"
-                              "  <node name=\"eui\" length=\"64bit\" displaytype=\"eui64\" byteorder=\"little\"/>\n"));
+                              "  <node name=\"eui\" length=\"64bit\" displaytype=\"eui64\" byteorder=\"little\"/>\n"
+                              "  <node name=\"k\" length=\"1byte\" displaytype=\"numberdec\"/>\n"
+                              "  <node name=\"oid\" length=\"../node[@name='k']\" displaytype=\"oid\"/>\n"));
     ASSERT_TRUE(f.ok()) << f.messages();
     const Protocol& p = *f.proto;
-    const std::pair<const char*, const char*> types[] = {{"v6", "FT_IPv6"}, {"mac", "FT_ETHER"}, {"eui", "FT_EUI64"}};
+    const std::pair<const char*, const char*> types[] = {
+        {"v6", "FT_IPv6"}, {"mac", "FT_ETHER"}, {"eui", "FT_EUI64"}, {"oid", "FT_OID"}};
     for (const auto& [name, type] : types) {
         EXPECT_EQ(field_type(*find(p, name)).type, type) << name;
         EXPECT_EQ(field_type(*find(p, name)).display, "BASE_NONE") << name;
@@ -82,7 +85,7 @@ TEST(DatesAndGuids, AddressesAreWiresharksAddressTypes) {
         EXPECT_TRUE(find(p, name)->is_compared_by_bytes()) << name;
     }
     std::string code = emit_cpp(p, "t.xml");
-    for (const char* show : {"DG_SHOW_IPV6", "DG_SHOW_MAC", "DG_SHOW_EUI64"})
+    for (const char* show : {"DG_SHOW_IPV6", "DG_SHOW_MAC", "DG_SHOW_EUI64", "DG_SHOW_OID"})
         EXPECT_EQ(count_of(code, show), 1u) << show << "\n" << code;
 }
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Addresses of one size, with real tshark: `ipv6` (FT_IPv6), `mac` (FT_ETHER) and `eui64`
-(FT_EUI64, in either byte order). Each value equals the bytes (tshark's fields), filters
+(FT_EUI64, in either byte order); and object identifiers, `oid` (FT_OID). Each value equals the bytes (tshark's fields), filters
 compare them as Wireshark's own fields do, the summary shows what the items show, the tree
 names the vendor of a MAC address and an EUI-64, and a message cut inside an address shows
 the fields before it and our expert info, never an exception; one pass and -2 alike.
@@ -115,6 +115,67 @@ class Addresses(TsharkTestCase, unittest.TestCase):
             self.assertEqual(p.returncode, 0, p.stderr[-2000:])
             self.assertNotIn("Dissector bug", p.stdout)
             self.assertNotIn("Malformed Packet", p.stdout)
+
+# --- object identifiers -------------------------------------------------------------
+
+OID_PORT = 47496
+OID_RULES = """<root name="Object ids" abbreviation="OIDT">
+  <hook table="udp.port" value="%d"/>
+  <node name="Entry" summary="{Object} / {Fixed}">
+    <node name="Length" length="1byte" displaytype="numberdec"/>
+    <node name="Object" length="../node[@name='Length']" displaytype="oid"/>
+    <node name="Fixed" length="3byte" displaytype="oid"/>
+  </node>
+</root>
+""" % OID_PORT
+
+
+def dotted(ber):
+    """An OID's BER content octets (no tag, no length) as dotted decimal: the truth from the bytes."""
+    arcs, value = [], 0
+    for b in ber:
+        value = value << 7 | b & 0x7F
+        if not b & 0x80:
+            arcs.append(value)
+            value = 0
+    first = arcs[0]
+    head = [min(first // 40, 2), first - 40 * min(first // 40, 2)]
+    return ".".join(str(a) for a in head + arcs[1:])
+
+
+class ObjectIdentifiers(TsharkTestCase, unittest.TestCase):
+    """`oid` (FT_OID): BER content octets shown dotted, as LLDP's management address OID or
+    SNMP's: values equal the bytes decoded here, filters compare OIDs, the Info column shows
+    what the items show, an empty one adds no item, and one cut short shows none of its
+    bytes (they would be another OID) with our expert info; one pass and -2 alike."""
+
+    OIDS = ["2b06010401bf08030204", "2b060102010101", "550403", "8837", ""]  # net-snmp, sysDescr, cn, 2.999
+    FIXED = "2a8648"
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("oids.xml", OID_RULES, "oidt")
+        entries = [bytes([len(o) // 2]) + bytes.fromhex(o + cls.FIXED) for o in cls.OIDS]
+        cut = bytes([10]) + bytes.fromhex(cls.OIDS[0])[:5]
+        cls.capture = cls.env.add_file("oids.pcap", pcap([udp(50000, OID_PORT, e) for e in entries + [cut]]))
+
+    def test_values_filters_and_info(self):
+        fields = ["frame.number", "oidt.entry.object", "oidt.entry.fixed", "_ws.col.Info", "_ws.expert.message"]
+        with self.checks() as check:
+            for how, rows in self.env.field_rows_each_pass(self.capture, fields, aggregator="|"):
+                for n, o in enumerate(self.OIDS, 1):
+                    want = [dotted(bytes.fromhex(o))] if o else []
+                    got = rows[n]["oidt.entry.object"], rows[n]["oidt.entry.fixed"], rows[n]["_ws.col.Info"]
+                    check(got == (want, ["1.2.840"], ["%s / 1.2.840" % (want[0] if want else "")]),
+                          "%s frame %d: %s, expected %s" % (how, n, got, want))
+                cut = rows[len(self.OIDS) + 1]
+                check(not cut["oidt.entry.object"] and cut["_ws.expert.message"] ==
+                      ["'Object' has length 10, past the end of its data (5 bytes left)"],
+                      "%s: a cut OID shows none of it, and our expert info: %s" % (how, cut))
+            found = self.env.field_rows(self.capture, ["frame.number"],
+                                        display_filter="oidt.entry.object == 1.3.6.1.2.1.1.1")
+            check(sorted(found) == [2], "the filter finds sysDescr's frame: %s" % sorted(found))
+
 
 if __name__ == "__main__":
     ARGS, status = run_unittests()
