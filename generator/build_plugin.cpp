@@ -5,7 +5,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -80,15 +82,29 @@ std::string find_runtime_dir(const std::string& argv0) {
     return has_runtime(installed) ? installed.string() : "";
 }
 
+std::string make_temp_folder(const std::string& prefix, std::string& tried) {
+    std::vector<std::string> parents;
+    if (const char* tmp = std::getenv("TMPDIR"); tmp && *tmp) parents.push_back(tmp);
+    parents.push_back("/tmp");
+    if (const char* cache = std::getenv("XDG_CACHE_HOME"); cache && *cache) parents.push_back(cache);
+    else if (const char* home = std::getenv("HOME"); home && *home) parents.push_back(std::string(home) + "/.cache");
+    for (const std::string& parent : parents) {
+        std::error_code ec;
+        fs::create_directories(parent, ec);
+        std::string tmpl = parent + "/" + prefix + "-XXXXXX";
+        std::vector<char> buf(tmpl.begin(), tmpl.end());
+        buf.push_back('\0');
+        if (const char* made = mkdtemp(buf.data())) return made;
+        tried += (tried.empty() ? "" : ", ") + parent + " (" + std::strerror(errno) + ")";
+    }
+    return "";
+}
+
 std::string build_and_install(const BuildRequest& req, std::string& installed_path) {
-    char pattern[] = "/tmp/dissgen-build-XXXXXX";
-    const char* tmp_env = std::getenv("TMPDIR");
-    std::string tmpl = std::string(tmp_env && *tmp_env ? tmp_env : "/tmp") + "/dissgen-build-XXXXXX";
-    std::vector<char> buf(tmpl.begin(), tmpl.end());
-    buf.push_back('\0');
-    const char* work = mkdtemp(buf.data());
-    if (!work) work = mkdtemp(pattern);
-    if (!work) return "cannot create a temporary build folder";
+    std::string tried;
+    const std::string work = make_temp_folder("dissgen-build", tried);
+    if (work.empty()) return "cannot create a temporary build folder in " + tried;
+    setenv("TMPDIR", work.c_str(), 1);  // the compiler's own temporary files too, where this user can write
     fs::path dir(work);
     struct Cleanup {
         fs::path d;

@@ -21,6 +21,11 @@ struct BuildRequest {
 // Returns "" on success, else a message for the user.
 std::string build_and_install(const BuildRequest& request, std::string& installed_path);
 
+// A private folder `prefix`-XXXXXX: under $TMPDIR, else /tmp, else the user's
+// cache folder (a machine whose /tmp this user may not write). Empty when
+// none can be made; `tried` then lists where, with why.
+std::string make_temp_folder(const std::string& prefix, std::string& tried);
+
 // <exe>/../share/dissgen: the runtime and shipped rules of an installed
 // dissgen, and (through links CMake makes) of build/bin/dissgen.
 std::string share_dir(const std::string& argv0);

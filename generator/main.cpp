@@ -310,15 +310,12 @@ std::string build_report_plugin(const std::string& rules, BusInput& bus, const s
         std::cerr << "dissgen: report: building a plugin for --esi/--network needs libwireshark-dev and the runtime\n";
         return "";
     }
-    const char* tmp_env = std::getenv("TMPDIR");
-    std::string tmpl = std::string(tmp_env && *tmp_env ? tmp_env : "/tmp") + "/dissgen-report-XXXXXX";
-    std::vector<char> buf(tmpl.begin(), tmpl.end());
-    buf.push_back('\0');
-    if (!mkdtemp(buf.data())) {
-        std::cerr << "dissgen: report: cannot create a temporary folder\n";
+    std::string tried;
+    const std::string root = make_temp_folder("dissgen-report", tried);
+    if (root.empty()) {
+        std::cerr << "dissgen: report: cannot create a temporary folder in " << tried << "\n";
         return "";
     }
-    std::string root = buf.data();
     BuildRequest req{generate_source(*l.proto, rules, bus), plugin_basename(rules), user_plugin_dir(*headers, root), runtime,
                      analysis_runtime_sources(*l.proto)};
     std::string installed, error = build_and_install(req, installed);

@@ -89,7 +89,7 @@ not_ok() { echo "FAILED: $1"; failed=$((failed + 1)); }
 work=$(mktemp -d /tmp/dissgen-gui.XXXXXX)
 chmod 755 "$work"
 home="$work/home"
-mkdir -p "$home/run" "$work/fb"
+mkdir -p "$home/run" "$home/tmp" "$work/fb"
 chmod 700 "$home/run"
 cp "$capture" "$home/$capture_name"
 xvfb_pid="" ws_pid=""
@@ -109,7 +109,7 @@ if [ "$(id -u)" -eq 0 ]; then
 else
   as_user() { "$@"; }
 fi
-user_env=(env -i HOME="$home" PATH=/usr/bin:/bin LANG=C.UTF-8 LC_ALL=C.UTF-8 TZ=UTC TMPDIR=/tmp
+user_env=(env -i HOME="$home" PATH=/usr/bin:/bin LANG=C.UTF-8 LC_ALL=C.UTF-8 TZ=UTC TMPDIR="$home/tmp"
           XDG_RUNTIME_DIR="$home/run" XDG_CONFIG_HOME="$home/.config")
 
 # What that user runs and reads is staged in $work: the checkout (build/bin/dissgen,

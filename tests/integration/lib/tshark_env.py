@@ -143,6 +143,11 @@ class TsharkEnv:
         self.abi = wireshark_abi()
         self.plugin_dir = os.path.join(self.home, ".local", "lib", "wireshark", "plugins",
                                        self.abi, "epan")
+        # TMPDIR for what runs as the tshark user (dissgen report builds there): a machine's
+        # /tmp is not always writable by everyone
+        self.tmp = os.path.join(self.home, "tmp")
+        os.makedirs(self.tmp, exist_ok=True)
+        os.chmod(self.tmp, 0o1777)
         self.installed = []
 
     # -- files ---------------------------------------------------------------
@@ -196,7 +201,7 @@ class TsharkEnv:
     def env(self):
         e = {"HOME": self.home, "PATH": os.environ.get("PATH", "/usr/bin:/bin"),
              "LANG": "C.UTF-8", "LC_ALL": "C.UTF-8", "TZ": "UTC",
-             "XDG_CONFIG_HOME": os.path.join(self.home, ".config")}
+             "XDG_CONFIG_HOME": os.path.join(self.home, ".config"), "TMPDIR": self.tmp}
         if SANITIZE:
             # The plugin is built with ASan+UBSan; tshark is not, so the runtimes are
             # preloaded. Any report aborts tshark (non-zero exit, report on stderr).

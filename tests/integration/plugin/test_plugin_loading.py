@@ -295,6 +295,33 @@ class PluginLoading(unittest.TestCase):
         self.assertNotIn("was not loaded", stderr)
         self.assertEqual(rows, [["ECATR", "0x04,0x0c"], ["ECATR", "0x07"], ["ECATR", "0x0e"]], stderr)
 
+    def test_install_where_tmp_is_not_writable(self):
+        """A user who may not write to TMPDIR (nor /tmp, on some machines) still installs: the
+        build, and the compiler's own temporary files, go to the user's cache folder."""
+        if os.geteuid() != 0:
+            self.skipTest("needs root, to run dissgen as another user")
+        home = tempfile.mkdtemp(dir=self.env.home)
+        closed = tempfile.mkdtemp(dir=self.env.home)  # root's, 0700: nobody may write there
+        # dissgen and its runtime where that user can read them (the checkout may be private)
+        prefix = tempfile.mkdtemp(dir=self.env.home)
+        os.makedirs(os.path.join(prefix, "bin"))
+        shutil.copy(ARGS.dissgen, os.path.join(prefix, "bin", "dissgen"))
+        shutil.copytree(os.path.join(os.path.dirname(os.path.abspath(ARGS.dissgen)), "..", "share", "dissgen"),
+                        os.path.join(prefix, "share", "dissgen"), symlinks=False)
+        rules = os.path.join(home, "ethercat.xml")
+        shutil.copy(self.rules, rules)
+        subprocess.run(["chmod", "-R", "a+rX", prefix, rules], check=True)
+        os.chmod(home, 0o777)
+        p = subprocess.run(["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups", "env", "-i",
+                            "HOME=" + home, "PATH=/usr/bin:/bin", "TMPDIR=" + closed,
+                            os.path.join(prefix, "bin", "dissgen"), "install", rules],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        self.assertTrue(os.path.exists(os.path.join(home, ".local", "lib", "wireshark", "plugins", self.env.abi,
+                                                    "epan", "dissgen_ethercat.so")), p.stdout)
+        self.assertEqual([f for f in os.listdir(os.path.join(home, ".cache")) if f.startswith("dissgen-build-")], [],
+                         "the build folder is removed")
+
     def test_editing_rules_and_installing_again_changes_the_decode(self):
         edited = os.path.join(self.env.home, "ethercat.xml")
         with open(self.rules, encoding="utf-8") as src:
