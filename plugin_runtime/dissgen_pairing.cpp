@@ -21,6 +21,11 @@
  *     request unless it is its key's waiting request come back untouched;
  *     without one, the order decides (the first message of a key is the
  *     request, the next one its response).
+ *  5. A request known to be one (by the transport or <request>) and sent to
+ *     a group address is a group request: each station of the group may
+ *     answer, so after its first answer it keeps waiting, and every later
+ *     response with its key answers it too, until it is given up as above
+ *     (then, answered, it is not lost).
  * Nothing here is touched on later passes.
  */
 #include "dissgen_pairing.h"
@@ -90,6 +95,11 @@ struct pending {
     guint64 key;    /* its first key value (dg_lost) */
     kept *record;              /* the request's record */
     gboolean guessed;          /* taken for a request for want of a better idea */
+    /* Sent to a group of stations (group_request): each may answer, so it
+     * waits for more answers after its first until it is given up, and then
+     * it is not lost. */
+    gboolean group;
+    gboolean answered;         /* a group request: answered at least once */
 };
 
 struct queue {
@@ -148,6 +158,7 @@ struct capture_state {
     wmem_array_t *table;         /* the frame table: chunks of table_chunk kept records */
     wmem_map_t *lost_lists;      /* kept record -> the dg_lost it proved (kept.lost_count) */
     wmem_map_t *long_trips;      /* kept record -> its round trip in ns (gint64), beyond a gint32 */
+    wmem_map_t *more_responses;  /* kept record of a group request -> its answers after the first (wmem_array_t of guint32) */
     /* The transactions of requests not answered, at the slot their records
      * name (kept.round_trip); a slot let go of (NULL) is on free_slots, for
      * the next request: an array, where a map would hash and allocate on
@@ -255,6 +266,7 @@ capture_state *current_capture(void)
         capture->table = wmem_array_new(wmem_file_scope(), sizeof(kept *));
         capture->lost_lists = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
         capture->long_trips = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
+        capture->more_responses = wmem_map_new(wmem_file_scope(), g_direct_hash, g_direct_equal);
         capture->unanswered = wmem_array_new(wmem_file_scope(), sizeof(dg_transaction *));
         capture->group_clients = wmem_map_new(wmem_file_scope(), key_hash, key_equal);
         order_count none = {0, 0};
@@ -511,6 +523,13 @@ void retire(capture_state *c, pending *q)
 void give_up(capture_state *c, pending *q)
 {
     if (q->done) return;
+    if (q->answered) {
+        /* a group request answered: no more answers are waited for */
+        recycle(&c->free_transactions, q->txn);
+        q->txn = NULL;
+        retire(c, q);
+        return;
+    }
     q->txn->given_up_in = c->frame;
     if (c->lost_count == c->lost_capacity) {
         c->lost_capacity = c->lost_capacity ? 2 * c->lost_capacity : 4;
@@ -692,11 +711,13 @@ gboolean keyed_by_client(const packet_info *pinfo, guint8 direction)
 }
 
 /* Whether a message to `a` goes to a group of stations: an IPv4 multicast
- * address or the limited broadcast, an IPv6 multicast address. (A subnet's
- * broadcast address cannot be told from a station's here.) */
+ * address or the limited broadcast, an IPv6 multicast address, an Ethernet
+ * multicast or broadcast address (its group bit). (A subnet's broadcast
+ * address cannot be told from a station's here.) */
 gboolean group_address(const address *a)
 {
     const guint8 *b = (const guint8 *)a->data;
+    if (a->type == AT_ETHER && a->len == 6) return (b[0] & 1) != 0;
     if (a->type == AT_IPv4 && a->len == 4)
         return (b[0] & 0xf0) == 0xe0 || (b[0] == 0xff && b[1] == 0xff && b[2] == 0xff && b[3] == 0xff);
     return a->type == AT_IPv6 && a->len == 16 && b[0] == 0xff;
@@ -841,13 +862,11 @@ void with_lost(capture_state *c, kept *k)
     k->lost_count = (guint16)MIN(c->lost_count, G_MAXUINT16);
 }
 
-/* This message, k, answers transaction t, whose request's record and bytes
- * (and view) are given. The transaction is freed: the two records say what it did. */
-void response_to(capture_state *c, dg_transaction *t, kept *request, const guint8 *request_bytes,
-                 guint request_length, guint request_view_count, kept *k, tvbuff_t *tvb, packet_info *pinfo)
+/* This message, k, answers transaction t: its record names the request and
+ * keeps the round trip (t's too). */
+void link_response(capture_state *c, dg_transaction *t, kept *k, packet_info *pinfo)
 {
     k->role = DG_ROLE_RESPONSE;
-    t->response_frame = pinfo->num;
     nstime_delta(&t->round_trip, &pinfo->abs_ts, &t->request_time);
     k->partner = t->request_frame;
     /* nstime_delta gives seconds and nanoseconds of one sign: exact both ways. */
@@ -858,26 +877,66 @@ void response_to(capture_state *c, dg_transaction *t, kept *request, const guint
         k->round_trip = long_trip;
         wmem_map_insert(c->long_trips, k, wmem_memdup(wmem_file_scope(), &ns, sizeof ns));
     }
+    c->just_answered = k;
+    c->just_answered_seq = t->seq;
+}
+
+/* The analysis compares response k with its request's bytes (and view). */
+void compare_with_request(capture_state *c, dg_transaction *t, const guint8 *request_bytes, guint request_length,
+                          guint request_view_count, kept *k, tvbuff_t *tvb, packet_info *pinfo)
+{
+    if (!analysis || !analysis->compare || !request_bytes) return;
+    tvbuff_t *bytes = tvb_new_real_data(request_bytes, request_length, (gint)request_length);
+    const dg_view request_view = kept_view(request_bytes, request_length, request_view_count);
+    k->analysis = analysis->compare(c->analysis, bytes, &request_view, tvb, c->view, t, pinfo);
+    tvb_free(bytes);
+}
+
+/* This message, k, is the first answer to transaction t, whose request's
+ * record and bytes (and view) are given. Unless `keep` (a group request,
+ * which more answers may follow), the transaction is freed: the two records
+ * say what it did. */
+void response_to(capture_state *c, dg_transaction *t, kept *request, const guint8 *request_bytes,
+                 guint request_length, guint request_view_count, kept *k, tvbuff_t *tvb, packet_info *pinfo,
+                 gboolean keep = FALSE)
+{
+    t->response_frame = pinfo->num;
+    link_response(c, t, k, pinfo);
     guint64 *answered = answered_in(c, t);
     k->out_of_order = protocol->pairing->ordered && t->order_seq < *answered;
     if (t->order_seq > *answered) *answered = t->order_seq;
     if (t->seq > c->answered_max) c->answered_max = t->seq;
-    c->just_answered = k;
-    c->just_answered_seq = t->seq;
-    if (analysis && analysis->compare && request_bytes) {
-        tvbuff_t *bytes = tvb_new_real_data(request_bytes, request_length, (gint)request_length);
-        const dg_view request_view = kept_view(request_bytes, request_length, request_view_count);
-        k->analysis = analysis->compare(c->analysis, bytes, &request_view, tvb, c->view, t, pinfo);
-        tvb_free(bytes);
-    }
+    compare_with_request(c, t, request_bytes, request_length, request_view_count, k, tvb, pinfo);
     request->partner = pinfo->num;
     set_answered(c, request);
-    recycle(&c->free_transactions, t);
+    if (!keep) recycle(&c->free_transactions, t);
+}
+
+/* Message k answers group request q again (another station of the group):
+ * never out of order, as the stations answer in no order of their own. */
+void answer_again(capture_state *c, pending *q, kept *k, tvbuff_t *tvb, packet_info *pinfo)
+{
+    link_response(c, q->txn, k, pinfo);
+    compare_with_request(c, q->txn, q->bytes, q->length, q->view_count, k, tvb, pinfo);
+    wmem_array_t *more = (wmem_array_t *)wmem_map_lookup(c->more_responses, q->record);
+    if (!more) {
+        more = wmem_array_sized_new(wmem_file_scope(), sizeof(guint32), 4);
+        wmem_map_insert(c->more_responses, q->record, more);
+    }
+    wmem_array_append_one(more, pinfo->num);
 }
 
 void answer(capture_state *c, pending *q, kept *k, tvbuff_t *tvb, packet_info *pinfo)
 {
-    response_to(c, q->txn, q->record, q->bytes, q->length, q->view_count, k, tvb, pinfo);
+    if (q->answered) {
+        answer_again(c, q, k, tvb, pinfo);
+        return;
+    }
+    response_to(c, q->txn, q->record, q->bytes, q->length, q->view_count, k, tvb, pinfo, q->group);
+    if (q->group) {
+        q->answered = TRUE; /* waits for the other stations' answers */
+        return;
+    }
     q->txn = NULL; /* freed: a retired request is never looked at again */
     retire(c, q);
 }
@@ -911,7 +970,7 @@ gboolean adopt_orphan(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, pa
 /* This message, k, is a new request: it waits for its response, a new
  * transaction (returned). */
 dg_transaction *new_request(capture_state *c, key_entry *e, kept *k, tvbuff_t *tvb, packet_info *pinfo, guint length,
-                 guint64 key, gboolean guessed)
+                 guint64 key, gboolean guessed, gboolean group)
 {
     if (analysis && analysis->sent) k->analysis = analysis->sent(c->analysis, tvb, c->view, pinfo);
     /* Kept until it is answered (response_to frees it), or for good when it is not. */
@@ -930,6 +989,7 @@ dg_transaction *new_request(capture_state *c, key_entry *e, kept *k, tvbuff_t *t
     n->key = key;
     n->record = k;
     n->guessed = guessed;
+    n->group = group;
     if (guessed) c->guessed++;
     keep_address(&n->src, n->src_bytes, &pinfo->src);
     if (analysis && analysis->compare) {
@@ -1012,7 +1072,8 @@ dg_transaction *first_pass(capture_state *c, kept *k, tvbuff_t *tvb, packet_info
     else if (orphan)
         k->role = DG_ROLE_ORPHAN;
     else {
-        t = new_request(c, e, k, tvb, pinfo, length, keys[0], direction == DG_DIR_ANY);
+        t = new_request(c, e, k, tvb, pinfo, length, keys[0], direction == DG_DIR_ANY,
+                        transport_direction == DG_DIR_REQUEST && group_address(&pinfo->dst));
         remember_group_client(c, pinfo, transport_direction, keys, key_count);
     }
     remember_last(c, e, tvb, pinfo, length, k->role);
@@ -1049,6 +1110,10 @@ const dg_frame_pairing *view_of(const capture_state *c, const kept *k, packet_in
         v->txn.request_frame = pinfo->num;
         v->txn.response_frame = k->partner;
         fp->txn = &v->txn;
+        if (wmem_array_t *more = (wmem_array_t *)wmem_map_lookup(c->more_responses, k)) {
+            fp->more_responses = (const guint32 *)wmem_array_get_raw(more);
+            fp->more_response_count = wmem_array_get_count(more);
+        }
         break;
     case DG_ROLE_RESPONSE: {
         v->txn.request_frame = k->partner;
@@ -1124,6 +1189,10 @@ void show(const dg_frame_pairing *fp, tvbuff_t *tvb, packet_info *pinfo, proto_t
         if (t->response_frame) {
             item = proto_tree_add_uint(tree, hf_response_in, tvb, 0, 0, t->response_frame);
             proto_item_set_generated(item);
+            for (guint i = 0; i < fp->more_response_count; i++) {
+                item = proto_tree_add_uint(tree, hf_response_in, tvb, 0, 0, fp->more_responses[i]);
+                proto_item_set_generated(item);
+            }
         } else if (PINFO_FD_VISITED(pinfo) && known_lost(t)) {
             /* Only once the whole capture has been read can "never" be said
              * here; in one pass the frame that proved it says so (show_lost). */

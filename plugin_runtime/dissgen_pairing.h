@@ -86,6 +86,9 @@ typedef struct dg_frame_pairing {
     guint32 duplicate_of;    /* duplicate: the frame it repeats */
     guint32 analysis;        /* response: the analysis's comparison; request: its sent() result; 0 none */
     const dg_lost *lost;     /* lost_count of them, or NULL */
+    /* request sent to a group: the answers after the first (txn->response_frame) */
+    const guint32 *more_responses;
+    guint more_response_count;
 } dg_frame_pairing;
 
 /* What an analysis reads from a message, as the walk decoded it: the

@@ -172,7 +172,7 @@ TESTS = {
     "transactions": integration("test_transactions.py"),
     "two_clients": integration("test_transactions.py", "TestTwoClients.test_each_response_answers_its_own_client",
                                "TestServerRequestsOnTwoConnections.test_each_connection_pairs_apart",
-                               "TestGroupAddressed"),
+                               "TestGroupAddressed", "TestGroupRequestManyAnswers"),
     "computed": integration("test_computed.py"),
     "learned": integration("test_learned.py"),
     "learned_layout": integration("test_learned_layout.py"),

@@ -15,7 +15,8 @@ still tells a message sent again with other bytes from a duplicate by the messag
 A request overtaken by the answers to 16 later requests still waits, by 17 it is lost; only
 requests on its own connection count. Over TCP the connection is the client: requests a server
 sends from its own port on two connections, with the same key, are paired apart. Over UDP a
-response sent to a group address answers the latest request with its key sent to a group.
+response sent to a group address answers the latest request with its key sent to a group. A
+request sent to a group (over UDP or right over Ethernet) takes every station's answer.
 Needs no corpus.
 """
 
@@ -415,6 +416,94 @@ class TestGroupAddressed(TsharkTestCase, unittest.TestCase):
                 pairs = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
                 check(pairs == self.FORGOTTEN_PAIRS, "%s: each response answers its request (%s)" % (
                     "-2" if two_pass else "one pass", pairs))
+
+
+class TestGroupRequestManyAnswers(TsharkTestCase, unittest.TestCase):
+    """A request sent to a group (a broadcast or multicast address, over UDP or right over
+    Ethernet) is answered by every station that answers it with its key within the timeout,
+    as PROFINET DCP's Identify All or EtherNet/IP's ListIdentity are: each answer links to it
+    and reads its values, the request (with -2) links to each, and, answered, it is not lost
+    when its sender asks again or its timeout passes. A group request nobody answers is lost as
+    before; a unicast request still takes one answer."""
+
+    A, D1, D2, D3 = CLIENT, SERVER, b"\x0a\x00\x00\x03", b"\x0a\x00\x00\x04"
+    GROUP, BROADCAST = b"\xe0\x00\x01\x81", b"\xff\xff\xff\xff"
+    # (ms, source, destination, transaction, kind): 1 a request, 2 a response
+    CAPTURE = [(0, A, BROADCAST, 1, 1),   # 1: A asks every station
+               (1, D1, A, 1, 2),          # 2: answers 1
+               (2, D2, A, 1, 2),          # 3: answers 1 too
+               (3, D3, A, 1, 2),          # 4: and so does a third station
+               (10, A, D1, 2, 1),         # 5: a unicast request
+               (11, D1, A, 2, 2),         # 6: answers 5
+               (12, D2, A, 2, 2),         # 7: 5 was answered, and to D1 alone: an orphan
+               (20, A, GROUP, 3, 1),      # 8: nobody answers: lost
+               (1500, A, BROADCAST, 4, 1),  # 9: past 8's timeout, after a quiet spell
+               (1501, D1, A, 4, 2),       # 10: answers 9, and proves 8 lost (the second message after it)
+               (1502, A, BROADCAST, 4, 1),  # 11: A asks again: 9, answered, is not lost
+               (1503, D2, A, 4, 2),       # 12: answers 11
+               (3000, D3, A, 4, 2)]       # 13: past 11's timeout: an orphan; 11 is not lost
+    PAIRS = {2: 1, 3: 1, 4: 1, 6: 5, 10: 9, 12: 11}
+    RESPONSES_IN = {1: "2,3,4", 5: "6", 9: "10", 11: "12"}
+    ORPHANS = {7, 13}
+    LOST = {8: 10}
+
+    ETHERTYPE = 0x88B6
+    ETHER_RULES = TestRequestRole.RULES.replace('<hook table="udp.port" value="%d"/>' % PORT,
+                                                '<hook table="ethertype" value="0x%04x"/>' % ETHERTYPE)
+    MAC = {A: b"\x02\x00\x00\x00\x00\x01", D1: b"\x02\x00\x00\x00\x00\x02",
+           D2: b"\x02\x00\x00\x00\x00\x03", D3: b"\x02\x00\x00\x00\x00\x04",
+           GROUP: b"\x01\x0e\xcf\x00\x00\x00", BROADCAST: b"\xff\xff\xff\xff\xff\xff"}
+
+    @classmethod
+    def prepare(cls):
+        assert cls.ETHER_RULES != TestRequestRole.RULES
+        cls.install_text("request_role.xml", TestRequestRole.RULES, "txnp")
+        cls.install_text("request_role_ether.xml", cls.ETHER_RULES.replace(
+            'name="Transactions Protocol" abbreviation="TXNP"', 'name="Transactions over Ethernet" abbreviation="TXNE"'),
+            "txne")
+
+    def udp_message(self, src, dst, transaction, kind, n):
+        return udp_frame(src, dst, PORT if kind == 2 else 40000, 40000 if kind == 2 else PORT,
+                         struct.pack(">HBBI", transaction, 1, kind, n))
+
+    def ether_message(self, src, dst, transaction, kind, n):
+        return self.MAC[dst] + self.MAC[src] + struct.pack(">HHBBI", self.ETHERTYPE, transaction, 1, kind, n)
+
+    def check_capture(self, name, message, proto):
+        path = self.env.path(name)
+        write_frames(path, [(ms, message(*m, n)) for n, (ms, *m) in enumerate(self.CAPTURE, 1)])
+        with self.checks() as check:
+            for two_pass in (True, False):
+                mode = "%s %s" % (name, "-2" if two_pass else "one pass")
+                fields = ["frame.number"] + [proto + f for f in (
+                    ".request_in", ".response_in", ".expert.no_response", ".no_response_to", ".no_request",
+                    ".answer.asked", ".expert.out_of_order", ".expert.duplicate")]
+                rows = {n: {f[len(proto) + 1:]: ",".join(v) for f, v in r.items()}
+                        for n, r in self.env.field_rows(path, fields, two_pass).items()}
+                check(len(rows) == len(self.CAPTURE), "%s: every frame decoded (%d)" % (mode, len(rows)))
+                pairs = {n: int(r["request_in"]) for n, r in rows.items() if r["request_in"]}
+                check(pairs == self.PAIRS, "%s: each answer links to its request (%s)" % (mode, pairs))
+                asked = {n: r["answer.asked"] for n, r in rows.items() if r["answer.asked"]}
+                check(asked == {n: str(m) for n, m in self.PAIRS.items()},
+                      "%s: each answer reads its request's Number (%s)" % (mode, asked))
+                linked = {n: r["response_in"] for n, r in rows.items() if r["response_in"]}
+                check(linked == (self.RESPONSES_IN if two_pass else {}),
+                      "%s: the requests link to their answers (%s)" % (mode, linked))
+                orphans = {n for n, r in rows.items() if r["no_request"]}
+                check(orphans == self.ORPHANS, "%s: orphans %s" % (mode, sorted(orphans)))
+                flagged = {n for n, r in rows.items() if r["expert.no_response"]}
+                want = set(self.LOST) if two_pass else set(self.LOST.values())
+                check(flagged == want, "%s: no_response on %s only (%s)" % (mode, sorted(want), sorted(flagged)))
+                proofs = {n: r["no_response_to"] for n, r in rows.items() if r["no_response_to"]}
+                check(proofs == {p: str(q) for q, p in self.LOST.items()}, "%s: losses proved %s" % (mode, proofs))
+                noise = sorted(n for n, r in rows.items() if r["expert.out_of_order"] or r["expert.duplicate"])
+                check(not noise, "%s: no out-of-order or duplicate note (%s)" % (mode, noise))
+
+    def test_over_udp_every_station_answers(self):
+        self.check_capture("group_many.pcap", self.udp_message, "txnp")
+
+    def test_over_ethernet_every_station_answers(self):
+        self.check_capture("group_many_ether.pcap", self.ether_message, "txne")
 
 
 class TestServerRequestsOnTwoConnections(TsharkTestCase, unittest.TestCase):
