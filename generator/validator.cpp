@@ -87,6 +87,7 @@ private:
     void unaligned_group(const Node& first, unsigned bits, const std::string& next);
     void layout_children(std::vector<std::unique_ptr<Node>>& children);
     void close_group(std::vector<Node*>& group, unsigned bits);
+    void join_groups_of_word(std::vector<std::unique_ptr<Node>>& children);
     void layout_packed_bits(Node& n);
     void mean_same_bits(Node& n, std::vector<const Node*>& alternatives);
     std::optional<uint64_t> fixed_bytes(const Node& n) const;
@@ -499,6 +500,55 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
         }
     }
     if (!group.empty()) unaligned_group(*group.front(), group_bits, "");
+    join_groups_of_word(children);
+}
+
+// A container of 2 to 8 bytes made of bit fields alone is one word (a 16-bit
+// flag word, IEC 104's 15-bit sequence number beside its format bit): its
+// groups, closed at each byte boundary above, become one group of its length,
+// so that each field's mask is on the word, as Wireshark's bitmasks are. A
+// whole-byte number among them (a spare octet) joins the word too. The values
+// are the same either way; only the masks and the fields' width change.
+void Validator::join_groups_of_word(std::vector<std::unique_ptr<Node>>& children) {
+    const Node* word = children.empty() ? nullptr : children.front()->parent;
+    if (!word || !word->has_fixed_length() || word->fixed_bits < 16 || word->fixed_bits > 64 ||
+        word->fixed_bits % 8 || word->is_overlay())
+        return;
+    auto whole_byte_member = [](const Node& n) {
+        return !n.in_bit_group && is_bit_leaf(n) && n.fixed_bits % 8 == 0 && !is_byte_display(n.display) &&
+               !n.is_repeated() && !n.packed_bits && !n.has_hook && n.direction == Direction::Any;
+    };
+    unsigned bytes = 0;
+    bool grouped = false;
+    for (const auto& c : children) {
+        if (c->byteorder != children.front()->byteorder) return;
+        if (c->in_bit_group) {
+            grouped = true;
+            if (c->group_last) bytes += c->group_bytes;
+        } else if (whole_byte_member(*c)) {
+            bytes += static_cast<unsigned>(c->fixed_bits / 8);
+        } else {
+            return;
+        }
+    }
+    if (!grouped || bytes * 8 != word->fixed_bits || children.front()->group_bytes == bytes) return;
+    unsigned before = 0;  // bytes of the word before the current group
+    for (auto& c : children) {
+        Node& n = *c;
+        if (!n.in_bit_group) {  // a whole-byte number: a group of its own first
+            n.in_bit_group = n.group_last = true;
+            n.group_bytes = static_cast<unsigned>(n.fixed_bits / 8);
+            n.bits = static_cast<unsigned>(n.fixed_bits);
+            n.shift = 0;
+        }
+        const unsigned own = n.group_bytes;
+        const unsigned after = bytes - before - own;
+        n.shift += 8 * (n.byteorder == ByteOrder::Little ? before : after);
+        n.group_bytes = bytes;
+        n.group_first = &c == &children.front();
+        if (n.group_last) before += own;
+        n.group_last = &c == &children.back();
+    }
 }
 
 // A bit field with count="...": its values are packed into whole bytes, N per byte

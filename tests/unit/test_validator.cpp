@@ -270,6 +270,50 @@ TEST(BitGroups, ByteOrderIsInheritedAndOverridden) {
     expect_layout(find(*f.proto, "d"), {0, 5, 1, false, true});
 }
 
+TEST(BitGroups, AWordOfBitFieldsIsOneGroup) {
+    // A 2-byte container of bit fields alone: its byte-sized groups join into one 16-bit
+    // group, so each mask is on the word (IEC 104's sequence number beside its format bit).
+    Front f = front_end(rules("  <node name=\"Big\" length=\"2byte\">\n"
+                              "    <node name=\"f\" length=\"1bit\" displaytype=\"bool\"/>\n"
+                              "    <node name=\"g\" length=\"7bit\" displaytype=\"numberhex\"/>\n"
+                              "    <node name=\"h\" length=\"3bit\" displaytype=\"numberhex\"/>\n"
+                              "    <node name=\"i\" length=\"5bit\" displaytype=\"numberhex\"/>\n"
+                              "  </node>\n"
+                              "  <node name=\"Little\" length=\"3byte\" byteorder=\"little\">\n"
+                              "    <node name=\"format\" length=\"1bit\" displaytype=\"bool\"/>\n"
+                              "    <node name=\"low\" length=\"7bit\" displaytype=\"numberdec\"/>\n"
+                              "    <node name=\"mid\" length=\"4bit\" displaytype=\"numberdec\"/>\n"
+                              "    <node name=\"high\" length=\"12bit\" displaytype=\"numberdec\"/>\n"
+                              "  </node>\n"
+                              "  <node name=\"Mixed\" length=\"2byte\">\n"
+                              "    <node name=\"x\" length=\"8bit\" displaytype=\"numberhex\"/>\n"
+                              "    <node name=\"y\" length=\"1bit\" displaytype=\"bool\"/>\n"
+                              "    <node name=\"z\" length=\"7bit\" displaytype=\"numberhex\"/>\n"
+                              "  </node>\n"
+                              "  <node name=\"Bytes\" length=\"2byte\">\n"
+                              "    <node name=\"raw\" length=\"1byte\"/>\n"
+                              "    <node name=\"p\" length=\"1bit\" displaytype=\"bool\"/>\n"
+                              "    <node name=\"q\" length=\"7bit\" displaytype=\"numberhex\"/>\n"
+                              "  </node>\n"));
+    ASSERT_TRUE(f.ok()) << f.messages();
+    expect_layout(find(*f.proto, "f"), {15, 1, 2, true, false});
+    expect_layout(find(*f.proto, "g"), {8, 7, 2, false, false});
+    expect_layout(find(*f.proto, "h"), {5, 3, 2, false, false});
+    expect_layout(find(*f.proto, "i"), {0, 5, 2, false, true});
+    expect_layout(find(*f.proto, "format"), {0, 1, 3, true, false});
+    expect_layout(find(*f.proto, "low"), {1, 7, 3, false, false});
+    expect_layout(find(*f.proto, "mid"), {8, 4, 3, false, false});
+    expect_layout(find(*f.proto, "high"), {12, 12, 3, false, true});
+    // a whole-byte number joins the word (a spare octet beside flags)
+    expect_layout(find(*f.proto, "x"), {8, 8, 2, true, false});
+    expect_layout(find(*f.proto, "y"), {7, 1, 2, false, false});
+    expect_layout(find(*f.proto, "z"), {0, 7, 2, false, true});
+    // raw bytes (no displaytype: origin) are no number: no word
+    EXPECT_FALSE(find(*f.proto, "raw")->in_bit_group);
+    expect_layout(find(*f.proto, "p"), {7, 1, 1, true, false});
+    expect_layout(find(*f.proto, "q"), {0, 7, 1, false, true});
+}
+
 TEST(BitGroups, WideGroupsAndWholeByteMembers) {
     Front f = front_end(rules("  <node name=\"a\" length=\"20bit\" displaytype=\"numberhex\"/>\n"
                               "  <node name=\"b\" length=\"4bit\" displaytype=\"numberhex\"/>\n"
