@@ -506,6 +506,54 @@ class TestGroupRequestManyAnswers(TsharkTestCase, unittest.TestCase):
         self.check_capture("group_many_ether.pcap", self.ether_message, "txne")
 
 
+class TestKeyFieldNotDecoded(TsharkTestCase, unittest.TestCase):
+    """A key field a message does not have is left out of its key: messages without it pair
+    with each other, and never with messages that have it (docs/manual.md, <key>)."""
+
+    RULES = """<root name="Transactions Protocol" abbreviation="TXNP" byteorder="big">
+  <hook table="udp.port" value="%d"/>
+  <pairing timeout="1">
+    <key field="node[@name='Transaction']"/>
+    <key field="node[@name='Unit']"/>
+  </pairing>
+  <node name="Transaction" length="2byte" displaytype="numberhex"/>
+  <node name="Has unit" length="1byte" displaytype="numberdec"/>
+  <node name="Unit" length="1byte" displaytype="numberdec" if="../node[@name='Has unit']" in="1"/>
+  <node name="Number" length="4byte" displaytype="numberdec"/>
+</root>
+""" % PORT
+    # (ms, direction, transaction, unit: None when the message has none)
+    CAPTURE = [(0, "request", 1, None),   # 1
+               (1, "request", 1, 7),      # 2: another key: (1, 7)
+               (2, "response", 1, 7),     # 3: answers 2
+               (3, "response", 1, None),  # 4: answers 1
+               (10, "request", 2, None),  # 5
+               (11, "response", 2, 2)]    # 6: (2, 2) is not (2): an orphan; 5 waits
+    PAIRS = {3: 2, 4: 1}
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("key_not_decoded.xml", cls.RULES, "txnp")
+
+    def test_messages_without_the_field_pair_apart(self):
+        def message(direction, transaction, unit, n):
+            head = struct.pack(">HB", transaction, 0) if unit is None else struct.pack(">HBB", transaction, 1, unit)
+            payload = head + struct.pack(">I", n)
+            if direction == "request":
+                return udp_frame(CLIENT, SERVER, 40000, PORT, payload)
+            return udp_frame(SERVER, CLIENT, PORT, 40000, payload)
+        path = self.env.path("key_not_decoded.pcap")
+        write_frames(path, [(ms, message(*m, n)) for n, (ms, *m) in enumerate(self.CAPTURE, 1)])
+        with self.checks() as check:
+            for two_pass in (True, False):
+                mode = "-2" if two_pass else "one pass"
+                rows = decode(self.env, path, two_pass, ["txnp.no_request"])
+                pairs = {n: int(r["txnp.request_in"]) for n, r in rows.items() if r["txnp.request_in"]}
+                check(pairs == self.PAIRS, "%s: pairs %s" % (mode, pairs))
+                orphans = sorted(n for n, r in rows.items() if r["txnp.no_request"])
+                check(orphans == [6], "%s: orphans %s" % (mode, orphans))
+
+
 class TestServerRequestsOnTwoConnections(TsharkTestCase, unittest.TestCase):
     """Over TCP the key holds the connection (both ends), not just the request's sender: a
     server asking both its clients from its own port with the same transaction (as an ADS
