@@ -22,7 +22,7 @@
  *     without one, the order decides (the first message of a key is the
  *     request, the next one its response).
  *  5. A request known to be one (by the transport or <request>) and sent to
- *     a group address is a group request: each station of the group may
+ *     a group address (its own or its link layer's) is a group request: each station of the group may
  *     answer, so after its first answer it keeps waiting, and every later
  *     response with its key answers it too, until it is given up as above
  *     (then, answered, it is not lost).
@@ -723,6 +723,14 @@ gboolean group_address(const address *a)
     return a->type == AT_IPv6 && a->len == 16 && b[0] == 0xff;
 }
 
+/* Whether a request goes to a group of stations: by its address, or by the
+ * link layer's (a subnet's broadcast, 192.168.1.255, goes to the Ethernet
+ * broadcast address, which tells it from a station's). */
+gboolean group_request(const packet_info *pinfo)
+{
+    return group_address(&pinfo->dst) || group_address(&pinfo->dl_dst);
+}
+
 /* A new request over UDP sent to a group address: its client (its keys'
  * last value, with_client) becomes the one a response sent to a group with
  * the same key values goes to (with_client). */
@@ -1073,7 +1081,7 @@ dg_transaction *first_pass(capture_state *c, kept *k, tvbuff_t *tvb, packet_info
         k->role = DG_ROLE_ORPHAN;
     else {
         t = new_request(c, e, k, tvb, pinfo, length, keys[0], direction == DG_DIR_ANY,
-                        transport_direction == DG_DIR_REQUEST && group_address(&pinfo->dst));
+                        transport_direction == DG_DIR_REQUEST && group_request(pinfo));
         remember_group_client(c, pinfo, transport_direction, keys, key_count);
     }
     remember_last(c, e, tvb, pinfo, length, k->role);

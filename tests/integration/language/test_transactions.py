@@ -428,6 +428,7 @@ class TestGroupRequestManyAnswers(TsharkTestCase, unittest.TestCase):
 
     A, D1, D2, D3 = CLIENT, SERVER, b"\x0a\x00\x00\x03", b"\x0a\x00\x00\x04"
     GROUP, BROADCAST = b"\xe0\x00\x01\x81", b"\xff\xff\xff\xff"
+    SUBNET = b"\x0a\x00\x00\xff"  # 10.0.0.255: a broadcast only its Ethernet address tells
     # (ms, source, destination, transaction, kind): 1 a request, 2 a response
     CAPTURE = [(0, A, BROADCAST, 1, 1),   # 1: A asks every station
                (1, D1, A, 1, 2),          # 2: answers 1
@@ -463,15 +464,16 @@ class TestGroupRequestManyAnswers(TsharkTestCase, unittest.TestCase):
             "txne")
 
     def udp_message(self, src, dst, transaction, kind, n):
-        return udp_frame(src, dst, PORT if kind == 2 else 40000, 40000 if kind == 2 else PORT,
-                         struct.pack(">HBBI", transaction, 1, kind, n))
+        frame = udp_frame(src, dst, PORT if kind == 2 else 40000, 40000 if kind == 2 else PORT,
+                          struct.pack(">HBBI", transaction, 1, kind, n))
+        return self.MAC[self.BROADCAST] + frame[6:] if dst == self.SUBNET else frame
 
     def ether_message(self, src, dst, transaction, kind, n):
         return self.MAC[dst] + self.MAC[src] + struct.pack(">HHBBI", self.ETHERTYPE, transaction, 1, kind, n)
 
-    def check_capture(self, name, message, proto):
+    def check_capture(self, name, message, proto, capture=CAPTURE):
         path = self.env.path(name)
-        write_frames(path, [(ms, message(*m, n)) for n, (ms, *m) in enumerate(self.CAPTURE, 1)])
+        write_frames(path, [(ms, message(*m, n)) for n, (ms, *m) in enumerate(capture, 1)])
         with self.checks() as check:
             for two_pass in (True, False):
                 mode = "%s %s" % (name, "-2" if two_pass else "one pass")
@@ -501,6 +503,11 @@ class TestGroupRequestManyAnswers(TsharkTestCase, unittest.TestCase):
 
     def test_over_udp_every_station_answers(self):
         self.check_capture("group_many.pcap", self.udp_message, "txnp")
+
+    def test_to_a_subnet_broadcast_every_station_answers(self):
+        capture = [(ms, src, self.SUBNET if dst == self.BROADCAST else dst, *rest)
+                   for ms, src, dst, *rest in self.CAPTURE]
+        self.check_capture("group_many_subnet.pcap", self.udp_message, "txnp", capture)
 
     def test_over_ethernet_every_station_answers(self):
         self.check_capture("group_many_ether.pcap", self.ether_message, "txne")
