@@ -511,8 +511,7 @@ void Validator::layout_children(std::vector<std::unique_ptr<Node>>& children) {
 // are the same either way; only the masks and the fields' width change.
 void Validator::join_groups_of_word(std::vector<std::unique_ptr<Node>>& children) {
     const Node* word = children.empty() ? nullptr : children.front()->parent;
-    if (!word || !word->has_fixed_length() || word->fixed_bits < 16 || word->fixed_bits > 64 ||
-        word->fixed_bits % 8 || word->is_overlay())
+    if (!word || !word->has_fixed_length() || word->fixed_bits < 16 || word->fixed_bits > 64 || word->fixed_bits % 8)
         return;
     auto whole_byte_member = [](const Node& n) {
         return !n.in_bit_group && is_bit_leaf(n) && n.fixed_bits % 8 == 0 && !is_byte_display(n.display) &&

@@ -206,6 +206,80 @@ class BitFields(TsharkTestCase, unittest.TestCase):
                                 for e in m.experts), f)
 
 
+
+class WordsOfBitFields(TsharkTestCase, unittest.TestCase):
+    """A container of 2 to 8 bytes made of bit fields (an overlay too) is one bit group: each
+    field's mask is on the whole word, as Wireshark registers a flag word's bits, and its value
+    is still what the bytes say (docs/manual.md, "Bit fields")."""
+
+    RULES = """<root name="Bit words" abbreviation="BITW" ethertype="0x%04x">
+  <node name="Control" filter="control" length="4byte" byteorder="little">
+    <node name="Flag" filter="flag" length="1bit" displaytype="numberdec"/>
+    <node name="Tx" filter="tx" length="15bit" displaytype="numberdec"/>
+    <node name="Spare" filter="spare" length="1bit" displaytype="numberdec"/>
+    <node name="Rx" filter="rx" length="15bit" displaytype="numberdec"/>
+  </node>
+  <node name="Again" filter="again" length="4byte" byteorder="little" overlay="../node[@name='Control']">
+    <node name="A" filter="a" length="2bit" displaytype="numberhex"/>
+    <node name="B" filter="b" length="6bit" displaytype="numberhex"/>
+    <node name="C" filter="c" length="8bit" displaytype="numberhex"/>
+    <node name="D" filter="d" length="16bit" displaytype="numberhex"/>
+  </node>
+  <node name="Flags" filter="flags" length="2byte">
+%s  </node>
+</root>
+""" % (ETHERTYPE + 1, "".join('    <node name="F%d" filter="f%d" length="1bit" displaytype="bool"/>\n' % (i, i)
+                               for i in range(16)))
+    # field: (type, mask) as tshark -G fields lists them
+    MASKS = {"control.flag": ("FT_UINT32", 0x1), "control.tx": ("FT_UINT32", 0xfffe),
+             "control.spare": ("FT_UINT32", 0x10000), "control.rx": ("FT_UINT32", 0xfffe0000),
+             "again.a": ("FT_UINT32", 0x3), "again.b": ("FT_UINT32", 0xfc), "again.c": ("FT_UINT32", 0xff00),
+             "again.d": ("FT_UINT32", 0xffff0000)}
+    MASKS.update({"flags.f%d" % i: ("FT_BOOLEAN", 0x8000 >> i) for i in range(16)})
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("bit_words.xml", cls.RULES, "bitw")
+
+    def test_masks_are_on_the_word(self):
+        out = self.env.tshark(["-G", "fields"]).stdout
+        listed = {}
+        for line in out.splitlines():
+            cols = line.split("\t")
+            if len(cols) >= 7 and cols[0] == "F" and cols[2].startswith("bitw."):
+                listed[cols[2][len("bitw."):]] = (cols[3], int(cols[6], 16))
+        with self.checks() as check:
+            for name, want in self.MASKS.items():
+                check(listed.get(name) == want, "bitw.%s: %s, expected %s" % (name, listed.get(name), want))
+
+    def test_values_are_what_the_bytes_say(self):
+        rng = random.Random(11)
+        words = [(rng.getrandbits(32), rng.getrandbits(16)) for _ in range(40)] + [(0xffffffff, 0xffff), (0, 0)]
+        path = self.env.add_file("bit_words.pcap", pcap([
+            (f, len(f)) for f in (b"\x02\xee\xee\xee\xee\xee\x02\x00\x00\x00\x00\x01" +
+                                  struct.pack("!H", ETHERTYPE + 1) + struct.pack("<I", c) + struct.pack(">H", fl)
+                                  for c, fl in words)]))
+        names = list(self.MASKS)
+        with self.checks() as check:
+            for label, rows in self.env.field_rows_each_pass(path, ["frame.number"] + ["bitw." + n for n in names]):
+                bad = []
+                for i, (c, fl) in enumerate(words, 1):
+                    for n in names:
+                        kind, mask = self.MASKS[n]
+                        raw = (fl if n.startswith("flags.") else c) & mask
+                        value = raw // (mask & -mask)
+                        if kind == "FT_BOOLEAN":
+                            want = ["1" if value else "0"]
+                        elif n.startswith("again."):
+                            want = ["0x%08x" % value]
+                        else:
+                            want = [str(value)]
+                        if rows[i]["bitw." + n] != want:
+                            bad.append("frame %d %s: %s, expected %s" % (i, n, rows[i]["bitw." + n], want))
+                check(not bad, "%s: %d words, every field as the bytes say%s" % (
+                    label, len(words), "".join("\n  " + b for b in bad[:8])))
+
+
 def main():
     def arguments(parser):
         parser.add_argument("--seed", type=int, default=7)
