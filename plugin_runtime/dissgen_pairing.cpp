@@ -22,10 +22,12 @@
  *     without one, the order decides (the first message of a key is the
  *     request, the next one its response).
  *  5. A request known to be one (by the transport or <request>) and sent to
- *     a group address (its own or its link layer's) is a group request: each station of the group may
- *     answer, so after its first answer it keeps waiting, and every later
- *     response with its key answers it too, until it is given up as above
- *     (then, answered, it is not lost).
+ *     a group address (over UDP also the Ethernet broadcast) is a group
+ *     request: each station of the group may answer, so after its first
+ *     answer it keeps waiting, and a later response with its key answers it
+ *     too when no request of the key waits for its first answer. Any other
+ *     message of the key ends its wait, as does step 1; answered, it is then
+ *     not lost.
  * Nothing here is touched on later passes.
  */
 #include "dissgen_pairing.h"
@@ -57,8 +59,8 @@ struct pair_key {
  * with p_add_proto_data. What few messages need sits in maps beside the
  * table: the requests it proved lost, a round trip beyond 2 s, and (in an
  * array) the transaction of a request not answered (which says why on
- * display); once
- * answered, the two frames' numbers and the round trip say everything. */
+ * display), and a group request's answers after its first; once answered,
+ * the two frames' numbers and the round trip say everything. */
 struct kept {
     guint32 partner;      /* request: its response's frame (0: none yet); response: its
                            * request's; duplicate: the frame it repeats */
@@ -88,7 +90,7 @@ struct pending {
     dg_transaction *txn;
     address src;
     guint8 src_bytes[16];  /* src's data when it fits (kept_address) */
-    guint8 *bytes;  /* the request's bytes and view, kept for the analysis until answered */
+    guint8 *bytes;  /* the request's bytes and view, kept for the analysis until retired */
     guint length;
     guint view_count; /* values of its view (kept_view) */
     guint capacity; /* of bytes (a buffer used again: capture_state.spare) */
@@ -136,7 +138,7 @@ struct capture_state {
     wmem_map_t *keys;            /* pair_key -> key_entry */
     key_entry *oldest, *newest;  /* key entries by their last message, least recent first */
     queue sent;                  /* every key's requests, in capture order */
-    guint waiting;               /* requests not yet answered nor given up */
+    guint waiting;               /* requests not yet answered nor given up (group requests answered not counted) */
     guint guessed;               /* of them, taken for requests for want of a better idea */
     guint64 requests;            /* the last request's seq */
     guint64 answered_max;        /* the highest seq answered so far, in any order scope */
@@ -505,7 +507,7 @@ void retire(capture_state *c, pending *q)
 {
     if (q->done) return;
     q->done = TRUE;
-    c->waiting--;
+    if (!q->answered) c->waiting--;
     if (q->guessed) c->guessed--;
     if (q->bytes && (!c->spare || q->capacity > c->spare_capacity)) {
         wmem_free(wmem_file_scope(), c->spare);
@@ -519,7 +521,8 @@ void retire(capture_state *c, pending *q)
 }
 
 /* Given up unanswered while the current message was paired: that message
- * proves it lost (its expert info goes there in one pass). */
+ * proves it lost (its expert info goes there in one pass). A group request
+ * answered is only retired: it waited for more answers, and had one. */
 void give_up(capture_state *c, pending *q)
 {
     if (q->done) return;
@@ -619,6 +622,7 @@ pending *take_oldest(capture_state *c, packet_info *pinfo)
      * was sent before the capture started. */
     if (!c->answered_max) return NULL;
     pending *q = oldest_waiting(c, &c->sent, FALSE, pinfo);
+    while (q && (q->done || q->answered)) q = q->next_sent;
     if (!q || c->waiting != 1 || !analysis || !analysis->is_response || analysis->is_response(c->analysis, &q->src, &pinfo->src) != 1)
         return NULL;
     if (analysis->key_changed && q->bytes) {
@@ -723,12 +727,16 @@ gboolean group_address(const address *a)
     return a->type == AT_IPv6 && a->len == 16 && b[0] == 0xff;
 }
 
-/* Whether a request goes to a group of stations: by its address, or by the
- * link layer's (a subnet's broadcast, 192.168.1.255, goes to the Ethernet
- * broadcast address, which tells it from a station's). */
+/* Whether a request goes to a group of stations: by its address, or over
+ * UDP by the link layer's broadcast address (a subnet's broadcast,
+ * 192.168.1.255, which its IP address does not tell from a station's). Not
+ * any multicast MAC: a unicast IP address may sit behind one (a cluster). */
 gboolean group_request(const packet_info *pinfo)
 {
-    return group_address(&pinfo->dst) || group_address(&pinfo->dl_dst);
+    static const guint8 all_ones[6] = {0xff, 0xff, 0xff, 0xff, 0xff, 0xff};
+    const address *mac = &pinfo->dl_dst;
+    return group_address(&pinfo->dst) || (pinfo->ptype == PT_UDP && mac->type == AT_ETHER && mac->len == 6 &&
+                                          memcmp(mac->data, all_ones, 6) == 0);
 }
 
 /* A new request over UDP sent to a group address: its client (its keys'
@@ -802,6 +810,14 @@ void give_up_sent_again(capture_state *c, key_entry *e, const packet_info *pinfo
         if (!q->done && addresses_equal(&q->src, &pinfo->src)) give_up(c, q);
 }
 
+/* The key's group requests that were answered wait no more (give_up
+ * retires them quietly). */
+void retire_answered_groups(capture_state *c, key_entry *e)
+{
+    for (pending *q = e->waiting.head; q; q = q->next)
+        if (!q->done && q->answered) give_up(c, q);
+}
+
 /* Messages taken for requests only for want of a better idea, from a source
  * now known to send responses only (a slave's marked return), were
  * responses whose requests were not captured: orphans, not lost. */
@@ -823,17 +839,22 @@ void orphan_guessed_from(capture_state *c, const packet_info *pinfo)
 pending *take_response(capture_state *c, key_entry *e, packet_info *pinfo)
 {
     oldest_waiting(c, &e->waiting, TRUE, pinfo); /* gives up the expired ones */
-    pending *maybe = NULL;
+    pending *maybe = NULL, *group = NULL;
     for (pending *q = e->waiting.head; q; q = q->next) {
         if (q->done) continue;
         int verdict = analysis && analysis->is_response ? analysis->is_response(c->analysis, &q->src, &pinfo->src) : -1;
+        if (q->answered) { /* a group request answered: only when no request waits for its first */
+            if (verdict != 0 && !group) group = q;
+            continue;
+        }
         if (verdict == 1) {
             if (c->guessed) orphan_guessed_from(c, pinfo);
             return q;
         }
         if (verdict < 0 && !maybe) maybe = q;
     }
-    return maybe ? maybe : take_oldest(c, pinfo);
+    if (maybe) return maybe;
+    return group ? group : take_oldest(c, pinfo);
 }
 
 /* A message its own bytes cannot place (the analysis has a direction()):
@@ -943,6 +964,7 @@ void answer(capture_state *c, pending *q, kept *k, tvbuff_t *tvb, packet_info *p
     response_to(c, q->txn, q->record, q->bytes, q->length, q->view_count, k, tvb, pinfo, q->group);
     if (q->group) {
         q->answered = TRUE; /* waits for the other stations' answers */
+        c->waiting--;       /* ... but for no first one */
         return;
     }
     q->txn = NULL; /* freed: a retired request is never looked at again */
@@ -981,7 +1003,8 @@ dg_transaction *new_request(capture_state *c, key_entry *e, kept *k, tvbuff_t *t
                  guint64 key, gboolean guessed, gboolean group)
 {
     if (analysis && analysis->sent) k->analysis = analysis->sent(c->analysis, tvb, c->view, pinfo);
-    /* Kept until it is answered (response_to frees it), or for good when it is not. */
+    /* Kept until it is answered (response_to frees it; a group request's
+     * when it is retired, give_up), or for good when it is not. */
     dg_transaction *t = new_recycled<dg_transaction>(&c->free_transactions);
     t->request_frame = pinfo->num;
     t->request_time = pinfo->abs_ts;
@@ -1023,6 +1046,9 @@ pending *classify(capture_state *c, key_entry *e, tvbuff_t *tvb, packet_info *pi
 {
     *orphan = FALSE;
     pending *q = NULL;
+    /* Only a response answers a group request again: another message of the
+     * key is a request, or where the order decides the next exchange's. */
+    if (direction != DG_DIR_RESPONSE) retire_answered_groups(c, e);
     if (direction == DG_DIR_RESPONSE) {
         q = take_response(c, e, pinfo);
         *orphan = !q;
@@ -1361,8 +1387,13 @@ const dg_request_values *dg_pairing_request_of(const guint64 *keys, guint key_co
     pair_key probe = {key_count, (guint64 *)keys};
     const key_entry *e = (const key_entry *)wmem_map_lookup(capture->keys, &probe);
     if (!e) return NULL;
-    for (const pending *q = e->waiting.head; q; q = q->next)
-        if (!q->done && !given_up(capture, q, pinfo, protocol->pairing->timeout)) return q->txn->values;
+    const pending *group = NULL; /* as take_response: a group request answered comes last */
+    for (const pending *q = e->waiting.head; q; q = q->next) {
+        if (q->done || given_up(capture, q, pinfo, protocol->pairing->timeout)) continue;
+        if (!q->answered) return q->txn->values;
+        if (!group) group = q;
+    }
+    if (group) return group->txn->values;
     /* a copy of the key's last response (same_again; the message's own length
      * is not known before its walk, its tvb's is) */
     const gboolean copy = e->last_answered && e->last_role == DG_ROLE_RESPONSE &&

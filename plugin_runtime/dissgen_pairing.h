@@ -11,7 +11,8 @@
  *   indexed by frame number, for a frame's first message; p_add_proto_data
  *   for the others), only what display needs: the role, the partner's
  *   frame, the round trip, the analysis's result; a request's transaction
- *   only while it is not answered. dg_pairing_dissect() hands out the
+ *   only while it is not answered (a group request's while it waits for more
+ *   answers), and a group request's later answers. dg_pairing_dissect() hands out the
  *   record as a dg_frame_pairing (and its dg_transaction) in pinfo->pool.
  *
  * Later passes (tshark -2, the GUI in any order, display filters) only read

@@ -427,6 +427,7 @@ class TestGroupRequestManyAnswers(TsharkTestCase, unittest.TestCase):
     before; a unicast request still takes one answer."""
 
     A, D1, D2, D3 = CLIENT, SERVER, b"\x0a\x00\x00\x03", b"\x0a\x00\x00\x04"
+    B = b"\x0a\x00\x00\x05"  # another station that asks
     GROUP, BROADCAST = b"\xe0\x00\x01\x81", b"\xff\xff\xff\xff"
     SUBNET = b"\x0a\x00\x00\xff"  # 10.0.0.255: a broadcast only its Ethernet address tells
     # (ms, source, destination, transaction, kind): 1 a request, 2 a response
@@ -452,7 +453,7 @@ class TestGroupRequestManyAnswers(TsharkTestCase, unittest.TestCase):
     ETHER_RULES = TestRequestRole.RULES.replace('<hook table="udp.port" value="%d"/>' % PORT,
                                                 '<hook table="ethertype" value="0x%04x"/>' % ETHERTYPE)
     MAC = {A: b"\x02\x00\x00\x00\x00\x01", D1: b"\x02\x00\x00\x00\x00\x02",
-           D2: b"\x02\x00\x00\x00\x00\x03", D3: b"\x02\x00\x00\x00\x00\x04",
+           D2: b"\x02\x00\x00\x00\x00\x03", D3: b"\x02\x00\x00\x00\x00\x04", B: b"\x02\x00\x00\x00\x00\x05",
            GROUP: b"\x01\x0e\xcf\x00\x00\x00", BROADCAST: b"\xff\xff\xff\xff\xff\xff"}
 
     @classmethod
@@ -511,6 +512,46 @@ class TestGroupRequestManyAnswers(TsharkTestCase, unittest.TestCase):
 
     def test_over_ethernet_every_station_answers(self):
         self.check_capture("group_many_ether.pcap", self.ether_message, "txne")
+
+    def test_other_requests_of_the_key_come_first(self):
+        """Right over Ethernet the key names no client: a request waiting for its first answer
+        takes an answer before a group request answered already, and any message of the key
+        other than a response ends the group request's wait (where the order decides, one
+        response answers a request)."""
+        A, B, D1, D2, D3, GROUP = self.A, self.B, self.D1, self.D2, self.D3, self.GROUP
+        capture = [(0, A, GROUP, 9, 1),     # 1: a group request
+                   (1, D1, A, 9, 2),        # 2: answers 1
+                   (2, B, D3, 9, 1),        # 3: another station's request with the key: 1 waits no more
+                   (3, D2, A, 9, 2),        # 4: answers 3
+                   (10, A, GROUP, 10, 1),   # 5: a group request
+                   (11, D1, A, 10, 2),      # 6: answers 5
+                   (12, D2, A, 10, None),   # 7: no Kind: the order decides, a new request
+                   (13, A, D2, 10, None),   # 8: answers 7
+                   (20, A, GROUP, 11, 1),   # 9: a group request
+                   (21, B, D3, 11, 1),      # 10: a request with the key before any answer
+                   (22, D1, A, 11, 2),      # 11: answers 9, the oldest
+                   (23, D3, B, 11, 2),      # 12: answers 10, which waits for its first answer
+                   (24, D2, A, 11, 2)]      # 13: answers 9 again
+        pairs_wanted = {2: 1, 4: 3, 6: 5, 8: 7, 11: 9, 12: 10, 13: 9}
+
+        def message(src, dst, transaction, kind, n):
+            if kind is None:
+                return self.MAC[dst] + self.MAC[src] + struct.pack(">HHBI", self.ETHERTYPE, transaction, 0, n)
+            return self.ether_message(src, dst, transaction, kind, n)
+        path = self.env.path("group_first_answers.pcap")
+        write_frames(path, [(ms, message(*m, n)) for n, (ms, *m) in enumerate(capture, 1)])
+        with self.checks() as check:
+            for two_pass in (True, False):
+                mode = "-2" if two_pass else "one pass"
+                rows = self.env.field_rows(path, ["frame.number", "txne.request_in", "txne.expert.no_response",
+                                                  "txne.no_request", "txne.answer.asked"], two_pass)
+                pairs = {n: int(r["txne.request_in"][0]) for n, r in rows.items() if r["txne.request_in"]}
+                check(pairs == pairs_wanted, "%s: pairs %s" % (mode, pairs))
+                asked = {n: r["txne.answer.asked"] for n, r in rows.items() if r["txne.answer.asked"]}
+                check(asked == {n: [str(m)] for n, m in pairs_wanted.items() if capture[n - 1][4] == 2},
+                      "%s: each answer reads its own request's Number (%s)" % (mode, asked))
+                noise = sorted(n for n, r in rows.items() if r["txne.expert.no_response"] or r["txne.no_request"])
+                check(not noise, "%s: nothing lost, no orphan (%s)" % (mode, noise))
 
 
 class TestKeyFieldNotDecoded(TsharkTestCase, unittest.TestCase):
