@@ -141,18 +141,23 @@ void dg_rt::find_handoff_dissectors(const dg_protocol *p)
 
 /* --- stream transports --------------------------------------------------- */
 
-extern "C" guint dg_message_length(packet_info *, tvbuff_t *tvb, int offset, void *data)
+gint64 dg_rt::stream_message_length(const dg_protocol *p, tvbuff_t *tvb, int offset)
 {
-    const dg_protocol *p = (const dg_protocol *)data;
     const dg_node *n = &p->nodes[p->pdu_node];
     guint64 value = read_uint(tvb, offset + (gint)p->pdu_offset, n->length, encoding_of(n));
     if (n->flags & DG_GROUP) value = bit_field(value, n->shift, n->bits);
-    gint64 total = (gint64)MIN(value, (guint64)G_MAXINT32) + p->pdu_add;
+    return (gint64)MIN(value, (guint64)G_MAXINT32) + p->pdu_add;
+}
+
+extern "C" guint dg_message_length(packet_info *, tvbuff_t *tvb, int offset, void *data)
+{
+    const dg_protocol *p = (const dg_protocol *)data;
+    const gint64 total = stream_message_length(p, tvb, offset);
     /* A length shorter than the bytes up to the end of the length field is
-     * malformed: tcp_dissect_pdus shows it as Wireshark's dissectors do (a
-     * malformed packet, the rest of the segment not decoded) rather than
-     * making messages up from what follows. 0 would ask for more data. */
-    if (total < (gint64)(p->pdu_offset + n->length)) return (guint)MAX(total, 1);
+     * malformed: that message takes the rest of the segment, where the walk
+     * shows its header and says so at the length field (dg_dissect), rather
+     * than messages being made up from what follows. */
+    if (total < (gint64)stream_header_length(p)) return (guint)tvb_reported_length_remaining(tvb, offset);
     return (guint)MIN(total, (gint64)G_MAXINT32);
 }
 
@@ -167,7 +172,6 @@ int dissect_message(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *d
 
 int dg_dissect_stream(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
-    const dg_node *n = &p->nodes[p->pdu_node];
-    tcp_dissect_pdus(tvb, pinfo, tree, TRUE, p->pdu_offset + n->length, dg_message_length, dissect_message, (void *)p);
+    tcp_dissect_pdus(tvb, pinfo, tree, TRUE, stream_header_length(p), dg_message_length, dissect_message, (void *)p);
     return (int)tvb_captured_length(tvb);
 }

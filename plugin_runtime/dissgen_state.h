@@ -80,6 +80,8 @@ struct dg_state {
     gboolean stopped;     /* a malformed spot was reported: decode nothing more */
     gboolean faulted;     /* a malformed spot was reported in this message, even if decoding went on */
     gboolean cut_shown;   /* the capture kept less than the frame had: shown once (capture_cut) */
+    gboolean header_only; /* a stream message whose length field says less than its header: only the
+                           * header is walked, and what it lacks is that one fault, told once */
     gint64 told_end;      /* where a length reported past the end of its data says its container ends
                            * (0: none), and where that data ran out: data missing there, needed up to
                            * no further than told_end, is that fault, not told again */
@@ -137,6 +139,14 @@ extern const dg_expr_readers message_readers;
 /* Reports a malformed spot at `offset` (clamped into the packet) and stops decoding. */
 void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format, ...)
     G_GNUC_PRINTF(6, 7);
+
+/* pdulength: the length of the stream message at offset its length field
+ * gives (with pdulengthadd), and the bytes up to the end of that field. */
+gint64 stream_message_length(const dg_protocol *p, tvbuff_t *tvb, int offset);
+static inline guint stream_header_length(const dg_protocol *p)
+{
+    return p->pdu_offset + p->nodes[p->pdu_node].length;
+}
 
 /* Whether bytes needed up to needed_end are missing only because the capture
  * kept less of the frame than was on the wire (a snapshot length): the data

@@ -28,6 +28,7 @@ static void report_v(dg_state *st, proto_tree *tree, expert_field *ei, gint offs
     if (length < 0 || offset + length > st->packet_end) length = st->packet_end - offset;
     st->stopped = TRUE;
     st->faulted = TRUE;
+    if (st->header_only) return; /* the message's length is the fault (report_short_stream_message) */
     if (st->quiet) {
         /* No tree and no tap listener: nobody reads the text, but the
          * severity still goes to the Expert column and the capture's highest
@@ -968,6 +969,34 @@ void dissect_instance(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
 
 } // namespace dg_rt
 
+namespace {
+
+/* A TCP message whose length field says less than the bytes up to the end
+ * of that field takes the rest of its segment (dg_message_length): only its
+ * header is walked, the bytes after it are not decoded. -1 when the message's
+ * length is sound (or it is not a stream message). */
+gint64 short_stream_length(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo)
+{
+    if (p->pdu_node < 0 || pinfo->ptype != PT_TCP) return -1;
+    if (tvb_captured_length(tvb) < stream_header_length(p)) return -1;
+    const gint64 length = stream_message_length(p, tvb, 0);
+    return length < (gint64)stream_header_length(p) ? length : -1;
+}
+
+void report_short_stream_message(dg_state *st, proto_tree *tree, gint64 length, guint rest)
+{
+    const dg_protocol *p = st->p;
+    const dg_node *n = &p->nodes[p->pdu_node];
+    st->header_only = FALSE;
+    st->stopped = FALSE; /* what the header lacked past its end was this fault */
+    report(st, tree, &p->ei->bad_length, (gint)p->pdu_offset, (gint)n->length,
+           "The message length '%s' gives (%" G_GINT64_MODIFIER "d) is shorter than the %u bytes up to its end; "
+           "the %u byte%s after %s not decoded",
+           n->name, length, stream_header_length(p), rest, rest == 1 ? "" : "s", rest == 1 ? "it is" : "them are");
+}
+
+} // namespace
+
 int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     col_set_str(pinfo->cinfo, COL_PROTOCOL, p->short_name);
@@ -977,9 +1006,14 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     gboolean first_message = messages == 1;
     if (first_message) col_clear(pinfo->cinfo, COL_INFO);
 
+    const gint64 short_length = short_stream_length(p, tvb, pinfo);
+    const guint segment_rest = (guint)tvb_reported_length(tvb) - (short_length >= 0 ? stream_header_length(p) : 0);
+    if (short_length >= 0) tvb = tvb_new_subset_length(tvb, 0, (gint)stream_header_length(p));
+
     dg_state st;
     dg_message_buffers buffers;
     begin_message(&st, &buffers, p, tvb, pinfo, tree);
+    st.header_only = short_length >= 0;
 
     proto_item *root = tree ? proto_tree_add_item(tree, *p->proto, tvb, 0, 0, ENC_NA) : NULL;
     proto_tree *subtree = proto_item_add_subtree(root, *p->ett);
@@ -987,6 +1021,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     st.message = messages - 1;
     if (p->request_context) request_begin(&st);
     walk_list(&st, p->top_walk, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
+    if (st.header_only) report_short_stream_message(&st, subtree, short_length, segment_rest);
     show_message_tail(&st, subtree, offset, on_ethertype);
     proto_item_set_len(root, offset);
     const dg_frame_pairing *fp = NULL;

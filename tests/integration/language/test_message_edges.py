@@ -9,7 +9,8 @@
   P.expert.bad_length on it, and nothing after it read as items;
 - a zero-length `string`: an item with the empty text, which `== ""` finds;
 - a stream message whose length (pdulength) is shorter than the bytes up to its length
-  field: malformed, and no messages made up from the bytes after it;
+  field: its header shown, one expert info at the length, and no messages made up
+  from the bytes after it;
 - a response whose request is not in the capture: its note
   (P.expert.no_request_context) is in `-z expert` also without a tree;
 - a frame shorter than nested lengths say: one expert info, the outermost length's.
@@ -102,7 +103,7 @@ class TestMessageEdges(TsharkTestCase, unittest.TestCase):
                 rows = self.rows(two_pass)
                 row = lambda what: rows[NUMBER[what]]  # noqa: E731
                 bad = [what for what, _f in FRAMES if row(what)["edge.expert.bad_length"]]
-                check(bad == ["negative length", "negative count"], "%s: bad_length on %s" % (how, bad))
+                check(bad == ["negative length", "negative count", "short length"], "%s: bad_length on %s" % (how, bad))
                 malformed = [what for what, _f in FRAMES if row(what)["_ws.malformed"]]
                 # bad_length is a malformed expert too (Wireshark adds _ws.malformed to each)
                 check(malformed == ["empty", "negative length", "negative count", "short length"],
@@ -120,8 +121,13 @@ class TestMessageEdges(TsharkTestCase, unittest.TestCase):
                 check(messages.count("is negative (-1)") == 2, "%s: both say -1: %s" % (how, messages))
                 check(row("empty text")["edge.item"] == ["0xa0"], "%s: after an empty text: %s" % (how, row("empty text")))
                 check(row("stream")["edge.kind"] == ["0x0001"], "%s: a stream message: %s" % (how, row("stream")))
-                check(not row("short length")["edge.kind"],
-                      "%s: nothing made up after a short length: %s" % (how, row("short length")["edge.kind"]))
+                short = row("short length")
+                check(short["edge.kind"] == ["0x0001"] and not short["edge.trailer"] and not short["edge.item"],
+                      "%s: a short length: its header shown, nothing made up after it: %s" % (how, short))
+                check(short["_ws.expert.message"] == [
+                    "The message length 'Size' gives (3) is shorter than the 4 bytes up to its end; "
+                    "the 13 bytes after them are not decoded"] and short["edge.expert.bad_length"],
+                      "%s: a short length is one fault, told at the length: %s" % (how, short["_ws.expert.message"]))
                 check(row("orphan")["edge.expert.no_request_context"] and
                       not any(row(w)["edge.expert.no_request_context"] for w, _f in FRAMES if w != "orphan"),
                       "%s: the request-context note on the orphan response only" % how)
