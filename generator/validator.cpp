@@ -1046,6 +1046,16 @@ void Validator::check_request_role(const CycleField& f, const std::string& eleme
             return;
         }
     mark_slot(t);
+    // The message's role is known once the field is decoded; a request{...}
+    // read before that takes it for what its direction says, and may read a
+    // request that is not its own (a notification, a request of the same key).
+    const Node* reader = proto_.first_request_reader;
+    if (reader && t->doc_index > reader->doc_index)
+        diags_.warning(f.line, element + " field " + quote(*t) + at_line(*t) + " is decoded after " + quote(*reader) +
+                                   at_line(*reader) + ", which reads request{...}: until it is decoded, a message is "
+                                   "taken " + (element == "request" ? "for what its direction says" : "to expect a response") +
+                                   ", so " + quote(*reader) + " may read a request that is not its own; move " +
+                                   quote(*t) + " before " + quote(*reader));
 }
 
 // <cycles>: numeric fields, each read for one thing, the sequence count no

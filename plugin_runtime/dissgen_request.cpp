@@ -164,7 +164,11 @@ void request_end(dg_state *st, const dg_frame_pairing *fp, proto_tree *tree)
 {
     if (!PINFO_FD_VISITED(st->pinfo) && fp && fp->role == DG_ROLE_REQUEST && fp->txn && !fp->txn->values)
         fp->txn->values = keep_values(st);
-    if (st->request_missed) proto_tree_add_expert(tree, st->pinfo, &ei_no_request_context, st->tvb, 0, 0);
+    /* Told with the whole message known: a <request> or <unanswered> field
+     * decoded after the value that missed may make it a request or a
+     * message that expects no response, which miss no request. */
+    if (st->request_missed && takes_part_in_pairing(st, st->p->pairing->unanswered) && !is_request(st))
+        proto_tree_add_expert(tree, st->pinfo, &ei_no_request_context, st->tvb, 0, 0);
 }
 
 gboolean read_request(const void *context, gint16 index, guint64 *value)

@@ -606,5 +606,49 @@ class TestRequestsReadNoRequest(TsharkTestCase, unittest.TestCase):
                             4: ([], [], True, note)}
                     check(got == want, "%s, %s: %s, expected %s" % (how, "-2" if two_pass else "one pass", got, want))
 
+
+class TestRoleDecodedAfterReader(TsharkTestCase, unittest.TestCase):
+    """The <unanswered> or <request> field decoded after the first request{...} (dissgen check
+    warns): a message it makes one that expects no response, or a request (here sent from the
+    service's port, whose direction says response), gets no no_request_context note, though the
+    value read before it missed; a response whose request was not captured still does."""
+
+    RULES = """<root name="Late role {how}" abbreviation="{abbreviation}" byteorder="big">
+  <hook table="udp.port" value="{port}"/>
+  <pairing>
+    <key field="node[@name='Sequence']"/>
+    {role}
+  </pairing>
+  <node name="Sequence" length="2byte" displaytype="numberdec"/>
+  <node name="Command" length="1byte" displaytype="numberdec"/>
+  <node name="Asked" value="request{{Command}}"/>
+  <node name="Type" length="1byte" displaytype="numberdec"/>
+</root>
+"""
+    KINDS = (("unanswered", "LRU", 47612, '<unanswered field="node[@name=\'Type\']" in="2"/>', 2),
+             ("request", "LRR", 47613, '<request field="node[@name=\'Type\']" in="0"/>', 0))
+
+    @classmethod
+    def prepare(cls):
+        for how, abbreviation, port, role, _type in cls.KINDS:
+            cls.install_text(abbreviation.lower() + ".xml", cls.RULES.format(
+                how=how, abbreviation=abbreviation, port=port, role=role), abbreviation.lower())
+
+    def test_only_responses_miss_their_request(self):
+        with self.checks() as check:
+            for how, abbreviation, port, _role, quiet_type in self.KINDS:
+                # from the service's port: the quiet message, then a response whose request is not here
+                frames = [udp(port, 40000, struct.pack("!HBB", sequence, 4, kind), (10, 0, 0, 1), (10, 0, 0, 10))
+                          for sequence, kind in ((7, quiet_type), (9, 1))]
+                path = self.env.add_file("late_role_%d.pcap" % port, pcapgen.raw_pcap_bytes(frames))
+                p = abbreviation.lower()
+                for two_pass in (False, True):
+                    rows = self.env.field_rows(path, ["frame.number", p + ".expert.no_request_context"],
+                                               two_pass=two_pass)
+                    noted = [n for n, r in sorted(rows.items()) if r[p + ".expert.no_request_context"]]
+                    check(noted == [2], "%s, %s: the note on %s, expected on frame 2 only" %
+                          (how, "-2" if two_pass else "one pass", noted))
+
+
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])
