@@ -22,16 +22,30 @@ guint64 field_value(const dg_valid_field *f, tvbuff_t *tvb, gint at)
     return value;
 }
 
+/* The bytes at the start of a message that the test reads (at least 1). */
+gint tested_length(const dg_validity *v)
+{
+    gint64 bytes = 1;
+    for (guint16 i = 0; i < v->field_count; i++) bytes = MAX(bytes, (gint64)v->fields[i].offset + v->fields[i].length);
+    return (gint)MIN(bytes, (gint64)v->header_length);
+}
+
 /* tcp_dissect_pdus: the length of a message that passes the test; a message
  * that fails takes the rest of the segment, which is then shown as data,
- * instead of a length that would hold back the messages after it. */
+ * instead of a length that would hold back the messages after it. The test
+ * comes first, as soon as the bytes it reads are there: a short tail that
+ * fails it does not wait for the next segment, which would be read as the
+ * rest of its header. */
 guint valid_message_length(packet_info *pinfo, tvbuff_t *tvb, int offset, void *data)
 {
     const dg_validity *v = (const dg_validity *)data;
+    const gint available = tvb_captured_length_remaining(tvb, offset);
+    const guint rest = (guint)tvb_reported_length_remaining(tvb, offset);
+    if (!dg_valid_at(v, tvb, pinfo, offset, available)) return rest;
+    if (available < (gint)v->header_length) return pinfo->can_desegment ? 0 : rest; /* 0: one more segment */
     guint length = dg_message_length(pinfo, tvb, offset, (void *)v->p);
-    gint available = tvb_captured_length_remaining(tvb, offset);
     if (dg_valid_at(v, tvb, pinfo, offset, MIN(available, (gint)MIN(length, (guint)G_MAXINT32)))) return length;
-    return (guint)MAX(tvb_reported_length_remaining(tvb, offset), (gint)v->header_length);
+    return rest;
 }
 
 int dissect_valid_message(tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree, void *data)
@@ -70,9 +84,10 @@ guint32 service_port(packet_info *pinfo)
 int dissect_valid_segment(const dg_validity *v, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
 {
     gint have = (gint)tvb_captured_length(tvb);
-    /* Too few bytes to tell: only reassembly can bring the rest of the header. */
-    if (have >= (gint)v->header_length ? !dg_valid_at(v, tvb, pinfo, 0, have) : !pinfo->can_desegment) return 0;
-    tcp_dissect_pdus(tvb, pinfo, tree, TRUE, v->header_length, valid_message_length, dissect_valid_message, (void *)v);
+    const gint tested = tested_length(v);
+    /* Too few bytes to tell: only reassembly can bring the rest of what the test reads. */
+    if (have >= tested ? !dg_valid_at(v, tvb, pinfo, 0, have) : !pinfo->can_desegment) return 0;
+    tcp_dissect_pdus(tvb, pinfo, tree, TRUE, (guint)tested, valid_message_length, dissect_valid_message, (void *)v);
     return have;
 }
 

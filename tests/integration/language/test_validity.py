@@ -341,6 +341,45 @@ class DisplacedDissector(TsharkTestCase, unittest.TestCase):
                   "gate disabled: the displaced dissectors take everything: %s" % gone)
 
 
+TESTED_FIRST = """<root name="Tested first" abbreviation="TFIRST" byteorder="little" pdulength="node[@name='Size']">
+  <hook table="tcp.port" value="48400"/>
+  <node name="Type" length="3byte" byteorder="big" displaytype="numberhex" valid="0x48454c,0x4d5347"/>
+  <node name="Chunk" length="1byte" displaytype="numberhex"/>
+  <node name="Size" length="4byte" displaytype="numberdec"/>
+  <node name="Body" length="rest" displaytype="origin"/>
+</root>
+"""
+
+
+class TestedBeforeTheLength(TsharkTestCase, unittest.TestCase):
+    """The valid field (3 bytes) ends before the length field (8): a short tail that fails
+    the test is data at once, and does not wait for the next segment to complete a
+    header (which made the next message part of a made-up length); a valid start of a
+    message cut before its length waits for the rest, one pass and -2."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("tfirst.xml", TESTED_FIRST, "tfirst")
+        flow = Flow(48400)
+        hello = lambda: b"HELF" + struct.pack("<I", 12) + b"\x01\x02\x03\x04"  # noqa: E731
+        msg = b"MSGF" + struct.pack("<I", 14) + b"\x05\x06\x07\x08\x09\x0a"
+        flow.send(hello() + b"\x00\x00abc")   # a valid message, then 5 bytes that fail the test
+        flow.send(msg)                        # a message of its own
+        flow.send(msg[:5])                    # a valid type, the length still to come
+        flow.send(msg[5:])
+        cls.capture = cls.env.add_file("tested_first.pcap", pcapgen.raw_pcap_bytes(flow.frames))
+
+    def test_a_failing_tail_does_not_swallow_the_next_message(self):
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = self.env.field_rows(self.capture, ["frame.number", "tfirst.type", "tfirst.size", "data.len"],
+                                           two_pass=two_pass)
+                got = {n: (r["tfirst.type"], r["tfirst.size"], r["data.len"]) for n, r in rows.items()}
+                want = {1: (["0x48454c"], ["12"], ["5"]), 2: (["0x4d5347"], ["14"], []), 3: ([], [], []),
+                        4: (["0x4d5347"], ["14"], [])}
+                check(got == want, "%s: %s, expected %s" % ("-2" if two_pass else "one pass", got, want))
+
+
 class WithoutValidity(TsharkTestCase, unittest.TestCase):
     """The same rules without `valid`: the bad header holds back the rest of the connection."""
 
