@@ -3,7 +3,7 @@
 // about, from parsing to the final "FILE:LINE: error: MESSAGE" text.
 #pragma once
 
-#include <set>
+#include <map>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -21,7 +21,8 @@ struct Diagnostic {
 class Diagnostics {
 public:
     // A message already given for the line is not repeated: the nodes of a
-    // group are checked once per use, and their mistake is one mistake.
+    // group are checked once per use, and their mistake is one mistake, told
+    // once with the lines of the uses it was found through.
     void error(int line, std::string message) { add(Severity::Error, line, std::move(message)); }
     void warning(int line, std::string message) { add(Severity::Warning, line, std::move(message)); }
     bool has_errors() const;
@@ -33,8 +34,18 @@ public:
 private:
     void add(Severity severity, int line, std::string message);
 
+    // The same mistake found through several uses of a group: its messages
+    // differ only in the "used on line N" of each use.
+    struct Uses {
+        size_t item;               // in items_
+        std::string first;         // the message as first given
+        std::vector<std::string> lines;  // the one use's line in each message (one use named)
+        size_t more = 0;           // further messages naming several nested uses
+    };
+    void merge_use(Uses& uses, const std::string& message);
+
     std::vector<Diagnostic> items_;
-    std::set<std::tuple<Severity, int, std::string>> given_;  // items_, to refuse repeats
+    std::map<std::tuple<Severity, int, std::string>, Uses> given_;  // by the message with its use lines left out
 };
 
 }  // namespace dissgen
