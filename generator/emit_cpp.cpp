@@ -707,7 +707,7 @@ void Emitter::summary_pieces(size_t first, size_t count, const std::string& comp
             const Node* f = p.leaf;
             bool plain = f && f->is_leaf() && f->is_numeric() && !f->is_computed() && !f->unit_given;
             if (p.node >= 0) value = summary_name(p.node) + "(st, out)";
-            else if (plain && f->display == Display::NumberHex)
+            else if (plain && f->display == Display::NumberHex && !f->is_number_sized_by_field())  // fixed width
                 value = "dg_rt::append_hex(out, " + slot + ".value, " + std::to_string((f->bits + 3) / 4) + ")";
             else if (plain && f->display == Display::NumberDec)
                 value = "dg_rt::append_dec(out, " + slot + ".value)";

@@ -188,7 +188,7 @@ tap_packet_status stats_packet(stats_tree *st, packet_info *pinfo, epan_dissect_
             label = enum_name(hfi, r->value);
             if (!label) {
                 /* padded like the tree item: "Unknown (0x07)" for an 8-bit field */
-                g_snprintf(buf, sizeof buf, "Unknown (0x%0*" G_GINT64_MODIFIER "x)", (int)((n->bits + 3) / 4), r->value);
+                g_snprintf(buf, sizeof buf, "Unknown (0x%0*" G_GINT64_MODIFIER "x)", (int)hex_digits(n, r->value), r->value);
                 label = buf;
             }
         } else {

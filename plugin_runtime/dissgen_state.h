@@ -214,6 +214,20 @@ void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offs
 
 /* The name an enum's value_string, val64_string or range_string gives the value, or NULL. */
 const char *enum_name(const header_field_info *hfi, guint64 value);
+/* The hex digits a number of n is shown with: as many as its bits need; a
+ * 64-bit field whose values vary in width (a length from a field, a
+ * computed value) shows the digits the value needs, in whole bytes, rather
+ * than sixteen for every value. */
+static inline guint hex_digits(const dg_node *n, guint64 value)
+{
+    if (n->bits < 64 || (n->length_kind != DG_LEN_FIELD && n->length_kind != DG_LEN_COMPUTED)) return (n->bits + 3) / 4;
+    guint digits = 2;
+    while (digits < 16 && (value >> (4 * digits)) != 0) digits += 2;
+    return digits;
+}
+/* A hex or enum item of such a field, with that many digits. */
+proto_item *add_variable_hex(const dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint length,
+                             guint64 value);
 /* A number as its field's tree item shows it, without an enum name or a unit
  * label: decimal, signed decimal, or hex with as many digits as its bits need
  * (dissgen_text.cpp). */

@@ -45,8 +45,22 @@ void append_number(dg_text *out, const dg_node *n, guint64 value)
         g_snprintf(buf, sizeof buf, "%" G_GINT64_MODIFIER "d", (gint64)v);
         append_str(out, buf);
     } else {
-        append_hex(out, value, (n->bits + 3) / 4);
+        append_hex(out, value, hex_digits(n, value));
     }
+}
+
+proto_item *add_variable_hex(const dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint length,
+                             guint64 value)
+{
+    const int digits = (int)hex_digits(n, value);
+    if (n->show != DG_SHOW_ENUM)
+        return proto_tree_add_uint64_format_value(tree, *n->hf, st->tvb, offset, length, value,
+                                                  "0x%0*" G_GINT64_MODIFIER "x", digits, value);
+    const header_field_info *hfi = proto_registrar_get_nth(*n->hf);
+    const char *name = hfi && hfi->strings ? enum_name(hfi, value) : NULL;
+    return proto_tree_add_uint64_format_value(tree, *n->hf, st->tvb, offset, length, value,
+                                              "%s (0x%0*" G_GINT64_MODIFIER "x)", name ? name : "Unknown", digits,
+                                              value);
 }
 
 } // namespace dg_rt
@@ -183,7 +197,7 @@ void append_bare_value(const dg_state *st, dg_text *out, const dg_slot *s)
     }
     switch (n->show) {
     case DG_SHOW_HEX:
-        append_hex(out, s->value, (n->bits + 3) / 4);
+        append_hex(out, s->value, hex_digits(n, s->value));
         return;
     case DG_SHOW_BOOL:
         append_str(out, s->value ? "True" : "False");
@@ -195,7 +209,7 @@ void append_bare_value(const dg_state *st, dg_text *out, const dg_slot *s)
         } else {
             /* As the tree shows it: as many hex digits as the field's bits need. */
             text_append(out, "Unknown (", 9);
-            append_hex(out, s->value, (n->bits + 3) / 4);
+            append_hex(out, s->value, hex_digits(n, s->value));
             text_append(out, ")", 1);
         }
         return;

@@ -199,6 +199,7 @@ void decode_sized_number(dg_state *st, const dg_node *n, proto_tree *tree, gint 
         switch (n->show) {
         case DG_SHOW_INT: item = proto_tree_add_int64(tree, *n->hf, st->tvb, offset, len, (gint64)value); break;
         case DG_SHOW_BOOL: item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, encoding_of(n)); break;
+        case DG_SHOW_HEX: case DG_SHOW_ENUM: item = add_variable_hex(st, n, tree, offset, len, value); break;
         default: item = proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, len, value); break;
         }
         if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
@@ -304,7 +305,7 @@ void dissect_computed(dg_state *st, const dg_node *n, proto_tree *tree, gint off
     case DG_SHOW_ENUM:
         /* a value masked to 32 bits or fewer has a field that wide (no wider value reaches it) */
         item = n->bits <= 32 ? proto_tree_add_uint(tree, *n->hf, st->tvb, offset, length, (guint32)bits)
-                             : proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, length, bits);
+                             : add_variable_hex(st, n, tree, offset, length, bits);
         break;
     default: item = proto_tree_add_int64(tree, *n->hf, st->tvb, offset, length, v.integer); break;
     }

@@ -187,5 +187,52 @@ class TestNegativeComputedLength(TsharkTestCase, unittest.TestCase):
                   "count 10: a body of 2 bytes, nothing reported on it (%s)" % rows[2])
 
 
+HEX_WIDTH_RULES = """<root name="Hex widths" abbreviation="HEXW" ethertype="0x88b8" byteorder="big">
+  <node name="Message" summary="{Kind} {Sized} {Code}">
+    <node name="Size" length="1byte" displaytype="numberdec"/>
+    <node name="Sized" length="../node[@name='Size']" displaytype="numberhex"/>
+    <node name="Kind" length="../node[@name='Size']" displaytype="enum">
+      <enum value="85" name="present-value"/>
+    </node>
+    <node name="Code" value="{Sized} + 0x200" displaytype="enum">
+      <enum value="0x255" name="answer"/>
+    </node>
+  </node>
+</root>
+"""
+
+
+class TestVariableWidthHex(TsharkTestCase, unittest.TestCase):
+    """Numbers of 64-bit fields whose values vary in width (a length from a field, a computed
+    value) show in hex with the digits the value needs, in whole bytes, in the tree and the
+    Info column; -T fields shows Wireshark's 64-bit field as it is."""
+    @classmethod
+    def prepare(cls):
+        cls.install_text("hex_widths.xml", HEX_WIDTH_RULES, "hexw")
+
+    def test_digits_the_value_needs(self):
+        macs = b"\x02\x00\x00\x00\x00\x02\x02\x00\x00\x00\x00\x01"
+        bodies = [b"\x01\x55\x55", b"\x02\x01\x02\x02\x00"]
+        frames = [macs + struct.pack(">H", 0x88B8) + b + bytes(46 - len(b)) for b in bodies]
+        out = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
+        for i, f in enumerate(frames):
+            out.append(struct.pack("<IIII", 1_700_000_000 + i, 0, len(f), len(f)) + f)
+        path = self.env.add_file("hex_widths.pcap", b"".join(out))
+        want = {1: ["Sized: 0x55", "Kind: present-value (0x55)", "Code: answer (0x0255)"],
+                2: ["Sized: 0x0102", "Kind: Unknown (0x0200)", "Code: Unknown (0x0302)"]}
+        info = {1: "present-value 0x55 answer", 2: "Unknown (0x0200) 0x0102 Unknown (0x0302)"}
+        with self.checks() as check:
+            for number in (1, 2):
+                for extra in ([], ["-2"]):
+                    text = self.env.tshark(["-r", path, "-V", "-Y", "frame.number == %d" % number] + extra).stdout
+                    lines = [line.strip().strip("[]") for line in text.splitlines()]  # a computed item is [generated]
+                    check(all(w in lines for w in want[number]), "frame %d %s: %s in %s" %
+                          (number, extra, want[number], [x for x in lines if x.startswith(("Sized", "Kind", "Code"))]))
+            rows = self.env.field_rows(path, ["frame.number", "_ws.col.Info", "hexw.message.sized"])
+            for number in (1, 2):
+                check(rows[number]["_ws.col.Info"] == [info[number]], "frame %d Info: %s" % (number, rows[number]))
+            check(rows[1]["hexw.message.sized"] == ["0x0000000000000055"], "-T fields: %s" % rows[1])
+
+
 if __name__ == "__main__":
     sys.exit(run_unittests()[1])
