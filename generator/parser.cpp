@@ -1073,10 +1073,21 @@ void Parser::parse_in_list(const std::string& text, int line, Node& node) {
 }
 
 // "1-9,0x0d,14": numbers and ranges, for 'in', 'ifhook' and 'valid'.
+// Whether an item of a value list starts with a minus sign ("-1", "2, -5").
+static bool has_negative_item(const std::string& text) {
+    std::stringstream ss(text);
+    for (std::string item; std::getline(ss, item, ',');)
+        if (trim(item).rfind('-', 0) == 0) return true;
+    return false;
+}
+
 bool Parser::parse_value_list(const std::string& text, int line, const std::string& attribute,
                               std::vector<ValueRange>& out) {
     const std::string bad = "bad '" + attribute + "' list '" + text +
-                            "': expected numbers and ranges such as \"1-9,0x0d,14\"";
+                            "': expected numbers and ranges such as \"1-9,0x0d,14\"" +
+                            (has_negative_item(text)
+                                 ? "; a negative value of an int field is written as its bits (-1 of 2 bytes: 0xffff)"
+                                 : "");
     std::stringstream ss(text);
     std::string item;
     bool any = false;

@@ -641,7 +641,7 @@ void Validator::check_reference(Node& n, const FieldRef& ref, const std::string&
     const std::string field = what + " field " + quote(*t) + at_line(*t);
     if (!t->is_numeric()) {
         diags_.error(n.line, field + " is not numeric: it must be a leaf of 1-64 bits shown as numberhex, "
-                                     "numberdec, bool, enum or nondisplay");
+                                     "numberdec, int, time, bool, enum or nondisplay, or an integer computed value");
         return;
     }
     if (what == "repeat") {
@@ -1899,7 +1899,7 @@ void Validator::check_offsets(Node& n) {
         const Node* outside = repeat_outside(t->parent, n);  // a repeated container around t but not around n
         if (!t->is_numeric())
             diags_.error(n.line, field + " is not numeric: it must be a leaf of 1-64 bits shown as numberhex, "
-                                         "numberdec, bool, enum or nondisplay");
+                                         "numberdec, int, time, bool, enum or nondisplay, or an integer computed value");
         else if (!t->count && !t->repeat && !t->repeat_rest)
             diags_.error(n.line, field + " is not repeated: it must have 'count' (or 'repeat'), one offset per "
                                          "instance of " + quote(n));
