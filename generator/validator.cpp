@@ -2245,6 +2245,14 @@ void Validator::parse_finding_text(Node& n, Finding& f, const ExprSite& at) {
             return;
         }
         const std::string name = s.substr(open + 1, close - open - 1);
+        for (const char* source : {"request", "learned"}) {
+            const std::string prefix = source;
+            if (open < prefix.size() || s.compare(open - prefix.size(), prefix.size(), prefix) != 0) continue;
+            diags_.error(at.line, prefix + "{" + name + "}" + at.in + ": the text shows fields of the message; put " +
+                                      prefix + "{" + name + "} in a computed value (value=\"" + prefix + "{" + name +
+                                      "}\", nondisplay if it need not be shown) and name that");
+            return;
+        }
         const Node* t = find_readable_before(at.reach, name, n);
         if (!t || t->is_container()) {
             diags_.error(at.line, "{" + name + "}" + at.in + ": no field of that name is decoded before it");
