@@ -175,9 +175,12 @@ Layout make_layout(const Protocol& proto, const std::map<const Node*, uint64_t>&
     for (const Node* n : l.nodes) {
         if (!n->summary_pieces.empty()) {
             l.piece_first[n] = static_cast<int>(l.pieces.size());
-            for (const SummaryPiece& p : n->summary_pieces)
-                l.pieces.push_back({p.text, p.leaf ? shown_slot(*n, *p.leaf) : -1, p.group,
-                                    p.leaf && p.leaf->is_container() ? p.leaf->doc_index - 1 : -1, p.leaf});
+            for (const SummaryPiece& p : n->summary_pieces) {
+                const int slot = p.leaf ? shown_slot(*n, *p.leaf) : -1;
+                // a container's kept copy holds its text, shown as a value; its own slot, its summary made again
+                const bool made_again = p.leaf && p.leaf->is_container() && slot == p.leaf->slot;
+                l.pieces.push_back({p.text, slot, p.group, made_again ? p.leaf->doc_index - 1 : -1, p.leaf});
+            }
         }
     }
     layout_conditions_and_windows(l, quiet);

@@ -1154,15 +1154,16 @@ bool Validator::check_cycle_field(const CycleField& f, const char* element, int 
     return true;
 }
 
-// A summary shows the last value of a leaf its container decoded, though a
-// repeat between them began an instance without it since (a TLV list: each
-// instance one member): such leaves keep a copy for each repeat a summary
-// names them across, which that repeat's instances leave and the summarised
-// container's own next instance clears.
+// A summary shows the last value of a leaf (or the last text of a summarised
+// container) its container decoded, though a repeat between them began an
+// instance without it since (a TLV list: each instance one member): such
+// nodes keep a copy for each repeat a summary names them across, which that
+// repeat's instances leave and the summarised container's own next instance
+// clears.
 void Validator::keep_values_across_repeats() {
     for_each_node(proto_.nodes, [&](Node& x) {
         for (const SummaryPiece& p : x.summary_pieces) {
-            if (!p.leaf || p.leaf->is_container()) continue;
+            if (!p.leaf) continue;  // a container's copy is its summary text (dissgen_walk.cpp, container_decoded)
             const Node* r = repeat_between(x, *p.leaf);
             if (r && p.leaf->kept_slots.emplace(r, -1).second) const_cast<Node*>(r)->kept_after.push_back(p.leaf);
         }

@@ -306,6 +306,10 @@ void append_text_pieces(const dg_state *st, dg_text *out, guint first, guint cou
 
 void append_shown_value(const dg_state *st, dg_text *out, const dg_slot *s)
 {
+    if (s->node->kind != DG_LEAF) { /* a container's kept copy: its summary text (container_decoded) */
+        append_str(out, (const char *)(guintptr)s->value);
+        return;
+    }
     append_bare_value(st, out, s);
     const dg_extra *x = s->node->extra;
     if (x && x->unit) append_str(out, x->unit);

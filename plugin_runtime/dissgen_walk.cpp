@@ -429,6 +429,14 @@ void container_decoded(dg_state *st, const dg_node *n, gint start, gint end)
     s->length = end - start;
     s->node = n;
     st->present[n->slot] = TRUE;
+    /* Named by a summary across a repeat (dg_extra.kept_slots): its text now,
+     * which a later instance of the repeat without it leaves. */
+    if (!n->extra || !n->extra->kept_count || !st->want_text) return;
+    s->value = (guint64)(guintptr)wmem_strdup(st->pinfo->pool, summary_text(st, n));
+    for (guint8 i = 0; i < n->extra->kept_count; i++) {
+        st->slots[n->extra->kept_slots[i]] = *s;
+        st->present[n->extra->kept_slots[i]] = TRUE;
+    }
 }
 
 /* The container's summary on its item and, outside other summaries, in the

@@ -359,6 +359,21 @@ ACROSS_STRIDE_RULES = """<root name="Summary across a stride" abbreviation="SUMS
 </root>
 """
 
+ACROSS_CONTAINER_RULES = """<root name="Container across repeats" abbreviation="SUMC" ethertype="0x88bb">
+  <node name="Length" length="1byte" displaytype="numberdec"/>
+  <node name="Msg" length="../node[@name='Length']" summary="{Obj}{? / {Prop}}">
+    <node name="Item" repeat="rest">
+      <node name="Kind" length="1byte" displaytype="numberdec"/>
+      <node name="Obj" length="2byte" if="../node[@name='Kind']" in="0" summary="{Hi}.{Lo}">
+        <node name="Hi" length="1byte" displaytype="numberdec"/>
+        <node name="Lo" length="1byte" displaytype="numberdec"/>
+      </node>
+      <node name="Prop" length="1byte" displaytype="numberdec" otherwise="true"/>
+    </node>
+  </node>
+</root>
+"""
+
 
 class SummaryAcrossRepeats(TsharkTestCase, unittest.TestCase):
     """A summary names leaves inside a list of tagged members (one member each, as TLVs):
@@ -372,6 +387,19 @@ class SummaryAcrossRepeats(TsharkTestCase, unittest.TestCase):
     def prepare(cls):
         cls.install_text("across_repeats.xml", ACROSS_REPEATS_RULES, "sumx")
         cls.install_text("across_stride.xml", ACROSS_STRIDE_RULES, "sums")
+        cls.install_text("across_container.xml", ACROSS_CONTAINER_RULES, "sumc")
+
+    def test_last_text_of_a_summarised_container(self):
+        """A summary names a container with a summary of its own inside the members: the
+        text of the last one decoded, whichever member came after it."""
+        bodies = [bytes([0, 1, 2, 1, 0x55]), bytes([1, 0x55, 0, 1, 2]), bytes([1, 0x55]), bytes([0, 1, 2, 0, 3, 4])]
+        cap = self.env.add_file("across_container.pcap",
+                                pcap([ethernet(bytes([len(b)]) + b, ethertype=0x88BB) for b in bodies]))
+        for walk in ({}, {"DISSGEN_TABLE_WALK": "1"}):
+            for extra in ([], ["-2"]):
+                info = self.env.tshark(["-r", cap, "-T", "fields", "-e", "_ws.col.Info"] + extra,
+                                       extra_env=walk).stdout.splitlines()
+                self.assertEqual(info, ["1.2 / 85", "1.2 / 85", "- / 85", "3.4"], "%s %s" % (walk, extra))
 
     def test_last_value_of_the_instance(self):
         first = bytes([1, 7, 3, 8, 2, 9, 2, 4])  # A=7, C=8, B=9, B=4
