@@ -462,6 +462,10 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
                        gboolean in_summary, dg_summaries *sink)
 {
     gint start = *offset;
+    if (G_UNLIKELY(st->header_only) && start >= st->packet_end) { /* past the header of a short stream message */
+        st->stopped = TRUE;
+        return;
+    }
     gint64 length = -1;
     if (!container_length(st, n, tree, start, end, &length)) return;
     gboolean past_end = length > end - start;
@@ -510,8 +514,13 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
                            end - start);
     }
     st->cut_end = outer_cut_end;
-    st->told_end = outer_told_end;
-    st->told_short_at = outer_told_short_at;
+    /* What was told inside stays inside, but for a list told short where the
+     * data this container shares with its parent ends (list_told_short):
+     * the parent's next field misses those bytes too. */
+    if (st->told_end != G_MAXINT64 || st->told_short_at < end) {
+        st->told_end = outer_told_end;
+        st->told_short_at = outer_told_short_at;
+    }
     st->stopped = st->stopped || was_stopped;
     if (!st->stopped && length >= 0 && *offset < inner_end &&
         (n->length_kind == DG_LEN_FIXED || n->length_kind == DG_LEN_FIELD)) {
@@ -539,6 +548,17 @@ void dissect_container(dg_state *st, const dg_node *n, proto_tree *tree, gint *o
  * packet's size does not bound it, this does. */
 #define DG_MAX_INSTANCES_WITHOUT_BYTES 65535
 
+/* A list told short where its data ends (a count or a repeat flag): that is
+ * the one fault; a later field of the message that needs the bytes past
+ * that end misses the same ones, and stops decoding without telling it again
+ * (report_missing), while empty ones still decode. */
+static void list_told_short(dg_state *st, gint end)
+{
+    if (!st->told_end || end < st->told_short_at) st->told_short_at = end;
+    st->told_end = G_MAXINT64;
+    st->stopped = FALSE;
+}
+
 /* repeat: another instance while the flag is set; count: exactly N. Every
  * instance must consume bytes, which bounds the loop by the packet size;
  * a counted list whose instances take none (computed values and overlays,
@@ -565,7 +585,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
             report_missing(st, tree, &st->p->ei->count_short, end, (gint64)end + 1, *offset, 0,
                            "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after "
                            "%" G_GINT64_MODIFIER "d", n->name, wanted, done);
-            st->stopped = FALSE; /* the data simply ended: siblings may still be empty-length */
+            list_told_short(st, end); /* the data simply ended: siblings may still be empty-length */
             break;
         }
         if (n->extra && n->extra->repeat_rest && *offset >= end) break; /* repeat="rest": stop where the data ends */
@@ -582,7 +602,7 @@ void dissect_repeated(dg_state *st, const dg_node *n, proto_tree *tree, gint *of
                 report_missing(st, tree, &st->p->ei->more_no_data, end, (gint64)end + 1, *offset, 0,
                                "'%s': the repeat flag '%s' says another follows, but no data is left", n->name,
                                flag->node->name);
-                st->stopped = FALSE;
+                list_told_short(st, end);
                 break;
             }
         }
@@ -627,7 +647,7 @@ void dissect_packed_bits(dg_state *st, const dg_node *n, proto_tree *tree, gint 
         report_missing(st, tree, &st->p->ei->count_short, *offset, (gint64)*offset + 1, *offset, 0,
                        "'%s' should occur %" G_GINT64_MODIFIER "d times, but the data ends after %" G_GINT64_MODIFIER
                        "d", n->name, wanted, instances);
-        st->stopped = FALSE; /* the data simply ended, as for any repetition */
+        list_told_short(st, *offset); /* the data simply ended, as for any repetition */
     }
 }
 

@@ -469,7 +469,8 @@ class Expected:
             self.cut_end = start + length if cut else KNOWN_END
         offset = self.node_list(n.children, item, offset, inner_end, in_summary or bool(n.pieces))
         self.cut_end = outer_cut_end
-        self.told_end, self.told_short_at = outer_told
+        if self.told_end != float("inf") or self.told_short_at < end:  # a list told short at the shared end stays
+            self.told_end, self.told_short_at = outer_told
         if past_end and (cut or n.lenkind != "field") and not self.stopped:  # no child ran out: the box is short
             self.expert(item, "truncated", "Truncated: '%s' needs %d bytes, only %d left" % (n.name, length, end - start),
                         data_end=end, needed=start + length)
@@ -491,6 +492,14 @@ class Expected:
                 (self.info if sink is None else sink).append(text)
         return offset
 
+    def list_told_short(self, end):
+        """A list told short where its data ends: later fields that need bytes past that end
+        miss the same ones (told, not again); empty ones still decode."""
+        if not self.told_end or end < self.told_short_at:
+            self.told_short_at = end
+        self.told_end = float("inf")
+        self.stopped = False
+
     def run(self, r, parent, offset, end, in_summary):
         sink = [] if r.summarised and not in_summary else None
         done = 0
@@ -498,7 +507,7 @@ class Expected:
             if r.mode == "count" and offset >= end:
                 self.expert(parent, "count_short", "'%s' should occur %d times, but the data ends after %d"
                             % (r.name, r.wanted, done), data_end=end, needed=end + 1)
-                self.stopped = False
+                self.list_told_short(end)
                 break
             inst = r.children[done]
             before = offset
@@ -512,7 +521,7 @@ class Expected:
                 if offset >= end:
                     self.expert(parent, "more_no_data", "'%s': the repeat flag '%s' says another follows, "
                                 "but no data is left" % (r.name, r.flag_name), data_end=end, needed=end + 1)
-                    self.stopped = False
+                    self.list_told_short(end)
                     break
         if sink and len(sink) > 1:
             self.info.append("%s %s%d: %s" % (r.name, TIMES, len(sink), ", ".join(sink)))

@@ -146,6 +146,37 @@ class TestMessageEdges(TsharkTestCase, unittest.TestCase):
                       (" ".join(extra) or "one pass", out))
 
 
+class TestShortStreamHeader(TsharkTestCase, unittest.TestCase):
+    """A stream message whose length says less than its 8-byte header: the header's fields,
+    the one expert info at the length, and no item for the body's container (empty, it
+    would show as if decoded)."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("short_header.xml", """<root name="Short header" abbreviation="SHDR" byteorder="little"
+      pdulength="node[@name='Size']">
+  <hook table="tcp.port" value="48401"/>
+  <node name="Type" length="3byte" displaytype="numberhex"/>
+  <node name="Chunk" length="1byte" displaytype="numberhex"/>
+  <node name="Size" length="4byte" displaytype="numberdec"/>
+  <node name="Hello" summary="version {Version}">
+    <node name="Version" length="4byte" displaytype="numberdec"/>
+  </node>
+</root>
+""", "shdr")
+
+    def test_header_then_nothing(self):
+        flow = TcpFlow(40002, 48401)
+        path = self.env.add_file("short_header.pcap", pcap([flow.segment(b"HELF" + struct.pack("<I", 4) + bytes(8))]))
+        for extra in ([], ["-2"]):
+            tree = self.env.tshark(["-r", path, "-V", "-O", "shdr"] + extra).stdout
+            lines = [line.strip() for line in tree.splitlines()[tree.splitlines().index("Short header") + 1:]]
+            self.assertEqual([x for x in lines if x and not x.startswith("[")], [
+                "Type: 0x4c4548", "Chunk: 0x46", "Size: 4",
+                "The message length 'Size' gives (4) is shorter than the 8 bytes up to its end; "
+                "the 8 bytes after them are not decoded"], extra)
+
+
 class TestHugeLengths(TsharkTestCase, unittest.TestCase):
     """A 4-byte length field of 2^31 or more points past the end: the message quotes the
     length the field holds (it was capped at 2147483648)."""
@@ -213,6 +244,35 @@ BOXED_RULES = """<root name="Boxed" abbreviation="BOXED" ethertype="0x88b7">
 """
 
 
+# A counted list the data ends in, then a field: the count is the one fault.
+COUNTED_RULES = """<root name="Counted" abbreviation="COUNTED" ethertype="0x88b8">
+  <node name="Count" length="1byte" displaytype="numberdec"/>
+  <node name="Items" count="../node[@name='Count']">
+    <node name="Item" length="1byte" displaytype="numberdec"/>
+  </node>
+  <node name="Trailer" length="4byte" displaytype="numberhex"/>
+</root>
+"""
+
+# Tags that open a constructed value until a closing tag (BACnet's), nested: an unclosed one
+# at each level runs out of data once.
+NESTED_TAGS_RULES = """<root name="Nested tags" abbreviation="NTAGS" ethertype="0x88b9">
+  <group name="Item" depth="4">
+    <node name="Tag" length="1byte" displaytype="numberhex"/>
+    <node name="Opening" value="{Tag} == 0x3e" displaytype="nondisplay"/>
+    <node name="Closing" value="{Tag} == 0x3f" displaytype="nondisplay"/>
+    <node name="Constructed" if="../node[@name='Opening']" in="1">
+      <node name="Member" repeat="node[@name='More']">
+        <use group="Item"/>
+        <node name="More" value="!{Closing}" displaytype="nondisplay"/>
+      </node>
+    </node>
+  </group>
+  <node name="Items" repeat="rest"><use group="Item"/></node>
+</root>
+"""
+
+
 class TestOneCauseOneExpert(TsharkTestCase, unittest.TestCase):
     """A frame shorter than its outer length says: that length past the end is the one
     expert info. The lengths and counts inside that end within it are not faults of their
@@ -225,6 +285,14 @@ class TestOneCauseOneExpert(TsharkTestCase, unittest.TestCase):
         cls.install_text("nested_lengths.xml", NESTED_RULES, "nest")
         cls.install_text("skipped_record.xml", SKIPPED_RULES, "skiprec")
         cls.install_text("boxed.xml", BOXED_RULES, "boxed")
+        cls.install_text("counted.xml", COUNTED_RULES, "counted")
+        cls.install_text("nested_tags.xml", NESTED_TAGS_RULES, "ntags")
+
+    def test_a_list_the_data_ends_in_is_the_one_fault(self):
+        self.assert_experts(0x88b8, "counted", bytes([3, 1]), [
+            "'Items' should occur 3 times, but the data ends after 1"])
+        self.assert_experts(0x88b9, "nested_tags", bytes([0x3e] * 4 + [0x21]), [
+            "'Member': the repeat flag 'More' says another follows, but no data is left"])
 
     def assert_experts(self, ethertype, name, message, want):
         """One frame of `message` bytes on `ethertype`: its expert infos are `want`, one pass and -2."""
