@@ -434,6 +434,7 @@ struct Protocol {
     std::vector<const Node*> request_fields;
     // the first node (document order) whose value reads request{...}
     const Node* first_request_reader = nullptr;
+    std::vector<const Node*> request_readers;  // every node whose value reads request{...}, in document order
     // every <learn>, in document order (Learn::index)
     std::vector<Learn*> learns;
     // readers whose lookups resolve to other fields (rows learns.size() + k)

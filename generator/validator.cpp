@@ -154,6 +154,7 @@ private:
     std::map<std::string, RequestTarget> request_targets_;  // request_field_target, by text
     bool check_defined(const Node& n, Expr& e);
     void check_request_keys();
+    const Node* reader_before(const Node& t) const;
     const Node* fixed_offset_blocker(const Node& n, uint64_t& offset) const;
     void check_validity();  // valid="LIST" fields and <heuristic>
     void check_pairing();
@@ -1049,8 +1050,7 @@ void Validator::check_request_role(const CycleField& f, const std::string& eleme
     // The message's role is known once the field is decoded; a request{...}
     // read before that takes it for what its direction says, and may read a
     // request that is not its own (a notification, a request of the same key).
-    const Node* reader = proto_.first_request_reader;
-    if (reader && t->doc_index > reader->doc_index)
+    if (const Node* reader = reader_before(*t))
         diags_.warning(f.line, element + " field " + quote(*t) + at_line(*t) + " is decoded after " + quote(*reader) +
                                    at_line(*reader) + ", which reads request{...}: until it is decoded, a message is "
                                    "taken " + (element == "request" ? "for what its direction says" : "to expect a response") +
@@ -1513,6 +1513,10 @@ bool Validator::check_request_field(Node& n, Expr& e) {
     e.is_float = t->display == Display::Float;
     if (!proto_.first_request_reader || n.doc_index < proto_.first_request_reader->doc_index)
         proto_.first_request_reader = &n;
+    auto& readers = proto_.request_readers;
+    auto at = std::lower_bound(readers.begin(), readers.end(), &n,
+                               [](const Node* a, const Node* b) { return a->doc_index < b->doc_index; });
+    if (at == readers.end() || *at != &n) readers.insert(at, &n);
     auto& kept = proto_.request_fields;
     auto it = std::find(kept.begin(), kept.end(), t);
     e.request_index = static_cast<int>(it - kept.begin());
@@ -1541,6 +1545,16 @@ bool Validator::check_defined(const Node& n, Expr& e) {
     return true;
 }
 
+// The first node before t in document order whose value reads request{...}
+// and that a message may decode with t (not an alternative to it), or nullptr.
+const Node* Validator::reader_before(const Node& t) const {
+    for (const Node* r : proto_.request_readers) {
+        if (r->doc_index >= t.doc_index) break;
+        if (!are_alternatives(proto_, t, *r)) return r;
+    }
+    return nullptr;
+}
+
 // With request{...}, a response looks its request up by its key values.
 // When every key field is at a fixed offset from the start of every message,
 // it reads them before it is decoded. Otherwise it takes the values the walk
@@ -1557,7 +1571,6 @@ void Validator::check_request_keys() {
         key.offset = offset;
     }
     if (!pairing.keys_decoded) return;
-    const Node* reader = proto_.first_request_reader;
     const Node* moving = nullptr;  // the first key field not at a fixed offset
     for (const PairingKey& key : pairing.keys) {
         uint64_t offset = 0;
@@ -1566,7 +1579,8 @@ void Validator::check_request_keys() {
     }
     for (const PairingKey& key : pairing.keys) {
         const Node* t = key.field.target;
-        if (!t || !t->is_numeric() || !reader || t->doc_index < reader->doc_index) continue;
+        const Node* reader = t && t->is_numeric() ? reader_before(*t) : nullptr;
+        if (!reader) continue;
         diags_.error(key.line, "key field " + quote(*t) + at_line(*t) + " is decoded after " + quote(*reader) +
                                    at_line(*reader) + ", which reads request{...}: key field " + quote(*moving) +
                                    " is not at a fixed offset, so a response looks its request up with the key "
