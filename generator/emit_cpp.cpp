@@ -1061,6 +1061,7 @@ std::string datetime_encoding(const Node& n) {
     if (unit == "us") return "ENC_TIME_USECS";
     if (unit == "ms") return "ENC_TIME_MSECS";
     if (unit == "s") return "ENC_TIME_SECS";
+    if (unit == "filetime") return "DG_TIME_FILETIME";  // no ENC_TIME_ of Wireshark's: the runtime converts it
     return "ENC_TIME_SECS_NSECS";
 }
 

@@ -1267,9 +1267,11 @@ void Validator::check_computed(Node& n) {
                                      (n.unit_given ? "'" + n.unit + "'" : "nanoseconds") +
                                      ", but its value has a fraction: compute a whole count, such as "
                                      "{Seconds} * 1000000000 + {Fraction} * 1000000000 / 16777216");
-        if (n.display == Display::DateTime && n.unit_given && n.unit == "s+ns")
-            diags_.error(n.line, what + " is a datetime with unit 's+ns', two numbers; a computed datetime is one "
-                                     "count since 1970: unit 'ns' (the default), 'us', 'ms' or 's'");
+        if (n.display == Display::DateTime && n.unit_given && (n.unit == "s+ns" || n.unit == "filetime"))
+            diags_.error(n.line, what + " is a datetime with unit '" + n.unit + "'" +
+                                     (n.unit == "s+ns" ? ", two numbers" : ", a field's encoding") +
+                                     "; a computed datetime is one count since 1970: unit 'ns' (the default), 'us', "
+                                     "'ms' or 's'");
         break;
     default:
         diags_.error(n.line, what + " is shown as " + display_name(n.display) +
@@ -1601,9 +1603,11 @@ void Validator::check_unit(const Node& n) {
         return;
     }
     if (n.display == Display::DateTime) {
-        if (n.unit != "s+ns" && n.unit != "ns" && n.unit != "us" && n.unit != "ms" && n.unit != "s")
+        if (n.unit != "s+ns" && n.unit != "ns" && n.unit != "us" && n.unit != "ms" && n.unit != "s" &&
+            n.unit != "filetime")
             diags_.error(n.line, "bad unit '" + n.unit + "' for a datetime: expected 's+ns' (seconds and nanoseconds, "
-                                 "the default), or a count since 1970 of 'ns', 'us', 'ms' or 's'");
+                                 "the default), a count since 1970 of 'ns', 'us', 'ms' or 's', or 'filetime' (100 ns "
+                                 "since 1601, Windows FILETIME and OPC UA's DateTime)");
         return;
     }
     if (n.is_container() || (n.display != Display::NumberDec && n.display != Display::Int && n.display != Display::Float)) {
@@ -1685,7 +1689,8 @@ void Validator::check_string_display(Node& n) {
 void Validator::check_datetime_length(const Node& n) {
     const std::string unit = n.datetime_unit();
     const bool seconds = unit == "s";
-    if (unit != "s+ns" && unit != "ns" && unit != "us" && unit != "ms" && !seconds) return;  // check_unit
+    if (unit != "s+ns" && unit != "ns" && unit != "us" && unit != "ms" && unit != "filetime" && !seconds)
+        return;  // check_unit
     if (n.has_fixed_length() && (n.fixed_bits == 64 || (seconds && n.fixed_bits == 32))) return;
     diags_.error(n.line, "datetime display with unit '" + unit + "' needs a length of " +
                              (seconds ? "4byte or 8byte" : "8byte") + "; " + quote(n) + " has another length");

@@ -66,6 +66,11 @@ typedef struct dg_summary_piece {
     guint16 node = 0;
 } dg_summary_piece;
 
+/* A datetime counting 100 ns since 1601 (Windows FILETIME, OPC UA's
+ * DateTime): Wireshark has no ENC_TIME_ for it, the runtime converts it
+ * (filetime_to_nstime). Outside every ENC_TIME_ value. */
+#define DG_TIME_FILETIME 0x7f000000u
+
 /* What few nodes need (direction, repeat="rest", strings, times,
  * hand-off, reassembly), kept out of dg_node so that it costs the others one
  * pointer. */
@@ -124,7 +129,7 @@ typedef struct dg_extra {
     guint8 cycle_role = 0;
     guint8 cycle_test = 0;
     /* datetime: its ENC_TIME_* encoding (ENC_TIME_SECS_NSECS, 0, when the node has no dg_extra) */
-    guint32 time_encoding = ENC_TIME_SECS_NSECS;
+    guint32 time_encoding = ENC_TIME_SECS_NSECS; /* or DG_TIME_FILETIME */
 } dg_extra;
 
 /* A <finding>: the expert info `ei` is raised on the node's bytes when the
@@ -152,6 +157,7 @@ typedef struct dg_learn {
 } dg_learn;
 
 /* The most keys a <learn> has (the generator refuses more). */
+
 #define DG_MAX_LEARN_KEYS 16
 
 /* A key of a <learn>: its value as the learner computes it, and as a reader

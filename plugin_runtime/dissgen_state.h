@@ -212,6 +212,8 @@ void dissect_window(dg_state *st, const dg_node *n, proto_tree *tree, gint *offs
 
 /* --- dissgen_text.cpp ---------------------------------------------------- */
 
+/* A datetime leaf's time from its `length` bytes at offset, by its unit. */
+nstime_t datetime_at(const dg_state *st, const dg_node *n, gint offset, gint length);
 /* The name an enum's value_string, val64_string or range_string gives the value, or NULL. */
 const char *enum_name(const header_field_info *hfi, guint64 value);
 /* The hex digits a number of n is shown with: as many as its bits need; a

@@ -67,14 +67,10 @@ proto_item *add_variable_hex(const dg_state *st, const dg_node *n, proto_tree *t
 
 using namespace dg_rt;
 
-namespace {
-
-/* --- shown values -------------------------------------------------------- */
-
 /* A datetime's bytes as Wireshark reads them for its item (the ENC_TIME_*
  * encodings the generator gives: seconds and nanoseconds, or a count of
- * ns, us, ms or s since 1970). */
-nstime_t datetime_at(const dg_state *st, const dg_node *n, gint offset, gint length)
+ * ns, us, ms or s since 1970, or DG_TIME_FILETIME). */
+nstime_t dg_rt::datetime_at(const dg_state *st, const dg_node *n, gint offset, gint length)
 {
     guint encoding = encoding_of(n);
     guint64 count = read_uint(st->tvb, offset, (guint)length, encoding);
@@ -84,6 +80,9 @@ nstime_t datetime_at(const dg_state *st, const dg_node *n, gint offset, gint len
     case ENC_TIME_USECS: t.secs = (time_t)(count / 1000000); t.nsecs = (int)(count % 1000000) * 1000; break;
     case ENC_TIME_MSECS: t.secs = (time_t)(count / 1000); t.nsecs = (int)(count % 1000) * 1000000; break;
     case ENC_TIME_SECS: t.secs = (time_t)count; t.nsecs = 0; break;
+    case DG_TIME_FILETIME:
+        if (!filetime_to_nstime(&t, count)) nstime_set_zero(&t); /* not a time this system shows */
+        break;
     default: /* two 32-bit values */
         t.secs = (time_t)read_uint(st->tvb, offset, 4, encoding);
         t.nsecs = (int)read_uint(st->tvb, offset + 4, 4, encoding);
@@ -91,6 +90,11 @@ nstime_t datetime_at(const dg_state *st, const dg_node *n, gint offset, gint len
     }
     return t;
 }
+
+namespace {
+
+/* --- shown values -------------------------------------------------------- */
+
 
 /* The values of string, stringz, int, float, time, datetime, guid and
  * address leaves, for summaries and the Info column (as the tree item shows

@@ -218,6 +218,11 @@ void decode_leaf_value(dg_state *st, const dg_node *n, proto_tree *tree, gint of
             nstime_t t = time_of(n, value);
             item = proto_tree_add_time(tree, *n->hf, st->tvb, offset, len, &t);
         }
+    } else if (n->show == DG_SHOW_DATETIME && n->extra && n->extra->time_encoding == DG_TIME_FILETIME) {
+        if (tree) {
+            const nstime_t t = datetime_at(st, n, offset, len);
+            item = proto_tree_add_time(tree, *n->hf, st->tvb, offset, len, &t);
+        }
     } else if (n->show == DG_SHOW_IPV4) {
         if (value_wanted(st, n)) value = read_uint(st->tvb, offset, 4, encoding_of(n));
         if (tree) item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, encoding_of(n));

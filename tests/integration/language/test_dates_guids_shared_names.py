@@ -250,6 +250,43 @@ class Latin1Text(TsharkTestCase, unittest.TestCase):
                   % report)
 
 
+
+FILETIME_RULES = """<root name="Filetime" abbreviation="FTIME" byteorder="little">
+  <hook table="udp.port" value="%d"/>
+  <node name="Stamp" summary="at {When}">
+    <node name="When" length="8byte" displaytype="datetime" unit="filetime"/>
+  </node>
+</root>
+""" % (PORT + 1)
+FILETIME_EPOCH = datetime.datetime(1601, 1, 1)
+
+
+def filetime_shown(count):
+    """A count of 100 ns since 1601 as tshark prints an FT_ABSOLUTE_TIME in UTC."""
+    t = FILETIME_EPOCH + datetime.timedelta(seconds=count // 10 ** 7)
+    return "%s %2d, %d %s.%09d UTC" % (t.strftime("%b"), t.day, t.year, t.strftime("%H:%M:%S"), count % 10 ** 7 * 100)
+
+
+class Filetime(TsharkTestCase, unittest.TestCase):
+    """unit="filetime": 100 ns since 1601 (Windows FILETIME, OPC UA's DateTime), to the last
+    100 ns, in the tree, -T fields and the summary, one pass and -2; OPC UA's null DateTime (0)
+    is 1601."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("filetime.xml", FILETIME_RULES, "ftime")
+
+    def test_every_count_to_the_last_digit(self):
+        counts = [0, 133485408001234567, 116444736000000000]   # 1601; 2024-01-01 00:00:00.1234567; 1970
+        path = self.env.add_file("filetime.pcap", pcap([udp(50000, PORT + 1, struct.pack("<Q", c)) for c in counts]))
+        for how, rows in self.env.field_rows_each_pass(path, ["frame.number", "ftime.stamp.when", "_ws.col.Info"],
+                                                      aggregator="|"):
+            for n, count in enumerate(counts, 1):
+                want = filetime_shown(count)
+                self.assertEqual(rows[n]["ftime.stamp.when"], [want], how)
+                self.assertEqual(rows[n]["_ws.col.Info"], ["at " + want], how)
+
+
 if __name__ == "__main__":
     ARGS, status = run_unittests()
     sys.exit(status)
