@@ -30,7 +30,7 @@ void Diagnostics::add(Severity severity, int line, std::string message) {
         merge_use(found->second, message);
         return;
     }
-    Uses uses{items_.size(), message, {}, 0};
+    Uses uses{items_.size(), message, {}, 0, {message}};
     std::smatch m;
     if (std::regex_search(message, m, use_line())) uses.lines.push_back(m[1]);
     given_.emplace(std::make_tuple(severity, line, key), uses);
@@ -40,7 +40,7 @@ void Diagnostics::add(Severity severity, int line, std::string message) {
 void Diagnostics::merge_use(Uses& uses, const std::string& message) {
     const auto count = std::distance(std::sregex_iterator(message.begin(), message.end(), use_line()),
                                      std::sregex_iterator());
-    if (count == 0 || message == uses.first) return;  // the very same message
+    if (count == 0 || !uses.seen.insert(message).second) return;  // a message already merged
     std::smatch m;
     if (count == 1 && uses.more == 0 && std::regex_search(message, m, use_line())) {
         if (std::find(uses.lines.begin(), uses.lines.end(), m[1].str()) != uses.lines.end()) return;

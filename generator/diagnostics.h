@@ -4,6 +4,7 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -41,6 +42,7 @@ private:
         std::string first;         // the message as first given
         std::vector<std::string> lines;  // the one use's line in each message (one use named)
         size_t more = 0;           // further messages naming several nested uses
+        std::set<std::string> seen;  // every message merged here, each counted once
     };
     void merge_use(Uses& uses, const std::string& message);
 

@@ -1549,10 +1549,17 @@ bool Validator::check_defined(const Node& n, Expr& e) {
 
 // The first node before t in document order whose value reads request{...}
 // and that a message may decode with t (not an alternative to it), or nullptr.
+// Alternatives inside a repeated node (a list of TLVs) are still decoded in
+// one message, by different instances.
 const Node* Validator::reader_before(const Node& t) const {
+    auto in_one_repeat = [](const Node& a, const Node& b) {
+        for (const Node* x = a.parent; x; x = x->parent)
+            if (x->is_repeated() && is_ancestor_or_self(x, &b)) return true;
+        return false;
+    };
     for (const Node* r : proto_.request_readers) {
         if (r->doc_index >= t.doc_index) break;
-        if (!are_alternatives(proto_, t, *r)) return r;
+        if (in_one_repeat(t, *r) || !are_alternatives(proto_, t, *r)) return r;
     }
     return nullptr;
 }

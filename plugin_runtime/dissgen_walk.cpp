@@ -28,7 +28,6 @@ static void report_v(dg_state *st, proto_tree *tree, expert_field *ei, gint offs
     if (length < 0 || offset + length > st->packet_end) length = st->packet_end - offset;
     st->stopped = TRUE;
     st->faulted = TRUE;
-    if (st->header_only) return; /* the message's length is the fault (report_short_stream_message) */
     if (st->quiet) {
         /* No tree and no tap listener: nobody reads the text, but the
          * severity still goes to the Expert column and the capture's highest
@@ -55,7 +54,11 @@ void report_missing(dg_state *st, proto_tree *tree, expert_field *ei, gint64 dat
         capture_cut(st, tree);
         return;
     }
-    if (data_end >= st->told_short_at && needed_end <= st->told_end) { /* one cause, one expert info */
+    /* one cause, one expert info: a length past the end told already, or the
+     * header of a stream message whose length is too short, where the data
+     * missing past the header is that length's fault (report_short_stream_message) */
+    if ((data_end >= st->told_short_at && needed_end <= st->told_end) ||
+        (st->header_only && data_end >= st->packet_end)) {
         st->stopped = TRUE;
         st->faulted = TRUE;
         return;

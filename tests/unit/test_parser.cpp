@@ -699,3 +699,28 @@ TEST(Structure, ErrorsAtTheEndNameALineOfTheFile) {
 
 }  // namespace
 }  // namespace dissgen::testing
+
+namespace dissgen::testing {
+namespace {
+
+// A group's mistake found through each use is one diagnostic naming the uses'
+// lines; through uses within uses, the others are counted, each once.
+TEST(Diagnostics, OneMistakeThroughSeveralUsesIsToldOnce) {
+    Diagnostics d;
+    d.error(4, "bad path (in group 'G' used on line 7) here");
+    d.error(4, "bad path (in group 'G' used on line 8) here");
+    d.error(4, "bad path (in group 'G' used on line 8) here");
+    d.error(4, "another mistake (in group 'G' used on line 7)");
+    ASSERT_EQ(d.items().size(), 2u);
+    EXPECT_EQ(d.items()[0].message, "bad path (in group 'G' used on lines 7 and 8) here");
+
+    Diagnostics nested;
+    const std::string a = "x (in group 'A' used on line 3, in group 'B' used on line 9)";
+    const std::string b = "x (in group 'A' used on line 5, in group 'B' used on line 9)";
+    for (const std::string& m : {a, b, b, b}) nested.warning(2, m);
+    ASSERT_EQ(nested.items().size(), 1u);
+    EXPECT_EQ(nested.items()[0].message, a + " (and through 1 more use of the groups)");
+}
+
+}  // namespace
+}  // namespace dissgen::testing
