@@ -14,8 +14,9 @@ random, the bits after a list's last value random too), each also cut short at r
 bytes, and checks every value of every field in -T fields against its own reading of the
 bytes, the Info column (a summary naming the last Coil), and the expert infos: a list the
 data ends inside says `'Coil' should occur N times, but the data ends after K` and the
-walk goes on; a one-byte field or bit group with no byte left is truncated (named by the
-group's first member, shown or not) and ends it. One pass and -2 alike.
+walk goes on, that being the one fault told (later fields missing the same bytes say
+nothing more); otherwise a one-byte field or bit group with no byte left is truncated
+(named by the group's first member, shown or not) and ends it. One pass and -2 alike.
 
     test_bit_fields.py --dissgen build/bin/dissgen --source-dir .
 """
@@ -107,11 +108,13 @@ def build(parts, cut=None):
     names = {"kind": "Kind", "coils": "Coils", "coil": "Coil", "pairs": "Pairs", "state": "State",
              "nibbles": "Nibbles", "offset": "Offset", "flag": "Flag", "tail": "Tail"}
     last_coil = None
+    told = False   # a list the data ended in is the one fault: later shortfalls are not told again
     for p in parts:
         name, what = p[0], p[1]
         if name == "group":
             if left < 1:
-                m.experts.append("Truncated: '%s' needs 1 bytes, only 0 left" % what)
+                if not told:
+                    m.experts.append("Truncated: '%s' needs 1 bytes, only 0 left" % what)
                 break
             for member, value in p[3]:
                 m.fields[member] = [shown(member, value, 4)]
@@ -120,7 +123,8 @@ def build(parts, cut=None):
             m.fields[name] = ["%d" % p[2]]
         elif what == "byte":
             if left < 1:
-                m.experts.append("Truncated: '%s' needs 1 bytes, only 0 left" % names[name])
+                if not told:
+                    m.experts.append("Truncated: '%s' needs 1 bytes, only 0 left" % names[name])
                 break
             m.fields[name] = [shown(name, m.data[at], 8)]
             at, left = at + 1, left - 1
@@ -133,8 +137,9 @@ def build(parts, cut=None):
                 m.fields[name] = [shown(name, v, bits) for v in values]
             if name == "coil" and values:
                 last_coil = values[-1]
-            if n < count:
+            if n < count and not told:
                 m.experts.append("'%s' should occur %d times, but the data ends after %d" % (names[name], count, n))
+            told = told or n < count
             at, left = at + have, left - have
     kind, coils = m.fields.get("kind"), m.fields.get("coils")
     m.info = "%s: %s coils, last %s" % (kind[0] if kind else "-", coils[0] if coils else "-",
