@@ -432,9 +432,8 @@ struct Protocol {
     // the fields of a request that responses read (request{Name}), each once;
     // a request keeps their values in this order
     std::vector<const Node*> request_fields;
-    // the first node (document order) whose value reads request{...}
-    const Node* first_request_reader = nullptr;
-    std::vector<const Node*> request_readers;  // every node whose value reads request{...}, in document order
+    // every node whose value reads request{...}, in document order
+    std::vector<const Node*> request_readers;
     // every <learn>, in document order (Learn::index)
     std::vector<Learn*> learns;
     // readers whose lookups resolve to other fields (rows learns.size() + k)

@@ -1072,7 +1072,6 @@ void Parser::parse_in_list(const std::string& text, int line, Node& node) {
     parse_value_list(text, line, "in", node.in_list);
 }
 
-// "1-9,0x0d,14": numbers and ranges, for 'in', 'ifhook' and 'valid'.
 // Whether an item of a value list starts with a minus sign ("-1", "2, -5").
 static bool has_negative_item(const std::string& text) {
     std::stringstream ss(text);
@@ -1081,6 +1080,7 @@ static bool has_negative_item(const std::string& text) {
     return false;
 }
 
+// "1-9,0x0d,14": numbers and ranges, for 'in', 'ifhook' and 'valid'.
 bool Parser::parse_value_list(const std::string& text, int line, const std::string& attribute,
                               std::vector<ValueRange>& out) {
     const std::string bad = "bad '" + attribute + "' list '" + text +

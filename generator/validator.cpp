@@ -1513,8 +1513,6 @@ bool Validator::check_request_field(Node& n, Expr& e) {
     }
     e.target = const_cast<Node*>(t);
     e.is_float = t->display == Display::Float;
-    if (!proto_.first_request_reader || n.doc_index < proto_.first_request_reader->doc_index)
-        proto_.first_request_reader = &n;
     auto& readers = proto_.request_readers;
     auto at = std::lower_bound(readers.begin(), readers.end(), &n,
                                [](const Node* a, const Node* b) { return a->doc_index < b->doc_index; });

@@ -157,7 +157,6 @@ typedef struct dg_learn {
 } dg_learn;
 
 /* The most keys a <learn> has (the generator refuses more). */
-
 #define DG_MAX_LEARN_KEYS 16
 
 /* A key of a <learn>: its value as the learner computes it, and as a reader

@@ -95,7 +95,6 @@ namespace {
 
 /* --- shown values -------------------------------------------------------- */
 
-
 /* The values of string, stringz, int, float, time, datetime, guid and
  * address leaves, for summaries and the Info column (as the tree item shows
  * them; a MAC address without its vendor's name, as tshark's fields). */
