@@ -195,8 +195,15 @@ Layout make_layout(const Protocol& proto, const std::map<const Node*, uint64_t>&
     return l;
 }
 
+// The dg_learn_ends of a <learn>: whose value it is besides its keys'.
+std::string learn_ends(const Learn& learn) {
+    return learn.conversation ? "DG_LEARN_ENDS_CONVERSATION"
+           : learn.sender     ? "DG_LEARN_ENDS_SENDER"
+                              : "DG_LEARN_ENDS_NONE";
+}
+
 // Each <learn>: its value, condition and keys' operations (after the
-// findings'), the sender flag; each key its value and lookup.
+// findings'), the transport's ends it is kept by; each key its value and lookup.
 void layout_learns(Layout& l, const Protocol& proto) {
     auto add = [&](const Expr* e) -> std::string {
         if (!e) return "0, 0";
@@ -217,7 +224,7 @@ void layout_learns(Layout& l, const Protocol& proto) {
             const std::string condition = add(learn.condition ? &*learn.condition : nullptr);
             l.learns.push_back("/* " + learn.name + ", line " + std::to_string(learn.line) + " */ { " + value + ", " +
                                condition + ", " + std::to_string(key_first) + ", " +
-                               std::to_string(learn.keys.size()) + ", " + (learn.sender ? "TRUE" : "FALSE") + " }");
+                               std::to_string(learn.keys.size()) + ", " + learn_ends(learn) + " }");
         }
     }
     // readers with keys of their own: what they read is their learn's
@@ -231,7 +238,7 @@ void layout_learns(Layout& l, const Protocol& proto) {
         }
         l.learns.push_back("/* learned{" + learn.name + "} at line " + std::to_string(read->line) + " */ { 0, 0, 0, 0, " +
                            std::to_string(key_first) + ", " + std::to_string(learn.keys.size()) + ", " +
-                           (learn.sender ? "TRUE" : "FALSE") + ", " + std::to_string(learn.index + 1) + " }");
+                           learn_ends(learn) + ", " + std::to_string(learn.index + 1) + " }");
     }
 }
 
@@ -609,7 +616,7 @@ void Emitter::condition_and_window_tables() {
 
 void Emitter::learn_tables() {
     if (l_.learns.empty()) return;
-    o_ << "/* <learn>s: value, if (first, count in exprs; 0, 0: none), keys (first, count), by sender. */\n";
+    o_ << "/* <learn>s: value, if (first, count in exprs; 0, 0: none), keys (first, count), the ends it is kept by. */\n";
     o_ << c_array("static const dg_learn " + p_.filter + "_learns", l_.learns);
     if (l_.learn_keys.empty()) return;
     o_ << "/* Their keys: value, lookup, span, id (first, count in exprs; lookup 0, 0: as the value; span, id 0, 0: none, or a reader's: its learn's). */\n";

@@ -106,10 +106,10 @@ struct Finding {
     std::string filter_name;
 };
 
-// <learn name="..." value="EXPR" [if="EXPR"] [sender="yes"]> <key value="EXPR"
-// [lookup="EXPR"] [span="EXPR"]/>... </learn> inside a node: once an
-// instance of the node is decoded (first pass), the value is learned under
-// the keys' values (and the sender's address); learned{NAME} in a later
+// <learn name="..." value="EXPR" [if="EXPR"] [sender="yes"|conversation="yes"]>
+// <key value="EXPR" [lookup="EXPR"] [span="EXPR"]/>... </learn> inside a node:
+// once an instance of the node is decoded (first pass), the value is learned
+// under the keys' values (and the sender's address, or the conversation's); learned{NAME} in a later
 // message reads the latest value learned under its own keys (lookup, else
 // value) in an earlier one. A key with a span learns a window: the values
 // value .. value + span - 1, any of which finds it; with an id, the window is
@@ -130,6 +130,7 @@ struct Learn {
     std::optional<Expr> condition;  // if="EXPR": learned only when it holds
     std::string condition_text;
     bool sender = false;            // sender="yes": the source address is a key too
+    bool conversation = false;      // conversation="yes": both ends are, either way round
     std::vector<LearnKey> keys;
     int line = 0;
     // derived by the validator

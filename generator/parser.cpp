@@ -54,7 +54,7 @@ const std::vector<std::string> kHookAttributes = {"table", "value"};
 const std::vector<std::string> kHeuristicAttributes = {"table", "enabled"};
 const std::vector<std::string> kWhenAttributes = {"field", "peek", "in"};
 const std::vector<std::string> kFindingAttributes = {"name", "severity", "group", "condition", "text"};
-const std::vector<std::string> kLearnAttributes = {"name", "value", "if", "sender"};
+const std::vector<std::string> kLearnAttributes = {"name", "value", "if", "sender", "conversation"};
 const std::vector<std::string> kLearnKeyAttributes = {"value", "lookup", "span", "id"};
 const std::vector<std::string> kPairingAttributes = {"timeout", "analysis", "order"};
 const std::vector<std::string> kKeyAttributes = {"field"};
@@ -890,7 +890,7 @@ bool Parser::parse_expression_attribute(const std::string& text, int line, const
     return false;
 }
 
-// <learn name="..." value="EXPR" [if="EXPR"] [sender="yes|no"]> <key value="EXPR"
+// <learn name="..." value="EXPR" [if="EXPR"] [sender="yes|no"] [conversation="yes|no"]> <key value="EXPR"
 // [lookup="EXPR"]/>... </learn>; the validator resolves the names.
 void Parser::parse_learn(xmlNode* el, Node& node) {
     Learn l;
@@ -911,6 +911,13 @@ void Parser::parse_learn(xmlNode* el, Node& node) {
         ok = parse_expression_attribute(l.condition_text, l.line, "if of " + what, *l.condition) && ok;
     }
     parse_yes_no(attrs, "sender", l.line, " of " + what, "the sender's address and port are a key too", l.sender);
+    parse_yes_no(attrs, "conversation", l.line, " of " + what,
+                 "both ends' addresses and ports are a key too, whichever sent the message", l.conversation);
+    if (l.sender && l.conversation) {
+        diags_.error(l.line, what + " has both sender=\"yes\" and conversation=\"yes\": a value is either each "
+                                    "sender's (sender) or shared by both ends of a conversation (conversation)");
+        ok = false;
+    }
     for (xmlNode* c = el->children; c; c = c->next) {
         if (c->type != XML_ELEMENT_NODE || element_name(c) != "key") {
             unexpected_child(c, "learn", {"key"});

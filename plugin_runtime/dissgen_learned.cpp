@@ -55,13 +55,14 @@ typedef struct record {
 } record;
 
 /* Who an entry, window or group belongs to: a learn, its keys and, with
- * sender="yes", the sender. First member of each, so one hash serves all. */
+ * sender="yes", the sender; with conversation="yes", both ends, the lower
+ * (address, then port) as src. First member of each, so one hash serves all. */
 typedef struct identity {
     guint32 hash;
     guint16 learn;
     guint16 key_count;
-    guint32 port;
-    address src;
+    guint32 port, dst_port;
+    address src, dst;
     guint64 *keys;
 } identity;
 
@@ -100,7 +101,8 @@ gboolean identity_equal(gconstpointer a, gconstpointer b)
 {
     const identity *x = (const identity *)a, *y = (const identity *)b;
     return x->hash == y->hash && x->learn == y->learn && x->key_count == y->key_count && x->port == y->port &&
-           addresses_equal(&x->src, &y->src) && memcmp(x->keys, y->keys, x->key_count * sizeof(guint64)) == 0;
+           x->dst_port == y->dst_port && addresses_equal(&x->src, &y->src) && addresses_equal(&x->dst, &y->dst) &&
+           memcmp(x->keys, y->keys, x->key_count * sizeof(guint64)) == 0;
 }
 
 dg_expr_value evaluate(const dg_state *st, guint16 first, guint16 count)
@@ -132,8 +134,34 @@ gboolean keys_of(const dg_state *st, const dg_learn *l, gboolean lookup, guint64
     return TRUE;
 }
 
+/* Whether the (address, port) end a comes before end b. */
+gboolean end_before(const address *a, guint32 a_port, const address *b, guint32 b_port)
+{
+    const int by_address = cmp_address(a, b);
+    return by_address < 0 || (by_address == 0 && a_port < b_port);
+}
+
+/* The transport's ends that are part of learn l's identity (shallow: copied
+ * when the entry is made). */
+void ends_of(const dg_state *st, const dg_learn *l, identity *probe)
+{
+    const packet_info *pinfo = st->pinfo;
+    if (l->ends == DG_LEARN_ENDS_NONE) return;
+    probe->src = pinfo->src;
+    probe->port = pinfo->srcport;
+    if (l->ends != DG_LEARN_ENDS_CONVERSATION) return;
+    probe->dst = pinfo->dst;
+    probe->dst_port = pinfo->destport;
+    if (end_before(&probe->dst, probe->dst_port, &probe->src, probe->port)) {
+        probe->src = pinfo->dst;
+        probe->port = pinfo->destport;
+        probe->dst = pinfo->src;
+        probe->dst_port = pinfo->srcport;
+    }
+}
+
 /* The identity of the entry, window or group of learn `index` under
- * keys[0 .. count) (the sender too, with by_sender). */
+ * keys[0 .. count) (and the transport's ends its `ends` names). */
 void probe_of(const dg_state *st, guint16 index, guint64 *keys, guint16 count, identity *probe)
 {
     const dg_learn *l = &st->p->learns[index];
@@ -143,14 +171,12 @@ void probe_of(const dg_state *st, guint16 index, guint64 *keys, guint16 count, i
     probe->key_count = count;
     probe->keys = keys;
     clear_address(&probe->src);
+    clear_address(&probe->dst);
+    ends_of(st, l, probe);
     guint32 h = 2166136261u ^ index;
     for (guint16 i = 0; i < count; i++) h = hash_mix(h, keys[i]);
-    if (l->by_sender) {
-        probe->src = st->pinfo->src; /* shallow: copied when the entry is made */
-        probe->port = st->pinfo->srcport;
-        h = hash_mix(h, probe->port);
-        h = add_address_to_hash(h, &probe->src);
-    }
+    if (probe->src.type != AT_NONE) h = add_address_to_hash(hash_mix(h, probe->port), &probe->src);
+    if (probe->dst.type != AT_NONE) h = add_address_to_hash(hash_mix(h, probe->dst_port), &probe->dst);
     probe->hash = h;
 }
 
@@ -190,6 +216,7 @@ template <typename T> T *new_keyed(wmem_map_t *map, const identity *probe)
     *id = *probe;
     id->keys = (guint64 *)wmem_memdup(wmem_file_scope(), probe->keys, probe->key_count * sizeof(guint64));
     copy_address_wmem(wmem_file_scope(), &id->src, &probe->src);
+    copy_address_wmem(wmem_file_scope(), &id->dst, &probe->dst);
     wmem_map_insert(map, id, made);
     return made;
 }

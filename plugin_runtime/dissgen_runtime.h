@@ -141,16 +141,21 @@ typedef struct dg_finding {
     guint16 text_first, text_count;
 } dg_finding;
 
+/* dg_learn.ends: the transport's ends that are a key of a learned value too:
+ * none, the sender's address and port, or both ends either way round (one
+ * value per conversation, taught by either side, read by both). */
+enum dg_learn_ends { DG_LEARN_ENDS_NONE = 0, DG_LEARN_ENDS_SENDER = 1, DG_LEARN_ENDS_CONVERSATION = 2 };
+
 /* A <learn>: once an instance of its node is decoded on the first pass, when
  * its condition (exprs[if_first ..], none when if_count is 0) holds, the
  * value exprs[value_first ..] is learned under its keys
- * (dg_protocol.learn_keys[key_first ..]) and, with by_sender, the sender's
- * address and port (dissgen_learned.cpp). */
+ * (dg_protocol.learn_keys[key_first ..]) and the transport's ends that
+ * `ends` names (dissgen_learned.cpp). */
 typedef struct dg_learn {
     guint16 value_first, value_count;
     guint16 if_first, if_count;
     guint16 key_first, key_count;
-    gboolean by_sender;
+    guint8 ends; /* dg_learn_ends: whose value it is besides the keys' */
     /* 0: a <learn>; n: the keys one reader of learned{...} computes for the
      * <learn> in row n - 1 (its lookups read the fields closest to it) */
     guint16 keys_of = 0;
