@@ -37,6 +37,17 @@ struct dg_claim {
 
 GArray *claims; /* of dg_claim: table entries this plugin must own */
 
+/* This plugin's protocol once handed off, for the dissectors its leaves name. */
+const dg_protocol *handed_off;
+
+/* Runs after every plugin's handoff: each dissgen protocol registers its
+ * dissector name at its own handoff (dissgen_compat.h), so one named by
+ * another rule file's dissector= exists only once every plugin is handed off. */
+void find_dissectors_named(void)
+{
+    if (handed_off) find_handoff_dissectors(handed_off);
+}
+
 /* The other registrant of a value, or NULL when there is none or it is this
  * protocol itself (a value hooked twice, or its TCP stream entry beside its
  * plain one): a refused message must never come back to us. */
@@ -309,9 +320,10 @@ void dg_handoff(const dg_protocol *p)
     if (!claims) {
         claims = g_array_new(FALSE, FALSE, sizeof(dg_claim));
         register_final_registration_routine(claim_tables);
+        register_final_registration_routine(find_dissectors_named);
         register_init_routine(follow_enabled_protocols);
     }
-    find_handoff_dissectors(p);
+    handed_off = p;
     for (guint i = 0; i < p->hook_count; i++) {
         const dg_hook *h = &p->hooks[i];
         if (!find_dissector_table(h->table) || !table_accepts_integers(h->table)) {

@@ -257,7 +257,8 @@ void summaries_end(dg_state *st, const dg_node *n, const dg_summaries *s);
  * the whole message) go to the named dissector, or are shown raw. */
 void dissect_handoff(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len);
 
-/* At handoff: the dissectors that dissector= names, the reassembled sources' names. */
+/* After every plugin's handoff: the dissectors that dissector= names, the
+ * reassembled sources' names. */
 void find_handoff_dissectors(const dg_protocol *p);
 
 /* --- dissgen_learned.cpp ------------------------------------------------- */

@@ -8,6 +8,8 @@
 - a rule file whose names clash with a Wireshark protocol (one name, or all three) is
   reported and skipped at load, and tshark keeps running; two plugins of the same rules
   load once, without a word;
+- a rule file's dissector="NAME" finds the protocol of another dissgen plugin, whichever
+  loads first;
 - editing the rules and installing again changes the decode;
 - the paper's own example generates a working plugin;
 - as root in CI, `dissgen install --system` serves root's tshark.
@@ -224,6 +226,28 @@ class PluginLoading(unittest.TestCase):
                     self.env.env = base_env
                 self.assertEqual([r[0] for r in rows], ["ECATR"] * 3, stderr)
                 self.assertEqual(decode_as[0][0], "ECAT")
+
+    def test_plugins_hand_bytes_to_each_other_by_name(self):
+        """Two rule files, each handing the rest of its message to the other's protocol by
+        name: each dissgen protocol registers its name at its own handoff, so whichever plugin
+        Wireshark hands off first, both names are found, and no warning is printed."""
+        halves = {"handa": ("Kind", "handb", "9997"), "handb": ("Code", "handa", "9996")}
+        for filter_name, (field, other, port) in halves.items():
+            rules = os.path.join(self.env.home, filter_name + ".xml")
+            with open(rules, "w", encoding="utf-8") as fh:
+                fh.write("""<root name="Half %s" abbreviation="%s" filter="%s">
+  <hook table="udp.port" value="%s"/>
+  <node name="%s" length="1byte" displaytype="numberdec"/>
+  <node name="Inner" if="../node[@name='%s']" in="1-2" length="rest" dissector="%s"/>
+</root>
+""" % (filter_name, filter_name.upper(), filter_name, port, field, field, other))
+            self.env.install_plugin(ARGS.dissgen, rules)
+        # 1 -> handb 2 -> handa 1 -> handb 7 (stops: 7 is not in 1-2)
+        capture = self.env.add_file("halves.pcap", pcapgen.raw_pcap_bytes(
+            [pcapgen.udp_ethernet_frame(bytes([1, 2, 1, 7]), 9997)]))
+        rows, stderr = fields(self.env, capture, ["handa.kind", "handb.code"])
+        self.assertNotIn("which this Wireshark does not have", stderr)
+        self.assertEqual(rows, [["1,1", "2,7"]], stderr)
 
     def test_name_clash_is_reported_and_tshark_keeps_running(self):
         paper = os.path.join(ARGS.source_dir, "tests", "rules", "paper_example.xml")
