@@ -881,8 +881,10 @@ void show_message_tail(dg_state *st, proto_tree *tree, gint offset, gboolean on_
                                  rest == 1 ? "" : "s", rest == 1 ? "is" : "are");
 }
 
-/* Key of the per-packet count of messages decoded (p_add_proto_data). */
+/* Keys of the per-packet count of messages decoded and of their Info texts
+ * joined (p_add_proto_data). */
 #define DG_MESSAGES_KEY 0x6d736773u
+#define DG_INFO_KEY 0x696e666fu
 
 /* How many messages of this protocol the packet has had, this one included.
  * Wireshark counts the calls of a protocol in a packet (curr_proto_layer_num:
@@ -1032,6 +1034,34 @@ void report_short_stream_message(dg_state *st, proto_tree *tree, gint64 length, 
            n->name, length, stream_header_length(p), rest, rest == 1 ? "" : "s", rest == 1 ? "it is" : "them are");
 }
 
+/* The Info column: the first message's text, each later one's joined with
+ * " | ". Joined from the texts of the frame's earlier messages, kept per
+ * packet, not from the column: a dissector that carries several of ours
+ * (TPKT and COTP calling a heuristic once per TPKT message) writes its own
+ * text over ours between them. Beyond what the column holds nothing is added.
+ * A message inside the first (EtherCAT in EoE) appends to the column: the
+ * first's text comes once it is decoded, and replaces it. */
+void show_info(const dg_protocol *p, packet_info *pinfo, const char *info, gboolean first_message,
+               gboolean on_ethertype)
+{
+    if (first_message && on_ethertype) { /* Ethernet carries one: nothing to keep (a message inside it appends) */
+        col_add_str(pinfo->cinfo, COL_INFO, info);
+        return;
+    }
+    wmem_strbuf_t *joined = (wmem_strbuf_t *)p_get_proto_data(pinfo->pool, pinfo, *p->proto, DG_INFO_KEY);
+    if (first_message) {
+        joined = wmem_strbuf_new(pinfo->pool, info);
+        p_set_proto_data(pinfo->pool, pinfo, *p->proto, DG_INFO_KEY, joined);
+    } else if (!joined) {
+        col_append_sep_str(pinfo->cinfo, COL_INFO, " | ", info);
+        return;
+    } else if (wmem_strbuf_get_len(joined) < COL_MAX_INFO_LEN) {
+        wmem_strbuf_append(joined, " | ");
+        wmem_strbuf_append(joined, info);
+    }
+    col_add_str(pinfo->cinfo, COL_INFO, wmem_strbuf_get_str(joined));
+}
+
 } // namespace
 
 int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tree *tree)
@@ -1078,11 +1108,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     }
 
     if (st.tap) tap_queue_packet(stats_tap, pinfo, st.tap);
-    const char *info = st.info && st.info->len > 0 ? st.info->data : p->name;
-    if (first_message)
-        col_add_str(pinfo->cinfo, COL_INFO, info);
-    else
-        col_append_sep_str(pinfo->cinfo, COL_INFO, " | ", info);
+    show_info(p, pinfo, st.info && st.info->len > 0 ? st.info->data : p->name, first_message, on_ethertype);
     /* The message is ours even when it took no bytes (an Ethernet frame that
      * ends after its type: its expert info says what is missing); 0 would
      * tell the caller (ethertype, udp) that it is not, and it would show the

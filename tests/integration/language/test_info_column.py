@@ -29,6 +29,7 @@ import testpaths  # noqa: E402,F401  (every folder of tests/integration: tests s
 from pcaprewrite import Capture, ecat_datagrams  # noqa: E402
 from tshark_env import TsharkEnv, TsharkTestCase, run_unittests  # noqa: E402
 from test_enip import ethernet, pcap  # noqa: E402
+from pcapgen import raw_pcap_bytes, tcp_ethernet_frame  # noqa: E402
 
 ARGS = None
 ENV = None
@@ -420,6 +421,49 @@ class SummaryAcrossRepeats(TsharkTestCase, unittest.TestCase):
                                           "Member: 2 a=-", "Member: 2 a=-", "Record: a=- b=5", "Member: 2 a=-",
                                           "Message: last a=6", "Record: a=6 b=-", "Member: 1 a=6"],
                                  "%s %s" % (walk, extra))
+
+
+# A protocol that Wireshark's COTP hands each data unit of a TPKT message to (its heuristic
+# list): COTP writes its own Info text once per TPKT message, between ours.
+CARRIED_RULES = """<root name="Carried by COTP" abbreviation="CBC" filter="cbc">
+  <heuristic table="cotp"/>
+  <node name="Protocol Id" length="1byte" displaytype="numberhex" valid="0x32"/>
+  <node name="Body" summary="kind {Kind}">
+    <node name="Kind" length="1byte" displaytype="numberdec"/>
+  </node>
+</root>
+"""
+
+
+def tpkt_data_unit(payload):
+    """A TPKT message (RFC 1006) holding a COTP data unit (last of its message) with payload."""
+    cotp = b"\x02\xf0\x80" + payload
+    return struct.pack("!BBH", 3, 0, 4 + len(cotp)) + cotp
+
+
+class InfoOfMessagesCarriedApart(TsharkTestCase, unittest.TestCase):
+    """Each message of ours in a TCP segment comes in its own call from COTP, which writes
+    its text over the column before each: the Info column still joins ours, in order."""
+
+    @classmethod
+    def prepare(cls):
+        cls.install_text("carried.xml", CARRIED_RULES, "cbc")
+
+    def test_each_message_joined_in_order(self):
+        segments = [[1], [1, 3], [4, 5, 6]]
+        frames, seq = [], 1
+        for kinds in segments:
+            payload = b"".join(tpkt_data_unit(bytes([0x32, k])) for k in kinds)
+            frames.append(tcp_ethernet_frame(payload, 40000, 102, seq))
+            seq += len(payload)
+        path = self.env.add_file("carried.pcap", raw_pcap_bytes(frames))
+        want = {n: [" | ".join("kind %d" % k for k in kinds)] for n, kinds in enumerate(segments, 1)}
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = self.env.field_rows(path, ["frame.number", "_ws.col.Info"], two_pass)
+                got = {n: r["_ws.col.Info"] for n, r in rows.items()}
+                check(got == want, "%s: Info joins every message's text: %s" % (
+                    "-2" if two_pass else "one pass", got))
 
 
 if __name__ == "__main__":
