@@ -106,7 +106,7 @@ TEST(NodeGroups, ALookupInEachCopyReadsTheFieldOfItsOwnCopy) {
     EXPECT_EQ(f.proto->learns[0]->keys[0].lookup->target->parent->name, "Outputs");
     // the plugin's learns table: the learn, then the reader's keys for it (keys_of = row 0 + 1)
     const std::string code = emit_cpp(*f.proto, "t.xml");
-    EXPECT_NE(code.find("/* learned{Size} at line 4 */ { 0, 0, 0, 0, 1, 1, FALSE, 1 }"), std::string::npos) << code;
+    EXPECT_NE(code.find("/* learned{Size} at line 4 */ { 0, 0, 0, 0, 1, 1, DG_LEARN_ENDS_NONE, 1 }"), std::string::npos) << code;
 }
 
 }  // namespace
