@@ -354,6 +354,7 @@ const char* show_of(const Node& n) {
         case Display::Mac: return "DG_SHOW_MAC";
         case Display::Eui64: return "DG_SHOW_EUI64";
         case Display::Oid: return "DG_SHOW_OID";
+        case Display::Varint: return "DG_SHOW_VARINT";
     }
     return "DG_SHOW_HIDDEN";
 }
@@ -839,7 +840,7 @@ std::string Emitter::protocol_row() const {
         "top_walk(" + walk_name(nullptr) + ")"};
     if (pdu)
         set.push_back("pdu_length(" + std::to_string(pdu->doc_index - 1) + ", " +
-                      std::to_string(p_.pdu_fixed_len - value_bytes(*pdu)) + ", " + std::to_string(p_.pdulengthadd) + ")");
+                      std::to_string(p_.pdu_offset) + ", " + std::to_string(p_.pdulengthadd) + ")");
     if (uses_reassembly()) set.push_back("reassembly(&" + f + "_reassembly, &" + f + "_fragment_items)");
     auto table = [&](const char* name, const std::vector<std::string>& rows) {
         if (!rows.empty()) set.push_back(std::string(name) + "(" + f + "_" + name + ")");
@@ -1172,6 +1173,7 @@ std::optional<FieldType> typed_field_type(const Node& n) {
         case Display::Mac: return FieldType{"FT_ETHER", "BASE_NONE", 0};
         case Display::Eui64: return FieldType{"FT_EUI64", "BASE_NONE", 0};
         case Display::Oid: return FieldType{"FT_OID", "BASE_NONE", 0};
+        case Display::Varint: return FieldType{"FT_UINT64", "BASE_DEC", 0};
         case Display::Int: {
             return FieldType{"FT_INT" + std::to_string(bytes * 8), "BASE_DEC", group_mask(n)};
         }

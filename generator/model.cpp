@@ -24,6 +24,7 @@ const char* display_name(Display d) {
         case Display::Mac: return "mac";
         case Display::Eui64: return "eui64";
         case Display::Oid: return "oid";
+        case Display::Varint: return "varint";
     }
     return "?";
 }
@@ -48,6 +49,7 @@ bool Node::takes_no_bytes() const {
 
 bool Node::is_numeric() const {
     if (is_computed()) return display != Display::Float;
+    if (display == Display::Varint) return is_leaf() && length_kind == LengthKind::Children;
     if (is_number_sized_by_field()) return true;
     if (!is_leaf() || !has_fixed_length()) return false;
     if (fixed_bits < 1 || fixed_bits > 64) return false;

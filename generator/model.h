@@ -26,7 +26,10 @@ enum class Display {
     // IPv6 addresses (FT_IPv6), MAC addresses (FT_ETHER: the vendor's name shown), EUI-64s (FT_EUI64)
     IPv6, Mac, Eui64,
     // object identifiers, BER-encoded without tag and length (FT_OID: shown dotted, 1.3.6.1...)
-    Oid
+    Oid,
+    // unsigned base-128 numbers of 1 to 10 bytes, lowest 7 bits first, bit 7 set while more follow
+    // (MQTT's remaining length, protobuf's varint): a leaf without a length, its bytes say where it ends
+    Varint
 };
 
 // direction="request|response" (Any: no such attribute)
@@ -429,7 +432,8 @@ struct Protocol {
 
     // --- derived by the validator ---
     int slot_count = 0;
-    unsigned pdu_fixed_len = 0;      // bytes needed to read the pdulength field
+    unsigned pdu_fixed_len = 0;      // bytes needed to read the pdulength field (a varint's first)
+    unsigned pdu_offset = 0;         // where the pdulength field starts in every message
     // the fields of a request that responses read (request{Name}), each once;
     // a request keeps their values in this order
     std::vector<const Node*> request_fields;

@@ -73,7 +73,9 @@ const std::vector<std::string> kDisplayNames = {"address", "numberhex", "numberd
                                                 // addresses of fixed size
                                                 "ipv6", "mac", "eui64",
                                                 // object identifiers
-                                                "oid"};
+                                                "oid",
+                                                // base-128 numbers of varying length
+                                                "varint"};
 
 int line_of(const xmlNode* el) { return xml_line(el); }  // lines above 65534: use_start_lines
 
@@ -1003,7 +1005,7 @@ void Parser::parse_display(const std::string& text, int line, Node& node) {
                                       Display::Int,     Display::Float,     Display::Time,
                                       Display::DateTime, Display::Guid,
                                       Display::IPv6,    Display::Mac,       Display::Eui64,
-                                      Display::Oid};
+                                      Display::Oid,     Display::Varint};
     for (size_t i = 0; i < kDisplayNames.size(); ++i) {
         if (text == kDisplayNames[i]) {
             node.display = kValues[i];

@@ -184,6 +184,7 @@ private:
     void check_display_direction_handoff(Node& n);
     void check_unit(const Node& n);
     void check_string_display(Node& n);
+    void check_varint(Node& n);
     void check_datetime_length(const Node& n);
     void check_enum_ranges(const Node& n);
     void check_handoff(const Node& n);
@@ -358,6 +359,10 @@ void Validator::inherit_and_check_node(Node& n, ByteOrder inherited) {
 
 void Validator::check_leaf_display(Node& n) {
     if (n.is_computed()) return;  // check_computed
+    if (n.display == Display::Varint) {
+        check_varint(n);
+        return;
+    }
     if (n.length_kind == LengthKind::Children && n.display != Display::StringZ)
         diags_.warning(n.line, "leaf " + quote(n) + " has no length and no children: it takes no bytes");
     if (!n.display_given) n.display = Display::Origin;
@@ -388,6 +393,17 @@ void Validator::check_leaf_display(Node& n) {
     } else if (!n.enums.empty()) {
         diags_.warning(n.line, "enum items of " + quote(n) + " are ignored: its displaytype is not 'enum'");
     }
+}
+
+// A varint's bytes say where it ends: it has no length, holds up to 64 bits
+// and names no enum items (shown in decimal).
+void Validator::check_varint(Node& n) {
+    if (n.length_kind != LengthKind::Children)
+        diags_.error(n.line, "varint display takes no length: its bytes say where it ends (bit 7 set while "
+                             "another byte follows); remove length= from " + quote(n));
+    n.bits = 64;
+    if (!n.enums.empty())
+        diags_.warning(n.line, "enum items of " + quote(n) + " are ignored: a varint is shown in decimal");
 }
 
 namespace {
@@ -732,7 +748,10 @@ void Validator::check_pdulength() {
                                       pdulength_blocker(*blocker, *t));
         return;
     }
-    proto_.pdu_fixed_len = static_cast<unsigned>(offset) + (t->in_bit_group ? t->group_bytes : t->bits / 8);
+    // a varint has one byte at least; its others come with the message (dissgen_handoff.cpp)
+    const unsigned field_bytes = t->display == Display::Varint ? 1 : t->in_bit_group ? t->group_bytes : t->bits / 8;
+    proto_.pdu_fixed_len = static_cast<unsigned>(offset) + field_bytes;
+    proto_.pdu_offset = static_cast<unsigned>(offset);
     mark_slot(const_cast<Node*>(t));
 }
 
@@ -785,6 +804,11 @@ void Validator::check_validity() {
         if (!n.is_numeric()) {
             diags_.error(n.line, "'valid' field " + quote(n) + " is not numeric: it must be a leaf of 1-64 bits shown as "
                                  "numberhex, numberdec, int, time, bool, enum or nondisplay");
+            return;
+        }
+        if (n.display == Display::Varint) {
+            diags_.error(n.line, "'valid' field " + quote(n) + " is a varint: the test reads fields of fixed length "
+                                 "before anything is decoded");
             return;
         }
         uint64_t offset = 0;
@@ -2076,6 +2100,10 @@ void Validator::check_peek(Node& n, When& w) {
                                      "bool, enum or nondisplay");
         return;
     }
+    if (t->display == Display::Varint) {
+        diags_.error(w.line, field + " is a varint: peek reads a field of fixed length before the walk reaches it");
+        return;
+    }
     if (t->doc_index <= n.doc_index) {
         diags_.error(w.line, field + " is not after " + quote(n) + "; peek looks ahead, use <when field=...> for an "
                                      "earlier field");
@@ -2101,7 +2129,8 @@ void Validator::check_peek(Node& n, When& w) {
             offset += s.fixed_bits / 8;
         else if (s.length_kind == LengthKind::Field && known_before(s.length_ref.target, n))
             lengths.push_back(&s.length_ref);
-        else if (auto sum = s.length_kind == LengthKind::Children ? children_fixed_bytes(s) : std::nullopt)
+        else if (auto sum = s.length_kind == LengthKind::Children && !s.is_leaf() ? children_fixed_bytes(s)
+                                                                                    : std::nullopt)
             offset += *sum;
         else
             not_known = lines_of(s) + " has a length not known before then";

@@ -141,23 +141,38 @@ void dg_rt::find_handoff_dissectors(const dg_protocol *p)
 
 /* --- stream transports --------------------------------------------------- */
 
-gint64 dg_rt::stream_message_length(const dg_protocol *p, tvbuff_t *tvb, int offset)
+gint64 dg_rt::stream_message_length(const dg_protocol *p, tvbuff_t *tvb, int offset, guint *header)
 {
     const dg_node *n = &p->nodes[p->pdu_node];
-    guint64 value = read_uint(tvb, offset + (gint)p->pdu_offset, n->length, encoding_of(n));
+    const gint at = offset + (gint)p->pdu_offset;
+    if (n->show == DG_SHOW_VARINT) {
+        const gint have = MIN(tvb_captured_length_remaining(tvb, at), DG_VARINT_MOST_BYTES);
+        guint64 value = 0;
+        const guint got = have > 0 ? tvb_get_varint(tvb, (guint)at, (guint)have, &value, ENC_VARINT_PROTOBUF) : 0;
+        if (!got) return have == DG_VARINT_MOST_BYTES ? DG_STREAM_LENGTH_BAD : DG_STREAM_LENGTH_MORE;
+        *header = p->pdu_offset + got;
+        return (gint64)MIN(value, (guint64)G_MAXINT32) + *header + p->pdu_add;
+    }
+    guint64 value = read_uint(tvb, at, n->length, encoding_of(n));
     if (n->flags & DG_GROUP) value = bit_field(value, n->shift, n->bits);
+    *header = stream_header_length(p);
     return (gint64)MIN(value, (guint64)G_MAXINT32) + p->pdu_add;
 }
 
-extern "C" guint dg_message_length(packet_info *, tvbuff_t *tvb, int offset, void *data)
+extern "C" guint dg_message_length(packet_info *pinfo, tvbuff_t *tvb, int offset, void *data)
 {
     const dg_protocol *p = (const dg_protocol *)data;
-    const gint64 total = stream_message_length(p, tvb, offset);
+    guint header = 0;
+    const gint64 total = stream_message_length(p, tvb, offset, &header);
+    const guint rest = (guint)tvb_reported_length_remaining(tvb, offset);
+    /* A varint length whose last byte is in the next segment: one more (0). */
+    if (total == DG_STREAM_LENGTH_MORE) return pinfo->can_desegment ? 0 : rest;
     /* A length shorter than the bytes up to the end of the length field is
-     * malformed: that message takes the rest of the segment, where the walk
-     * shows its header and says so at the length field (dg_dissect), rather
-     * than messages being made up from what follows. */
-    if (total < (gint64)stream_header_length(p)) return (guint)tvb_reported_length_remaining(tvb, offset);
+     * malformed (and so is a varint that never ends): that message takes the
+     * rest of the segment, where the walk shows its header and says so at the
+     * length field (dg_dissect), rather than messages being made up from
+     * what follows. */
+    if (total < (gint64)header) return rest;
     return (guint)MIN(total, (gint64)G_MAXINT32);
 }
 

@@ -30,7 +30,9 @@ enum dg_show {
     DG_SHOW_STRING, DG_SHOW_STRINGZ, DG_SHOW_IPV4, DG_SHOW_INT, DG_SHOW_FLOAT, DG_SHOW_TIME,
     DG_SHOW_DATETIME, DG_SHOW_GUID,
     /* addresses of one size: IPv6, MAC (FT_ETHER), EUI-64 */
-    DG_SHOW_IPV6, DG_SHOW_MAC, DG_SHOW_EUI64, DG_SHOW_OID
+    DG_SHOW_IPV6, DG_SHOW_MAC, DG_SHOW_EUI64, DG_SHOW_OID,
+    /* an unsigned base-128 number whose bytes say where it ends (decimal) */
+    DG_SHOW_VARINT
 };
 enum dg_flags {
     DG_LITTLE = 1 << 0,      /* little-endian value */

@@ -140,12 +140,18 @@ extern const dg_expr_readers message_readers;
 void report(dg_state *st, proto_tree *tree, expert_field *ei, gint offset, gint length, const char *format, ...)
     G_GNUC_PRINTF(6, 7);
 
-/* pdulength: the length of the stream message at offset its length field
- * gives (with pdulengthadd), and the bytes up to the end of that field. */
-gint64 stream_message_length(const dg_protocol *p, tvbuff_t *tvb, int offset);
+/* pdulength: the length of the stream message at offset that its length
+ * field gives (with pdulengthadd; a varint's counts from its own end), and in
+ * *header the bytes up to the end of that field. DG_STREAM_LENGTH_MORE when a
+ * varint length is not all there yet, DG_STREAM_LENGTH_BAD when it never ends
+ * (its 10 bytes all say another follows). */
+enum { DG_STREAM_LENGTH_MORE = -1, DG_STREAM_LENGTH_BAD = -2 };
+gint64 stream_message_length(const dg_protocol *p, tvbuff_t *tvb, int offset, guint *header);
+/* The fewest bytes up to the end of the length field: a varint has 1 at least. */
 static inline guint stream_header_length(const dg_protocol *p)
 {
-    return p->pdu_offset + p->nodes[p->pdu_node].length;
+    const dg_node *n = &p->nodes[p->pdu_node];
+    return p->pdu_offset + (n->show == DG_SHOW_VARINT ? 1 : n->length);
 }
 
 /* Whether bytes needed up to needed_end are missing only because the capture
@@ -256,6 +262,9 @@ void summaries_end(dg_state *st, const dg_node *n, const dg_summaries *s);
 /* A leaf with dissector= or reassemble-*: its bytes (or, once reassembled,
  * the whole message) go to the named dissector, or are shown raw. */
 void dissect_handoff(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len);
+
+/* The most bytes a varint has: 10 hold 70 bits, enough for 64. */
+#define DG_VARINT_MOST_BYTES 10
 
 /* After every plugin's handoff: the dissectors that dissector= names, the
  * reassembled sources' names. */

@@ -100,6 +100,20 @@ gint64 stringz_length(const dg_state *st, gint offset, gint end)
     return nul < 0 ? (gint64)(end - offset) + 1 : (gint64)(nul - offset) + 1;
 }
 
+/* A varint's bytes at offset: up to the first without bit 7 (a 1 to 10
+ * byte number, lowest 7 bits first), or 10 when they all have it (too long:
+ * decode_varint says so). One more than is left when its last
+ * byte is past end or not captured (report_short_leaf tells which). */
+gint64 varint_length(const dg_state *st, gint offset, gint end)
+{
+    const gint captured = (gint)tvb_captured_length(st->tvb);
+    for (gint i = 0; i < DG_VARINT_MOST_BYTES; i++) {
+        if (offset + i >= end || offset + i >= captured) return (gint64)(end - offset) + 1;
+        if (!(dg_tvb_get_uint8(st->tvb, offset + i) & 0x80)) return i + 1;
+    }
+    return DG_VARINT_MOST_BYTES;
+}
+
 /* `rest - N` (N in n->length, 0 for plain `rest`): the bytes to the end but
  * the last N, which the trailer after the node takes; FALSE (reported) when
  * fewer than N are left. */
@@ -141,8 +155,10 @@ gint64 leaf_length(dg_state *st, const dg_node *n, proto_tree *tree, gint offset
         if (!rest_length(st, n, tree, offset, end, &length)) return -1;
         break;
     default:
-        /* a stringz without a length runs to its NUL, included. */
-        length = n->show == DG_SHOW_STRINGZ ? stringz_length(st, offset, end) : 0;
+        /* a stringz without a length runs to its NUL, included; a varint to its last byte. */
+        length = n->show == DG_SHOW_STRINGZ  ? stringz_length(st, offset, end)
+                 : n->show == DG_SHOW_VARINT ? varint_length(st, offset, end)
+                                             : 0;
         break;
     }
     return length;
@@ -167,6 +183,10 @@ void report_short_leaf(dg_state *st, const dg_node *n, proto_tree *tree, gint of
     if (n->show == DG_SHOW_STRINGZ && n->length_kind == DG_LEN_CHILDREN)
         report_missing(st, tree, &st->p->ei->truncated, data_end, needed_end, offset, left,
                        "Truncated: '%s' has no NUL before the end of its data (%d bytes left)", n->name, left);
+    else if (n->show == DG_SHOW_VARINT)
+        report_missing(st, tree, &st->p->ei->truncated, data_end, needed_end, offset, left,
+                       "Truncated: '%s' has no last byte (bit 7 clear) before the end of its data (%d byte%s left)",
+                       n->name, left, left == 1 ? "" : "s");
     else if (n->length_kind == DG_LEN_FIELD)
         report_missing(st, tree, &st->p->ei->past_end, data_end, needed_end, offset, left,
                        "'%s' has length %" G_GINT64_MODIFIER "d, past the end of its data (%d bytes left)", n->name,
@@ -210,6 +230,24 @@ void decode_sized_number(dg_state *st, const dg_node *n, proto_tree *tree, gint 
     store(st, n, value, offset, len);
 }
 
+/* A varint of len bytes (varint_length): its value, or a malformed number
+ * when its first 10 bytes all say that another follows. */
+void decode_varint(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len)
+{
+    guint64 value = 0;
+    if (tvb_get_varint(st->tvb, (guint)offset, (guint)len, &value, ENC_VARINT_PROTOBUF) != (guint)len) {
+        report(st, tree, &st->p->ei->bad_length, offset, DG_VARINT_MOST_BYTES,
+               "'%s' is a varint of more than %d bytes (bit 7 set in each): none holds more than 64 bits", n->name,
+               DG_VARINT_MOST_BYTES);
+        return;
+    }
+    if (tree) {
+        proto_item *item = proto_tree_add_uint64(tree, *n->hf, st->tvb, offset, len, value);
+        if (n->flags & DG_HIDDEN) proto_item_set_hidden(item);
+    }
+    store(st, n, value, offset, len);
+}
+
 void decode_leaf_value(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len)
 {
     guint64 value = 0;
@@ -230,6 +268,10 @@ void decode_leaf_value(dg_state *st, const dg_node *n, proto_tree *tree, gint of
         if (value_wanted(st, n)) value = read_uint(st->tvb, offset, 4, encoding_of(n));
         if (tree) item = proto_tree_add_item(tree, *n->hf, st->tvb, offset, len, encoding_of(n));
     } else if (n->flags & DG_NUMERIC) {
+        if (n->show == DG_SHOW_VARINT) {
+            decode_varint(st, n, tree, offset, len);
+            return;
+        }
         if (n->length_kind == DG_LEN_FIELD) {
             decode_sized_number(st, n, tree, offset, len);
             return;
@@ -1014,24 +1056,26 @@ namespace {
  * of that field takes the rest of its segment (dg_message_length): only its
  * header is walked, the bytes after it are not decoded. -1 when the message's
  * length is sound (or it is not a stream message). */
-gint64 short_stream_length(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo)
+gint64 short_stream_length(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, guint *header)
 {
     if (p->pdu_node < 0 || pinfo->ptype != PT_TCP) return -1;
     if (tvb_captured_length(tvb) < stream_header_length(p)) return -1;
-    const gint64 length = stream_message_length(p, tvb, 0);
-    return length < (gint64)stream_header_length(p) ? length : -1;
+    const gint64 length = stream_message_length(p, tvb, 0, header);
+    /* a varint length cut short or never ending: the walk says so at it */
+    if (length == DG_STREAM_LENGTH_MORE || length == DG_STREAM_LENGTH_BAD) return -1;
+    return length < (gint64)*header ? length : -1;
 }
 
-void report_short_stream_message(dg_state *st, proto_tree *tree, gint64 length, guint rest)
+void report_short_stream_message(dg_state *st, proto_tree *tree, gint64 length, guint rest, guint header)
 {
     const dg_protocol *p = st->p;
     const dg_node *n = &p->nodes[p->pdu_node];
     st->header_only = FALSE;
     st->stopped = FALSE; /* what the header lacked past its end was this fault */
-    report(st, tree, &p->ei->bad_length, (gint)p->pdu_offset, (gint)n->length,
+    report(st, tree, &p->ei->bad_length, (gint)p->pdu_offset, (gint)(header - p->pdu_offset),
            "The message length '%s' gives (%" G_GINT64_MODIFIER "d) is shorter than the %u bytes up to its end; "
            "the %u byte%s after %s not decoded",
-           n->name, length, stream_header_length(p), rest, rest == 1 ? "" : "s", rest == 1 ? "it is" : "them are");
+           n->name, length, header, rest, rest == 1 ? "" : "s", rest == 1 ? "it is" : "them are");
 }
 
 /* The Info column: the first message's text, each later one's joined with
@@ -1073,9 +1117,10 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     gboolean first_message = messages == 1;
     if (first_message) col_clear(pinfo->cinfo, COL_INFO);
 
-    const gint64 short_length = short_stream_length(p, tvb, pinfo);
-    const guint segment_rest = (guint)tvb_reported_length(tvb) - (short_length >= 0 ? stream_header_length(p) : 0);
-    if (short_length >= 0) tvb = tvb_new_subset_length(tvb, 0, (gint)stream_header_length(p));
+    guint header = 0;
+    const gint64 short_length = short_stream_length(p, tvb, pinfo, &header);
+    const guint segment_rest = (guint)tvb_reported_length(tvb) - (short_length >= 0 ? header : 0);
+    if (short_length >= 0) tvb = tvb_new_subset_length(tvb, 0, (gint)header);
 
     dg_state st;
     dg_message_buffers buffers;
@@ -1088,7 +1133,7 @@ int dg_dissect(const dg_protocol *p, tvbuff_t *tvb, packet_info *pinfo, proto_tr
     st.message = messages - 1;
     if (p->request_context) request_begin(&st);
     walk_list(&st, p->top_walk, p->top_first, p->top_count, subtree, &offset, st.packet_end, FALSE);
-    if (st.header_only) report_short_stream_message(&st, subtree, short_length, segment_rest);
+    if (st.header_only) report_short_stream_message(&st, subtree, short_length, segment_rest, header);
     show_message_tail(&st, subtree, offset, on_ethertype);
     proto_item_set_len(root, offset);
     const dg_frame_pairing *fp = NULL;

@@ -175,6 +175,7 @@ TESTS = {
                                "TestGroupAddressed", "TestGroupRequestManyAnswers"),
     "computed": integration("test_computed.py"),
     "learned": integration("test_learned.py"),
+    "varint": integration("test_varint.py"),
     "learned_layout": integration("test_learned_layout.py"),
     "learned_ranges": integration("test_learned_ranges.py"),
     "rule_findings": integration("test_rule_findings.py"),
