@@ -658,7 +658,7 @@ void Validator::check_reference(Node& n, const FieldRef& ref, const std::string&
     const std::string field = what + " field " + quote(*t) + at_line(*t);
     if (!t->is_numeric()) {
         diags_.error(n.line, field + " is not numeric: it must be a leaf of 1-64 bits shown as numberhex, "
-                                     "numberdec, int, time, bool, enum or nondisplay, or an integer computed value");
+                                     "numberdec, int, time, bool, enum, varint or nondisplay, or an integer computed value");
         return;
     }
     if (what == "repeat") {
@@ -803,7 +803,7 @@ void Validator::check_validity() {
         }
         if (!n.is_numeric()) {
             diags_.error(n.line, "'valid' field " + quote(n) + " is not numeric: it must be a leaf of 1-64 bits shown as "
-                                 "numberhex, numberdec, int, time, bool, enum or nondisplay");
+                                 "numberhex, numberdec, int, time, bool, enum, varint or nondisplay");
             return;
         }
         if (n.display == Display::Varint) {
@@ -1598,7 +1598,8 @@ void Validator::check_request_keys() {
         const Node* t = key.field.target;
         if (!t || !t->is_numeric()) continue;  // reported
         uint64_t offset = 0;
-        if (fixed_offset_blocker(*t, offset)) pairing.keys_decoded = true;
+        // a varint is read by the walk, never from its bytes ahead of it
+        if (fixed_offset_blocker(*t, offset) || t->display == Display::Varint) pairing.keys_decoded = true;
         key.offset = offset;
     }
     if (!pairing.keys_decoded) return;
@@ -1606,7 +1607,8 @@ void Validator::check_request_keys() {
     for (const PairingKey& key : pairing.keys) {
         uint64_t offset = 0;
         const Node* t = key.field.target;
-        if (!moving && t && t->is_numeric() && fixed_offset_blocker(*t, offset)) moving = t;
+        if (!moving && t && t->is_numeric() && (fixed_offset_blocker(*t, offset) || t->display == Display::Varint))
+            moving = t;
     }
     for (const PairingKey& key : pairing.keys) {
         const Node* t = key.field.target;
@@ -1948,7 +1950,7 @@ void Validator::check_offsets(Node& n) {
         const Node* outside = repeat_outside(t->parent, n);  // a repeated container around t but not around n
         if (!t->is_numeric())
             diags_.error(n.line, field + " is not numeric: it must be a leaf of 1-64 bits shown as numberhex, "
-                                         "numberdec, int, time, bool, enum or nondisplay, or an integer computed value");
+                                         "numberdec, int, time, bool, enum, varint or nondisplay, or an integer computed value");
         else if (!t->count && !t->repeat && !t->repeat_rest)
             diags_.error(n.line, field + " is not repeated: it must have 'count' (or 'repeat'), one offset per "
                                          "instance of " + quote(n));
@@ -2127,6 +2129,9 @@ void Validator::check_peek(Node& n, When& w) {
             not_known = lines_of(s) + " is " + (s.is_repeated() ? "repeated" : "conditional");
         else if (s.has_fixed_length())
             offset += s.fixed_bits / 8;
+        else if (s.is_computed() || (s.is_leaf() && s.length_kind == LengthKind::Children &&
+                                     s.display != Display::StringZ && s.display != Display::Varint))
+            ;  // takes no bytes
         else if (s.length_kind == LengthKind::Field && known_before(s.length_ref.target, n))
             lengths.push_back(&s.length_ref);
         else if (auto sum = s.length_kind == LengthKind::Children && !s.is_leaf() ? children_fixed_bytes(s)

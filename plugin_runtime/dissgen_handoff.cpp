@@ -150,6 +150,7 @@ gint64 dg_rt::stream_message_length(const dg_protocol *p, tvbuff_t *tvb, int off
         guint64 value = 0;
         const guint got = have > 0 ? tvb_get_varint(tvb, (guint)at, (guint)have, &value, ENC_VARINT_PROTOBUF) : 0;
         if (!got) return have == DG_VARINT_MOST_BYTES ? DG_STREAM_LENGTH_BAD : DG_STREAM_LENGTH_MORE;
+        if (!dg_read_varint(tvb, at, (gint)got, &value)) return DG_STREAM_LENGTH_BAD; /* more than 64 bits */
         *header = p->pdu_offset + got;
         return (gint64)MIN(value, (guint64)G_MAXINT32) + *header + p->pdu_add;
     }

@@ -266,6 +266,15 @@ void dissect_handoff(dg_state *st, const dg_node *n, proto_tree *tree, gint offs
 /* The most bytes a varint has: 10 hold 70 bits, enough for 64. */
 #define DG_VARINT_MOST_BYTES 10
 
+/* The varint in the `len` captured bytes at offset (Wireshark's
+ * tvb_get_varint): FALSE when it does not end in them or holds more than 64
+ * bits (a 10th byte above 1), which tvb_get_varint would silently drop. */
+static inline gboolean dg_read_varint(tvbuff_t *tvb, gint offset, gint len, guint64 *value)
+{
+    if (tvb_get_varint(tvb, (guint)offset, (guint)len, value, ENC_VARINT_PROTOBUF) != (guint)len) return FALSE;
+    return len < DG_VARINT_MOST_BYTES || dg_tvb_get_uint8(tvb, offset + len - 1) <= 1;
+}
+
 /* After every plugin's handoff: the dissectors that dissector= names, the
  * reassembled sources' names. */
 void find_handoff_dissectors(const dg_protocol *p);

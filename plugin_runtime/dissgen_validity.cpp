@@ -44,6 +44,7 @@ guint valid_message_length(packet_info *pinfo, tvbuff_t *tvb, int offset, void *
     if (!dg_valid_at(v, tvb, pinfo, offset, available)) return rest;
     if (available < (gint)v->header_length) return pinfo->can_desegment ? 0 : rest; /* 0: one more segment */
     guint length = dg_message_length(pinfo, tvb, offset, (void *)v->p);
+    if (length == 0) return 0; /* a varint length whose last byte is in the next segment */
     if (dg_valid_at(v, tvb, pinfo, offset, MIN(available, (gint)MIN(length, (guint)G_MAXINT32)))) return length;
     return rest;
 }

@@ -231,14 +231,17 @@ void decode_sized_number(dg_state *st, const dg_node *n, proto_tree *tree, gint 
 }
 
 /* A varint of len bytes (varint_length): its value, or a malformed number
- * when its first 10 bytes all say that another follows. */
+ * when its first 10 bytes all say that another follows, or its 10th holds
+ * more than the 64th bit. */
 void decode_varint(dg_state *st, const dg_node *n, proto_tree *tree, gint offset, gint len)
 {
     guint64 value = 0;
-    if (tvb_get_varint(st->tvb, (guint)offset, (guint)len, &value, ENC_VARINT_PROTOBUF) != (guint)len) {
-        report(st, tree, &st->p->ei->bad_length, offset, DG_VARINT_MOST_BYTES,
-               "'%s' is a varint of more than %d bytes (bit 7 set in each): none holds more than 64 bits", n->name,
-               DG_VARINT_MOST_BYTES);
+    if (!dg_read_varint(st->tvb, offset, len, &value)) {
+        report(st, tree, &st->p->ei->bad_length, offset, len,
+               "'%s' is a varint of more than 64 bits (%d bytes%s)", n->name, len,
+               len == DG_VARINT_MOST_BYTES && (dg_tvb_get_uint8(st->tvb, offset + len - 1) & 0x80)
+                   ? ", bit 7 set in each: another would follow"
+                   : "");
         return;
     }
     if (tree) {
@@ -1079,10 +1082,13 @@ void report_short_stream_message(dg_state *st, proto_tree *tree, gint64 length, 
 }
 
 /* The Info column: the first message's text, each later one's joined with
- * " | ". Joined from the texts of the frame's earlier messages, kept per
- * packet, not from the column: a dissector that carries several of ours
- * (TPKT and COTP calling a heuristic once per TPKT message) writes its own
- * text over ours between them. Beyond what the column holds nothing is added.
+ * " | ". The texts of the frame's earlier messages are kept per packet: a
+ * dissector that carries several of ours (TPKT and COTP calling a heuristic
+ * once per TPKT message) writes its own text over ours between them, and
+ * then the column is written again from them. While the column still holds
+ * ours, the text is appended (after a fence TCP set between two messages of
+ * a segment, writing the column would repeat the first's). Beyond what the
+ * column holds nothing is added.
  * A message inside the first (EtherCAT in EoE) appends to the column: the
  * first's text comes once it is decoded, and replaces it. */
 void show_info(const dg_protocol *p, packet_info *pinfo, const char *info, gboolean first_message,
@@ -1096,14 +1102,19 @@ void show_info(const dg_protocol *p, packet_info *pinfo, const char *info, gbool
     if (first_message) {
         joined = wmem_strbuf_new(pinfo->pool, info);
         p_set_proto_data(pinfo->pool, pinfo, *p->proto, DG_INFO_KEY, joined);
-    } else if (!joined) {
-        col_append_sep_str(pinfo->cinfo, COL_INFO, " | ", info);
+        col_add_str(pinfo->cinfo, COL_INFO, info);
         return;
-    } else if (wmem_strbuf_get_len(joined) < COL_MAX_INFO_LEN) {
+    }
+    const char *shown = col_get_text(pinfo->cinfo, COL_INFO);
+    const gboolean still_ours = !joined || (shown && strcmp(shown, wmem_strbuf_get_str(joined)) == 0);
+    if (joined && wmem_strbuf_get_len(joined) < COL_MAX_INFO_LEN) {
         wmem_strbuf_append(joined, " | ");
         wmem_strbuf_append(joined, info);
     }
-    col_add_str(pinfo->cinfo, COL_INFO, wmem_strbuf_get_str(joined));
+    if (still_ours)
+        col_append_sep_str(pinfo->cinfo, COL_INFO, " | ", info);
+    else
+        col_add_str(pinfo->cinfo, COL_INFO, wmem_strbuf_get_str(joined));
 }
 
 } // namespace

@@ -5,10 +5,13 @@ while another byte follows) with real tshark, in one pass and -2, against the by
 
 - a varint's value and its bytes (the item covers them), as a length and as a count;
 - one whose last byte is missing: one P.expert.truncated at it, nothing after it; one whose
-  10 bytes all say another follows: one P.expert.bad_length at it;
+  10 bytes all say another follows, or whose 10th byte holds more than the 64th bit: one
+  P.expert.bad_length at it;
 - a TCP protocol framed by a varint (pdulength, MQTT's remaining length, counted from the
-  end of the length field): messages split anywhere across segments (inside the varint
-  too) and several in one segment decode as the messages written.
+  end of the length field), with and without valid=: messages split anywhere across
+  segments (inside the varint too) and several in one segment decode as the messages
+  written, and each frame's Info column names each of its messages once;
+- a varint pairing key: a response finds its request's fields (request{...}).
 
     test_varint.py --dissgen build/bin/dissgen --source-dir .
 """
@@ -34,14 +37,28 @@ RULES = """<root name="Varints" abbreviation="VAR" filter="var">
 </root>
 """ % UDP_PORT
 
-# MQTT's fixed header: a type byte, then the remaining length (a varint) counting what follows it.
-STREAM_RULES = """<root name="Varint stream" abbreviation="VST" filter="vst" pdulength="node[@name='Remaining']">
+# MQTT's fixed header: a type byte, then the remaining length (a varint) counting what follows it;
+# the same with a valid= test on the type (framed by the test, then the length).
+STREAM_RULES = """<root name="%s" abbreviation="%s" filter="%s" pdulength="node[@name='Remaining']">
   <hook table="tcp.port" value="%d"/>
-  <node name="Type" length="1byte" displaytype="numberhex"/>
+  <node name="Type" length="1byte" displaytype="numberhex"%s/>
   <node name="Remaining" displaytype="varint"/>
   <node name="Payload" length="rest" displaytype="origin"/>
 </root>
-""" % TCP_PORT
+"""
+STREAMS = {"vst": ("Varint stream", TCP_PORT, ""), "vsv": ("Varint stream tested", TCP_PORT + 1, ' valid="0x30-0x3f"')}
+
+PAIRED_PORT = 47625
+PAIRED_RULES = """<root name="Varint keys" abbreviation="VKEY" filter="vkey">
+  <hook table="udp.port" value="%d"/>
+  <pairing>
+    <key field="node[@name='Transaction']"/>
+  </pairing>
+  <node name="Transaction" displaytype="varint"/>
+  <node name="Quantity" length="1byte" displaytype="numberdec" direction="request"/>
+  <node name="Asked" value="request{Quantity}" direction="response"/>
+</root>
+""" % PAIRED_PORT
 
 
 def varint(value):
@@ -67,7 +84,9 @@ class TestVarint(TsharkTestCase, unittest.TestCase):
     @classmethod
     def prepare(cls):
         cls.install_text("varints.xml", RULES, "var")
-        cls.install_text("varint_stream.xml", STREAM_RULES, "vst")
+        for name, (title, port, valid) in STREAMS.items():
+            cls.install_text(name + ".xml", STREAM_RULES % (title, name.upper(), name, port, valid), name)
+        cls.install_text("varint_keys.xml", PAIRED_RULES, "vkey")
 
     def rows(self, path, fields, two_pass):
         return self.env.field_rows(path, ["frame.number"] + fields, two_pass, aggregator="|")
@@ -108,21 +127,31 @@ class TestVarint(TsharkTestCase, unittest.TestCase):
     def test_faults_told_once_where_they_are(self):
         too_long = b"\x02ab\x01" + b"\xff" * 10 + b"\x01\xee"
         cut = b"\x02ab\x02\x05\x81"
+        too_big = b"\x02ab\x01" + b"\xff" * 9 + b"\x02\xee"  # a 10th byte above 1: 65 bits
         path = self.env.add_file("faults.pcap", pcap([udp(UDP_PORT, UDP_PORT, too_long),
-                                                      udp(UDP_PORT, UDP_PORT, cut)]))
+                                                      udp(UDP_PORT, UDP_PORT, cut),
+                                                      udp(UDP_PORT, UDP_PORT, too_big)]))
         with self.checks() as check:
             for two_pass in (False, True):
                 rows = self.rows(path, ["var.item", "var.last", "var.expert.bad_length", "var.expert.truncated",
                                         "_ws.expert.message"], two_pass)
-                r1, r2 = rows[1], rows[2]
+                r1, r2, r3 = rows[1], rows[2], rows[3]
                 check(r1["var.expert.bad_length"] and not r1["var.item"] and not r1["var.last"] and
-                      len(r1["_ws.expert.message"]) == 1 and "more than 10 bytes" in r1["_ws.expert.message"][0],
+                      len(r1["_ws.expert.message"]) == 1 and "more than 64 bits" in r1["_ws.expert.message"][0],
                       "10 bytes with bit 7: one bad_length, nothing after it: %s" % r1)
+                check(r3["var.expert.bad_length"] and not r3["var.item"] and not r3["var.last"] and
+                      len(r3["_ws.expert.message"]) == 1 and "more than 64 bits" in r3["_ws.expert.message"][0],
+                      "a 10th byte of 2: one bad_length, nothing after it: %s" % r3)
                 check(r2["var.expert.truncated"] and r2["var.item"] == ["5"] and not r2["var.last"] and
                       len(r2["_ws.expert.message"]) == 1 and "has no last byte" in r2["_ws.expert.message"][0],
                       "a last byte missing: one truncated at it, the item before it decoded: %s" % r2)
 
     def test_stream_framed_by_a_varint(self):
+        for name, (title, port, _valid) in STREAMS.items():
+            with self.subTest(protocol=name):
+                self.check_stream(name, title, port)
+
+    def check_stream(self, name, title, port):
         rng = random.Random(7)
         sizes = [0, 1, 127, 128, 200, 16383, 16384, 70000, 5, 300] + [rng.randrange(400) for _ in range(30)]
         stream, inside_varints = b"", set()
@@ -131,24 +160,30 @@ class TestVarint(TsharkTestCase, unittest.TestCase):
                 inside_varints |= {len(stream) + 2, len(stream) + len(varint(size))}
             stream += bytes([0x30 | (n & 0xF)]) + varint(size) + bytes((n + i) & 0xFF for i in range(size))
         # cut anywhere: inside headers, inside varints, several messages in one segment
-        flow, frames, at = TcpFlow(50000, TCP_PORT), [], 0
+        flow, frames, at = TcpFlow(50000, port), [], 0
         cuts = sorted(set(rng.randrange(1, len(stream)) for _ in range(60)) | {2, 3, 4} | inside_varints)
         for cut in cuts + [len(stream)]:
             if cut > at:
                 frames.append(flow.segment(stream[at:cut]))
                 at = cut
-        path = self.env.add_file("stream.pcap", pcap(frames))
+        path = self.env.add_file(name + "_stream.pcap", pcap(frames))
         want = ["%d:%d" % (0x30 | (n & 0xF), size) for n, size in enumerate(sizes)]
         with self.checks() as check:
             for two_pass in (False, True):
-                rows = self.rows(path, ["vst.type", "vst.remaining", "vst.payload", "_ws.expert"], two_pass)
-                got, payload_ok, experts = [], True, []
+                f = dict((k, name + "." + k) for k in ("type", "remaining", "payload"))
+                rows = self.rows(path, [f["type"], f["remaining"], f["payload"], "_ws.expert", "_ws.col.Info"],
+                                 two_pass)
+                got, payload_ok, experts, info_wrong = [], True, [], []
                 for n in sorted(rows):
                     r = rows[n]
                     if r["_ws.expert"]:
                         experts.append(n)
-                    payloads = r["vst.payload"] + [""] * (len(r["vst.type"]) - len(r["vst.payload"]))
-                    for t, size, data in zip(r["vst.type"], r["vst.remaining"], payloads):
+                    types = r[f["type"]]
+                    info = "|".join(r["_ws.col.Info"])  # the aggregator split it
+                    if types and info.split(" | ") != [title] * len(types):
+                        info_wrong.append((n, info))
+                    payloads = r[f["payload"]] + [""] * (len(types) - len(r[f["payload"]]))
+                    for t, size, data in zip(types, r[f["remaining"]], payloads):
                         got.append("%d:%s" % (int(t, 16), size))
                         index = len(got) - 1
                         expect = bytes((index + i) & 0xFF for i in range(int(size)))
@@ -157,6 +192,26 @@ class TestVarint(TsharkTestCase, unittest.TestCase):
                     "-2" if two_pass else "one pass", sum(a == b for a, b in zip(got, want)), len(want)))
                 check(payload_ok, "each payload holds the bytes written")
                 check(not experts, "no expert info (got on frames %s)" % experts[:5])
+                check(not info_wrong, "each frame's Info names each of its messages once (wrong: %s)" % info_wrong[:3])
+
+    def test_pairing_key(self):
+        client, server = (10, 1, 1, 167), (10, 1, 1, 164)
+
+        def request(payload):
+            return udp(40000, PAIRED_PORT, payload, client, server)
+
+        def response(payload):
+            return udp(PAIRED_PORT, 40000, payload, server, client)
+        frames = [request(varint(300) + b"\x07"), response(varint(300)),
+                  request(varint(5) + b"\x09"), response(varint(5))]
+        path = self.env.add_file("keys.pcap", pcap(frames))
+        with self.checks() as check:
+            for two_pass in (False, True):
+                rows = self.rows(path, ["vkey.transaction", "vkey.asked"], two_pass)
+                got = {n: (r["vkey.transaction"], r["vkey.asked"]) for n, r in rows.items()}
+                check(got[2] == (["300"], ["7"]) and got[4] == (["5"], ["9"]),
+                      "%s: each response reads its own request's quantity: %s" % (
+                          "-2" if two_pass else "one pass", got))
 
 
 if __name__ == "__main__":
