@@ -102,7 +102,7 @@ gboolean identity_equal(gconstpointer a, gconstpointer b)
     const identity *x = (const identity *)a, *y = (const identity *)b;
     return x->hash == y->hash && x->learn == y->learn && x->key_count == y->key_count && x->port == y->port &&
            x->dst_port == y->dst_port && addresses_equal(&x->src, &y->src) && addresses_equal(&x->dst, &y->dst) &&
-           memcmp(x->keys, y->keys, x->key_count * sizeof(guint64)) == 0;
+           (x->key_count == 0 || memcmp(x->keys, y->keys, x->key_count * sizeof(guint64)) == 0);
 }
 
 dg_expr_value evaluate(const dg_state *st, guint16 first, guint16 count)
